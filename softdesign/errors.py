@@ -1,0 +1,40 @@
+"""The errors the command line expects.
+
+Every user-facing failure is a :class:`SoftdesignError`; the CLI maps
+:class:`ConfigError` and :class:`InputDataError` to exit code 2 (bad usage or
+bad input) and the others to exit code 1 (processing failure).  Anything else
+that escapes is a bug and keeps its traceback.
+
+A message says what went wrong, where, what was expected, what was found and
+what to do, e.g. ``case.yaml: fit.knot_spacing_mm must be > 0, got -2``.
+"""
+
+
+class SoftdesignError(Exception):
+    """Base class of every error softdesign reports to a user."""
+
+    exit_code = 1
+
+
+class ConfigError(SoftdesignError):
+    """The case file or a command-line option is invalid."""
+
+    exit_code = 2
+
+
+class InputDataError(SoftdesignError):
+    """An input file is missing, unreadable or geometrically unusable."""
+
+    exit_code = 2
+
+
+class GeometryError(SoftdesignError):
+    """A curve, frame or link cannot be computed (e.g. Frenet frame on a straight run)."""
+
+
+class FitError(SoftdesignError):
+    """The surface fit failed or violates a stated bound."""
+
+
+class MeshError(SoftdesignError):
+    """A mesh could not be made into a valid solid."""
