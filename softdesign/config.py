@@ -1,0 +1,344 @@
+"""The case file: YAML -> validated models, defaults filled in, paths resolved.
+
+A case file is YAML validated by pydantic models that forbid unknown keys.
+Errors are reported with the file, the line, the dotted field, what was
+expected and what was found; an unknown key gets the nearest valid key as a
+suggestion.  Relative paths are relative to the case file.  ``units`` names
+the unit of the *input files* (and of ``final.inlet``); everything inside
+softdesign is millimetres, the conversion happens at ingest.
+"""
+
+from __future__ import annotations
+
+import difflib
+from pathlib import Path
+from typing import Any, Literal
+
+import yaml
+import os
+
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
+
+from softdesign.errors import ConfigError
+
+
+class _Section(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class FinalShape(_Section):
+    """The patient's shape, q = 1."""
+
+    centerline: Path
+    surface: Path | None = None
+    path: int = Field(0, ge=0)
+    inlet: tuple[float, float, float] | None = None
+    reverse: bool = False
+
+
+class IntermediateShape(_Section):
+    """A keyframe centerline reached at ``q`` (piecewise-linear in q between keyframes)."""
+
+    q: float = Field(gt=0.0, lt=1.0)
+    centerline: Path
+    path: int = Field(0, ge=0)
+    reverse: bool = False
+
+
+class InitialShape(_Section):
+    """The insertion shape, q = 0, and the body radius there."""
+
+    kind: Literal["straight", "arc", "file"] = "straight"
+    length_mm: float | None = Field(None, gt=0.0)
+    radius_mm: float | None = Field(None, gt=0.0)
+    surface: Path | None = None
+    bend_radius_mm: float | None = Field(None, gt=0.0)
+    bend_plane_deg: float = 0.0
+    centerline: Path | None = None
+    path: int = Field(0, ge=0)
+    align_base: bool = True
+
+    @model_validator(mode="after")
+    def _kind_needs(self) -> "InitialShape":
+        if self.kind == "arc" and self.bend_radius_mm is None:
+            raise ValueError("kind: arc needs bend_radius_mm (the arc's radius of curvature, mm)")
+        if self.kind == "file" and self.centerline is None:
+            raise ValueError("kind: file needs centerline (a path to the q = 0 centerline)")
+        if self.radius_mm is not None and self.surface is not None:
+            raise ValueError("give radius_mm or surface for the q = 0 body, not both")
+        return self
+
+
+class Resample(_Section):
+    """Arc-length resampling and smoothing of every centerline."""
+
+    spacing_mm: float = Field(0.5, gt=0.0)
+    count: int | None = Field(None, ge=4)
+    smoothing_mm: float = Field(0.1, ge=0.0)
+    end_straight_mm: float = Field(2.0, ge=0.0)
+
+
+class Links(_Section):
+    """How the actuator is split into links: exactly one of the three keys."""
+
+    count: int | None = Field(None, ge=1)
+    breaks: list[float] | None = None
+    length_mm: float | None = Field(None, gt=0.0)
+
+    @model_validator(mode="after")
+    def _one_rule(self) -> "Links":
+        given = [k for k in ("count", "breaks", "length_mm") if getattr(self, k) is not None]
+        if len(given) > 1:
+            raise ValueError(f"give one of count, breaks, length_mm; got {', '.join(given)}")
+        if not given:
+            raise ValueError("give one of count, breaks (normalized l), length_mm")
+        if self.breaks is not None:
+            _check_breaks(self.breaks)
+        return self
+
+
+def _check_breaks(breaks: list[float]) -> None:
+    if len(breaks) < 2 or breaks[0] != 0.0 or breaks[-1] != 1.0:
+        raise ValueError(f"breaks must start at 0 and end at 1 (normalized l), got {breaks}")
+    if any(nxt <= prev for prev, nxt in zip(breaks, breaks[1:])):
+        raise ValueError(f"breaks must be strictly increasing, got {breaks}")
+
+
+class Fit(_Section):
+    """Least-squares spline surface rho(l, a) per link."""
+
+    knot_spacing_mm: float | Literal["auto"] = 2.0
+    angular_intervals: int = Field(16, ge=4)
+    smoothing: float = Field(1.0e-3, ge=0.0)
+    holdout_folds: int = Field(5, ge=2)
+    outlier_factor: float = Field(1.6, gt=1.0)
+
+    @field_validator("knot_spacing_mm", mode="before")
+    @classmethod
+    def _spacing(cls, value: Any) -> Any:
+        if value == "auto":
+            return value
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ValueError(f"must be a number of mm or 'auto', got {value!r}")
+        if value <= 0:
+            raise ValueError(f"must be > 0 mm, got {value}")
+        return float(value)
+
+
+class Export(_Section):
+    """Meshes at the requested q values."""
+
+    q: list[float] | None = None
+    frames: int | None = Field(None, ge=2)
+    offset_mm: float = 0.0
+    wall_mm: float | None = Field(None, gt=0.0)
+    port_mm: float | None = Field(None, gt=0.0)
+    formats: list[Literal["stl", "ply", "obj", "glb"]] = ["stl"]
+    spacing_mm: float = Field(0.5, gt=0.0)
+    angular_count: int = Field(64, ge=8)
+
+    @model_validator(mode="after")
+    def _q_values(self) -> "Export":
+        if self.q is not None and self.frames is not None:
+            raise ValueError("give q (a list) or frames (a count), not both")
+        if self.port_mm is not None and self.wall_mm is None:
+            raise ValueError("port_mm needs wall_mm (a port opens into the hollow chamber)")
+        if self.q is not None:
+            bad = [v for v in self.q if not 0.0 <= v <= 1.0]
+            if bad or not self.q:
+                raise ValueError(f"q values must lie in [0, 1], got {self.q}")
+        return self
+
+    def q_values(self) -> list[float]:
+        """The export q values, sorted and unique; default [0, 0.5, 1]."""
+        if self.frames is not None:
+            return [i / (self.frames - 1) for i in range(self.frames)]
+        return sorted(set(self.q if self.q is not None else [0.0, 0.5, 1.0]))
+
+
+class Case(_Section):
+    """A whole case file, every default filled in."""
+
+    name: str
+    units: Literal["mm", "cm", "m"] = "mm"
+    final: FinalShape
+    initial: InitialShape = InitialShape()
+    intermediate: list[IntermediateShape] = []
+    resample: Resample = Resample()
+    frames: Literal["rmf", "frenet"] = "rmf"
+    blend: Literal["linear", "intrinsic"] = "linear"
+    links: Links = Links(count=4)
+    fit: Fit = Fit()
+    export: Export = Export()
+
+    _base: Path = PrivateAttr(default_factory=Path.cwd)
+
+    @property
+    def base_dir(self) -> Path:
+        """The folder of the case file; relative input paths start here."""
+        return self._base
+
+    def resolved(self) -> dict[str, Any]:
+        """The case as a JSON-ready dict, defaults filled in, for the build folder.
+
+        Input paths are written relative to the case file's folder so that the
+        same case built from another checkout gives the same bytes.
+        """
+        return _relative_paths(self.model_dump(mode="json"), self._base)
+
+
+def load_case(path: str | Path) -> Case:
+    """Read, validate and resolve a case file.
+
+    Raises
+    ------
+    ConfigError
+        The file is missing or unreadable, is not valid YAML, or does not
+        match the schema; the message names the file, line and field.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: case file not found; check the path") from None
+    except (OSError, UnicodeDecodeError) as err:
+        raise ConfigError(f"{path}: cannot read the case file ({err})") from err
+    raw, root = _parse_yaml(path, text)
+    raw.setdefault("name", path.stem)
+    try:
+        case = Case.model_validate(raw)
+    except ValidationError as err:
+        raise ConfigError(_format_errors(path, root, err)) from None
+    return _resolve_paths(case, path.resolve().parent)
+
+
+def _parse_yaml(path: Path, text: str) -> tuple[dict[str, Any], yaml.Node | None]:
+    try:
+        raw = yaml.safe_load(text)
+        root = yaml.compose(text)
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f"{path}:{mark.line + 1}" if mark is not None else str(path)
+        problem = getattr(err, "problem", None) or str(err)
+        raise ConfigError(f"{where}: not valid YAML ({problem}); fix the syntax at that line") from None
+    if not isinstance(raw, dict):
+        raise ConfigError(
+            f"{path}: expected a mapping of keys (name, units, final, ...), "
+            f"got {type(raw).__name__}; see configs/demo.yaml for an example"
+        )
+    return raw, root
+
+
+def _resolve_paths(case: Case, base: Path) -> Case:
+    def full(p: Path | None) -> Path | None:
+        return None if p is None else (p if p.is_absolute() else base / p)
+
+    final = case.final.model_copy(update={"centerline": full(case.final.centerline), "surface": full(case.final.surface)})
+    initial = case.initial.model_copy(
+        update={"centerline": full(case.initial.centerline), "surface": full(case.initial.surface)}
+    )
+    inter = [s.model_copy(update={"centerline": full(s.centerline)}) for s in case.intermediate]
+    resolved = case.model_copy(update={"final": final, "initial": initial, "intermediate": inter})
+    resolved._base = base
+    return resolved
+
+
+def _relative_paths(data: Any, base: Path) -> Any:
+    if isinstance(data, dict):
+        return {k: _relative_paths(v, base) for k, v in data.items()}
+    if isinstance(data, list):
+        return [_relative_paths(v, base) for v in data]
+    if isinstance(data, str) and os.path.isabs(data):
+        return Path(os.path.relpath(data, base)).as_posix()
+    return data
+
+
+# --- error messages ---------------------------------------------------------------
+
+_TEMPLATES = {
+    "greater_than": "must be > {gt}",
+    "greater_than_equal": "must be >= {ge}",
+    "less_than": "must be < {lt}",
+    "less_than_equal": "must be <= {le}",
+    "missing": "is required",
+}
+
+
+def _format_errors(path: Path, root: yaml.Node | None, err: ValidationError) -> str:
+    lines = [f"{path}: the case file is invalid ({err.error_count()} problem(s)):"]
+    for item in err.errors():
+        loc = tuple(item["loc"])
+        line = _line_of(root, loc)
+        where = f"{path}:{line}" if line else str(path)
+        lines.append(f"  {where}: {_describe(loc, item)}")
+    lines.append("Fix the listed keys; `softdesign validate CASE.yaml` re-checks without building.")
+    return "\n".join(lines)
+
+
+def _describe(loc: tuple[Any, ...], item: dict[str, Any]) -> str:
+    field = ".".join(str(p) for p in loc) or "(top level)"
+    kind = item["type"]
+    if kind == "extra_forbidden":
+        return _unknown_key(loc)
+    ctx = item.get("ctx") or {}
+    if kind in _TEMPLATES:
+        text = _TEMPLATES[kind].format(**ctx)
+    else:
+        text = item["msg"].removeprefix("Value error, ")
+        if text.startswith("Input should be"):
+            text = "should be" + text[len("Input should be") :]
+    # a model-level rule names its keys and quotes the values in its own message
+    if kind == "value_error":
+        return f"{field}: {text}"
+    got = "" if kind == "missing" else f", got {item.get('input')!r}"
+    return f"{field} {text}{got}"
+
+
+def _unknown_key(loc: tuple[Any, ...]) -> str:
+    model: type[BaseModel] = Case
+    for part in loc[:-1]:
+        if isinstance(part, int):
+            continue
+        ann = model.model_fields[str(part)].annotation
+        model = next((a for a in _model_args(ann)), model)
+    valid = sorted(model.model_fields)
+    key = str(loc[-1])
+    near = difflib.get_close_matches(key, valid, n=1, cutoff=0.5)
+    parent = ".".join(str(p) for p in loc[:-1]) or "the top level"
+    hint = f"did you mean '{near[0]}'? " if near else ""
+    return f"unknown key '{key}' in {parent}; {hint}valid keys: {', '.join(valid)}"
+
+
+def _model_args(ann: Any) -> list[type[BaseModel]]:
+    if isinstance(ann, type) and issubclass(ann, BaseModel):
+        return [ann]
+    found: list[type[BaseModel]] = []
+    for arg in getattr(ann, "__args__", ()):
+        found.extend(_model_args(arg))
+    return found
+
+
+def _line_of(root: yaml.Node | None, loc: tuple[Any, ...]) -> int | None:
+    """1-based line of the YAML node at ``loc`` (or of its deepest existing parent)."""
+    node, line = root, None
+    for part in loc:
+        if isinstance(node, yaml.MappingNode):
+            match = next(((k, v) for k, v in node.value if k.value == str(part)), None)
+            if match is None:
+                break
+            line = match[0].start_mark.line + 1
+            node = match[1]
+        elif isinstance(node, yaml.SequenceNode) and isinstance(part, int) and part < len(node.value):
+            node = node.value[part]
+            line = node.start_mark.line + 1
+        else:
+            break
+    return line
