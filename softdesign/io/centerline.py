@@ -1,0 +1,128 @@
+"""Read centerline files into a :class:`CenterlineNetwork` (mm).
+
+Formats, by suffix: ``.vtp`` (VTK XML PolyData, as VMTK writes it,
+zlib-compressed binary included), ``.vtk`` (legacy PolyData), ``.csv`` (a
+header row naming ``x, y, z`` and optionally ``radius``) and ``.npy`` (an
+(n, 3) or (n, 4) array, the 4th column a radius).  CSV and NPY files hold
+one polyline.
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from softdesign.errors import InputDataError
+from softdesign.geometry.network import TRACT_KEYS, CenterlineNetwork, Polyline
+from softdesign.io.vtk_polydata import polydata_arrays, read_polydata
+
+RADIUS_KEY = "MaximumInscribedSphereRadius"
+
+
+def read_centerline_network(path: str | Path, scale_to_mm: float = 1.0) -> CenterlineNetwork:
+    """Read every polyline of a centerline file.
+
+    Parameters
+    ----------
+    path : file with suffix .vtp, .vtk, .csv or .npy
+    scale_to_mm : factor from the file's units to mm (10 for cm, 1000 for m)
+
+    Raises
+    ------
+    InputDataError
+        Missing or unreadable file, unknown suffix, no lines in the file.
+    """
+    path = Path(path)
+    reader = _READERS.get(path.suffix.lower())
+    if reader is None:
+        raise InputDataError(
+            f"{path}: unknown centerline format '{path.suffix}'; expected one of "
+            f"{', '.join(sorted(_READERS))} (convert it, e.g. with vmtkcenterlines -ofile x.vtp)"
+        )
+    if not path.is_file():
+        raise InputDataError(f"{path}: centerline file not found; check final.centerline in the case file")
+    lines = reader(path)
+    if not lines:
+        raise InputDataError(
+            f"{path}: the file has no polylines (no lines); expected VMTK centerlines "
+            "(vmtkcenterlines output), not a surface or a point cloud"
+        )
+    scaled = tuple(
+        Polyline(line.points * scale_to_mm, None if line.radius is None else line.radius * scale_to_mm, line.cell_data)
+        for line in lines
+    )
+    return CenterlineNetwork(scaled, source=str(path))
+
+
+def _read_vtk_lines(path: Path) -> list[Polyline]:
+    poly = read_polydata(path)
+    points, point_arrays, cell_arrays = polydata_arrays(poly)
+    radius_all = point_arrays.get(RADIUS_KEY)
+    lines = []
+    for cell_index, ids in enumerate(_line_cells(poly)):
+        radius = None if radius_all is None else np.array(radius_all[ids], float).reshape(-1)
+        cell_data = {k: int(cell_arrays[k][cell_index]) for k in TRACT_KEYS if k in cell_arrays}
+        lines.append(Polyline(np.array(points[ids], float), radius, cell_data))
+    return lines
+
+
+def _line_cells(poly) -> list[np.ndarray]:
+    """Point ids of each line/polyline cell, in cell order (other cell types skipped)."""
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    if poly.GetNumberOfLines() == 0:
+        return []
+    conn = poly.GetLines()
+    offsets = vtk_to_numpy(conn.GetOffsetsArray()).astype(np.int64)
+    ids = vtk_to_numpy(conn.GetConnectivityArray()).astype(np.int64)
+    return [ids[a:b] for a, b in zip(offsets[:-1], offsets[1:]) if b - a >= 1]
+
+
+def _read_csv(path: Path) -> list[Polyline]:
+    try:
+        with path.open(newline="", encoding="utf-8") as handle:
+            rows = list(csv.reader(handle))
+    except (OSError, UnicodeDecodeError) as err:
+        raise InputDataError(f"{path}: cannot read the CSV centerline ({err})") from err
+    if not rows:
+        raise InputDataError(f"{path}: the CSV file is empty; expected a header row 'x,y,z[,radius]' and points")
+    header = [h.strip().lower() for h in rows[0]]
+    missing = [k for k in ("x", "y", "z") if k not in header]
+    if missing:
+        raise InputDataError(
+            f"{path}: the header row must name x, y, z (and optionally radius), got {rows[0]}; add the header"
+        )
+    cols = [header.index(k) for k in ("x", "y", "z")] + ([header.index("radius")] if "radius" in header else [])
+    values = np.array([_csv_row(path, n + 2, row, cols) for n, row in enumerate(rows[1:]) if row], float)
+    if values.size == 0:
+        return []
+    return [Polyline(values[:, :3], values[:, 3] if values.shape[1] == 4 else None)]
+
+
+def _csv_row(path: Path, line: int, row: list[str], cols: list[int]) -> list[float]:
+    try:
+        return [float(row[c]) for c in cols]
+    except (ValueError, IndexError):
+        raise InputDataError(f"{path}:{line}: expected {len(cols)} numbers, got {row}; fix or remove the row") from None
+
+
+def _read_npy(path: Path) -> list[Polyline]:
+    try:
+        values = np.load(path, allow_pickle=False)
+    except (OSError, ValueError) as err:
+        raise InputDataError(f"{path}: cannot read the .npy centerline ({err})") from err
+    if values.ndim != 2 or values.shape[1] not in (3, 4):
+        raise InputDataError(f"{path}: expected an (n, 3) or (n, 4) array (x, y, z[, radius]), got shape {values.shape}")
+    values = values.astype(float)
+    return [Polyline(values[:, :3], values[:, 3] if values.shape[1] == 4 else None)] if len(values) else []
+
+
+_READERS: dict[str, Callable[[Path], list[Polyline]]] = {
+    ".vtp": _read_vtk_lines,
+    ".vtk": _read_vtk_lines,
+    ".csv": _read_csv,
+    ".npy": _read_npy,
+}

@@ -1,0 +1,104 @@
+"""VTK PolyData files (XML .vtp and legacy .vtk) through the vtk package.
+
+VMTK writes zlib-compressed binary XML; vtk's own readers handle every
+variant, so nothing here parses bytes by hand.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+from softdesign.errors import InputDataError
+
+
+def read_polydata(path: Path):
+    """Read a .vtp or legacy .vtk file into a ``vtkPolyData``.
+
+    Raises
+    ------
+    InputDataError
+        The file is missing, not PolyData, or vtk reports a read error.
+    """
+    import vtk
+
+    if not path.is_file():
+        raise InputDataError(f"{path}: file not found; check the path in the case file")
+    _silence_vtk_log()
+    if path.suffix.lower() == ".vtp":
+        reader = vtk.vtkXMLPolyDataReader()
+    else:
+        reader = vtk.vtkPolyDataReader()
+    errors = _ErrorCatcher()
+    reader.AddObserver("ErrorEvent", errors.catch)
+    reader.SetFileName(str(path))
+    reader.Update()
+    poly = reader.GetOutput()
+    if errors.messages or poly is None or (path.suffix.lower() == ".vtk" and not reader.IsFilePolyData()):
+        detail = errors.messages[0] if errors.messages else "not VTK PolyData"
+        raise InputDataError(f"{path}: cannot read it as VTK PolyData ({detail}); re-export it from VMTK or ParaView")
+    return poly
+
+
+def _silence_vtk_log() -> None:
+    """vtk prints parser errors to stderr itself; we report them as one clear message."""
+    import vtk
+
+    vtk.vtkLogger.SetStderrVerbosity(vtk.vtkLogger.VERBOSITY_OFF)
+
+
+class _ErrorCatcher:
+    """Collects vtk error events instead of letting vtk print them."""
+
+    def __init__(self) -> None:
+        self.messages: list[str] = []
+
+    def catch(self, caller, event, calldata=None) -> None:  # noqa: ARG002 - vtk's observer signature
+        text = str(calldata or f"{event} in {caller.GetClassName()}").strip()
+        text = re.sub(r" \(0x[0-9a-fA-F]+\)", "", text.splitlines()[-1] if text else str(event))
+        self.messages.append(text)
+
+    catch.CallDataType = "string0"  # vtk passes the error text to the observer
+
+
+def polydata_arrays(poly) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """Points (n, 3) float64 and the point and cell data arrays by name."""
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    if poly.GetPoints() is None or poly.GetNumberOfPoints() == 0:
+        return np.zeros((0, 3)), {}, {}
+    points = vtk_to_numpy(poly.GetPoints().GetData()).astype(np.float64)
+
+    def arrays(data) -> dict[str, np.ndarray]:
+        found = {}
+        for i in range(data.GetNumberOfArrays()):
+            array = data.GetArray(i)
+            if array is not None and data.GetArrayName(i):
+                found[data.GetArrayName(i)] = vtk_to_numpy(array)
+        return found
+
+    return points, arrays(poly.GetPointData()), arrays(poly.GetCellData())
+
+
+def triangles_from_polydata(poly) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices (V, 3) float64 and triangles (F, 3) int64 of a surface, polygons triangulated."""
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    tri = vtk.vtkTriangleFilter()
+    tri.SetInputData(poly)
+    tri.PassLinesOff()
+    tri.PassVertsOff()
+    tri.Update()
+    out = tri.GetOutput()
+    if out.GetNumberOfPolys() == 0:
+        return np.zeros((0, 3)), np.zeros((0, 3), np.int64)
+    cells = out.GetPolys()
+    offsets = vtk_to_numpy(cells.GetOffsetsArray())
+    conn = vtk_to_numpy(cells.GetConnectivityArray()).astype(np.int64)
+    if not np.all(np.diff(offsets) == 3):
+        raise InputDataError("surface: triangulation left non-triangle cells; clean the surface (vmtksurfacecleaner)")
+    vertices = vtk_to_numpy(out.GetPoints().GetData()).astype(np.float64)
+    return vertices, conn.reshape(-1, 3)
