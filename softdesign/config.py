@@ -42,6 +42,7 @@ class FinalShape(_Section):
     path: int = Field(0, ge=0)
     inlet: tuple[float, float, float] | None = None
     reverse: bool = False
+    surface_units: Literal["mm", "cm", "m"] | None = None
 
 
 class IntermediateShape(_Section):
@@ -185,6 +186,10 @@ class Case(_Section):
     def base_dir(self) -> Path:
         """The folder of the case file; relative input paths start here."""
         return self._base
+
+    def resolved_path(self, path: Path) -> str:
+        """``path`` relative to the case file's folder, POSIX style (for outputs)."""
+        return Path(os.path.relpath(path, self._base)).as_posix()
 
     def resolved(self) -> dict[str, Any]:
         """The case as a JSON-ready dict, defaults filled in, for the build folder.

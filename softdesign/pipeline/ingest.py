@@ -1,0 +1,184 @@
+"""Stage 1, ingest: read the case's centerlines and surfaces, select the path, check them.
+
+Everything is converted to millimetres here.  The result is kept in the
+build folder under ``ingest/`` so later stages never re-read the inputs.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from softdesign.config import Case
+from softdesign.geometry.network import CenterlineNetwork, Orientation, SelectedPath, all_paths, select_path
+from softdesign.geometry.plausibility import check_surface_surrounds, radius_note
+from softdesign.geometry.surface_info import SurfaceInfo, describe_surface
+from softdesign.io.centerline import read_centerline_network
+from softdesign.io.surface import read_surface
+from softdesign.pipeline.store import Staging, load_npz, npz_bytes
+from softdesign.types import UNIT_SCALE_TO_MM, FloatArray
+
+STAGE = "ingest"
+VERSION = 1
+
+
+@dataclass(frozen=True)
+class IngestResult:
+    """What ingest found, in mm.
+
+    Attributes
+    ----------
+    path : the selected final path, inlet first
+    others : every other path of the network, inlet first (for branch exclusion)
+    vertices, faces : the final surface, or empty arrays when none was given
+    initial_path : the q = 0 centerline when ``initial.kind: file``
+    keyframes : (q, path) of each intermediate shape
+    initial_surface : (vertices, faces) of ``initial.surface``, or None
+    summary : the JSON-ready report printed and stored
+    notes : what was done on the way (duplicates, orientation, warnings)
+    """
+
+    path: SelectedPath
+    others: tuple[SelectedPath, ...]
+    vertices: FloatArray
+    faces: np.ndarray
+    initial_path: SelectedPath | None = None
+    keyframes: tuple[tuple[float, SelectedPath], ...] = ()
+    initial_surface: tuple[FloatArray, np.ndarray] | None = None
+    summary: dict[str, Any] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+
+
+def input_files(case: Case) -> list[Path]:
+    """Every file ingest reads (for the cache key and the manifest)."""
+    files = [case.final.centerline, case.final.surface, case.initial.centerline, case.initial.surface]
+    files += [k.centerline for k in case.intermediate]
+    return [f for f in files if f is not None]
+
+
+def run_ingest(case: Case) -> IngestResult:
+    """Read and check every input of ``case``.
+
+    Raises
+    ------
+    InputDataError
+        A file is missing, unreadable or geometrically unusable.
+    """
+    scale = UNIT_SCALE_TO_MM[case.units]
+    network = read_centerline_network(case.final.centerline, scale)
+    inlet = None if case.final.inlet is None else np.asarray(case.final.inlet, float) * scale
+    orientation = Orientation(inlet=inlet, reverse=case.final.reverse)
+    path = select_path(network, case.final.path, orientation)
+    others = tuple(p for p in all_paths(network, Orientation(inlet=path.points[0])) if p.index != path.index)
+    notes = list(path.notes)
+    vertices, faces, info = _final_surface(case, path, scale)
+    note = radius_note(path.radius, str(case.final.centerline))
+    notes += [note] if note else []
+    initial_path = None
+    if case.initial.kind == "file" and case.initial.centerline is not None:
+        initial_path = _one_path(case.initial.centerline, case.initial.path, scale, Orientation())
+        notes += initial_path.notes
+    keyframes = tuple(
+        (k.q, _one_path(k.centerline, k.path, scale, Orientation(inlet=path.points[0], reverse=k.reverse)))
+        for k in case.intermediate
+    )
+    initial_surface = None
+    if case.initial.surface is not None:
+        initial_surface = read_surface(case.initial.surface, scale)
+    summary = _summary(case, network, path, info)
+    return IngestResult(path, others, vertices, faces, initial_path, keyframes, initial_surface, summary, tuple(notes))
+
+
+def _one_path(file: Path, index: int, scale: float, orientation: Orientation) -> SelectedPath:
+    return select_path(read_centerline_network(file, scale), index, orientation)
+
+
+def _final_surface(case: Case, path: SelectedPath, scale: float) -> tuple[FloatArray, np.ndarray, SurfaceInfo | None]:
+    if case.final.surface is None:
+        return np.zeros((0, 3)), np.zeros((0, 3), np.int64), None
+    surface_scale = UNIT_SCALE_TO_MM[case.final.surface_units] if case.final.surface_units else scale
+    vertices, faces = read_surface(case.final.surface, surface_scale)
+    check_surface_surrounds(path.points, path.radius, vertices, str(case.final.surface))
+    return vertices, faces, describe_surface(vertices, faces)
+
+
+def _summary(case: Case, network: CenterlineNetwork, path: SelectedPath, info: SurfaceInfo | None) -> dict[str, Any]:
+    paths = [
+        {"path": p.index, "points": int(len(p.points)), "length_mm": round(p.length, 6)}
+        for p in all_paths(network, Orientation(inlet=path.points[0]))
+    ]
+    radius = None if path.radius is None else [float(path.radius.min()), float(path.radius.max())]
+    return {
+        "units": case.units,
+        "centerline": {
+            "file": case.final.centerline.name,
+            "branch_split": network.branch_split,
+            "polylines": len(network.polylines),
+            "paths": paths,
+            "selected": path.index,
+            "selected_points": int(len(path.points)),
+            "selected_length_mm": path.length,
+            "radius_range_mm": radius,
+            "inlet_mm": path.points[0].tolist(),
+            "outlet_mm": path.points[-1].tolist(),
+            "bounds_mm": [path.points.min(axis=0).tolist(), path.points.max(axis=0).tolist()],
+        },
+        "surface": None if info is None else {"file": case.final.surface.name, **info.as_dict()},
+    }
+
+
+def write_ingest(result: IngestResult, staging: Staging) -> None:
+    """Keep the ingest result in the build folder (``ingest/``)."""
+    staging.write_bytes("ingest/path.npz", _path_npz(result.path))
+    others = {f"path_{p.index}": p.points for p in result.others}
+    staging.write_bytes("ingest/network.npz", npz_bytes(**others))
+    staging.write_bytes("ingest/surface.npz", npz_bytes(vertices=result.vertices, faces=result.faces))
+    if result.initial_path is not None:
+        staging.write_bytes("ingest/initial_path.npz", _path_npz(result.initial_path))
+    for k, (q, keyframe) in enumerate(result.keyframes):
+        staging.write_bytes(f"ingest/keyframe_{k}.npz", _path_npz(keyframe, q=np.array(q)))
+    if result.initial_surface is not None:
+        v, f = result.initial_surface
+        staging.write_bytes("ingest/initial_surface.npz", npz_bytes(vertices=v, faces=f))
+    staging.write_json("ingest/summary.json", {**result.summary, "notes": list(result.notes)})
+
+
+def _path_npz(path: SelectedPath, **extra: np.ndarray) -> bytes:
+    arrays = {"points": path.points, "index": np.array(path.index), **extra}
+    if path.radius is not None:
+        arrays["radius"] = path.radius
+    return npz_bytes(**arrays)
+
+
+def load_ingest(build_dir: Path) -> IngestResult:
+    """Re-read the ingest result kept in ``build_dir/ingest``."""
+    root = Path(build_dir) / "ingest"
+    path = _load_path(root / "path.npz")
+    network = load_npz(root / "network.npz")
+    others = tuple(
+        SelectedPath(v, None, int(k.removeprefix("path_"))) for k, v in sorted(network.items())
+    )
+    surface = load_npz(root / "surface.npz")
+    initial = _load_path(root / "initial_path.npz") if (root / "initial_path.npz").is_file() else None
+    keyframes = tuple(
+        (float(load_npz(f)["q"]), _load_path(f))
+        for f in sorted(root.glob("keyframe_*.npz"), key=lambda f: int(f.stem.removeprefix("keyframe_")))
+    )
+    initial_surface = None
+    if (root / "initial_surface.npz").is_file():
+        data = load_npz(root / "initial_surface.npz")
+        initial_surface = (data["vertices"], data["faces"])
+    summary = json.loads((root / "summary.json").read_text(encoding="utf-8"))
+    notes = tuple(summary.pop("notes", ()))
+    return IngestResult(
+        path, others, surface["vertices"], surface["faces"], initial, keyframes, initial_surface, summary, notes
+    )
+
+
+def _load_path(file: Path) -> SelectedPath:
+    data = load_npz(file)
+    return SelectedPath(data["points"], data.get("radius"), int(data["index"]))

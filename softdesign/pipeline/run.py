@@ -1,0 +1,178 @@
+"""Run stages in order with a content-hash cache, then write the manifest.
+
+A stage's cache key is the sha256 of its name and version, the canonical
+JSON of the case sections it reads, and the keys of the stages it depends on
+(ingest: the sha256 of its input files).  A stage whose key matches the one
+recorded in ``DIR/<stage>/stage.json`` *and* whose recorded outputs are all
+present with their recorded hashes is skipped; nothing is reused merely
+because a file exists.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+from softdesign import __version__
+from softdesign.config import Case
+from softdesign.pipeline.store import MANIFEST, Staging, canonical_json, sha256_bytes, sha256_file
+
+Results = dict[str, Any]
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One pipeline stage.
+
+    Attributes
+    ----------
+    name, version : identify the code; bump ``version`` when outputs change
+    sections : case keys whose values change the outputs
+    upstream : stages whose results ``compute`` reads
+    compute : (case, results of upstream stages) -> result; no file writes
+    write : (result, staging) -> None; stages the outputs under ``name/``
+    load : build_dir -> result, for a skipped stage
+    describe : result -> short human summary lines
+    metrics : result -> JSON-ready figures for the manifest
+    """
+
+    name: str
+    version: int
+    sections: tuple[str, ...]
+    upstream: tuple[str, ...]
+    compute: Callable[[Case, Results], Any]
+    write: Callable[[Any, Staging], None]
+    load: Callable[[Path], Any]
+    describe: Callable[[Any], list[str]]
+    metrics: Callable[[Any], dict[str, Any]]
+
+
+@dataclass
+class StageRun:
+    """What happened to one stage in a run."""
+
+    name: str
+    key: str
+    status: str  # "ran" | "skipped"
+    seconds: float
+    lines: list[str] = field(default_factory=list)
+
+
+def stage_key(stage: Stage, case: Case, upstream_keys: list[str], input_hashes: list[str]) -> str:
+    """The content hash that decides whether ``stage`` must run again."""
+    resolved = case.resolved()
+    payload = {
+        "stage": stage.name,
+        "version": stage.version,
+        "config": {s: resolved.get(s) for s in stage.sections},
+        "upstream": upstream_keys,
+        "inputs": input_hashes,
+    }
+    return sha256_bytes(canonical_json(payload).encode("utf-8"))
+
+
+def _recorded(build_dir: Path, stage: Stage) -> dict[str, Any] | None:
+    file = build_dir / stage.name / "stage.json"
+    if not file.is_file():
+        return None
+    try:
+        return json.loads(file.read_text(encoding="utf-8"))
+    except (OSError, json.JSONDecodeError):
+        return None
+
+
+def _up_to_date(build_dir: Path, stage: Stage, key: str) -> bool:
+    record = _recorded(build_dir, stage)
+    if record is None or record.get("key") != key:
+        return False
+    outputs = record.get("outputs", {})
+    return all((build_dir / rel).is_file() and sha256_file(build_dir / rel) == sha for rel, sha in outputs.items())
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """How to run: which stages, forced or cached, where to report progress."""
+
+    force: bool = False
+    progress: Callable[[str], None] = lambda line: None
+
+
+def run_stages(
+    case: Case, build_dir: Path, stages: list[Stage], inputs: list[Path], options: RunOptions = RunOptions()
+) -> tuple[Results, list[StageRun]]:
+    """Run ``stages`` (in order, upstream first) into ``build_dir``.
+
+    All new files are staged and committed only when every stage succeeded;
+    a failure leaves the previous build folder as it was.
+    """
+    build_dir = Path(build_dir)
+    input_hashes = [sha256_file(p) for p in inputs]
+    results: Results = {}
+    keys: dict[str, str] = {}
+    runs: list[StageRun] = []
+    with Staging(build_dir) as staging:
+        for stage in stages:
+            upstream = [keys[u] for u in stage.upstream]
+            keys[stage.name] = stage_key(stage, case, upstream, input_hashes if not stage.upstream else [])
+            runs.append(_run_one(stage, case, build_dir, keys[stage.name], results, staging, options))
+        manifest = build_manifest(case, build_dir, stages, runs, results, inputs, input_hashes, staging)
+        staging.write_json(MANIFEST, manifest)
+        staging.commit()
+    return results, runs
+
+
+def _run_one(
+    stage: Stage, case: Case, build_dir: Path, key: str, results: Results, staging: Staging, options: RunOptions
+) -> StageRun:
+    start = time.perf_counter()
+    if not options.force and _up_to_date(build_dir, stage, key):
+        results[stage.name] = stage.load(build_dir)
+        options.progress(f"{stage.name}: unchanged, skipped")
+        return StageRun(stage.name, key, "skipped", time.perf_counter() - start, stage.describe(results[stage.name]))
+    options.progress(f"{stage.name}: running")
+    results[stage.name] = stage.compute(case, results)
+    before = set(staging.written)
+    stage.write(results[stage.name], staging)
+    outputs = {rel: staging.written[rel] for rel in sorted(set(staging.written) - before)}
+    staging.write_json(f"{stage.name}/stage.json", {"stage": stage.name, "version": stage.version, "key": key, "outputs": outputs})
+    seconds = time.perf_counter() - start
+    options.progress(f"{stage.name}: done in {seconds:.2f} s")
+    return StageRun(stage.name, key, "ran", seconds, stage.describe(results[stage.name]))
+
+
+def build_manifest(
+    case: Case,
+    build_dir: Path,
+    stages: list[Stage],
+    runs: list[StageRun],
+    results: Results,
+    inputs: list[Path],
+    input_hashes: list[str],
+    staging: Staging,
+) -> dict[str, Any]:
+    """The manifest: software, inputs with sha256, resolved case, stages, metrics, outputs."""
+    outputs = _all_outputs(build_dir, stages, staging)
+    return {
+        "software": {"softdesign": __version__},
+        "case": case.resolved(),
+        "inputs": [
+            {"path": case.resolved_path(p), "sha256": h, "bytes": p.stat().st_size} for p, h in zip(inputs, input_hashes)
+        ],
+        "stages": [{"name": r.name, "status": r.status, "key": r.key} for r in runs],
+        "timing_s": {r.name: round(r.seconds, 3) for r in runs},
+        "metrics": {s.name: s.metrics(results[s.name]) for s in stages if s.name in results},
+        "outputs": outputs,
+    }
+
+
+def _all_outputs(build_dir: Path, stages: list[Stage], staging: Staging) -> list[dict[str, Any]]:
+    found: dict[str, str] = {}
+    for stage in stages:
+        record = staging.written.get(f"{stage.name}/stage.json")
+        source = json.loads(staging.staged_path(f"{stage.name}/stage.json").read_text()) if record else _recorded(build_dir, stage)
+        if source:
+            found.update(source.get("outputs", {}))
+    return [{"path": rel, "sha256": sha} for rel, sha in sorted(found.items())]
