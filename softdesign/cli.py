@@ -13,6 +13,7 @@ from typing import Annotated, Optional
 import typer
 
 from softdesign.cli_support import note, run_guarded
+from softdesign.errors import SoftdesignError
 from softdesign.pcc_cli import pcc_app
 
 app = typer.Typer(
@@ -39,7 +40,10 @@ def _run(case_file: Path, out: Optional[Path], target: str | None, force: bool) 
     case = load_case(case_file)
     build_dir = _build_dir(case, out)
     stages = STAGES if target is None else stages_through(target)
-    _, runs = run_stages(case, build_dir, stages, input_files(case), RunOptions(force=force, progress=note))
+    try:
+        _, runs = run_stages(case, build_dir, stages, input_files(case), RunOptions(force=force, progress=note))
+    except SoftdesignError as err:
+        raise type(err)(f"{case_file}: {err}") from err
     for run in runs:
         typer.echo(f"[{run.name}] {run.status} ({run.seconds:.2f} s)")
         for line in run.lines:
@@ -53,14 +57,11 @@ def validate(case_file: CaseArg) -> None:
 
     def action() -> None:
         from softdesign.config import load_case
-        from softdesign.errors import ConfigError
         from softdesign.pipeline.stages import input_files
 
         case = load_case(case_file)
-        missing = [p for p in input_files(case) if not p.is_file()]
-        if missing:
-            raise ConfigError(f"{case_file}: input file(s) not found: {', '.join(map(str, missing))}; fix the paths")
-        typer.echo(f"{case_file}: valid (case '{case.name}', {len(input_files(case))} input file(s))")
+        files = input_files(case)
+        typer.echo(f"{case_file}: valid (case '{case.name}', {len(files)} input file(s) found)")
 
     run_guarded(action)
 

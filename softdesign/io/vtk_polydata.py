@@ -102,3 +102,51 @@ def triangles_from_polydata(poly) -> tuple[np.ndarray, np.ndarray]:
         raise InputDataError("surface: triangulation left non-triangle cells; clean the surface (vmtksurfacecleaner)")
     vertices = vtk_to_numpy(out.GetPoints().GetData()).astype(np.float64)
     return vertices, conn.reshape(-1, 3)
+
+
+def polydata_from_lines(
+    lines: list[np.ndarray],
+    point_arrays: dict[str, list[np.ndarray]] | None = None,
+    cell_arrays: dict[str, list[int]] | None = None,
+):
+    """A ``vtkPolyData`` with one polyline cell per (n, 3) array.
+
+    ``point_arrays`` maps a name to one (n,) or (n, k) array per line;
+    ``cell_arrays`` maps a name to one integer per line (VMTK's CenterlineIds...).
+    """
+    import vtk
+    from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+
+    points = np.concatenate([np.asarray(p, np.float64).reshape(-1, 3) for p in lines])
+    sizes = np.array([len(p) for p in lines], np.int64)
+    poly = vtk.vtkPolyData()
+    vtk_points = vtk.vtkPoints()
+    vtk_points.SetData(numpy_to_vtk(points, deep=True))
+    poly.SetPoints(vtk_points)
+    cells = vtk.vtkCellArray()
+    offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    cells.SetData(numpy_to_vtkIdTypeArray(offsets, deep=True), numpy_to_vtkIdTypeArray(np.arange(len(points), dtype=np.int64), deep=True))
+    poly.SetLines(cells)
+    for name, per_line in (point_arrays or {}).items():
+        array = numpy_to_vtk(np.concatenate([np.asarray(a, np.float64) for a in per_line]), deep=True)
+        array.SetName(name)
+        poly.GetPointData().AddArray(array)
+    for name, values in (cell_arrays or {}).items():
+        array = numpy_to_vtk(np.asarray(values, np.int32), deep=True)
+        array.SetName(name)
+        poly.GetCellData().AddArray(array)
+    return poly
+
+
+def write_polydata(poly, path: Path) -> None:
+    """Write XML PolyData as VMTK does: binary, zlib-compressed, appended data."""
+    import vtk
+
+    writer = vtk.vtkXMLPolyDataWriter()
+    writer.SetFileName(str(path))
+    writer.SetInputData(poly)
+    writer.SetDataModeToAppended()
+    writer.SetCompressorTypeToZLib()
+    writer.EncodeAppendedDataOff()
+    if writer.Write() != 1:
+        raise OSError(f"{path}: vtk could not write the file")

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from softdesign.config import Case
+from softdesign.errors import InputDataError
 from softdesign.geometry.network import CenterlineNetwork, Orientation, SelectedPath, all_paths, select_path
 from softdesign.geometry.plausibility import check_surface_surrounds, radius_note
 from softdesign.geometry.surface_info import SurfaceInfo, describe_surface
@@ -53,11 +54,32 @@ class IngestResult:
     notes: tuple[str, ...] = ()
 
 
+def input_fields(case: Case) -> list[tuple[str, Path]]:
+    """Every file ingest reads, with the case field that names it."""
+    named = [
+        ("final.centerline", case.final.centerline),
+        ("final.surface", case.final.surface),
+        ("initial.centerline", case.initial.centerline),
+        ("initial.surface", case.initial.surface),
+    ]
+    named += [(f"intermediate[{i}].centerline", k.centerline) for i, k in enumerate(case.intermediate)]
+    return [(name, path) for name, path in named if path is not None]
+
+
 def input_files(case: Case) -> list[Path]:
-    """Every file ingest reads (for the cache key and the manifest)."""
-    files = [case.final.centerline, case.final.surface, case.initial.centerline, case.initial.surface]
-    files += [k.centerline for k in case.intermediate]
-    return [f for f in files if f is not None]
+    """Every file ingest reads (for the cache key and the manifest).
+
+    Raises
+    ------
+    InputDataError
+        A named file does not exist.
+    """
+    for name, path in input_fields(case):
+        if not path.is_file():
+            raise InputDataError(
+                f"{name}: file not found: {path}; check the path (relative paths start at the case file's folder)"
+            )
+    return [path for _, path in input_fields(case)]
 
 
 def run_ingest(case: Case) -> IngestResult:
