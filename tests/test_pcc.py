@@ -340,5 +340,7 @@ def test_bad_inputs_raise_located_errors():
         pcc.lengths_from_arcs(0.01, 0.0, 100.0, np.nan)
     with pytest.raises(ConfigError, match="points per section"):
         pcc.sample_backbone(0.01, 0.0, 100.0, 1)
+    with pytest.raises(ConfigError, match=r"chain is \(\.\.\., k, 4, 4\)"):
+        pcc.chain_transforms(np.eye(4))
     with pytest.raises(ConfigError, match="D-H table"):
         pcc.transform_from_dh_table(np.zeros((5, 3)))

@@ -295,6 +295,8 @@ def chain_transforms(section2prev: npt.ArrayLike) -> Pose:
         Each section's tip frame in the base frame of the first section.
     """
     section2prev = _as_float(section2prev)
+    if section2prev.ndim < 3 or section2prev.shape[-2:] != (4, 4):
+        raise ConfigError(f"pcc: a chain is (..., k, 4, 4) section poses; got shape {section2prev.shape}")
     out = np.empty_like(section2prev)
     if section2prev.shape[-3] == 0:
         return out
