@@ -1,5 +1,350 @@
-"""`softdesign pcc ...`: seed 003's piecewise-constant-curvature model (placeholder until issue 6 lands)."""
+"""`softdesign pcc ...`: seed 003's piecewise-constant-curvature model from encoder lengths.
 
+Parsing, files and printing live here; the model is :mod:`softdesign.kinematics.pcc`.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+from pathlib import Path
+from typing import Annotated, NamedTuple, Optional
+
+import numpy as np
 import typer
 
-pcc_app = typer.Typer(no_args_is_help=True, help="Piecewise constant curvature (seed 003).")
+from softdesign.cli_support import emit_json, note, run_guarded
+from softdesign.errors import ConfigError, InputDataError
+
+CONVENTION = (
+    "Encoders at 90, 210, 330 degrees from the section's base x axis, d mm from the backbone; "
+    "a section bends towards phi (its shortest cable); z is the tangent at the base; "
+    "each section's frame continues from the previous section's tip without twist."
+)
+
+pcc_app = typer.Typer(
+    no_args_is_help=True,
+    help="Piecewise constant curvature from three cable-encoder lengths per section (seed 003). " + CONVENTION,
+)
+
+LengthsOpt = Annotated[
+    str,
+    typer.Option(
+        "--lengths",
+        help='Encoder lengths in mm, three per section, sections separated by ";": "120,123,124;125,123,121".',
+        show_default=False,
+    ),
+]
+DOpt = Annotated[
+    str,
+    typer.Option(
+        "--d", help='Distance of the cables from the backbone, mm: one value ("15") or one per section ("15,14,13").',
+        show_default=False,
+    ),
+]
+
+
+def _number(text: str, what: str, fix: str) -> float:
+    """``text`` as a finite float, or a ConfigError naming ``what``."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise ConfigError(f"{what}: '{text.strip()}' is not a number; {fix}") from None
+    if not math.isfinite(value):
+        raise ConfigError(f"{what}: got {text.strip()}, expected a finite number; {fix}")
+    return value
+
+
+def lengths_from_text(text: str) -> np.ndarray:
+    """Parse ``--lengths`` ("l11,l12,l13;l21,l22,l23") into a (k, 3) array, mm, each > 0."""
+    fix = 'give three lengths in mm per section, sections separated by ";", e.g. "120,123,124;125,123,121"'
+    sections = [part for part in text.split(";") if part.strip()]
+    if not sections:
+        raise ConfigError(f"--lengths: no lengths given; {fix}")
+    rows = []
+    for i, part in enumerate(sections, start=1):
+        values = part.split(",")
+        if len(values) != 3:
+            raise ConfigError(f"--lengths: section {i} has {len(values)} length(s) ('{part.strip()}'), expected 3; {fix}")
+        row = [_number(v, f"--lengths: section {i} cable {j}", fix) for j, v in enumerate(values, start=1)]
+        for j, value in enumerate(row, start=1):
+            if value <= 0:
+                raise ConfigError(f"--lengths: section {i} cable {j} is {value:g} mm, expected > 0; {fix}")
+        rows.append(row)
+    return np.array(rows, dtype=np.float64)
+
+
+def spacing_from_text(text: str, sections: int, where: str = "--lengths") -> np.ndarray:
+    """Parse ``--d`` into one cable distance per section, (k,) mm, each > 0."""
+    fix = f'give one distance in mm ("15") or one per section ({sections} values, e.g. "{",".join(["15"] * sections)}")'
+    values = [_number(v, f"--d value {i}", fix) for i, v in enumerate(text.split(","), start=1)]
+    if len(values) not in (1, sections):
+        raise ConfigError(f"--d: {len(values)} values for {sections} section(s) in {where}; {fix}")
+    for i, value in enumerate(values, start=1):
+        if value <= 0:
+            raise ConfigError(f"--d value {i}: {value:g} mm, expected > 0 (cable distance from the backbone); {fix}")
+    return np.broadcast_to(np.array(values, dtype=np.float64), (sections,)).copy()
+
+
+def forward_payload(lengths: np.ndarray, d: np.ndarray) -> dict:
+    """The JSON object of ``pcc forward``: per-section arcs and transforms, the tip and base-to-tip pose."""
+    from softdesign.kinematics import pcc
+
+    arcs = pcc.arcs_from_lengths(lengths, d)
+    section2prev = pcc.transform_from_arc(arcs.kappa, arcs.phi, arcs.length)
+    tip2base = pcc.chain_transforms(section2prev)[-1]
+    sections = [
+        {
+            "kappa": float(arcs.kappa[i]),
+            "phi": float(arcs.phi[i]),
+            "length": float(arcs.length[i]),
+            "theta": float(arcs.theta[i]),
+            "transform": (section2prev[i] + 0.0).tolist(),  # + 0.0 turns -0.0 into 0.0
+        }
+        for i in range(len(lengths))
+    ]
+    tip2base = tip2base + 0.0
+    return {"sections": sections, "tip": tip2base[:3, 3].tolist(), "transform": tip2base.tolist()}
+
+
+def _print_forward(payload: dict) -> None:
+    typer.echo(f"{'section':>7}  {'kappa [1/mm]':>13}  {'phi [rad]':>10}  {'phi [deg]':>9}  {'L [mm]':>10}  {'theta [rad]':>11}")
+    for i, s in enumerate(payload["sections"], start=1):
+        typer.echo(
+            f"{i:>7}  {s['kappa']:>13.6e}  {s['phi']:>10.6f}  {math.degrees(s['phi']):>9.3f}  "
+            f"{s['length']:>10.4f}  {s['theta']:>11.6f}"
+        )
+    x, y, z = payload["tip"]
+    typer.echo(f"tip [mm]: x = {x:.4f}, y = {y:.4f}, z = {z:.4f}")
+    typer.echo("base-to-tip transform:")
+    for row in payload["transform"]:
+        typer.echo("  " + "  ".join(f"{v:>10.6f}" for v in row))
+    typer.echo(f"convention: {CONVENTION}")
+
+
+@pcc_app.command()
+def forward(
+    lengths: LengthsOpt,
+    d: DOpt,
+    json_out: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
+) -> None:
+    """Shape of a chain of sections from encoder lengths: kappa, phi, L, theta per section, and the tip pose.
+
+    JSON: {"sections": [{"kappa" (1/mm), "phi" (rad), "length" (mm), "theta" (rad),
+    "transform" (4x4, section tip to previous tip)}], "tip" [x, y, z] (mm), "transform" (4x4, tip to base)}.
+    """
+
+    def action() -> None:
+        readings = lengths_from_text(lengths)
+        payload = forward_payload(readings, spacing_from_text(d, len(readings)))
+        if json_out:
+            emit_json(payload)
+        else:
+            _print_forward(payload)
+
+    run_guarded(action)
+
+
+class Readings(NamedTuple):
+    """Rows of an encoder-readings CSV, screened."""
+
+    times: np.ndarray  #: (n,) s, accepted rows
+    lengths: np.ndarray  #: (n, k, 3) mm, accepted rows
+    lines: np.ndarray  #: (n,) int, line numbers of the accepted rows in the file
+    rejected: list[tuple[int, str, str]]  #: (line, time as written, reason)
+
+
+def _header_sections(path: Path, header: list[str]) -> int:
+    """Number of sections a header declares (time + 3 per section)."""
+    fix = "expected a header row: a time column, then 3 length columns per section, e.g. 't,l11,l12,l13,l21,l22,l23'"
+    count = len(header)
+    if count < 4 or (count - 1) % 3:
+        raise InputDataError(f"{path} line 1: the header has {count} column(s); {fix}")
+    try:
+        float(header[0])
+    except ValueError:
+        return (count - 1) // 3
+    raise InputDataError(f"{path} line 1: the first row is numbers, not a header; {fix}")
+
+
+def _parse_row(values: list[str], sections: int) -> tuple[float | None, np.ndarray | None, list[str]]:
+    """Time and (k, 3) lengths of a data row, or the reasons it is unusable."""
+    reasons = []
+    try:
+        time = float(values[0])
+        if not math.isfinite(time):
+            raise ValueError
+    except ValueError:
+        time = None
+        reasons.append(f"time '{values[0].strip()}' is not a finite number")
+    lengths = np.full((sections, 3), np.nan)
+    for index, text in enumerate(values[1:]):
+        section, cable = divmod(index, 3)
+        try:
+            value = float(text)
+        except ValueError:
+            reasons.append(f"section {section + 1} cable {cable + 1}: '{text.strip()}' is not a number")
+            continue
+        if not (math.isfinite(value) and value > 0):
+            reasons.append(f"section {section + 1} cable {cable + 1}: length {value:g} mm is not > 0")
+        lengths[section, cable] = value
+    return time, (None if reasons else lengths), reasons
+
+
+def _rate_reasons(time: float, lengths: np.ndarray, previous: tuple[int, float, np.ndarray], max_rate: float | None) -> list[str]:
+    """Why a row cannot follow the previous accepted row in time (empty when it can)."""
+    line, last_time, last_lengths = previous
+    dt = time - last_time
+    if dt <= 0:
+        return [f"time {time:g} s is not after the previous accepted row (line {line}, time {last_time:g} s)"]
+    if max_rate is None:
+        return []
+    reasons = []
+    rates = np.abs(lengths - last_lengths) / dt
+    for section, cable in np.argwhere(rates > max_rate):
+        change = lengths[section, cable] - last_lengths[section, cable]
+        reasons.append(
+            f"section {section + 1} cable {cable + 1} changed {change:+g} mm in {dt:g} s "
+            f"({rates[section, cable]:g} mm/s > --max-rate {max_rate:g}) since line {line}"
+        )
+    return reasons
+
+
+def read_readings(path: Path, max_rate: float | None = None) -> Readings:
+    """Read and screen an encoder-readings CSV; bad rows are rejected with a reason, not fatal.
+
+    Raises
+    ------
+    InputDataError
+        Missing or unreadable file, a bad header, or a row with the wrong number of columns.
+    """
+    if not path.is_file():
+        raise InputDataError(f"{path}: readings file not found; check the path")
+    try:
+        rows = [(n, row) for n, row in enumerate(csv.reader(io.StringIO(path.read_text())), start=1) if row]
+    except (OSError, UnicodeDecodeError, csv.Error) as err:
+        raise InputDataError(f"{path}: cannot read it as a CSV text file ({err}); save it as plain CSV") from err
+    if not rows:
+        raise InputDataError(f"{path}: the file is empty; expected a header row and one row per reading")
+    sections = _header_sections(path, rows[0][1])
+    times, accepted, lines, rejected = [], [], [], []
+    for line, values in rows[1:]:
+        if len(values) != 3 * sections + 1:
+            raise InputDataError(
+                f"{path} line {line}: {len(values)} column(s), expected {3 * sections + 1} as in the header "
+                f"(time + 3 lengths for each of {sections} section(s)); fix or remove the row"
+            )
+        time, lengths, reasons = _parse_row(values, sections)
+        if not reasons and accepted:
+            reasons = _rate_reasons(time, lengths, (lines[-1], times[-1], accepted[-1]), max_rate)
+        if reasons:
+            rejected.append((line, values[0].strip(), "; ".join(reasons)))
+            continue
+        times.append(time)
+        accepted.append(lengths)
+        lines.append(line)
+    return Readings(
+        np.array(times, dtype=np.float64),
+        np.array(accepted, dtype=np.float64).reshape(-1, sections, 3),
+        np.array(lines, dtype=np.int64),
+        rejected,
+    )
+
+
+def _write_text_atomically(path: Path, text: str) -> Path:
+    """Write ``text`` under a temporary name beside ``path``, then rename it to ``path``."""
+    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        temporary.write_text(text)
+        os.replace(temporary, path)
+    finally:
+        temporary.unlink(missing_ok=True)
+    return path
+
+
+def _csv_text(header: list[str], rows: list[list]) -> str:
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(header)
+    writer.writerows([[repr(float(v)) if isinstance(v, (float, np.floating)) else v for v in row] for row in rows])
+    return buffer.getvalue()
+
+
+def _tips_csv(readings: Readings, arcs, tip2base: np.ndarray) -> str:
+    sections = readings.lengths.shape[1]
+    header = ["time", "tip_x", "tip_y", "tip_z"] + [f"r{i}{j}" for i in range(1, 4) for j in range(1, 4)]
+    header += [f"{name}_{s}" for s in range(1, sections + 1) for name in ("kappa", "phi", "length", "theta")]
+    per_section = np.stack([arcs.kappa, arcs.phi, arcs.length, arcs.theta], axis=-1).reshape(len(readings.times), 4 * sections)
+    table = np.column_stack([readings.times, tip2base[:, :3, 3], tip2base[:, :3, :3].reshape(-1, 9), per_section])
+    return _csv_text(header, table.tolist())
+
+
+def _write_backbones(path: Path, readings: Readings, arcs, points_per_section: int) -> Path:
+    from softdesign.io.polylines_vtp import write_polylines_vtp
+    from softdesign.kinematics import pcc
+
+    poses = pcc.sample_backbone_poses(arcs.kappa, arcs.phi, arcs.length, points_per_section)
+    arc_length, section = pcc.backbone_arc_lengths(arcs.length, points_per_section)
+    count = poses.shape[1]
+    point_arrays = {
+        "time": [np.full(count, t) for t in readings.times],
+        "section": [section + 1.0] * len(readings.times),
+        "arc_length": list(arc_length),
+        "N": list(poses[:, :, :3, 0]),
+        "B": list(poses[:, :, :3, 1]),
+        "T": list(poses[:, :, :3, 2]),
+    }
+    cell_arrays = {"time": readings.times, "line": readings.lines}
+    return write_polylines_vtp(path, list(poses[:, :, :3, 3]), point_arrays, cell_arrays)
+
+
+@pcc_app.command()
+def reconstruct(
+    readings_csv: Annotated[Path, typer.Argument(help="Encoder readings over time (CSV).", show_default=False)],
+    d: DOpt,
+    out_dir: Annotated[Path, typer.Option("--out", "-o", help="Folder for the results (created if missing).", show_default=False)],
+    max_rate: Annotated[
+        Optional[float], typer.Option("--max-rate", help="Reject a row whose length changes faster than this, mm/s.")
+    ] = None,
+    points_per_section: Annotated[int, typer.Option("--points-per-section", min=2, help="Backbone samples per arc.")] = 21,
+) -> None:
+    """Backbone and tip pose for every row of an encoder-readings CSV.
+
+    READINGS.csv has a header row, then per row a time (first column, s) and
+    three lengths (mm) per section, sections in order.  Writes, in OUT_DIR:
+    tips.csv (time, tip_x/y/z in mm, the tip-to-base rotation r11..r33 row by
+    row, and kappa/phi/length/theta per section); backbones.vtp (one file, one
+    polyline per accepted row, base to tip, with point arrays time, section,
+    arc_length (mm) and the frame axes N, B, T (T the tangent), and cell arrays
+    time and line); rejected.csv (line, time, reason).  A row is rejected, and
+    reported on stderr, when a length is not a number or not > 0, its time is
+    not after the previous accepted row, or (with --max-rate) a cable changed
+    faster than MAX_RATE mm/s since the previous accepted row.
+    """
+
+    def action() -> None:
+        from softdesign.kinematics import pcc
+
+        if max_rate is not None and not (math.isfinite(max_rate) and max_rate > 0):
+            raise ConfigError(f"--max-rate must be a finite number > 0 mm/s, got {max_rate:g}; omit it to skip the check")
+        readings = read_readings(readings_csv, max_rate)
+        spacing = spacing_from_text(d, readings.lengths.shape[1], where=str(readings_csv))
+        for line, time, reason in readings.rejected:
+            note(f"{readings_csv} line {line} (time {time}): rejected: {reason}")
+        out_dir.mkdir(parents=True, exist_ok=True)
+        arcs = pcc.arcs_from_lengths(readings.lengths, spacing)
+        tip2base = pcc.chain_transforms(pcc.transform_from_arc(arcs.kappa, arcs.phi, arcs.length))[:, -1]
+        written = [
+            _write_text_atomically(out_dir / "tips.csv", _tips_csv(readings, arcs, tip2base)),
+            _write_backbones(out_dir / "backbones.vtp", readings, arcs, points_per_section),
+            _write_text_atomically(out_dir / "rejected.csv", _csv_text(["line", "time", "reason"], readings.rejected)),
+        ]
+        typer.echo(f"{readings_csv}: {len(readings.times)} row(s) accepted, {len(readings.rejected)} rejected")
+        for path in written:
+            typer.echo(f"wrote {path}")
+        if not len(readings.times):
+            raise InputDataError(f"{readings_csv}: no row was usable; see {out_dir / 'rejected.csv'} for the reasons")
+
+    run_guarded(action)
