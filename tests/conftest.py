@@ -34,15 +34,12 @@ def straight_tube(folder: Path, radius: float = 3.0, length: float = 40.0, scale
     """
     import trimesh
 
-    from softdesign.io.vtk_polydata import polydata_from_lines, write_polydata
+    from softdesign.io.polylines_vtp import write_polylines_vtp
 
     z = np.linspace(0.0, length, 81)
     points = np.column_stack([np.zeros_like(z), np.zeros_like(z), z]) * scale
     centerline = folder / "centerline.vtp"
-    write_polydata(
-        polydata_from_lines([points], {"MaximumInscribedSphereRadius": [np.full(len(z), radius * scale)]}),
-        centerline,
-    )
+    write_polylines_vtp(centerline, [points], {"MaximumInscribedSphereRadius": [np.full(len(z), radius * scale)]})
     tube = trimesh.creation.cylinder(radius=radius, height=length + 2.0, sections=48)
     tube.apply_translation([0.0, 0.0, length / 2])
     tube.apply_scale(scale)

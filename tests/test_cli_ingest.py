@@ -69,14 +69,15 @@ def _write_csv(path: Path, rows: list[list[float]]) -> Path:
 def _no_lines_vtp(path: Path) -> Path:
     import vtk
 
-    from softdesign.io.vtk_polydata import write_polydata
-
     poly = vtk.vtkPolyData()
     points = vtk.vtkPoints()
     for p in [(0, 0, 0), (1, 0, 0), (0, 1, 0)]:
         points.InsertNextPoint(p)
     poly.SetPoints(points)
-    write_polydata(poly, path)
+    writer = vtk.vtkXMLPolyDataWriter()
+    writer.SetFileName(str(path))
+    writer.SetInputData(poly)
+    assert writer.Write() == 1
     return path
 
 

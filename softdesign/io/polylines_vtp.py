@@ -93,7 +93,9 @@ def _stack_point_array(name: str, arrays: Sequence[npt.ArrayLike], sizes: list[i
 
 
 def _check_cell_array(name: str, values: npt.ArrayLike, count: int) -> np.ndarray:
-    values = np.asarray(values, dtype=np.float64)
+    values = np.asarray(values)
+    # integer ids (VMTK's CenterlineIds, TractIds) stay integers; everything else is float64
+    values = values.astype(np.int32 if np.issubdtype(values.dtype, np.integer) else np.float64)
     if values.ndim not in (1, 2) or len(values) != count:
         raise InputDataError(
             f"cell array '{name}': expected ({count},) or ({count}, c), one value per polyline, got shape {values.shape}"
