@@ -183,3 +183,29 @@ def test_the_same_vessel_in_mm_and_in_m_ingests_identically(tmp_path):
     np.testing.assert_allclose(m.path.radius, mm.path.radius, rtol=0, atol=1e-9)
     np.testing.assert_allclose(m.vertices, mm.vertices, rtol=0, atol=1e-5)
     assert m.summary["surface"]["faces"] == mm.summary["surface"]["faces"]
+
+
+def test_sample_generator_rebuilds_the_committed_demo_data(tmp_path):
+    """data/demo is the generator's output, byte for byte (so it never goes stale)."""
+    result = runner.invoke(app, ["sample", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    committed = Path(__file__).resolve().parents[1] / "data" / "demo"
+    for name in ("centerline.vtp", "surface.stl"):
+        assert (tmp_path / name).read_bytes() == (committed / name).read_bytes(), name
+
+
+def test_sample_is_a_vmtk_style_network_with_a_capped_wall(tmp_path):
+    from softdesign.geometry.network import select_path
+    from softdesign.geometry.surface_info import describe_surface
+    from softdesign.io.centerline import read_centerline_network
+    from softdesign.io.surface import read_surface
+
+    runner.invoke(app, ["sample", str(tmp_path)])
+    network = read_centerline_network(tmp_path / "centerline.vtp")
+    main, branch = (select_path(network, i) for i in (0, 1))
+    assert "shared with 1 other path" in main.notes[-1] and "shared with 1 other path" in branch.notes[-1]
+    np.testing.assert_array_equal(main.points[0], branch.points[0])
+    assert np.linalg.norm(main.points[-1] - branch.points[-1]) > 20.0  # a real side branch
+    assert 2.9 < main.radius.min() < main.radius.max() < 4.0  # minor semi-axis of the elliptical lumen
+    info = describe_surface(*read_surface(tmp_path / "surface.stl"))
+    assert info.capped and info.nonmanifold_edges == 0
