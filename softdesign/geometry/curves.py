@@ -1,0 +1,339 @@
+"""Smooth centerlines parameterized by normalized arc length l in [0, 1].
+
+A polyline (mm, proximal first) becomes a :class:`SmoothCurve` in four steps:
+
+1. a parametric spline on the chord-length parameter, interpolating
+   (``smoothing_mm = 0``) or smoothing with ``s = n * smoothing_mm**2`` (the
+   RMS distance of the input points from the spline is at most ``smoothing_mm``);
+2. reparameterization by its true arc length (Gauss-Legendre quadrature, then
+   Newton on s(u) = target);
+3. optional end handling: the last ``end_straight_mm`` of each end is replaced
+   by a straight extension along the tangent where the trim starts, so that the
+   length is kept and the curl of a VMTK centerline into its caps is removed;
+4. resampling at equal arc length (``spacing_mm`` or ``count`` points) and a
+   quintic interpolating spline in l on that uniform grid.
+
+Step 4 gives every curve resampled with the same count the same knot vector,
+so blends of shapes are exact on the spline coefficients, and curvature and
+torsion come from analytic derivatives, not finite differences.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+from scipy.interpolate import BSpline, make_interp_spline, splprep
+
+from softdesign.errors import ConfigError, GeometryError
+from softdesign.types import FRENET_KAPPA_TOL, POINT_TOL_MM, FloatArray, Points
+
+#: Degree of the spline in l (5: torsion, a third derivative, is still C2).
+DEGREE = 5
+#: Gauss-Legendre nodes per interval for arc-length integrals.
+GAUSS_NODES = 8
+#: Dense evaluation grid (frames, reports): at least this many per sample interval ...
+DENSE_PER_INTERVAL = 8
+#: ... and no coarser than this arc step, mm.
+DENSE_STEP_MM = 0.05
+#: Newton iterations allowed to invert s(u) = target; converges in 3-4 on smooth splines.
+NEWTON_STEPS = 8
+#: Relative tolerance on arc length when inverting s(u), and on l at the domain ends.
+ARC_REL_TOL = 1e-13
+#: A FITPACK warning is accepted when the residual sum of squares is within this factor of its target s.
+SMOOTHING_SLACK = 1.5
+#: Fewest distinct input points: a cubic (torsion needs a third derivative) needs 4.
+MIN_POLYLINE_POINTS = 4
+
+
+@dataclass(frozen=True)
+class CurveOptions:
+    """How a polyline is smoothed, trimmed and resampled (mm).
+
+    Attributes
+    ----------
+    spacing_mm : target arc-length spacing of the samples (the actual one is <= it)
+    count : number of samples; overrides ``spacing_mm`` when given (>= 6)
+    smoothing_mm : allowed RMS deviation of the smoothing spline from the input; 0 interpolates
+    end_straight_mm : length at each end replaced by a straight extension along the end tangent
+    """
+
+    spacing_mm: float = 0.5
+    count: int | None = None
+    smoothing_mm: float = 0.1
+    end_straight_mm: float = 0.0
+
+
+@dataclass(frozen=True)
+class CurveReport:
+    """Per-path figures for the manifest: mm, 1/mm; ``*_l`` is where the maximum is."""
+
+    length_mm: float
+    sample_count: int
+    spacing_mm: float
+    max_curvature_per_mm: float
+    max_curvature_l: float
+    max_abs_torsion_per_mm: float
+    max_abs_torsion_l: float
+
+
+@dataclass(frozen=True)
+class SmoothCurve:
+    """A quintic spline c(l), l in [0, 1], interpolating samples at equal arc length.
+
+    Attributes
+    ----------
+    spline : scipy BSpline in l, values (3,) mm
+    length : arc length of the spline, mm
+    l_grid : (m,) uniform sample parameters, l_grid[0] = 0, l_grid[-1] = 1
+    """
+
+    spline: BSpline
+    length: float
+    l_grid: FloatArray
+
+    def points(self, l: npt.ArrayLike) -> Points:
+        """Positions c(l), (n, 3) mm, for l (n,) in [0, 1]."""
+        return self.spline(checked_l(l))
+
+    def derivative(self, l: npt.ArrayLike, order: int = 1) -> Points:
+        """d^k c / dl^k (n, 3), mm, with respect to normalized l."""
+        return self.spline(checked_l(l), nu=order)
+
+    def speed(self, l: npt.ArrayLike) -> FloatArray:
+        """|dc/dl| (n,), mm: the local arc length per unit l (= length if l is exact arc length)."""
+        return np.linalg.norm(self.derivative(l), axis=1)
+
+    def tangents(self, l: npt.ArrayLike) -> Points:
+        """Unit tangents T = c' / |c'|, (n, 3)."""
+        d1 = self.derivative(l)
+        return d1 / np.linalg.norm(d1, axis=1, keepdims=True)
+
+    def curvature(self, l: npt.ArrayLike) -> FloatArray:
+        """kappa = |c' x c''| / |c'|^3, (n,) 1/mm."""
+        d1, d2 = self.derivative(l, 1), self.derivative(l, 2)
+        return np.linalg.norm(np.cross(d1, d2), axis=1) / np.linalg.norm(d1, axis=1) ** 3
+
+    def curvature_vectors(self, l: npt.ArrayLike) -> Points:
+        """dT/ds = kappa * N_frenet, (n, 3) 1/mm (defined on straight runs too, where it is 0)."""
+        d1, d2 = self.derivative(l, 1), self.derivative(l, 2)
+        speed2 = np.einsum("ij,ij->i", d1, d1)
+        normal_part = d2 - (np.einsum("ij,ij->i", d2, d1) / speed2)[:, None] * d1
+        return normal_part / speed2[:, None]
+
+    def torsion(self, l: npt.ArrayLike) -> FloatArray:
+        """tau = (c' x c'') . c''' / |c' x c''|^2, (n,) 1/mm; NaN where kappa < FRENET_KAPPA_TOL.
+
+        Torsion is the turning rate of the Frenet binormal; where the curve is
+        straight there is no binormal and no torsion, so NaN says so.
+        """
+        d1, d2, d3 = (self.derivative(l, k) for k in (1, 2, 3))
+        cross = np.cross(d1, d2)
+        norm2 = np.einsum("ij,ij->i", cross, cross)
+        kappa = np.sqrt(norm2) / np.linalg.norm(d1, axis=1) ** 3
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tau = np.einsum("ij,ij->i", cross, d3) / norm2
+        return np.where(kappa >= FRENET_KAPPA_TOL, tau, np.nan)
+
+    def arc_length(self, l: npt.ArrayLike) -> FloatArray:
+        """Arc length from l = 0 to each l (n,), mm (Gauss-Legendre on the sample intervals)."""
+        l = checked_l(l)
+        table = _arc_length_table(self.spline, self.l_grid)
+        k = np.clip(np.searchsorted(self.l_grid, l, side="right") - 1, 0, len(self.l_grid) - 2)
+        return table[k] + _speed_integral(self.spline, self.l_grid[k], l)
+
+    def dense_l(self) -> FloatArray:
+        """Uniform evaluation grid containing ``l_grid``: DENSE_PER_INTERVAL per interval, steps <= DENSE_STEP_MM."""
+        intervals = len(self.l_grid) - 1
+        step = self.length / intervals
+        factor = max(DENSE_PER_INTERVAL, int(np.ceil(step / DENSE_STEP_MM)))
+        return np.linspace(0.0, 1.0, intervals * factor + 1)
+
+    def report(self) -> CurveReport:
+        """Length, sample count and spacing, max curvature and max |torsion| (on the dense grid)."""
+        l = self.dense_l()
+        kappa = self.curvature(l)
+        tau = np.abs(self.torsion(l))
+        ik = int(np.argmax(kappa))
+        it = int(np.nanargmax(tau)) if np.any(np.isfinite(tau)) else 0
+        return CurveReport(
+            length_mm=float(self.length),
+            sample_count=len(self.l_grid),
+            spacing_mm=float(self.length / (len(self.l_grid) - 1)),
+            max_curvature_per_mm=float(kappa[ik]),
+            max_curvature_l=float(l[ik]),
+            max_abs_torsion_per_mm=float(tau[it]) if np.isfinite(tau[it]) else 0.0,
+            max_abs_torsion_l=float(l[it]),
+        )
+
+
+def checked_l(l: npt.ArrayLike) -> FloatArray:
+    """l as a float array (n,) in [0, 1] (rounding just outside is clipped).
+
+    Raises
+    ------
+    ConfigError
+        A value outside [0, 1] or not finite.
+    """
+    l = np.atleast_1d(np.asarray(l, float))
+    if l.ndim != 1 or not np.all(np.isfinite(l)) or l.min() < -ARC_REL_TOL or l.max() > 1.0 + ARC_REL_TOL:
+        raise ConfigError(
+            f"l (normalized arc length) must be finite values in [0, 1], got shape {l.shape}, "
+            f"range [{np.nanmin(l) if l.size else np.nan:.6g}, {np.nanmax(l) if l.size else np.nan:.6g}]"
+        )
+    return np.clip(l, 0.0, 1.0)
+
+
+def smooth_curve_from_samples(samples: npt.ArrayLike) -> SmoothCurve:
+    """Quintic interpolating spline through samples taken at equal arc length.
+
+    Parameters
+    ----------
+    samples : (m, 3) float, mm, m >= 6, at l = linspace(0, 1, m)
+
+    Every call with the same m gives the same knot vector, so spline
+    coefficients of such curves blend exactly.
+    """
+    samples = np.asarray(samples, float)
+    if samples.ndim != 2 or samples.shape[1] != 3 or len(samples) < DEGREE + 1:
+        raise GeometryError(
+            f"curve samples: expected an (m, 3) array with m >= {DEGREE + 1}, got shape {samples.shape}; "
+            "resample with more points (resample.count or a smaller resample.spacing_mm)"
+        )
+    l_grid = np.linspace(0.0, 1.0, len(samples))
+    spline = make_interp_spline(l_grid, samples, k=DEGREE)
+    length = float(_arc_length_table(spline, l_grid)[-1])
+    return SmoothCurve(spline, length, l_grid)
+
+
+def smooth_curve_from_polyline(points: npt.ArrayLike, options: CurveOptions = CurveOptions()) -> SmoothCurve:
+    """Smooth, end-trim and resample a polyline by arc length (see the module docstring).
+
+    Parameters
+    ----------
+    points : (n, 3) float, mm, proximal first; consecutive duplicates are skipped
+    options : spacing or count, smoothing and end handling, mm
+
+    Raises
+    ------
+    GeometryError
+        Fewer than 4 distinct points, non-finite points, or the spline fit failed.
+    ConfigError
+        Bad options (negative sizes, count < 6, ends longer than half the path).
+    """
+    _check_options(options)
+    points = _distinct_points(points)
+    spline, u = _chord_spline(points, options.smoothing_mm)
+    table = _arc_length_table(spline, u)
+    total = float(table[-1])
+    end = options.end_straight_mm
+    if 2.0 * end >= total:
+        raise ConfigError(
+            f"resample.end_straight_mm = {end:g} mm must be less than half the path length "
+            f"({total:.4g} mm); lower it"
+        )
+    count = options.count if options.count is not None else int(np.ceil(total / options.spacing_mm - 1e-9)) + 1
+    count = max(count, DEGREE + 1)
+    s_target = np.linspace(0.0, total, count)
+    samples = _points_at_arc_length(spline, u, table, s_target, end)
+    return smooth_curve_from_samples(samples)
+
+
+def measure_deviation(curve: SmoothCurve, points: npt.ArrayLike) -> FloatArray:
+    """Distance from each point to the curve (its foot point, Newton-refined), (n,) mm."""
+    points = np.asarray(points, float)
+    l_dense = curve.dense_l()
+    dense = curve.points(l_dense)
+    nearest = np.argmin(((points[:, None, :] - dense[None, ::4, :]) ** 2).sum(-1), axis=1) * 4
+    l = np.minimum(l_dense[nearest], 1.0)
+    for _ in range(NEWTON_STEPS):
+        d = points - curve.points(l)
+        d1, d2 = curve.derivative(l, 1), curve.derivative(l, 2)
+        g = np.einsum("ij,ij->i", d, d1)
+        h = np.einsum("ij,ij->i", d1, d1) - np.einsum("ij,ij->i", d, d2)
+        l = np.clip(l + g / h, 0.0, 1.0)
+    return np.linalg.norm(points - curve.points(l), axis=1)
+
+
+def _check_options(options: CurveOptions) -> None:
+    if not options.spacing_mm > 0.0:
+        raise ConfigError(f"resample.spacing_mm must be > 0 mm, got {options.spacing_mm}")
+    if options.count is not None and options.count < DEGREE + 1:
+        raise ConfigError(f"resample.count must be >= {DEGREE + 1} (a quintic spline), got {options.count}")
+    for key in ("smoothing_mm", "end_straight_mm"):
+        if not getattr(options, key) >= 0.0:
+            raise ConfigError(f"resample.{key} must be >= 0 mm, got {getattr(options, key)}")
+
+
+def _distinct_points(points: npt.ArrayLike) -> Points:
+    points = np.asarray(points, float)
+    if points.ndim != 2 or points.shape[1] != 3 or not np.all(np.isfinite(points)):
+        raise GeometryError(f"centerline: expected finite (n, 3) points in mm, got shape {points.shape}")
+    step = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    kept = points[np.concatenate([[True], step > POINT_TOL_MM])]
+    if len(kept) < MIN_POLYLINE_POINTS:
+        raise GeometryError(
+            f"centerline: expected at least {MIN_POLYLINE_POINTS} distinct points, got {len(kept)}; "
+            "the path is too short to carry curvature and torsion - pick another path or re-export it"
+        )
+    return kept
+
+
+def _chord_spline(points: Points, smoothing_mm: float) -> tuple[BSpline, FloatArray]:
+    """Spline on the chord-length parameter u (mm) and the parameters of the input points."""
+    u = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    k = DEGREE if len(points) > DEGREE else 3
+    if smoothing_mm == 0.0:
+        return make_interp_spline(u, points, k=k), u
+    s = len(points) * smoothing_mm**2
+    ((t, c, k), _), fp, ier, msg = splprep(points.T, u=u, k=k, s=s, full_output=True, quiet=True)
+    # FITPACK: ier <= 0 success, 1..3 warnings (then check the residual it reached), >= 10 bad input.
+    if ier >= 10 or (ier > 0 and fp > SMOOTHING_SLACK * s):
+        raise GeometryError(
+            f"centerline: the smoothing spline failed (FITPACK ier = {ier}: {msg}); "
+            "raise resample.smoothing_mm or check the centerline for loops"
+        )
+    return BSpline(np.asarray(t), np.asarray(c).T, k), u
+
+
+def _speed_integral(spline: BSpline, a: FloatArray, b: FloatArray) -> FloatArray:
+    """Integral of |spline'| from a to b (element-wise), Gauss-Legendre."""
+    x, w = np.polynomial.legendre.leggauss(GAUSS_NODES)
+    half = 0.5 * (np.asarray(b) - np.asarray(a))
+    nodes = 0.5 * (np.asarray(a) + np.asarray(b))[..., None] + half[..., None] * x
+    speed = np.linalg.norm(spline(nodes.ravel(), nu=1), axis=1).reshape(nodes.shape)
+    return half * (speed @ w)
+
+
+def _arc_length_table(spline: BSpline, u: FloatArray) -> FloatArray:
+    """Cumulative arc length at the parameters u (m,), mm."""
+    return np.concatenate([[0.0], np.cumsum(_speed_integral(spline, u[:-1], u[1:]))])
+
+
+def _u_at_arc_length(spline: BSpline, u: FloatArray, table: FloatArray, s: FloatArray) -> FloatArray:
+    """Parameters where the arc length equals s (Newton from linear interpolation of the table)."""
+    k = np.clip(np.searchsorted(table, s, side="right") - 1, 0, len(u) - 2)
+    frac = (s - table[k]) / (table[k + 1] - table[k])
+    ut = u[k] + frac * (u[k + 1] - u[k])
+    for _ in range(NEWTON_STEPS):
+        err = table[k] + _speed_integral(spline, u[k], ut) - s
+        if np.max(np.abs(err)) <= ARC_REL_TOL * table[-1]:
+            break
+        ut = np.clip(ut - err / np.linalg.norm(spline(ut, nu=1), axis=1), u[0], u[-1])
+    return ut
+
+
+def _points_at_arc_length(
+    spline: BSpline, u: FloatArray, table: FloatArray, s: FloatArray, end_mm: float
+) -> Points:
+    """Points at arc lengths s; within end_mm of either end, a straight extension of the tangent there."""
+    total = table[-1]
+    inner = np.clip(s, end_mm, total - end_mm)
+    ut = _u_at_arc_length(spline, u, table, inner)
+    out = spline(ut)
+    if end_mm > 0.0:
+        tangent = spline(ut, nu=1)
+        tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
+        out = out + (s - inner)[:, None] * tangent
+    return out
