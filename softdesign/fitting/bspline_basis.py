@@ -1,0 +1,200 @@
+"""One-dimensional cubic B-spline bases: knot vectors, basis values, Gram matrices, knot insertion.
+
+Two kinds of knot vector are used by the surface fit:
+
+* along the centerline (normalized l in [0, 1]): an *open* (clamped) vector
+  with ``DEGREE + 1`` copies of 0 and 1, every link break as a simple knot
+  and equal intervals inside each link;
+* around it (angle a in [0, 2 pi)): a *periodic* uniform vector with
+  ``M`` intervals, written out with ``DEGREE`` extra knots on each side so
+  that the open-vector algorithms apply; basis index ``i`` is taken mod ``M``.
+
+Only the ``DEGREE + 1`` basis functions that are nonzero at a point are ever
+evaluated, so every matrix built from them is sparse.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+import scipy.sparse as sp
+
+from softdesign.types import FloatArray, IntArray
+
+#: Cubic in both directions (C2 across simple knots).
+DEGREE = 3
+#: Gauss-Legendre nodes per knot interval: exact for the degree-6 products in a Gram matrix.
+_GAUSS_NODES, _GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(4)
+
+
+def open_knots(breaks: npt.ArrayLike, intervals: npt.ArrayLike) -> FloatArray:
+    """Clamped knot vector on [0, 1] with each break a knot and equal intervals between breaks.
+
+    Parameters
+    ----------
+    breaks : (J + 1,) float, strictly increasing from 0 to 1 (normalized l)
+    intervals : (J,) int >= 1, knot intervals inside each [breaks[j], breaks[j + 1]]
+
+    Returns
+    -------
+    (n + DEGREE + 1,) float, n = sum(intervals) + DEGREE basis functions
+    """
+    breaks = np.asarray(breaks, float)
+    counts = np.asarray(intervals, int)
+    pieces = [np.linspace(b0, b1, c + 1)[:-1] for b0, b1, c in zip(breaks[:-1], breaks[1:], counts)]
+    inner = np.concatenate(pieces)[1:]
+    return np.concatenate([np.zeros(DEGREE + 1), inner, np.ones(DEGREE + 1)])
+
+
+def periodic_knots(intervals: int) -> FloatArray:
+    """Uniform knots ``(j - DEGREE) 2 pi / M``, j = 0 .. M + 2 DEGREE, for a periodic basis (rad)."""
+    step = 2.0 * np.pi / intervals
+    return (np.arange(intervals + 2 * DEGREE + 1) - DEGREE) * step
+
+
+def open_spans(knots: FloatArray, x: FloatArray) -> IntArray:
+    """Knot span index ``s`` with ``knots[s] <= x < knots[s + 1]`` (x = 1 in the last span)."""
+    last = len(knots) - DEGREE - 2
+    return np.clip(np.searchsorted(knots, x, side="right") - 1, DEGREE, last).astype(np.int64)
+
+
+def periodic_spans(intervals: int, angle: FloatArray) -> tuple[IntArray, FloatArray]:
+    """Span index in :func:`periodic_knots` and the angle wrapped into [0, 2 pi)."""
+    wrapped = np.mod(angle, 2.0 * np.pi)
+    span = np.floor(wrapped * intervals / (2.0 * np.pi)).astype(np.int64)
+    return np.clip(span, 0, intervals - 1) + DEGREE, wrapped
+
+
+def nonzero_basis(knots: FloatArray, x: FloatArray, span: IntArray, deriv: int = 0) -> FloatArray:
+    """Derivative ``deriv`` of the DEGREE + 1 basis functions nonzero in ``span``.
+
+    Parameters
+    ----------
+    knots : (m,) float, nondecreasing
+    x : (n,) float, parameter values inside their spans
+    span : (n,) int, from :func:`open_spans` or :func:`periodic_spans`
+    deriv : order of the derivative with respect to x
+
+    Returns
+    -------
+    (n, DEGREE + 1) float; column r belongs to basis function ``span - DEGREE + r``.
+    """
+    if deriv > DEGREE:
+        return np.zeros((len(x), DEGREE + 1))
+    values = _basis_values(knots, x, span, DEGREE - deriv)
+    for degree in range(DEGREE - deriv, DEGREE):
+        values = _raise_derivative(knots, values, span, degree)
+    return values
+
+
+def _basis_values(knots: FloatArray, x: FloatArray, span: IntArray, degree: int) -> FloatArray:
+    """Cox-de Boor triangle: the degree + 1 nonzero functions of ``degree`` at ``span``."""
+    values = np.ones((len(x), 1))
+    for j in range(1, degree + 1):
+        offsets = np.arange(1, j + 1)
+        left = x[:, None] - knots[span[:, None] + 1 - offsets]
+        right = knots[span[:, None] + offsets] - x[:, None]
+        new = np.zeros((len(x), j + 1))
+        for r in range(j):
+            denom = right[:, r] + left[:, j - r - 1]
+            temp = np.divide(values[:, r], denom, out=np.zeros_like(denom), where=denom > 0)
+            new[:, r] += right[:, r] * temp
+            new[:, r + 1] = left[:, j - r - 1] * temp
+        values = new
+    return values
+
+
+def _raise_derivative(knots: FloatArray, lower: FloatArray, span: IntArray, degree: int) -> FloatArray:
+    """From the k-th derivative of the degree-``degree`` functions to the (k+1)-th of degree + 1.
+
+    Uses ``B'_{i,p+1} = (p+1) (B_{i,p} / (t_{i+p+1} - t_i) - B_{i+1,p} / (t_{i+p+2} - t_{i+1}))``.
+    """
+    n, p = len(span), degree
+    out = np.zeros((n, p + 2))
+    for r in range(p + 2):
+        i = span - p - 1 + r
+        if r >= 1:
+            d1 = knots[i + p + 1] - knots[i]
+            out[:, r] += np.divide(lower[:, r - 1], d1, out=np.zeros(n), where=d1 > 0)
+        if r <= p:
+            d2 = knots[i + p + 2] - knots[i + 1]
+            out[:, r] -= np.divide(lower[:, r], d2, out=np.zeros(n), where=d2 > 0)
+    return (p + 1) * out
+
+
+def open_local(knots: FloatArray, x: npt.ArrayLike, deriv: int = 0) -> tuple[IntArray, FloatArray]:
+    """Indices (n, DEGREE + 1) and derivative values (n, DEGREE + 1) of the open basis nonzero at x."""
+    x = np.asarray(x, float).reshape(-1)
+    span = open_spans(knots, x)
+    return span[:, None] - DEGREE + np.arange(DEGREE + 1), nonzero_basis(knots, x, span, deriv)
+
+
+def periodic_local(intervals: int, angle: npt.ArrayLike, deriv: int = 0) -> tuple[IntArray, FloatArray]:
+    """Indices (n, DEGREE + 1), mod M, and derivative values of the periodic basis nonzero at the angles."""
+    angle = np.asarray(angle, float).reshape(-1)
+    span, wrapped = periodic_spans(intervals, angle)
+    values = nonzero_basis(periodic_knots(intervals), wrapped, span, deriv)
+    # M >= 4 keeps the DEGREE + 1 indices of a row distinct.
+    return np.mod(span[:, None] - DEGREE + np.arange(DEGREE + 1), intervals), values
+
+
+def open_basis_matrix(knots: FloatArray, x: npt.ArrayLike, deriv: int = 0) -> sp.csr_matrix:
+    """Sparse (n, n_basis) matrix of open-basis derivatives at x (normalized l)."""
+    cols, values = open_local(knots, x, deriv)
+    return _local_to_csr(cols, values, len(knots) - DEGREE - 1)
+
+
+def periodic_basis_matrix(intervals: int, angle: npt.ArrayLike, deriv: int = 0) -> sp.csr_matrix:
+    """Sparse (n, M) matrix of periodic-basis derivatives at the angles (rad)."""
+    cols, values = periodic_local(intervals, angle, deriv)
+    return _local_to_csr(cols, values, intervals)
+
+
+def _local_to_csr(cols: IntArray, values: FloatArray, n_basis: int) -> sp.csr_matrix:
+    rows = np.repeat(np.arange(len(cols)), cols.shape[1])
+    return sp.csr_matrix((values.ravel(), (rows, cols.ravel())), shape=(len(cols), n_basis))
+
+
+def gram_matrix(basis_at, breakpoints: FloatArray, deriv: int) -> sp.csr_matrix:
+    """``G[i, j] = integral of B_i^(deriv) B_j^(deriv)`` over the breakpoints' range.
+
+    Parameters
+    ----------
+    basis_at : callable (x, deriv) -> sparse (n, n_basis) basis matrix
+    breakpoints : (m,) float, the distinct knots bounding the polynomial pieces
+    deriv : derivative order
+
+    Returns
+    -------
+    (n_basis, n_basis) sparse symmetric matrix; exact (4-point Gauss per piece).
+    """
+    lo, hi = breakpoints[:-1], breakpoints[1:]
+    half = 0.5 * (hi - lo)
+    nodes = (0.5 * (hi + lo))[:, None] + half[:, None] * _GAUSS_NODES[None, :]
+    weights = (half[:, None] * _GAUSS_WEIGHTS[None, :]).ravel()
+    values = basis_at(nodes.ravel(), deriv)
+    return (values.T @ sp.diags(weights) @ values).tocsr()
+
+
+def insert_knot(knots: FloatArray, coefficients: FloatArray, x: float) -> tuple[FloatArray, FloatArray]:
+    """Insert ``x`` once into an open knot vector (Boehm); the spline is unchanged.
+
+    Parameters
+    ----------
+    knots : (m,) float
+    coefficients : (m - DEGREE - 1, ...) float; trailing axes are carried along
+    x : the new knot, inside the domain; its multiplicity must stay <= DEGREE + 1
+
+    Returns
+    -------
+    new knots (m + 1,), new coefficients (m - DEGREE, ...); inputs untouched.
+    """
+    span = int(np.searchsorted(knots, x, side="right") - 1)
+    span = min(span, len(knots) - DEGREE - 2)
+    out = np.empty((len(coefficients) + 1,) + coefficients.shape[1:])
+    out[: span - DEGREE + 1] = coefficients[: span - DEGREE + 1]
+    out[span + 1 :] = coefficients[span:]
+    for i in range(span - DEGREE + 1, span + 1):
+        alpha = (x - knots[i]) / (knots[i + DEGREE] - knots[i])
+        out[i] = alpha * coefficients[i] + (1.0 - alpha) * coefficients[i - 1]
+    return np.insert(knots, span + 1, x), out
