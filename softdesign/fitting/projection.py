@@ -1,0 +1,153 @@
+"""Surface points in the centerline's frames: p -> (l, a, rho).
+
+The foot point of ``p`` is the point ``c(l)`` of the smooth centerline where
+``(p - c(l)) . T(l) = 0`` and ``|p - c(l)|`` is least.  It is seeded by the
+nearest of a dense set of curve samples (a KD-tree query) and refined on the
+curve itself by a safeguarded Newton iteration inside the bracket of the
+neighbouring samples, for all points at once.  Then, with the frame columns
+(N, B, T) at l::
+
+    a   = atan2((p - c) . B, (p - c) . N)      in (-pi, pi]
+    rho = |p - c|                              mm
+
+A foot point that falls outside [0, 1] is clamped to the end, and the point
+is flagged as lying before the start (-1) or beyond the end (+1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+from scipy.spatial import cKDTree
+
+from softdesign.errors import InputDataError
+from softdesign.types import FloatArray, FramedCurve, Points
+
+#: Spacing of the curve samples that seed the Newton iteration, mm.
+SEED_SPACING_MM = 0.5
+#: Newton stops when every step is below this, mm of arc length.
+NEWTON_TOL_MM = 1e-10
+#: Safeguarded Newton converges in 4-6 steps from a bracket one sample wide; this is a hard stop.
+NEWTON_MAX_STEPS = 60
+
+
+@dataclass(frozen=True)
+class PolarPoints:
+    """Points with their coordinates in the centerline's frames.
+
+    Attributes
+    ----------
+    points : (n, 3) float, mm, the input points
+    l : (n,) float, normalized arc length of the foot point, in [0, 1]
+    angle : (n,) float, rad, in (-pi, pi], measured from N towards B
+    rho : (n,) float, mm, distance from the foot point
+    end_side : (n,) int8, -1 foot clamped at l = 0, +1 clamped at l = 1, 0 inside
+    """
+
+    points: Points
+    l: FloatArray
+    angle: FloatArray
+    rho: FloatArray
+    end_side: npt.NDArray[np.int8]
+
+    def __len__(self) -> int:
+        return len(self.l)
+
+    def subset(self, mask: npt.ArrayLike) -> "PolarPoints":
+        """The points selected by a boolean mask or an index array (copies)."""
+        mask = np.asarray(mask)
+        return PolarPoints(
+            self.points[mask].copy(), self.l[mask].copy(), self.angle[mask].copy(),
+            self.rho[mask].copy(), self.end_side[mask].copy(),
+        )
+
+
+def project_points(curve: FramedCurve, points: npt.ArrayLike) -> PolarPoints:
+    """Foot point, angle and distance of every point on a framed centerline.
+
+    Parameters
+    ----------
+    curve : the smooth centerline (normalized l, frames with columns N, B, T)
+    points : (n, 3) float, mm
+
+    Returns
+    -------
+    PolarPoints with the foot point refined on the curve to ``NEWTON_TOL_MM``.
+
+    Raises
+    ------
+    InputDataError
+        ``points`` is not an (n, 3) array of finite numbers.
+    """
+    points = np.asarray(points, float)
+    if points.ndim != 2 or points.shape[1] != 3 or not np.all(np.isfinite(points)):
+        raise InputDataError(
+            f"surface points: expected an (n, 3) array of finite mm coordinates, got shape {points.shape}; "
+            "check the surface file"
+        )
+    l = foot_parameters(curve, points)
+    origin, frames = curve.points(l), curve.frames(l)
+    offset = points - origin
+    local = np.einsum("nij,ni->nj", frames, offset)
+    tangent_part = curve.derivative(np.array([0.0, 1.0]))
+    side = np.zeros(len(points), np.int8)
+    side[(l <= 0.0) & (offset @ tangent_part[0] < 0.0)] = -1
+    side[(l >= 1.0) & (offset @ tangent_part[1] > 0.0)] = 1
+    return PolarPoints(points.copy(), l, np.arctan2(local[:, 1], local[:, 0]), np.linalg.norm(offset, axis=1), side)
+
+
+def foot_parameters(curve: FramedCurve, points: Points) -> FloatArray:
+    """Normalized l of the nearest foot point of each point, clamped to [0, 1].
+
+    Minimizes ``g(l) = |p - c(l)|^2 / 2``: ``g' = -(p - c) . c'`` and
+    ``g'' = |c'|^2 - (p - c) . c''``, by Newton steps kept inside the bracket
+    of the samples next to the nearest sample (bisection when a step leaves it).
+    """
+    count = max(int(np.ceil(curve.length / SEED_SPACING_MM)), 8) + 1
+    grid = np.linspace(0.0, 1.0, count)
+    nearest = cKDTree(curve.points(grid)).query(points)[1]
+    lo = grid[np.maximum(nearest - 1, 0)]
+    hi = grid[np.minimum(nearest + 1, count - 1)]
+    slope_lo, slope_hi = _slope(curve, points, lo), _slope(curve, points, hi)
+    x = grid[nearest].copy()
+    at_lo, at_hi = slope_lo >= 0.0, slope_hi <= 0.0
+    active = ~(at_lo | at_hi)
+    tol = NEWTON_TOL_MM / curve.length
+    for _ in range(NEWTON_MAX_STEPS):
+        if not active.any():
+            break
+        idx = np.flatnonzero(active)
+        x_new, lo_new, hi_new = _safeguarded_step(curve, points[idx], x[idx], lo[idx], hi[idx])
+        done = np.abs(x_new - x[idx]) <= tol
+        x[idx], lo[idx], hi[idx] = x_new, lo_new, hi_new
+        active[idx[done]] = False
+    # A slope that already points away from the bracket means the minimum is at its edge
+    # (only the curve's ends, for a dense enough sampling).
+    x[at_lo] = lo[at_lo]
+    x[at_hi & ~at_lo] = hi[at_hi & ~at_lo]
+    return np.clip(x, 0.0, 1.0)
+
+
+def _slope(curve: FramedCurve, points: Points, l: FloatArray) -> FloatArray:
+    """``g'(l) = -(p - c(l)) . c'(l)``, mm^2."""
+    return -np.einsum("ni,ni->n", points - curve.points(l), curve.derivative(l, 1))
+
+
+def _safeguarded_step(
+    curve: FramedCurve, points: Points, x: FloatArray, lo: FloatArray, hi: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """One Newton step on g'(l) = 0 with bisection fallback; returns x, and the shrunk bracket."""
+    offset = points - curve.points(x)
+    d1, d2 = curve.derivative(x, 1), curve.derivative(x, 2)
+    slope = -np.einsum("ni,ni->n", offset, d1)
+    curvature = np.einsum("ni,ni->n", d1, d1) - np.einsum("ni,ni->n", offset, d2)
+    lo = np.where(slope < 0.0, x, lo)
+    hi = np.where(slope > 0.0, x, hi)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        newton = x - slope / curvature
+    ok = (curvature > 0.0) & (newton > lo) & (newton < hi)
+    x_new = np.where(ok, newton, 0.5 * (lo + hi))
+    x_new = np.where(slope == 0.0, x, x_new)
+    return x_new, lo, hi
