@@ -77,29 +77,34 @@ class Expectation:
     volume_rtol: float = VOLUME_RTOL
 
 
-def _edges(faces: IntArray, n_vertices: int) -> tuple[IntArray, bool, bool, int]:
-    """Directed half-edge keys, watertight, winding consistent and the number of undirected edges."""
+def _edges(faces: IntArray, n_vertices: int) -> tuple[IntArray, IntArray, bool, bool, int]:
+    """Half-edges sorted by key (their order and keys), watertight, winding consistent, undirected edge count.
+
+    Half-edge j = 3f + p runs from faces[f, p] to faces[f, (p + 1) % 3]; its key is a * V + b.
+    """
     half = faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
-    undirected = np.sort(half, axis=1) @ np.array([n_vertices, 1])
-    _, counts = np.unique(undirected, return_counts=True)
-    directed = half @ np.array([n_vertices, 1])
+    undirected = np.sort(np.minimum(half[:, 0], half[:, 1]) * n_vertices + np.maximum(half[:, 0], half[:, 1]))
+    starts = np.flatnonzero(np.concatenate([[True], undirected[1:] != undirected[:-1]]))
+    counts = np.diff(np.append(starts, undirected.size))
+    directed = half[:, 0] * n_vertices + half[:, 1]
+    order = np.argsort(directed, kind="stable")
+    keys = directed[order]
     watertight = bool(np.all(counts == 2))
-    consistent = watertight and np.unique(directed).size == directed.size
-    return directed, watertight, consistent, counts.size
+    # two half-edges on each edge with distinct keys can only be a -> b and b -> a
+    consistent = watertight and bool(np.all(keys[1:] != keys[:-1]))
+    return order, keys, watertight, consistent, int(starts.size)
 
 
-def _vertex_manifold(faces: IntArray, directed: IntArray, n_vertices: int, used: int) -> bool:
+def _vertex_manifold(faces: IntArray, order: IntArray, keys: IntArray, n_vertices: int, used: int) -> bool:
     """True when the face corners around each vertex join into a single fan (needs consistent winding).
 
     Half-edge j = 3f + p runs a -> b; its twin b -> a is half-edge 3g + p'; the
     corners of a in f (3f + p) and in g (3g + (p' + 1) % 3) are neighbours in a's fan.
     """
     half = faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
-    twin_key = half[:, 1] * n_vertices + half[:, 0]
-    order = np.argsort(directed)
-    twin = order[np.searchsorted(directed, twin_key, sorter=order)]
+    twin = order[np.searchsorted(keys, half[:, 1] * n_vertices + half[:, 0])]
     neighbour = 3 * (twin // 3) + (twin % 3 + 1) % 3
-    n = directed.size
+    n = twin.size
     graph = coo_matrix((np.ones(n), (np.arange(n), neighbour)), shape=(n, n))
     fans = connected_components(graph, directed=False)[0]
     return fans == used
@@ -112,7 +117,7 @@ def _shells(vertices: FloatArray, faces: IntArray, used: IntArray) -> tuple[int,
     cols = faces[:, [1, 2, 0]].ravel()
     graph = coo_matrix((np.ones(rows.size), (rows, cols)), shape=(n, n))
     _, labels = connected_components(graph, directed=False)
-    relabel = np.unique(labels[used], return_inverse=True)[1]
+    relabel = np.unique(labels[used], return_inverse=True)[1]  # components numbered over used vertices
     shell_of_vertex = np.zeros(n, np.int64)
     shell_of_vertex[used] = relabel
     p = vertices - vertices[used].mean(axis=0)
@@ -143,9 +148,9 @@ def inspect_mesh(
     if faces.size and (faces.min() < 0 or faces.max() >= vertices.shape[0]):
         raise ValueError("faces refer to vertices that do not exist")
     n = vertices.shape[0]
-    used = np.unique(faces)
-    directed, watertight, consistent, n_edges = _edges(faces, n)
-    manifold = consistent and _vertex_manifold(faces, directed, n, used.size)
+    used = np.flatnonzero(np.bincount(faces.ravel(), minlength=n))
+    order, keys, watertight, consistent, n_edges = _edges(faces, n)
+    manifold = consistent and _vertex_manifold(faces, order, keys, n, used.size)
     cross = np.cross(vertices[faces[:, 1]] - vertices[faces[:, 0]], vertices[faces[:, 2]] - vertices[faces[:, 0]])
     double_area = np.linalg.norm(cross, axis=1)
     edge_sq = np.mean(np.sum(np.diff(vertices[faces[:, [0, 1, 2, 0]]], axis=1) ** 2, axis=-1)) if faces.size else 0.0
