@@ -126,7 +126,8 @@ class Body:
 
         def evaluate(l):
             s = np.asarray(l, float) * self.line.length
-            return Stations(self.rho(s, na), self.rho_s(s, na), self.line.curvature(s), np.full(s.size, self.line.length))
+            speed = np.full(s.size, self.line.length)
+            return Stations(self.rho(s, na), self.rho_s(s, na), self.line.curvature(s), speed)
 
         return evaluate
 
@@ -137,7 +138,8 @@ def test_frames_are_rotation_minimizing_and_curvature_matches():
     for line in (straight_line(10.0), circular_arc(15.0, 1.2), helix(6.0, 9.0, 1.5)):
         s = np.linspace(0.1, line.length - 0.1, 7)
         f = line.frames(s)
-        np.testing.assert_allclose(np.einsum("nji,njk->nik", f, f), np.broadcast_to(np.eye(3), f.shape), rtol=0, atol=FRAME_TOL)
+        identity = np.broadcast_to(np.eye(3), f.shape)
+        np.testing.assert_allclose(np.einsum("nji,njk->nik", f, f), identity, rtol=0, atol=FRAME_TOL)
         np.testing.assert_allclose(np.linalg.det(f), 1.0, rtol=0, atol=FRAME_TOL)
         tangent = (line.points(s + h) - line.points(s - h)) / (2 * h)
         np.testing.assert_allclose(tangent, f[:, :, 2], rtol=0, atol=1e-8)  # central difference, O(h^2)

@@ -78,7 +78,8 @@ def test_tube_form_and_section_form_agree_on_a_random_smooth_section():
     rng = np.random.default_rng(7)
     a = angle_grid(48)
     coeffs = rng.normal(scale=0.2, size=(5, 4, 2))
-    rho = 2.0 + sum(c[:, :1] * np.cos(m * a) + c[:, 1:] * np.sin(m * a) for m, c in enumerate(coeffs.transpose(1, 0, 2), 1))
+    modes = enumerate(coeffs.transpose(1, 0, 2), 1)
+    rho = 2.0 + sum(c[:, :1] * np.cos(m * a) + c[:, 1:] * np.sin(m * a) for m, c in modes)
     curvature, weights = rng.normal(scale=0.05, size=(5, 2)), rng.uniform(0.5, 1.0, 5)
     xy = section_curves(rho, np.zeros_like(rho), curvature, 0.0)
     tube, sweep = tube_volume(rho, curvature, weights), sweep_volume(xy, curvature, weights)
@@ -134,7 +135,8 @@ def test_offset_frustum_volume():
     r0, slope, length, d = 2.0, 0.05, 30.0, 0.4
     got = integrate_body(Body(straight_line(length), r0, slope).field(NA), [0, 1], BodySpec(offset_mm=d))
     g = d * np.hypot(1, slope)
-    volume = np.pi * length * ((r0 + g) ** 2 + (r0 + g) * (r0 + slope * length + g) + (r0 + slope * length + g) ** 2) / 3
+    a, b = r0 + g, r0 + slope * length + g
+    volume = np.pi * length * (a**2 + a * b + b**2) / 3
     np.testing.assert_allclose(got.volume, volume, rtol=0, atol=QUAD_RTOL * volume)
     assert got.area is None
 

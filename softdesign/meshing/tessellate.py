@@ -192,11 +192,12 @@ def _complete(sections: TubeSections) -> tuple[FloatArray, FloatArray, FloatArra
     s = arclength_from_centers(sections.centers) if sections.s is None else np.asarray(sections.s, float)
     if np.any(np.diff(s) <= 0) or np.any(np.diff(np.asarray(sections.l, float)) <= 0):
         raise ValueError("sections: l and s must be strictly increasing (a joint l value given twice?)")
-    rho = np.asarray(sections.rho, float)
-    rho_s = np.gradient(rho, s, axis=0, edge_order=2 if n > 2 else 1) if sections.rho_s is None else np.asarray(sections.rho_s, float)
-    curvature = (
-        curvature_from_frames(sections.frames, s) if sections.curvature is None else np.asarray(sections.curvature, float)
-    )
+    if sections.rho_s is None:
+        rho_s = np.gradient(np.asarray(sections.rho, float), s, axis=0, edge_order=2 if n > 2 else 1)
+    else:
+        rho_s = np.asarray(sections.rho_s, float)
+    given = sections.curvature
+    curvature = curvature_from_frames(sections.frames, s) if given is None else np.asarray(given, float)
     return s, rho_s, curvature
 
 
@@ -276,7 +277,10 @@ def sweep_from_sections(
     rho = np.asarray(sections.rho, float)
     if not np.all(np.isfinite(rho) & (rho > 0)):
         i = int(np.argwhere(~(np.isfinite(rho) & (rho > 0)))[0, 0])
-        raise MeshError(f"rho must be finite and > 0 mm at every ring; at {_where(sections.q, l[i])} it is {rho[i].min()}")
+        raise MeshError(
+            f"rho must be finite and > 0 mm on every ring; at {_where(sections.q, l[i])} its smallest value is "
+            f"{rho[i].min()}; check the surface fit of this link"
+        )
     _refuse_fold(sections.q, l, section_curves(rho, rho_s, curvature, 0.0), curvature, "")
     xy = section_curves(rho, rho_s, curvature, offset_mm)
     _refuse_bad_sections(sections.q, l, xy, rho, min_radius_mm if offset_mm < 0 else 0.0, field)

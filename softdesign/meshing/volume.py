@@ -278,7 +278,10 @@ def l_at_arclength(field: SectionField, breaks: npt.ArrayLike, s: float, order: 
     return l
 
 
-def _sweep_integral(field: SectionField, breaks: FloatArray, span: tuple[float, float], offset_mm: float, order: int) -> float:
+def _sweep_integral(
+    field: SectionField, breaks: FloatArray, span: tuple[float, float], offset_mm: float, order: int
+) -> float:
+    """Volume swept by the sections offset by ``offset_mm`` for l in ``span``, mm^3."""
     nodes, weights = gauss_legendre_nodes(_sub_breaks(breaks, *span), order)
     st = field(nodes)
     return sweep_volume(section_curves(st.rho, st.rho_s, st.curvature, offset_mm), st.curvature, weights * st.speed)
