@@ -1,0 +1,105 @@
+"""True point-to-surface distances against closed forms, summaries, hold-out and the ``auto`` spacing."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from softdesign.errors import ConfigError
+from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
+from softdesign.fitting.metrics import (
+    HoldoutSettings,
+    choose_knot_spacing,
+    closest_surface_points,
+    fold_labels,
+    holdout_rms,
+    measure_fit,
+    summarize_distances,
+)
+from softdesign.fitting.projection import project_points
+from tests.fit_analytic import Arc, Line, grid_parameters, tube_points
+
+#: Gauss-Newton stops at 1e-9 mm steps; the fitted shapes here are exact to ~1e-12 mm.
+DISTANCE_TOL_MM = 1e-8
+
+
+def _fitted(curve, rho_of, settings=FitSettings()):
+    rng = np.random.default_rng(4)
+    l, a = grid_parameters(50, 36, rng)
+    polar = project_points(curve, tube_points(curve, l, a, rho_of(l, a)))
+    return fit_radius_surface(polar, curve.length, settings)
+
+
+def _off_surface(curve, rho_of, offset, seed=9):
+    rng = np.random.default_rng(seed)
+    l, a = rng.uniform(0.1, 0.9, 400), rng.uniform(-np.pi, np.pi, 400)
+    return l, a, project_points(curve, tube_points(curve, l, a, rho_of(l, a) + offset(rng, 400)))
+
+
+@pytest.mark.parametrize("curve", [Line(30.0), Arc(25.0, 1.2)], ids=["cylinder", "torus"])
+def test_distance_to_a_round_tube_is_the_radial_offset(curve):
+    fit = _fitted(curve, lambda l, a: np.full_like(l, 3.0))
+    _, _, polar = _off_surface(curve, lambda l, a: np.full_like(l, 3.0), lambda rng, n: rng.uniform(-1, 1, n))
+    distance, _, _ = closest_surface_points(curve, fit.whole, polar)
+    np.testing.assert_allclose(distance, np.abs(polar.rho - 3.0), rtol=0, atol=DISTANCE_TOL_MM)
+
+
+def test_distance_to_a_cone_is_less_than_the_radial_residual():
+    # rho = r0 + k s along a line: the meridian is a straight line, distance |rho - r0 - k s| / sqrt(1 + k^2).
+    length, r0, k = 30.0, 2.0, 0.1
+    curve = Line(length)
+    fit = _fitted(curve, lambda l, a: r0 + k * length * l)
+    l, _, polar = _off_surface(curve, lambda l, a: r0 + k * length * l, lambda rng, n: rng.uniform(-0.5, 0.5, n))
+    exact = np.abs(polar.rho - r0 - k * length * polar.l) / np.sqrt(1.0 + k**2)
+    distance, l_closest, _ = closest_surface_points(curve, fit.whole, polar)
+    np.testing.assert_allclose(distance, exact, rtol=0, atol=DISTANCE_TOL_MM)
+    assert np.all(np.abs(l_closest - polar.l) > 0) and np.all(distance < np.abs(polar.rho - r0 - k * length * polar.l))
+
+
+def test_summary_of_known_distances():
+    metrics = summarize_distances(np.array([3.0, -4.0]))
+    assert metrics.rms_mm == pytest.approx(np.sqrt(12.5), abs=1e-15)
+    assert metrics.max_mm == 4.0 and metrics.count == 2
+    spread = summarize_distances(np.arange(101.0))
+    assert (spread.p95_mm, spread.p99_mm) == (95.0, 99.0)
+    assert set(spread.as_dict()) == {"rms_mm", "p95_mm", "p99_mm", "max_mm", "count"}
+
+
+def test_folds_are_balanced_and_reproducible_from_the_seed():
+    a = fold_labels(103, 5, np.random.default_rng(7))
+    b = fold_labels(103, 5, np.random.default_rng(7))
+    np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(np.bincount(a), [21, 21, 21, 20, 20])
+    assert not np.array_equal(a, fold_labels(103, 5, np.random.default_rng(8)))
+    with pytest.raises(ConfigError, match="holdout_folds must be an integer >= 2, got 1"):
+        HoldoutSettings(folds=1)
+
+
+def test_holdout_of_an_exact_shape_is_zero_and_of_noise_is_the_noise():
+    curve = Line(30.0)
+    rng = np.random.default_rng(12)
+    l, a = grid_parameters(60, 40, rng)
+    exact = project_points(curve, tube_points(curve, l, a, 3.0 + 0.5 * l))
+    assert holdout_rms(curve, exact, FitSettings(), np.random.default_rng(0)).rms_mm <= DISTANCE_TOL_MM
+    sigma = 0.05
+    noisy = project_points(curve, tube_points(curve, l, a, 3.0 + 0.5 * l + rng.normal(0, sigma, l.size)))
+    report = holdout_rms(curve, noisy, FitSettings(), np.random.default_rng(0))
+    trained = measure_fit(curve, fit_radius_surface(noisy, curve.length, FitSettings()).whole, noisy)
+    # Held-out error estimates the noise from above: 2400 points, ~520 coefficients -> ~1.1 sigma.
+    assert sigma <= report.rms_mm <= 1.3 * sigma
+    assert trained.rms_mm < report.rms_mm
+    assert report.fold_rms_mm.shape == (5,)
+
+
+def test_auto_spacing_rejects_knots_too_coarse_for_the_shape():
+    # An axial ripple of 8 mm wavelength: 8 mm knots cannot follow it, 1-2 mm knots can.
+    curve = Line(48.0)
+    rng = np.random.default_rng(21)
+    l, a = grid_parameters(96, 24, rng)
+    rho = 3.0 + 0.3 * np.sin(2 * np.pi * 48.0 * l / 8.0) + rng.normal(0, 0.02, l.size)
+    polar = project_points(curve, tube_points(curve, l, a, rho))
+    holdout = HoldoutSettings(candidates_mm=(1.0, 2.0, 8.0))
+    best, scores = choose_knot_spacing(curve, polar, FitSettings(), np.random.default_rng(0), holdout)
+    assert set(scores) == {1.0, 2.0, 8.0}
+    assert best in (1.0, 2.0)
+    assert scores[8.0] > 3 * scores[best]
