@@ -175,3 +175,17 @@ def test_angle_grid_starts_at_n():
     first = ring_points(sweep_from_sections(sections))[:, 0]
     np.testing.assert_allclose(first, sections.centers + [2.0, 0, 0], rtol=0, atol=0)
     np.testing.assert_allclose(angle_grid(4), [0, np.pi / 2, np.pi, 3 * np.pi / 2], rtol=0, atol=0)
+
+
+@pytest.mark.parametrize("offset", [0.0, 0.5])
+def test_largest_rho_kappa_of_a_torus_section(offset):
+    """The ring at a = 0 (along N, towards the axis) reaches (r + d) / R."""
+    sweep = sweep_from_sections(Body(circular_arc(20.0, 1.0), 4.0).sections(11, 16), offset)
+    np.testing.assert_allclose(sweep.max_rho_kappa, (4.0 + offset) / 20.0, rtol=0, atol=ROUNDOFF_MM)
+
+
+def test_frames_that_are_not_orthonormal_are_a_caller_bug():
+    sections = Body(straight_line(5.0), 1.0).sections(3, 8)
+    bent = TubeSections(sections.q, sections.l, sections.centers, 1.01 * sections.frames, sections.rho)
+    with pytest.raises(ValueError, match="orthonormal"):
+        sweep_from_sections(bent)

@@ -54,6 +54,8 @@ class Solid:
         Expected Euler characteristic (2 solid or ported, 4 sealed hollow).
     kind : str
         ``solid``, ``hollow`` or ``ported``.
+    max_rho_kappa : float
+        Largest rho * kappa of the outer surface (offset included); it folds at 1.
     """
 
     vertices: FloatArray
@@ -61,6 +63,7 @@ class Solid:
     regions: npt.NDArray[np.int8]
     euler: int
     kind: str
+    max_rho_kappa: float
 
     def expectation(self, volume: float | None) -> Expectation:
         """What :func:`~softdesign.meshing.checks.check_solid` must find for this solid."""
@@ -197,7 +200,7 @@ def build_solid(sections: TubeSections, spec: BodySpec = BodySpec()) -> Solid:
     body = tessellate(outer)
     body_manifold, body_id = manifold_from_mesh(body.vertices, body.faces, f"{label}: body")
     if spec.wall_mm == 0:
-        return Solid(body.vertices, body.faces, body.regions, 2, "solid")
+        return Solid(body.vertices, body.faces, body.regions, 2, "solid", outer.max_rho_kappa)
     chamber = _chamber(sections, outer, spec)
     cavity: TubeMesh = tessellate(chamber)
     cavity_manifold, cavity_id = manifold_from_mesh(cavity.vertices, cavity.faces, f"{label}: chamber")
@@ -212,4 +215,5 @@ def build_solid(sections: TubeSections, spec: BodySpec = BodySpec()) -> Solid:
         hollow = hollow - port
     result = checked(hollow, f"{label}: hollow body")
     vertices, faces, regions = _regions_after(result, sources)
-    return Solid(vertices, faces, regions, 2 if spec.port_mm > 0 else 4, "ported" if spec.port_mm > 0 else "hollow")
+    kind, euler = ("ported", 2) if spec.port_mm > 0 else ("hollow", 4)
+    return Solid(vertices, faces, regions, euler, kind, outer.max_rho_kappa)

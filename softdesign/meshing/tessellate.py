@@ -36,6 +36,8 @@ from softdesign.types import FloatArray, IntArray
 
 #: A surface folds where rho * kappa (the section's reach towards the centre of curvature) reaches this.
 FOLD_LIMIT = 1.0
+#: Largest |F^T F - I| accepted for a frame (columns N, B, T).
+FRAME_TOL = 1e-6
 #: A ring closer than this fraction of the local ring spacing to a trimmed end is dropped (no slivers).
 TRIM_GAP_FRACTION = 0.25
 
@@ -97,6 +99,8 @@ class Sweep:
     frames : (n, 3, 3) float, columns (N, B, T)
     xy : (n, na, 2) float, mm
         Section curves in frame coordinates (x along N, y along B).
+    max_rho_kappa : float
+        Largest reach towards the centre of curvature, max of (x k1 + y k2), of these sections.
     """
 
     q: float
@@ -105,6 +109,7 @@ class Sweep:
     centers: FloatArray
     frames: FloatArray
     xy: FloatArray
+    max_rho_kappa: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -189,6 +194,10 @@ def _complete(sections: TubeSections) -> tuple[FloatArray, FloatArray, FloatArra
         raise ValueError(f"sections: expected l (n,), centers (n, 3), frames (n, 3, 3) with n={n}")
     if n < 2 or na < 3:
         raise ValueError(f"sections: need >= 2 rings of >= 3 angles, got rho of shape {(n, na)}")
+    frames = np.asarray(sections.frames, float)
+    gram = np.einsum("nji,njk->nik", frames, frames) - np.eye(3)
+    if not (np.all(np.abs(gram) <= FRAME_TOL) and np.all(np.linalg.det(frames) > 0)):
+        raise ValueError("sections: frames must be orthonormal and right-handed (columns N, B, T)")
     s = arclength_from_centers(sections.centers) if sections.s is None else np.asarray(sections.s, float)
     if np.any(np.diff(s) <= 0) or np.any(np.diff(np.asarray(sections.l, float)) <= 0):
         raise ValueError("sections: l and s must be strictly increasing (a joint l value given twice?)")
@@ -201,8 +210,8 @@ def _complete(sections: TubeSections) -> tuple[FloatArray, FloatArray, FloatArra
     return s, rho_s, curvature
 
 
-def _refuse_fold(q: float, l: FloatArray, xy: FloatArray, curvature: FloatArray, field: str) -> None:
-    """Refuse sections reaching the centre of curvature (rho * kappa >= 1); ``field`` prefixes the message."""
+def _refuse_fold(q: float, l: FloatArray, xy: FloatArray, curvature: FloatArray, field: str) -> float:
+    """The largest rho * kappa of the sections; refused when >= FOLD_LIMIT; ``field`` prefixes the message."""
     reach = np.einsum("nkj,nj->nk", xy, curvature)
     i, k = np.unravel_index(np.argmax(reach), reach.shape)
     if reach[i, k] >= FOLD_LIMIT:
@@ -213,6 +222,7 @@ def _refuse_fold(q: float, l: FloatArray, xy: FloatArray, curvature: FloatArray,
             f"{np.linalg.norm(curvature[i]):.4f} 1/mm); smooth the centerline more (resample.smoothing_mm) "
             "or use a smaller offset"
         )
+    return float(reach[i, k])
 
 
 def _refuse_bad_sections(q: float, l: FloatArray, xy: FloatArray, rho: FloatArray, limit: float, field: str) -> None:
@@ -284,8 +294,9 @@ def sweep_from_sections(
     _refuse_fold(sections.q, l, section_curves(rho, rho_s, curvature, 0.0), curvature, "")
     xy = section_curves(rho, rho_s, curvature, offset_mm)
     _refuse_bad_sections(sections.q, l, xy, rho, min_radius_mm if offset_mm < 0 else 0.0, field)
-    _refuse_fold(sections.q, l, xy, curvature, f"{field}={offset_mm:g} mm: offset ")
-    sweep = Sweep(sections.q, l, s, np.asarray(sections.centers, float), np.asarray(sections.frames, float), xy)
+    reach = _refuse_fold(sections.q, l, xy, curvature, f"{field}={offset_mm:g} mm: offset ")
+    centers, frames = np.asarray(sections.centers, float), np.asarray(sections.frames, float)
+    sweep = Sweep(sections.q, l, s, centers, frames, xy, reach)
     _refuse_ring_crossing(sweep, field)
     return sweep
 
@@ -321,7 +332,7 @@ def trim_sweep(sweep: Sweep, s_start: float, s_end: float) -> Sweep:
         for j, values in enumerate((sweep.l, sweep.centers, sweep.frames, sweep.xy))
     ]
     s = np.concatenate([[s_start], sweep.s[keep], [s_end]])
-    return Sweep(sweep.q, parts[0], s, parts[1], parts[2], parts[3])
+    return Sweep(sweep.q, parts[0], s, parts[1], parts[2], parts[3], sweep.max_rho_kappa)
 
 
 def ring_points(sweep: Sweep) -> FloatArray:
