@@ -1,0 +1,182 @@
+"""The radius field rho(q, l, a) of the actuator, per link, and the self-folding check.
+
+``rho(q, l, a) = (1 - q) rho0(l, a) + q rhof(l, a)``: rhof is the fitted wall
+(q = 1), rho0 the insertion shape's radius (q = 0).  Both are splines on the
+*same* knots, so rho(q) is one spline whose coefficients blend linearly, and
+the C2 joints of the fit stay C2 at every q.  rho0 is, by default, the mean
+of rhof around each l (an axially symmetric body, exact in the spline space
+because every periodic basis function has the same integral), or a constant,
+or another fitted surface on the same knots.
+
+A tube ``c(l) + rho (cos a N + sin a B)`` folds through itself where
+``rho * kappa_n >= 1``, kappa_n = the curvature vector's component along the
+direction (cos a N + sin a B) (its inner side); :func:`check_self_folding`
+measures the largest value on a dense grid.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from softdesign.errors import FitError
+from softdesign.fitting.bspline_surface import RadiusSpline
+from softdesign.types import FloatArray, FramedCurve
+
+#: Grid spacing along the centerline for the folding check, mm.
+FOLD_SPACING_MM = 0.1
+#: Angles per angular knot interval for the folding check.
+FOLD_ANGLES_PER_INTERVAL = 8
+
+
+def axisymmetric(spline: RadiusSpline) -> RadiusSpline:
+    """The mean of rho over a at each l, as a spline on the same knots (exact)."""
+    mean = spline.coefficients.mean(axis=1, keepdims=True)
+    return RadiusSpline(spline.knots.copy(), np.repeat(mean, spline.angular_intervals, axis=1))
+
+
+def constant_like(spline: RadiusSpline, radius_mm: float) -> RadiusSpline:
+    """rho = radius_mm everywhere on the knots of ``spline`` (B-splines sum to one)."""
+    if not radius_mm > 0:
+        raise FitError(f"initial radius: initial.radius_mm must be > 0 mm, got {radius_mm}")
+    return RadiusSpline(spline.knots.copy(), np.full_like(spline.coefficients, float(radius_mm)))
+
+
+@dataclass(frozen=True)
+class FoldReport:
+    """Largest rho * kappa_n over the tube, where it occurs, and the smallest rho.
+
+    Attributes
+    ----------
+    max_rho_kappa : dimensionless; the tube folds where it reaches 1
+    l : normalized l of the maximum
+    arc_mm : the same place in mm of arc length
+    angle : rad, angle of the maximum (from N towards B)
+    min_rho_mm : smallest radius on the grid, mm
+    """
+
+    max_rho_kappa: float
+    l: float
+    arc_mm: float
+    angle: float
+    min_rho_mm: float
+
+
+@dataclass(frozen=True)
+class RadiusField:
+    """Per-link rho0 and rhof on shared knots, with ``breaks`` (J + 1,) in normalized l."""
+
+    breaks: FloatArray
+    final: tuple[RadiusSpline, ...]
+    initial: tuple[RadiusSpline, ...]
+
+    def __post_init__(self) -> None:
+        if not (len(self.final) == len(self.initial) == len(self.breaks) - 1):
+            raise FitError(
+                f"radius field: expected {len(self.breaks) - 1} links for breaks {list(self.breaks)}, "
+                f"got {len(self.final)} final and {len(self.initial)} initial splines"
+            )
+        for j, (f, i) in enumerate(zip(self.final, self.initial)):
+            if f.knots.shape != i.knots.shape or not np.array_equal(f.knots, i.knots) or (
+                f.coefficients.shape != i.coefficients.shape
+            ):
+                raise FitError(
+                    f"radius field: link {j}: the initial surface's knots differ from the final's; "
+                    "fit the initial surface with the same fit settings and link breaks"
+                )
+
+    @classmethod
+    def from_links(cls, breaks: npt.ArrayLike, final: tuple[RadiusSpline, ...], radius_mm: float | None = None):
+        """rho0 = the constant ``radius_mm``, or (None) the axially symmetric mean of each final link."""
+        initial = tuple(axisymmetric(s) if radius_mm is None else constant_like(s, radius_mm) for s in final)
+        return cls(np.array(breaks, float), tuple(final), initial)
+
+    def link_spline(self, link: int, q: float) -> RadiusSpline:
+        """rho(q) of one link as a spline: coefficients ``(1 - q) C0 + q Cf``."""
+        f, i = self.final[link], self.initial[link]
+        return RadiusSpline(f.knots.copy(), (1.0 - q) * i.coefficients + q * f.coefficients)
+
+    def link_of(self, l: npt.ArrayLike) -> np.ndarray:
+        """Index of the link containing each l (a joint belongs to the link after it; l = 1 to the last)."""
+        return np.clip(np.searchsorted(self.breaks, np.asarray(l, float), side="right") - 1, 0, len(self.final) - 1)
+
+    def evaluate_grid(self, q: float, l: npt.ArrayLike, a: npt.ArrayLike, dl: int = 0, da: int = 0) -> FloatArray:
+        """rho(q) (or its derivatives) on the grid l (p,) x a (m,), (p, m) mm; each l in its own link."""
+        l = np.asarray(l, float).reshape(-1)
+        out = np.empty((len(l), np.size(a)))
+        owner = self.link_of(l)
+        for j in np.unique(owner):
+            rows = owner == j
+            out[rows] = self.link_spline(int(j), q).evaluate_grid(l[rows], a, dl, da)
+        return out
+
+    def to_arrays(self) -> dict[str, FloatArray]:
+        """Plain arrays for ``np.savez``: ``breaks`` and ``link{j}_knots|final|initial``."""
+        out = {"breaks": np.array(self.breaks, float)}
+        for j, (f, i) in enumerate(zip(self.final, self.initial)):
+            out[f"link{j}_knots"] = f.knots.copy()
+            out[f"link{j}_final"] = f.coefficients.copy()
+            out[f"link{j}_initial"] = i.coefficients.copy()
+        return out
+
+    @classmethod
+    def from_arrays(cls, arrays) -> "RadiusField":
+        """The inverse of :meth:`to_arrays` (accepts the mapping ``np.load`` returns)."""
+        breaks = np.array(arrays["breaks"], float)
+        count = len(breaks) - 1
+        final = tuple(RadiusSpline.from_arrays(arrays[f"link{j}_knots"], arrays[f"link{j}_final"]) for j in range(count))
+        initial = tuple(
+            RadiusSpline.from_arrays(arrays[f"link{j}_knots"], arrays[f"link{j}_initial"]) for j in range(count)
+        )
+        return cls(breaks, final, initial)
+
+
+def fold_margin(curve: FramedCurve, field: RadiusField, q: float = 1.0) -> FoldReport:
+    """Largest ``rho(q) * kappa_n`` on a dense grid over the tube around ``curve``.
+
+    Parameters
+    ----------
+    curve : the centerline at this q (c(q, .) with its frames); l normalized
+    field : the radius field
+    q : blend parameter in [0, 1]
+    """
+    count = max(int(np.ceil(curve.length / FOLD_SPACING_MM)), 16) + 1
+    l = np.linspace(0.0, 1.0, count)
+    a = np.linspace(0.0, 2.0 * np.pi, FOLD_ANGLES_PER_INTERVAL * field.final[0].angular_intervals, endpoint=False)
+    d1, d2, frames = curve.derivative(l, 1), curve.derivative(l, 2), curve.frames(l)
+    speed2 = np.einsum("ni,ni->n", d1, d1)
+    tangent = d1 / np.sqrt(speed2)[:, None]
+    kvec = (d2 - np.einsum("ni,ni->n", d2, tangent)[:, None] * tangent) / speed2[:, None]
+    k_n = np.einsum("ni,ni->n", kvec, frames[:, :, 0])
+    k_b = np.einsum("ni,ni->n", kvec, frames[:, :, 1])
+    kappa = k_n[:, None] * np.cos(a)[None, :] + k_b[:, None] * np.sin(a)[None, :]
+    rho = field.evaluate_grid(q, l, a)
+    product = rho * kappa
+    i, j = np.unravel_index(int(np.argmax(product)), product.shape)
+    return FoldReport(float(product[i, j]), float(l[i]), float(l[i] * curve.length), float(a[j]), float(rho.min()))
+
+
+def check_self_folding(curve: FramedCurve, field: RadiusField, q: float = 1.0, limit: float = 1.0) -> FoldReport:
+    """:func:`fold_margin`, raising FitError when rho * kappa_n reaches ``limit`` or rho <= 0.
+
+    Raises
+    ------
+    FitError
+        Naming q, the place (l, mm, angle) and the fixes to try.
+    """
+    report = fold_margin(curve, field, q)
+    if report.min_rho_mm <= 0.0:
+        raise FitError(
+            f"radius field at q = {q:g}: rho reaches {report.min_rho_mm:.3g} mm, expected > 0 everywhere; "
+            "raise fit.smoothing, or check the wall points near the path's ends"
+        )
+    if report.max_rho_kappa >= limit:
+        raise FitError(
+            f"radius field at q = {q:g}: the tube folds through itself: rho * kappa = {report.max_rho_kappa:.3f} "
+            f"(expected < {limit:g}) at l = {report.l:.4f} ({report.arc_mm:.1f} mm from the inlet), "
+            f"angle {np.degrees(report.angle):.0f} deg; try more centerline smoothing "
+            "(resample.smoothing_mm), a longer straight end (resample.end_straight_mm), or a smaller radius"
+        )
+    return report
