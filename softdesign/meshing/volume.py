@@ -60,7 +60,8 @@ class BodySpec:
     port_mm : float
         0, or the diameter of an inlet channel through the base cap along the base tangent.
     min_radius_mm : float
-        Smallest radius an inward offset or the chamber may keep.
+        Smallest radius an inward offset or the chamber may keep; also the
+        least chamber length and the least ledge left around the port.
     port_segments : int
         Polygon sides of the port channel; 0 takes the body's angular count.
     """
