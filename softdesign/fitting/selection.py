@@ -1,0 +1,191 @@
+"""Which surface points are the selected path's wall, with the count of every reason to drop one.
+
+Each point is dropped for the first reason that applies, in this order:
+
+``other_branch``
+    its nearest point on the centerline network lies on another polyline,
+    off the trunk that polyline shares with the path.  Distances are to the
+    nearest point of each polyline's segments, so a foot point beyond a
+    polyline's end is clamped to that end (without the clamp the far dome of
+    the other iliac looks close to the path's extension and is kept).
+``cap``
+    its foot point on the path is at, or beyond, an end of the path (within
+    ``end_margin_mm``).  VMTK caps are rounded domes that meet the wall at a
+    shallow angle, so no crease-angle rule finds them; every dome point lies
+    past the end of the centerline it caps.
+``outlier``
+    rho exceeds ``outlier_factor`` times the ``MaximumInscribedSphereRadius``
+    interpolated at the foot point, or, without it, times the median rho of
+    the kept points within ``median_window_mm`` of arc length.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from softdesign.errors import ConfigError, InputDataError
+from softdesign.fitting.projection import PolarPoints, project_points
+from softdesign.types import FloatArray, FramedCurve, Points
+
+REASONS = ("other_branch", "cap", "outlier")
+#: Points per chunk in the brute-force point-to-polyline distance (bounds memory to ~10 MB).
+_CHUNK = 2048
+
+
+@dataclass(frozen=True)
+class SelectionSettings:
+    """Thresholds of the point selection.
+
+    Attributes
+    ----------
+    outlier_factor : rho above this many times the reference radius is an outlier (> 1)
+    median_window_mm : arc-length window of the local median rho, mm (used without radii)
+    end_margin_mm : foot points this close to an end count as cap points, mm (>= 0)
+    shared_tol_mm : another polyline's points this close to the path are shared trunk, mm
+    """
+
+    outlier_factor: float = 2.0
+    median_window_mm: float = 5.0
+    end_margin_mm: float = 0.0
+    shared_tol_mm: float = 0.05
+
+    def __post_init__(self) -> None:
+        if not self.outlier_factor > 1.0:
+            raise ConfigError(f"fit.outlier_factor must be > 1, got {self.outlier_factor}")
+        if not (self.median_window_mm > 0 and self.end_margin_mm >= 0 and self.shared_tol_mm >= 0):
+            raise ConfigError(
+                "selection: median_window_mm must be > 0 and end_margin_mm, shared_tol_mm >= 0, got "
+                f"{self.median_window_mm}, {self.end_margin_mm}, {self.shared_tol_mm}"
+            )
+
+
+@dataclass(frozen=True)
+class NetworkContext:
+    """The centerline network around the selected path.
+
+    Attributes
+    ----------
+    path : (m, 3) float, mm, the selected path's polyline as in the file
+    others : every other polyline of the network, each (k, 3) mm
+    inscribed_l : (m,) normalized l of the inscribed-sphere radii, or None
+    inscribed_radius : (m,) mm, ``MaximumInscribedSphereRadius``, or None
+    """
+
+    path: Points
+    others: tuple[Points, ...] = ()
+    inscribed_l: FloatArray | None = None
+    inscribed_radius: FloatArray | None = None
+
+
+@dataclass(frozen=True)
+class WallSelection:
+    """Per-point reason code (0 kept, else 1 + index in ``REASONS``) and counts by name."""
+
+    reason: np.ndarray
+    counts: dict[str, int]
+
+    @property
+    def keep(self) -> np.ndarray:
+        """(n,) bool, the wall points to fit."""
+        return self.reason == 0
+
+
+def inscribed_profile(curve: FramedCurve, path: Points, radius: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Normalized l (sorted) and radius of a polyline's inscribed-sphere radii, by projection on ``curve``."""
+    path, radius = np.asarray(path, float), np.asarray(radius, float).reshape(-1)
+    if len(radius) != len(path) or not np.all(np.isfinite(radius)) or np.any(radius <= 0):
+        raise InputDataError(
+            f"centerline: MaximumInscribedSphereRadius must be positive and one per point ({len(path)}), "
+            f"got {len(radius)} values with minimum {np.min(radius) if radius.size else 'none'}; re-run vmtkcenterlines"
+        )
+    l = project_points(curve, path).l
+    order = np.argsort(l, kind="stable")
+    return l[order], radius[order]
+
+
+def select_wall_points(
+    polar: PolarPoints, length_mm: float, network: NetworkContext, settings: SelectionSettings = SelectionSettings()
+) -> WallSelection:
+    """Classify every projected surface point as kept wall or dropped, with the reason.
+
+    Parameters
+    ----------
+    polar : every surface point projected on the path's smooth centerline
+    length_mm : arc length of that centerline, mm
+    network : the path's polyline, the network's other polylines, inscribed radii
+    settings : thresholds
+
+    Returns
+    -------
+    WallSelection with counts ``input``, ``kept`` and one per reason.
+    """
+    reason = np.zeros(len(polar), np.int8)
+    reason[other_branch_mask(polar.points, network, settings.shared_tol_mm)] = 1
+    s = polar.l * length_mm
+    at_end = (polar.end_side != 0) | (s <= settings.end_margin_mm) | (length_mm - s <= settings.end_margin_mm)
+    reason[(reason == 0) & at_end] = 2
+    reference = _reference_radius(polar, reason == 0, length_mm, network, settings)
+    reason[(reason == 0) & (polar.rho > settings.outlier_factor * reference)] = 3
+    counts = {"input": len(polar), "kept": int(np.count_nonzero(reason == 0))}
+    counts.update({name: int(np.count_nonzero(reason == k + 1)) for k, name in enumerate(REASONS)})
+    return WallSelection(reason, counts)
+
+
+def other_branch_mask(points: Points, network: NetworkContext, shared_tol_mm: float) -> np.ndarray:
+    """(n,) bool: the point is nearer another polyline's own (unshared) part than the path."""
+    to_path = polyline_distances(points, network.path)
+    nearer = np.zeros(len(points), bool)
+    for other in network.others:
+        other = np.asarray(other, float)
+        on_path = polyline_distances(other, network.path) <= shared_tol_mm
+        own = ~(on_path[:-1] & on_path[1:])
+        if own.any():
+            nearer |= polyline_distances(points, other, own) < to_path
+    return nearer
+
+
+def polyline_distances(points: Points, polyline: Points, segments: np.ndarray | None = None) -> FloatArray:
+    """Distance from each point to the nearest point of a polyline's segments (ends clamped), mm.
+
+    Parameters
+    ----------
+    points : (n, 3) mm
+    polyline : (m, 3) mm, m >= 1
+    segments : (m - 1,) bool, the segments to use (default all)
+    """
+    polyline = np.asarray(polyline, float)
+    if len(polyline) == 1:
+        return np.linalg.norm(points - polyline[0], axis=1)
+    start, end = polyline[:-1], polyline[1:]
+    if segments is not None:
+        start, end = start[segments], end[segments]
+    edge = end - start
+    edge2 = np.maximum(np.einsum("ij,ij->i", edge, edge), np.finfo(float).tiny)
+    out = np.empty(len(points))
+    for lo in range(0, len(points), _CHUNK):
+        p = points[lo : lo + _CHUNK, None, :]
+        t = np.clip(np.einsum("nsj,sj->ns", p - start[None], edge) / edge2, 0.0, 1.0)
+        nearest = start[None] + t[:, :, None] * edge[None]
+        out[lo : lo + _CHUNK] = np.sqrt(np.min(np.sum((p - nearest) ** 2, axis=2), axis=1))
+    return out
+
+
+def _reference_radius(
+    polar: PolarPoints, candidate: np.ndarray, length_mm: float, network: NetworkContext, settings: SelectionSettings
+) -> FloatArray:
+    """The radius rho is compared with: inscribed radius at the foot point, else the local median."""
+    if network.inscribed_l is not None and network.inscribed_radius is not None:
+        return np.interp(polar.l, network.inscribed_l, network.inscribed_radius)
+    if not candidate.any():
+        return np.full(len(polar), np.inf)
+    bins = max(1, int(round(length_mm / settings.median_window_mm)))
+    index = np.minimum((polar.l * bins).astype(int), bins - 1)
+    centres, medians = [], []
+    for k in range(bins):
+        rows = candidate & (index == k)
+        if rows.any():
+            centres.append((k + 0.5) / bins)
+            medians.append(np.median(polar.rho[rows]))
+    return np.interp(polar.l, centres, medians)

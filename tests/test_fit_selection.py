@@ -1,0 +1,133 @@
+"""Wall-point selection on a synthetic Y network whose every point's fate is known by construction."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from softdesign.errors import ConfigError, InputDataError
+from softdesign.fitting.projection import project_points
+from softdesign.fitting.selection import (
+    NetworkContext,
+    SelectionSettings,
+    inscribed_profile,
+    polyline_distances,
+    select_wall_points,
+)
+from tests.fit_analytic import Line
+
+RADIUS = 3.0
+#: The other branch leaves the trunk at z = 40 at 45 degrees, in the xz plane.
+BRANCH_DIR = np.array([np.sqrt(0.5), 0.0, np.sqrt(0.5)])
+JUNCTION = np.array([0.0, 0.0, 40.0])
+#: Distances are closed-form segment distances: rounding only.
+DISTANCE_TOL_MM = 1e-12
+
+
+def _ring(axis_point, direction, radius, count):
+    """Points on a circle around ``direction`` through ``axis_point``."""
+    u = np.cross(direction, [0.0, 1.0, 0.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(direction, u)
+    a = np.linspace(0.0, 2 * np.pi, count, endpoint=False)
+    return axis_point + radius * (np.cos(a)[:, None] * u + np.sin(a)[:, None] * v)
+
+
+def _dome(centre, direction, radius):
+    """A hemisphere of points beyond ``centre`` along ``direction`` (the pole excluded)."""
+    rings = [_ring(centre + radius * np.cos(t) * direction, direction, radius * np.sin(t), 12)
+             for t in np.radians([15, 35, 55, 75])]
+    return np.concatenate(rings)
+
+
+def _y_network(trunk_offset_mm=0.0):
+    """Path: z axis 0..80 mm.  Other: the same trunk to z = 40 (shifted along +x), then 40 mm along BRANCH_DIR."""
+    path = np.column_stack([np.zeros(81), np.zeros(81), np.arange(81.0)])
+    branch = JUNCTION + np.arange(1.0, 41.0)[:, None] * BRANCH_DIR
+    other = np.concatenate([path[:41] + [trunk_offset_mm, 0.0, 0.0], branch])
+    return path, other
+
+
+def _surface():
+    """Labelled points: path wall away from the junction, the other branch's wall, three domes, outliers."""
+    z_axis = np.array([0.0, 0.0, 1.0])
+    # Path wall only where the other branch's axis is farther than RADIUS, so the label is unambiguous:
+    # the wall point (3, 0, z) is |3 - (z - 40)| / sqrt(2) from the branch axis (> 3 for z > 47.3), and
+    # 5 mm or more from its start (0, 0, 40) for z <= 36.
+    wall = np.concatenate([_ring([0, 0, z], z_axis, RADIUS, 16) for z in [*range(2, 37, 2), *range(50, 79, 2)]])
+    branch_wall = np.concatenate([_ring(JUNCTION + t * BRANCH_DIR, BRANCH_DIR, RADIUS, 16) for t in range(10, 39, 2)])
+    path_dome = _dome(np.array([0.0, 0.0, 80.0]), z_axis, RADIUS)
+    inlet_dome = _dome(np.zeros(3), -z_axis, RADIUS)
+    branch_end = JUNCTION + 40.0 * BRANCH_DIR
+    branch_dome = _dome(branch_end, BRANCH_DIR, RADIUS)
+    outliers = np.array([[-2.5 * RADIUS, 0.0, z] for z in (10.0, 20.0, 30.0)])
+    parts = {"kept": wall, "other_branch": np.concatenate([branch_wall, branch_dome]),
+             "cap": np.concatenate([path_dome, inlet_dome]), "outlier": outliers}
+    return parts
+
+
+def _select(parts, settings=SelectionSettings(), with_radius=True, trunk_offset_mm=0.0):
+    curve = Line(80.0)
+    path, other = _y_network(trunk_offset_mm)
+    points = np.concatenate(list(parts.values()))
+    polar = project_points(curve, points)
+    if with_radius:
+        l, r = inscribed_profile(curve, path, np.full(len(path), RADIUS))
+        network = NetworkContext(path, (other,), l, r)
+    else:
+        network = NetworkContext(path, (other,))
+    return select_wall_points(polar, curve.length, network, settings)
+
+
+@pytest.mark.parametrize(
+    "with_radius, trunk_offset_mm",
+    # A trunk written twice with 0.01 mm between the copies is still shared (shared_tol_mm = 0.05):
+    # without that rule the +x wall of the trunk would be nearer the other polyline and dropped.
+    [(True, 0.0), (False, 0.0), (True, 0.01)],
+    ids=["inscribed_radius", "local_median", "near_coincident_trunk"],
+)
+def test_every_reason_is_counted_on_a_y_network(with_radius, trunk_offset_mm):
+    parts = _surface()
+    selection = _select(parts, with_radius=with_radius, trunk_offset_mm=trunk_offset_mm)
+    expected = {name: len(p) for name, p in parts.items()}
+    assert selection.counts == {"input": sum(expected.values()), **expected}
+    # And point by point, not only in total.
+    codes = {"kept": 0, "other_branch": 1, "cap": 2, "outlier": 3}
+    labels = np.concatenate([np.full(len(p), codes[name]) for name, p in parts.items()])
+    np.testing.assert_array_equal(selection.reason, labels)
+    np.testing.assert_array_equal(selection.keep, labels == 0)
+
+
+def test_the_far_dome_of_the_other_branch_is_the_other_branch_not_the_path():
+    # Its foot on the path lies inside (z ~ 70), so only the end-clamped distance to the other polyline catches it.
+    dome = _dome(JUNCTION + 40.0 * BRANCH_DIR, BRANCH_DIR, RADIUS)
+    selection = _select({"other_branch": dome}, SelectionSettings(outlier_factor=100.0))
+    assert selection.counts["other_branch"] == len(dome)
+
+
+def test_end_margin_moves_wall_near_the_ends_to_caps():
+    parts = _surface()
+    selection = _select(parts, SelectionSettings(end_margin_mm=3.0))
+    # Rings at z = 2 and z = 78 are within 3 mm of an end: 2 x 16 wall points become caps.
+    assert selection.counts["kept"] == len(parts["kept"]) - 32
+    assert selection.counts["cap"] == len(parts["cap"]) + 32
+
+
+def test_polyline_distance_is_to_the_end_clamped_segments():
+    polyline = np.array([[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 10.0, 0.0]])
+    points = np.array([[5.0, 3.0, 0.0], [-4.0, 3.0, 0.0], [13.0, 14.0, 0.0], [12.0, 5.0, 0.0]])
+    np.testing.assert_allclose(polyline_distances(points, polyline), [3.0, 5.0, 5.0, 2.0], rtol=0, atol=DISTANCE_TOL_MM)
+    only_first = np.array([True, False])
+    np.testing.assert_allclose(polyline_distances(points[3:], polyline, only_first), [np.hypot(2, 5)], rtol=0,
+                               atol=DISTANCE_TOL_MM)
+
+
+def test_inscribed_profile_is_sorted_by_l_and_checked():
+    path = np.column_stack([np.zeros(5), np.zeros(5), [80.0, 60.0, 40.0, 20.0, 0.0]])
+    l, r = inscribed_profile(Line(80.0), path, np.array([5.0, 4.0, 3.0, 2.0, 1.0]))
+    np.testing.assert_allclose(l, [0.0, 0.25, 0.5, 0.75, 1.0], rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(r, [1.0, 2.0, 3.0, 4.0, 5.0])
+    with pytest.raises(InputDataError, match="MaximumInscribedSphereRadius must be positive"):
+        inscribed_profile(Line(80.0), path, np.array([5.0, 4.0, 0.0, 2.0, 1.0]))
+    with pytest.raises(ConfigError, match="outlier_factor must be > 1, got 0.5"):
+        SelectionSettings(outlier_factor=0.5)
