@@ -43,7 +43,7 @@ def _tube(points: FloatArray, radius: FloatArray, ellipticity: float, major_angl
     rho = elliptical_rho(ring_radius, ellipticity, ring_angle, angle_grid(SAMPLE_ANGULAR_COUNT))
     sections = TubeSections(q=1.0, l=l, centers=framed.points(l), frames=framed.frames(l), rho=rho)
     mesh = tessellate(sweep_from_sections(sections))
-    return manifold_from_mesh(mesh.vertices, mesh.faces, "sample vessel tube")
+    return manifold_from_mesh(mesh.vertices, mesh.faces, "sample vessel tube")[0]
 
 
 def sample_surface(vessel: SampleVessel) -> tuple[FloatArray, IntArray]:
