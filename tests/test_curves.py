@@ -8,6 +8,7 @@ import pytest
 from softdesign.errors import ConfigError, GeometryError
 from softdesign.geometry.curves import (
     CurveOptions,
+    l_from_points,
     measure_deviation,
     smooth_curve_from_polyline,
     smooth_curve_from_samples,
@@ -126,6 +127,20 @@ def test_end_straight_keeps_length_and_makes_the_ends_straight():
     assert trimmed.curvature(l[straight]).max() < 0.02 / radius
     middle = (l > 2 * s_trim) & (l < 1 - 2 * s_trim)
     np.testing.assert_allclose(trimmed.curvature(l[middle]), 1.0 / radius, rtol=1e-4, atol=0)
+
+
+def test_foot_points_of_points_off_a_circle_are_known():
+    radius, length = 12.0, 60.0
+    curve = smooth_curve_from_polyline(circle_points(radius, length, 2001), CurveOptions(smoothing_mm=0.0))
+    s = np.random.default_rng(4).uniform(0, length, 50)
+    offset = np.random.default_rng(5).uniform(-3, 3, 50)
+    # points on the circle's normal lines (radially in or out, plus a z offset): the foot is s itself
+    points = np.column_stack([(radius + offset) * np.cos(s / radius), (radius + offset) * np.sin(s / radius), offset])
+    np.testing.assert_allclose(l_from_points(curve, points), s / length, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(measure_deviation(curve, points), np.sqrt(2) * np.abs(offset), rtol=0, atol=1e-7)
+    # beyond the ends the foot is clamped to the end
+    before = circle_points(radius, length, 2)[0] - np.array([0.0, 5.0, 0.0])
+    np.testing.assert_allclose(l_from_points(curve, before[None]), [0.0], rtol=0, atol=0)
 
 
 def test_duplicates_are_skipped_and_deviation_of_exact_data_is_nil():

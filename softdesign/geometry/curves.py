@@ -240,20 +240,32 @@ def smooth_curve_from_polyline(points: npt.ArrayLike, options: CurveOptions = Cu
     return smooth_curve_from_samples(samples)
 
 
-def measure_deviation(curve: SmoothCurve, points: npt.ArrayLike) -> FloatArray:
-    """Distance from each point to the curve (its foot point, Newton-refined), (n,) mm."""
-    points = np.asarray(points, float)
+def l_from_points(curve: SmoothCurve, points: npt.ArrayLike) -> FloatArray:
+    """Foot point parameters (n,) in [0, 1]: where (p - c(l)) . c'(l) = 0, or the nearer end.
+
+    Seeded from the nearest dense sample (KD-tree), then safeguarded Newton
+    steps (at most one dense interval each) on the spline.
+    """
+    from scipy.spatial import cKDTree
+
+    points = np.asarray(points, float).reshape(-1, 3)
     l_dense = curve.dense_l()
-    dense = curve.points(l_dense)
-    nearest = np.argmin(((points[:, None, :] - dense[None, ::4, :]) ** 2).sum(-1), axis=1) * 4
-    l = np.minimum(l_dense[nearest], 1.0)
+    step = l_dense[1] - l_dense[0]
+    l = l_dense[cKDTree(curve.points(l_dense)).query(points)[1]]
     for _ in range(NEWTON_STEPS):
         d = points - curve.points(l)
         d1, d2 = curve.derivative(l, 1), curve.derivative(l, 2)
-        g = np.einsum("ij,ij->i", d, d1)
-        h = np.einsum("ij,ij->i", d1, d1) - np.einsum("ij,ij->i", d, d2)
-        l = np.clip(l + g / h, 0.0, 1.0)
-    return np.linalg.norm(points - curve.points(l), axis=1)
+        slope = np.einsum("ij,ij->i", d, d1)
+        curvature_term = np.einsum("ij,ij->i", d1, d1) - np.einsum("ij,ij->i", d, d2)
+        move = np.where(curvature_term > 0.0, slope / np.where(curvature_term > 0.0, curvature_term, 1.0), 0.0)
+        l = np.clip(l + np.clip(move, -step, step), 0.0, 1.0)
+    return l
+
+
+def measure_deviation(curve: SmoothCurve, points: npt.ArrayLike) -> FloatArray:
+    """Distance from each point (n, 3) to the curve at its foot point, (n,) mm."""
+    points = np.asarray(points, float).reshape(-1, 3)
+    return np.linalg.norm(points - curve.points(l_from_points(curve, points)), axis=1)
 
 
 def _check_options(options: CurveOptions) -> None:

@@ -136,14 +136,19 @@ def adjacent_rotation_angles(frames: Frames) -> FloatArray:
     return np.arctan2(sin_t, cos_t)
 
 
-def check_no_flips(frames: Frames, l: FloatArray, label: str, limit_rad: float = FLIP_LIMIT_RAD) -> float:
-    """Largest adjacent rotation, rad; GeometryError naming the l interval if it exceeds ``limit_rad``."""
+def check_no_flips(
+    frames: Frames, l: FloatArray, label: str, limit_rad: float = FLIP_LIMIT_RAD, why: str = ""
+) -> float:
+    """Largest adjacent rotation, rad; GeometryError naming the l interval if it exceeds ``limit_rad``.
+
+    ``why`` is appended to the message (the likely cause for the frame mode).
+    """
     angles = adjacent_rotation_angles(frames)
     worst = int(np.argmax(angles))
     if angles[worst] > limit_rad:
         raise GeometryError(
             f"frames: {label}: adjacent frames at l = {l[worst]:.6f} and {l[worst + 1]:.6f} differ by "
-            f"{angles[worst]:.3g} rad (limit {limit_rad:g}): the frame flips there; use frames: rmf, "
+            f"{angles[worst]:.3g} rad (limit {limit_rad:g}): the frame flips there{why}; use frames: rmf, "
             "or smooth the centerline more (resample.smoothing_mm)"
         )
     return float(angles[worst])
@@ -226,7 +231,8 @@ def framed_curve(
         frames = frenet_frames(curve, l, label)
     else:
         frames = _rmf_along(curve, l, base_normal)
-    worst = check_no_flips(frames, l, f"{mode}, {label}")
+    why = " (the Frenet normal reverses where the curvature passes through zero)" if mode == "frenet" else ""
+    worst = check_no_flips(frames, l, f"{mode}, {label}", why=why)
     at = float(l[int(np.argmax(adjacent_rotation_angles(frames)))])
     return FramedSpline(curve, mode, label, l, frames, worst, at)
 
