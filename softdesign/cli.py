@@ -12,7 +12,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from softdesign.cli_support import note, run_guarded
+from softdesign.cli_support import emit_json, note, run_guarded
 from softdesign.errors import SoftdesignError
 from softdesign.pcc_cli import pcc_app
 
@@ -32,7 +32,8 @@ def _build_dir(case, out: Optional[Path]) -> Path:
     return out if out is not None else Path("build") / case.name
 
 
-def _run(case_file: Path, out: Optional[Path], target: str | None, force: bool) -> None:
+def _run(case_file: Path, out: Optional[Path], target: str | None, force: bool):
+    """Load the case and run the stages through ``target``; returns (case, build_dir, results, runs)."""
     from softdesign.config import load_case
     from softdesign.pipeline.run import RunOptions, run_stages
     from softdesign.pipeline.stages import STAGES, input_files, stages_through
@@ -41,14 +42,26 @@ def _run(case_file: Path, out: Optional[Path], target: str | None, force: bool) 
     build_dir = _build_dir(case, out)
     stages = STAGES if target is None else stages_through(target)
     try:
-        _, runs = run_stages(case, build_dir, stages, input_files(case), RunOptions(force=force, progress=note))
+        results, runs = run_stages(case, build_dir, stages, input_files(case), RunOptions(force=force, progress=note))
     except SoftdesignError as err:
         raise type(err)(f"{case_file}: {err}") from err
+    return case, build_dir, results, runs
+
+
+def _report(build_dir: Path, runs) -> None:
     for run in runs:
         typer.echo(f"[{run.name}] {run.status} ({run.seconds:.2f} s)")
         for line in run.lines:
             typer.echo(f"  {line}")
     typer.echo(f"build folder: {build_dir}")
+
+
+def _stage_command(case_file: Path, out: Optional[Path], target: str | None, force: bool) -> None:
+    def action() -> None:
+        _, build_dir, _, runs = _run(case_file, out, target, force)
+        _report(build_dir, runs)
+
+    run_guarded(action)
 
 
 @app.command()
@@ -69,13 +82,84 @@ def validate(case_file: CaseArg) -> None:
 @app.command()
 def build(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:
     """Run every stage (unchanged stages are skipped) and write the manifest."""
-    run_guarded(lambda: _run(case_file, out, None, force))
+    _stage_command(case_file, out, None, force)
 
 
 @app.command()
 def ingest(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:
     """Read and check the inputs; keep them, in mm, under BUILD/ingest."""
-    run_guarded(lambda: _run(case_file, out, "ingest", force))
+    _stage_command(case_file, out, "ingest", force)
+
+
+@app.command()
+def blend(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:
+    """Smooth and resample the centerlines, blend c(q, l), frames; figures per export q."""
+    _stage_command(case_file, out, "blend", force)
+
+
+@app.command()
+def kinematics(
+    case_file: CaseArg,
+    out: OutOpt = None,
+    force: ForceOpt = False,
+    q: Annotated[Optional[str], typer.Option(help="One q for every link ('0.5') or one per link ('0.2,0.8,1').")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
+) -> None:
+    """Links, S_T_E and POE per link; with --q, the chain at that q (one per link allowed)."""
+
+    def action() -> None:
+        from softdesign.pipeline.kinematics_stage import pose_document
+
+        q_values = None if q is None else _q_values(q)
+        case, build_dir, results, runs = _run(case_file, out, "kinematics", force)
+        if q_values is None:
+            if as_json:
+                emit_json(results["kinematics"].document)
+            else:
+                _report(build_dir, runs)
+            return
+        document = pose_document(results["kinematics"].chain, q_values)
+        payload = {
+            "q": document["q"],
+            "links": [{k: link[k] for k in KINEMATICS_LINK_KEYS} for link in document["links"]],
+            "base_to_tip": document["base_to_tip"],
+            "frames": case.frames,
+        }
+        if as_json:
+            emit_json(payload)
+        else:
+            _print_pose(payload)
+
+    run_guarded(action)
+
+
+KINEMATICS_LINK_KEYS = ("index", "l_start", "l_end", "length", "transform", "poe")
+
+
+def _q_values(text: str) -> list[float]:
+    from softdesign.errors import ConfigError
+
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise ConfigError(f"--q: expected numbers separated by commas (e.g. 0.5 or 0.2,0.8,1), got {text!r}") from None
+    if not all(0.0 <= v <= 1.0 for v in values):
+        raise ConfigError(f"--q: every value must lie in [0, 1], got {text!r}")
+    return values
+
+
+def _print_pose(payload: dict) -> None:
+    typer.echo(f"q = {payload['q']} (frames {payload['frames']})")
+    for link in payload["links"]:
+        p = link["poe"]
+        omega = "null" if p["omega"] is None else "[" + ", ".join(f"{v:.4f}" for v in p["omega"]) + "]"
+        typer.echo(
+            f"link {link['index']} l {link['l_start']:.3f}..{link['l_end']:.3f}: length {link['length']:.3f} mm, "
+            f"theta1 {p['theta1']:.4f} mm, theta2 {p['theta2']:.5f} rad about {omega}"
+        )
+    typer.echo("base_to_tip:")
+    for row in payload["base_to_tip"]:
+        typer.echo("  " + "  ".join(f"{v:12.6f}" for v in row))
 
 
 @app.command()

@@ -34,7 +34,7 @@ class Stage:
     upstream : stages whose results ``compute`` reads
     compute : (case, results of upstream stages) -> result; no file writes
     write : (result, staging) -> None; stages the outputs under ``name/``
-    load : build_dir -> result, for a skipped stage
+    load : (build_dir, results of upstream stages) -> result, for a skipped stage
     describe : result -> short human summary lines
     metrics : result -> JSON-ready figures for the manifest
     """
@@ -45,7 +45,7 @@ class Stage:
     upstream: tuple[str, ...]
     compute: Callable[[Case, Results], Any]
     write: Callable[[Any, Staging], None]
-    load: Callable[[Path], Any]
+    load: Callable[[Path, Results], Any]
     describe: Callable[[Any], list[str]]
     metrics: Callable[[Any], dict[str, Any]]
 
@@ -129,7 +129,7 @@ def _run_one(
 ) -> StageRun:
     start = time.perf_counter()
     if not options.force and _up_to_date(build_dir, stage, key):
-        results[stage.name] = stage.load(build_dir)
+        results[stage.name] = stage.load(build_dir, results)
         options.progress(f"{stage.name}: unchanged, skipped")
         return StageRun(stage.name, key, "skipped", time.perf_counter() - start, stage.describe(results[stage.name]))
     options.progress(f"{stage.name}: running")

@@ -6,12 +6,8 @@ from pathlib import Path
 from typing import Any
 
 from softdesign.config import Case
-from softdesign.pipeline import ingest
+from softdesign.pipeline import blend_stage, ingest, kinematics_stage
 from softdesign.pipeline.run import Results, Stage
-
-
-def _ingest_compute(case: Case, results: Results) -> ingest.IngestResult:  # noqa: ARG001 - no upstream
-    return ingest.run_ingest(case)
 
 
 def _ingest_describe(result: ingest.IngestResult) -> list[str]:
@@ -31,24 +27,44 @@ def _ingest_describe(result: ingest.IngestResult) -> list[str]:
     return lines + list(result.notes)
 
 
-def _ingest_metrics(result: ingest.IngestResult) -> dict[str, Any]:
-    return result.summary
-
-
 INGEST = Stage(
     name="ingest",
     version=ingest.VERSION,
     sections=("units", "final", "initial", "intermediate"),
     upstream=(),
-    compute=_ingest_compute,
+    compute=lambda case, results: ingest.run_ingest(case),
     write=ingest.write_ingest,
-    load=ingest.load_ingest,
+    load=lambda build_dir, results: ingest.load_ingest(build_dir),
     describe=_ingest_describe,
-    metrics=_ingest_metrics,
+    metrics=lambda result: result.summary,
+)
+
+BLEND = Stage(
+    name="blend",
+    version=blend_stage.VERSION,
+    sections=("initial", "resample", "frames", "blend", "export"),
+    upstream=("ingest",),
+    compute=lambda case, results: blend_stage.run_blend(case, results["ingest"]),
+    write=blend_stage.write_blend,
+    load=lambda build_dir, results: blend_stage.load_blend(build_dir),
+    describe=blend_stage.describe_blend,
+    metrics=lambda result: result.summary,
+)
+
+KINEMATICS = Stage(
+    name="kinematics",
+    version=kinematics_stage.VERSION,
+    sections=("links", "export"),
+    upstream=("blend",),
+    compute=lambda case, results: kinematics_stage.run_kinematics(case, results["blend"]),
+    write=kinematics_stage.write_kinematics,
+    load=lambda build_dir, results: kinematics_stage.load_kinematics(build_dir, results["blend"]),
+    describe=kinematics_stage.describe_kinematics,
+    metrics=lambda result: {"links": len(result.document["links"]), "file": kinematics_stage.FILE},
 )
 
 #: Every stage, in build order.
-STAGES: list[Stage] = [INGEST]
+STAGES: list[Stage] = [INGEST, BLEND, KINEMATICS]
 
 
 def stages_through(name: str) -> list[Stage]:
@@ -60,3 +76,6 @@ def stages_through(name: str) -> list[Stage]:
 def input_files(case: Case) -> list[Path]:
     """Files the build reads."""
     return ingest.input_files(case)
+
+
+__all__: list[Any] = ["STAGES", "stages_through", "input_files"]

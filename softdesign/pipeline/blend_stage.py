@@ -1,0 +1,139 @@
+"""Stage 2, blend: smooth and resample the centerlines, build c(q, l) and its frames.
+
+Kept in the build folder: ``blend/curves.npz`` (each key shape's samples at
+equal arc length; the quintic spline through them is rebuilt exactly on
+load) and ``blend/summary.json`` (per path and per export q figures).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from softdesign.config import Case
+from softdesign.geometry.blend import BlendedShape, blend_shapes
+from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline, smooth_curve_from_samples
+from softdesign.geometry.initial import InitialSpec, build_initial_shape
+from softdesign.pipeline.ingest import IngestResult
+from softdesign.pipeline.store import Staging, load_npz, npz_bytes
+
+VERSION = 1
+
+
+@dataclass(frozen=True)
+class BlendResult:
+    """The blended shape and its figures."""
+
+    shape: BlendedShape
+    summary: dict[str, Any]
+
+
+def curve_options(case: Case, count: int | None = None) -> CurveOptions:
+    """The case's resampling settings (``count`` forces the final shape's sample count)."""
+    r = case.resample
+    return CurveOptions(
+        spacing_mm=r.spacing_mm,
+        count=count if count is not None else r.count,
+        smoothing_mm=r.smoothing_mm,
+        end_straight_mm=r.end_straight_mm,
+    )
+
+
+def run_blend(case: Case, ingest: IngestResult) -> BlendResult:
+    """Build c(q, l) for the case from the ingested paths."""
+    final = smooth_curve_from_polyline(ingest.path.points, curve_options(case))
+    same_grid = curve_options(case, count=len(final.l_grid))
+    spec = InitialSpec(
+        kind=case.initial.kind,
+        length_mm=case.initial.length_mm,
+        bend_radius_mm=case.initial.bend_radius_mm,
+        bend_plane_rad=float(np.deg2rad(case.initial.bend_plane_deg)),
+        points=None if ingest.initial_path is None else ingest.initial_path.points,
+        align_base=case.initial.align_base,
+    )
+    initial = build_initial_shape(final, spec, same_grid)
+    keyframes = tuple((q, smooth_curve_from_polyline(p.points, same_grid)) for q, p in ingest.keyframes)
+    shape = blend_shapes(initial, final, keyframes, case.blend, case.frames)
+    return BlendResult(shape, _summary(case, shape))
+
+
+def _summary(case: Case, shape: BlendedShape) -> dict[str, Any]:
+    final = shape.keys[-1].report()
+    per_q = []
+    for q in case.export.q_values():
+        curve = shape.curve_at(q)  # builds the frames: a flip or an undefined Frenet frame fails here
+        stats = shape.stats_at(q)
+        per_q.append(
+            {
+                "q": q,
+                "length_mm": stats.length_mm,
+                "stretch_min": stats.stretch_min,
+                "stretch_max": stats.stretch_max,
+                "curvature_max_per_mm": stats.curvature_max_per_mm,
+                "max_frame_step_rad": curve.max_frame_step,
+            }
+        )
+    shortening = shape.shortening()
+    return {
+        "mode": shape.mode,
+        "frames": shape.frames,
+        "final_path": {
+            "length_mm": final.length_mm,
+            "samples": final.sample_count,
+            "spacing_mm": final.spacing_mm,
+            "max_curvature_per_mm": final.max_curvature_per_mm,
+            "max_curvature_l": final.max_curvature_l,
+            "max_abs_torsion_per_mm": final.max_abs_torsion_per_mm,
+            "max_abs_torsion_l": final.max_abs_torsion_l,
+        },
+        "initial_length_mm": shape.keys[0].length,
+        "per_q": per_q,
+        "shortening": {
+            "q_at_min": shortening.q_at_min,
+            "min_length_mm": shortening.min_length_mm,
+            "reference_length_mm": shortening.reference_length_mm,
+            "ratio": shortening.ratio,
+        },
+    }
+
+
+def write_blend(result: BlendResult, staging: Staging) -> None:
+    """Keep the key shapes' samples and the figures."""
+    shape = result.shape
+    samples = {f"key_{k}": curve.points(curve.l_grid) for k, curve in enumerate(shape.keys)}
+    staging.write_bytes("blend/curves.npz", npz_bytes(key_q=shape.key_q, **samples))
+    staging.write_json("blend/summary.json", result.summary)
+
+
+def load_blend(build_dir: Path) -> BlendResult:
+    """Rebuild the blended shape from the kept samples (no smoothing is redone)."""
+    root = Path(build_dir) / "blend"
+    data = load_npz(root / "curves.npz")
+    summary = json.loads((root / "summary.json").read_text(encoding="utf-8"))
+    keys = [smooth_curve_from_samples(data[f"key_{k}"]) for k in range(len(data["key_q"]))]
+    keyframes = tuple(zip(data["key_q"][1:-1].tolist(), keys[1:-1]))
+    shape = blend_shapes(keys[0], keys[-1], keyframes, summary["mode"], summary["frames"])
+    return BlendResult(shape, summary)
+
+
+def describe_blend(result: BlendResult) -> list[str]:
+    """Human summary lines."""
+    s = result.summary
+    f = s["final_path"]
+    lines = [
+        f"final path: {f['length_mm']:.2f} mm, {f['samples']} samples every {f['spacing_mm']:.3f} mm, "
+        f"max curvature {f['max_curvature_per_mm']:.4f} /mm, max |torsion| {f['max_abs_torsion_per_mm']:.4f} /mm",
+        f"blend {s['mode']}, frames {s['frames']}; initial length {s['initial_length_mm']:.2f} mm",
+    ]
+    for row in s["per_q"]:
+        lines.append(
+            f"  q = {row['q']:.3f}: length {row['length_mm']:.2f} mm, stretch {row['stretch_min']:.4f}"
+            f"..{row['stretch_max']:.4f}, max curvature {row['curvature_max_per_mm']:.4f} /mm"
+        )
+    sh = s["shortening"]
+    lines.append(f"shortest shape: {sh['min_length_mm']:.2f} mm at q = {sh['q_at_min']:.3f} ({100 * sh['ratio']:.2f}% shorter)")
+    return lines

@@ -1,0 +1,128 @@
+"""Stage 3, kinematics: links, their S_T_E(q) and POE form at every export q.
+
+``kinematics.json`` (at the top of the build folder) holds, per export q and
+per link, the transform S_T_E = inv(F(q, l_s)) F(q, l_e) (4x4, mm), its POE
+split, the link's arc length, stretch and curvature range, and the chain's
+base_to_tip.  Conventions are written into the file itself.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from softdesign.config import Case
+from softdesign.kinematics.links import LinkChain, LinkReport, link_breaks
+from softdesign.kinematics.poe import PoeSplit
+from softdesign.pipeline.blend_stage import BlendResult
+from softdesign.pipeline.store import Staging
+
+VERSION = 1
+FILE = "kinematics.json"
+CONVENTION = (
+    "F(q, l) = [[N B T c], [0 0 0 1]]; transform = S_T_E = inv(F(q, l_start)) F(q, l_end), "
+    "mapping end-frame coordinates into start-frame coordinates; "
+    "S_T_E = exp(xi1 theta1) exp(omega theta2): translation theta1 (mm) along unit xi1 (in {S}), "
+    "then rotation theta2 in [0, pi] (rad) about unit omega (null when theta2 = 0); "
+    "base_to_tip = product of the link transforms in link order (the tip frame in link 1's {S})"
+)
+
+
+@dataclass(frozen=True)
+class KinematicsResult:
+    """The link chain and the JSON document kept in the build folder."""
+
+    chain: LinkChain
+    document: dict[str, Any]
+
+
+def chain_for_case(case: Case, blend: BlendResult) -> LinkChain:
+    """Split the blended shape into the case's links."""
+    links = case.links
+    breaks = link_breaks(blend.shape.keys[-1].length, links.count, links.breaks, links.length_mm)
+    return LinkChain(blend.shape, breaks)
+
+
+def poe_dict(split: PoeSplit) -> dict[str, Any]:
+    """The POE split as JSON (axes as lists, null when undefined)."""
+    return {
+        "theta1": split.theta1,
+        "xi1": None if split.xi1 is None else np.asarray(split.xi1).tolist(),
+        "theta2": split.theta2,
+        "omega": None if split.omega is None else np.asarray(split.omega).tolist(),
+    }
+
+
+def link_dict(report: LinkReport) -> dict[str, Any]:
+    """One link at one q as JSON."""
+    return {
+        "index": report.index,
+        "q": report.q,
+        "l_start": report.l_start,
+        "l_end": report.l_end,
+        "length": report.length_mm,
+        "transform": report.transform.tolist(),
+        "poe": poe_dict(report.poe),
+        "stretch": [report.stats.stretch_min, report.stats.stretch_max],
+        "curvature_per_mm": [report.stats.curvature_min_per_mm, report.stats.curvature_max_per_mm],
+    }
+
+
+def pose_document(chain: LinkChain, q: float | list[float]) -> dict[str, Any]:
+    """Links, base_to_tip and base_to_world of the chain at one q (or one q per link)."""
+    q_links = chain.q_per_link(q)
+    reports = chain.reports(q_links)
+    tip2base = np.eye(4)
+    for report in reports:
+        tip2base = tip2base @ report.transform
+    return {
+        "q": q_links.tolist(),
+        "links": [link_dict(r) for r in reports],
+        "base_to_tip": tip2base.tolist(),
+        "base_to_world": chain.base2world(q_links).tolist(),
+    }
+
+
+def run_kinematics(case: Case, blend: BlendResult) -> KinematicsResult:
+    """Link transforms and POE at every export q."""
+    chain = chain_for_case(case, blend)
+    document = {
+        "frames": case.frames,
+        "convention": CONVENTION,
+        "units": {"length": "mm", "angle": "rad"},
+        "links": [
+            {"index": j, "l_start": float(chain.breaks[j]), "l_end": float(chain.breaks[j + 1])} for j in range(chain.count)
+        ],
+        "poses": [pose_document(chain, q) for q in case.export.q_values()],
+    }
+    return KinematicsResult(chain, document)
+
+
+def write_kinematics(result: KinematicsResult, staging: Staging) -> None:
+    """Write ``kinematics.json``."""
+    staging.write_json(FILE, result.document)
+
+
+def load_kinematics(build_dir: Path, blend: BlendResult) -> KinematicsResult:
+    """The document from disk and the chain rebuilt on the (already loaded) blend."""
+    document = json.loads((Path(build_dir) / FILE).read_text(encoding="utf-8"))
+    breaks = [document["links"][0]["l_start"]] + [link["l_end"] for link in document["links"]]
+    return KinematicsResult(LinkChain(blend.shape, np.array(breaks)), document)
+
+
+def describe_kinematics(result: KinematicsResult) -> list[str]:
+    """One line per export q and link."""
+    lines = [f"{len(result.document['links'])} link(s), frames {result.document['frames']}"]
+    for pose in result.document["poses"]:
+        for link in pose["links"]:
+            p = link["poe"]
+            lines.append(
+                f"  q = {link['q']:.3f} link {link['index']}: length {link['length']:.2f} mm, "
+                f"theta1 {p['theta1']:.3f} mm, theta2 {p['theta2']:.4f} rad, "
+                f"stretch {link['stretch'][0]:.3f}..{link['stretch'][1]:.3f}"
+            )
+    return lines
