@@ -1,9 +1,17 @@
 """Geometric difference between two meshes, for regression checks.
 
-Compared by geometry, never by bytes or vertex counts: the symmetric surface
-distance (points sampled densely and deterministically on each surface, area
-weighted, their exact closest-point distance to the other surface), the
-relative change of volume and area, and watertightness of each.
+Compared by geometry, never by bytes or vertex counts:
+
+- the symmetric surface distance: points spread over each surface by area
+  (deterministic, no random numbers: the same meshes give the same figures on
+  every machine), plus every vertex, and each point's exact closest-point
+  distance to the other surface;
+- the relative change of enclosed volume and of area;
+- watertightness of each mesh.
+
+Exact distances come from vtk's static cell locator (a compiled bin search
+that returns the true closest point on a triangle), about six times faster
+than a Python-side query for the same answer.
 """
 
 from __future__ import annotations
@@ -11,18 +19,31 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
+from softdesign.errors import MeshError
 from softdesign.types import FloatArray, IntArray
 
-#: Surface samples per mesh; enough that a 1-face defect on a 10k-face mesh is hit.
+#: Fewest surface samples per mesh; with the vertices added, a 10k-face mesh gets ~25k points.
 DEFAULT_SAMPLES = 20000
-#: Fixed seed: the same meshes always give the same figures.
-SAMPLE_SEED = 20261121
+#: Samples per face when that gives more: dense meshes keep about two points per triangle.
+SAMPLES_PER_FACE = 2
+#: Fractional part of the golden ratio: the second sample coordinate, spread evenly without randomness.
+_GOLDEN_FRACTION = (np.sqrt(5.0) - 1.0) / 2.0
 
 
 @dataclass(frozen=True)
 class MeshDifference:
-    """How far two meshes are apart (mm) and how their size changed (relative)."""
+    """How far two meshes are apart (mm) and how their size changed (relative, signed).
+
+    Attributes
+    ----------
+    distance_max_mm : largest point-to-surface distance, either direction
+    distance_rms_mm : root mean square of the area-weighted samples' distances, both directions
+    volume_rel_change : (V - V_ref) / V_ref of the enclosed volumes
+    area_rel_change : (A - A_ref) / A_ref
+    watertight, reference_watertight : every edge shared by exactly two faces, in opposite directions
+    """
 
     distance_max_mm: float
     distance_rms_mm: float
@@ -44,42 +65,166 @@ class MeshDifference:
 
 
 def compare_meshes(
-    vertices: FloatArray, faces: IntArray, ref_vertices: FloatArray, ref_faces: IntArray, samples: int = DEFAULT_SAMPLES
+    vertices: npt.ArrayLike,
+    faces: npt.ArrayLike,
+    ref_vertices: npt.ArrayLike,
+    ref_faces: npt.ArrayLike,
+    samples: int = DEFAULT_SAMPLES,
 ) -> MeshDifference:
     """Symmetric surface distance, volume and area change of a mesh against a reference.
 
     Parameters
     ----------
-    vertices, faces : the mesh under test, (V, 3) mm and (F, 3)
-    ref_vertices, ref_faces : the reference mesh
-    samples : surface points sampled on each mesh
-    """
-    import trimesh
+    vertices, faces : (V, 3) float mm and (F, 3) int -- the mesh under test
+    ref_vertices, ref_faces : the reference mesh, same shapes
+    samples : fewest area-weighted surface points per mesh (more on dense
+        meshes: ``max(samples, SAMPLES_PER_FACE * F)``); every vertex is added
 
-    mesh = trimesh.Trimesh(np.asarray(vertices, float), np.asarray(faces, np.int64), process=False)
-    ref = trimesh.Trimesh(np.asarray(ref_vertices, float), np.asarray(ref_faces, np.int64), process=False)
-    there = _distances(mesh, ref, samples)
-    back = _distances(ref, mesh, samples)
-    both = np.concatenate([there, back])
+    Returns
+    -------
+    MeshDifference
+
+    Raises
+    ------
+    MeshError
+        A mesh with bad arrays, no faces or zero area.
+    """
+    mesh = _checked_mesh(vertices, faces, "mesh")
+    ref = _checked_mesh(ref_vertices, ref_faces, "reference mesh")
+    there_max, there_sq = _one_way(mesh, ref, samples)
+    back_max, back_sq = _one_way(ref, mesh, samples)
     return MeshDifference(
-        distance_max_mm=float(both.max()),
-        distance_rms_mm=float(np.sqrt(np.mean(both**2))),
-        volume_rel_change=_relative(abs(mesh.volume), abs(ref.volume)),
-        area_rel_change=_relative(mesh.area, ref.area),
-        watertight=bool(mesh.is_watertight),
-        reference_watertight=bool(ref.is_watertight),
+        distance_max_mm=max(there_max, back_max),
+        distance_rms_mm=float(np.sqrt(np.mean(np.concatenate([there_sq, back_sq])))),
+        volume_rel_change=_relative(abs(enclosed_volume(*mesh)), abs(enclosed_volume(*ref))),
+        area_rel_change=_relative(surface_area(*mesh), surface_area(*ref)),
+        watertight=is_watertight(mesh[1]),
+        reference_watertight=is_watertight(ref[1]),
     )
 
 
-def _distances(source, target, samples: int) -> FloatArray:
-    """Distances from area-weighted samples on ``source`` (and its vertices) to ``target``."""
-    import trimesh
+def surface_samples(vertices: npt.ArrayLike, faces: npt.ArrayLike, count: int) -> FloatArray:
+    """Points spread evenly over a triangle mesh by area, without random numbers.
 
-    points, _ = trimesh.sample.sample_surface(source, samples, seed=SAMPLE_SEED)
-    points = np.concatenate([points, source.vertices])
-    _, distance, _ = trimesh.proximity.closest_point(target, points)
-    return np.asarray(distance, float)
+    Systematic sampling: the k-th point sits at cumulative area
+    ``(k + 1/2) / count`` of the total, so each face gets its area share of the
+    points (to within one); inside the face, that position gives one coordinate
+    and the golden-ratio sequence ``k * 0.618... mod 1`` the other, mapped
+    uniformly onto the triangle.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float, mm
+    faces : (F, 3) int
+    count : number of points, >= 1
+
+    Returns
+    -------
+    (count, 3) float, mm
+    """
+    if int(count) < 1:
+        raise ValueError(f"surface_samples: count must be >= 1, got {count}")
+    v, f = _checked_mesh(vertices, faces, "mesh")
+    corners = v[f]
+    area = _face_areas(corners)
+    cumulative = np.cumsum(area)
+    k = np.arange(int(count), dtype=np.float64)
+    position = (k + 0.5) / count * cumulative[-1]
+    # side="right" never lands on a zero-area face: its cumulative value equals its predecessor's.
+    face = np.minimum(np.searchsorted(cumulative, position, side="right"), len(f) - 1)
+    s = np.clip((position - (cumulative[face] - area[face])) / area[face], 0.0, 1.0)
+    t = (k * _GOLDEN_FRACTION) % 1.0
+    root = np.sqrt(s)[:, None]
+    a, b, c = corners[face, 0], corners[face, 1], corners[face, 2]
+    return (1.0 - root) * a + root * (1.0 - t[:, None]) * b + root * t[:, None] * c
+
+
+def enclosed_volume(vertices: FloatArray, faces: IntArray) -> float:
+    """Signed volume (mm^3) enclosed by a closed, outward-oriented triangle mesh (divergence theorem)."""
+    corners = np.asarray(vertices, float)[np.asarray(faces, np.int64)]
+    return float(np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])).sum() / 6.0)
+
+
+def surface_area(vertices: FloatArray, faces: IntArray) -> float:
+    """Total triangle area, mm^2."""
+    return float(_face_areas(np.asarray(vertices, float)[np.asarray(faces, np.int64)]).sum())
+
+
+def is_watertight(faces: IntArray) -> bool:
+    """True when every edge is shared by exactly two faces that run it in opposite directions.
+
+    That is closed, edge-manifold and consistently oriented; vertices must be
+    merged (an STL read without merging is never watertight).
+    """
+    f = np.asarray(faces, np.int64)
+    directed = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+    unique_directed = np.unique(directed, axis=0)
+    if len(unique_directed) != len(directed):
+        return False
+    # Each directed edge has its reverse, and no other: the set equals its reversal (np.unique sorts rows).
+    return bool(np.array_equal(unique_directed, np.unique(unique_directed[:, ::-1], axis=0)))
+
+
+def _checked_mesh(vertices: npt.ArrayLike, faces: npt.ArrayLike, what: str) -> tuple[FloatArray, IntArray]:
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces)
+    if v.ndim != 2 or v.shape[1] != 3 or f.ndim != 2 or f.shape[1] != 3:
+        raise MeshError(f"{what}: expected vertices (V, 3) and faces (F, 3), got {v.shape} and {f.shape}")
+    if len(f) == 0:
+        raise MeshError(f"{what}: no faces")
+    f = f.astype(np.int64)
+    if f.min() < 0 or f.max() >= len(v):
+        raise MeshError(f"{what}: face indices must lie in [0, {len(v) - 1}], got [{f.min()}, {f.max()}]")
+    if not np.all(np.isfinite(v)):
+        raise MeshError(f"{what}: NaN or infinite vertex coordinates")
+    if surface_area(v, f) <= 0.0:
+        raise MeshError(f"{what}: zero total area ({len(f)} degenerate faces)")
+    return v, f
+
+
+def _face_areas(corners: FloatArray) -> FloatArray:
+    return 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+
+
+def _one_way(
+    source: tuple[FloatArray, IntArray], target: tuple[FloatArray, IntArray], samples: int
+) -> tuple[float, FloatArray]:
+    """Largest distance from ``source`` (samples and vertices) to ``target``, and the samples' squared distances."""
+    count = max(int(samples), SAMPLES_PER_FACE * len(source[1]))
+    points = np.concatenate([surface_samples(*source, count), source[0]])
+    squared = _squared_distances(points, *target)
+    return float(np.sqrt(squared.max())), squared[:count]
+
+
+def _squared_distances(points: FloatArray, vertices: FloatArray, faces: IntArray) -> FloatArray:
+    """Exact squared distance (mm^2) from each point (n, 3) to the closest point on a triangle mesh."""
+    import vtk
+    from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+
+    poly = vtk.vtkPolyData()
+    vtk_points = vtk.vtkPoints()
+    vtk_points.SetData(numpy_to_vtk(np.ascontiguousarray(vertices), deep=True))
+    poly.SetPoints(vtk_points)
+    cells = vtk.vtkCellArray()
+    offsets = np.arange(0, 3 * len(faces) + 1, 3, dtype=np.int64)
+    cells.SetData(
+        numpy_to_vtkIdTypeArray(offsets, deep=True),
+        numpy_to_vtkIdTypeArray(np.ascontiguousarray(faces.reshape(-1), dtype=np.int64), deep=True),
+    )
+    poly.SetPolys(cells)
+    locator = vtk.vtkStaticCellLocator()
+    locator.SetDataSet(poly)
+    locator.BuildLocator()
+    closest, cell, sub, dist2 = [0.0, 0.0, 0.0], vtk.reference(0), vtk.reference(0), vtk.reference(0.0)
+    out = np.empty(len(points))
+    for i, point in enumerate(points.tolist()):
+        locator.FindClosestPoint(point, closest, cell, sub, dist2)
+        out[i] = dist2.get()
+    return out
 
 
 def _relative(value: float, reference: float) -> float:
-    return float((value - reference) / reference) if reference != 0 else float("inf") if value else 0.0
+    """(value - reference) / reference; inf when only the reference is zero."""
+    if reference != 0.0:
+        return float((value - reference) / reference)
+    return float("inf") if value != 0.0 else 0.0
