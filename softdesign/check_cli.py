@@ -1,0 +1,104 @@
+"""`softdesign check BUILD_DIR --reference REF_DIR`: regression check of a build against a reference.
+
+Parsing and printing live here; the comparison is :mod:`softdesign.regression`.
+Register with ``app.command()(check)`` in :mod:`softdesign.cli`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from softdesign.cli_support import emit_json, note, run_guarded
+from softdesign.regression import CheckOptions, CheckReport, Figure, check_build
+
+#: Significant digits of the figures in the table (JSON keeps full precision).
+TABLE_DIGITS = 4
+HEADER = ("item", "figure", "change", "tolerance", "status", "note")
+
+
+def check(
+    build_dir: Annotated[Path, typer.Argument(help="The build folder to check.", show_default=False)],
+    reference: Annotated[
+        Path,
+        typer.Option("--reference", "-r", help="The reference build folder (e.g. a golden one).", show_default=False),
+    ],
+    tolerance_mm: Annotated[
+        float,
+        typer.Option("--tolerance-mm", help="Surface distance, transform translation, lengths and fit metrics, mm."),
+    ] = 0.01,
+    rtol: Annotated[float, typer.Option("--rtol", help="Relative change of mesh volume and area.")] = 1e-3,
+    rotation_tol: Annotated[
+        float, typer.Option("--rotation-tol", help="Rotation between link transforms and POE theta2, rad.")
+    ] = 1e-4,
+    json_out: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
+) -> None:
+    """Compare meshes (by geometry), kinematics and fit metrics with a reference build.
+
+    Exit 0 when every figure is within tolerance, 1 when one is not (or a mesh
+    is missing on either side), 2 for a missing folder or bad option.  A
+    reference's golden.json (decimation error per mesh) widens that mesh's
+    tolerances.
+    """
+
+    def action() -> None:
+        options = CheckOptions(distance_mm=tolerance_mm, rtol=rtol, rotation_rad=rotation_tol)
+        report = check_build(build_dir, reference, options, progress=note)
+        if json_out:
+            emit_json(report.as_dict())
+            for line in summary_lines(report):
+                note(line)
+        else:
+            for line in table_lines(report.figures) + [""] + summary_lines(report):
+                typer.echo(line)
+        if not report.passed:
+            raise typer.Exit(code=1)
+
+    run_guarded(action)
+
+
+def table_lines(figures: tuple[Figure, ...]) -> list[str]:
+    """One aligned row per figure: item, figure, change, tolerance, PASS/FAIL, note."""
+    rows = [HEADER] + [
+        (f.item, f.figure, _change_text(f), _number_text(f.tolerance), "PASS" if f.passed else "FAIL", f.note)
+        for f in figures
+    ]
+    widths = [max(len(row[i]) for row in rows) for i in range(len(HEADER) - 1)]
+    return [("  ".join(cell.ljust(w) for cell, w in zip(row, widths)) + "  " + row[-1]).rstrip() for row in rows]
+
+
+def summary_lines(report: CheckReport) -> list[str]:
+    """The verdict, then every failed figure with its value and tolerance, then the notes."""
+    lines = [f"note: {text}" for text in report.notes]
+    total, build, ref = len(report.figures), report.build_dir, report.reference_dir
+    if report.passed:
+        return lines + [f"check PASSED: {total} figure(s) of {build} within tolerance of {ref}"]
+    failures = report.failures
+    lines.append(f"check FAILED: {len(failures)} of {total} figure(s) of {build} moved from {ref}:")
+    for f in failures:
+        lines.append(f"  {f.item}: {f.figure} {_verdict_text(f)}")
+    return lines
+
+
+def _verdict_text(f: Figure) -> str:
+    if f.change is None:
+        text = f"build {_value_text(f.build)}, reference {_value_text(f.reference)}"
+    else:
+        text = f"{_number_text(f.change)} outside tolerance {_number_text(f.tolerance)}"
+    return text + (f" ({f.note})" if f.note else "")
+
+
+def _change_text(f: Figure) -> str:
+    if f.change is None:
+        return f"{_value_text(f.build)} (ref {_value_text(f.reference)})"
+    return _number_text(f.change)
+
+
+def _value_text(value) -> str:
+    return "-" if value is None else _number_text(value) if isinstance(value, float) else str(value)
+
+
+def _number_text(value) -> str:
+    return "-" if value is None else f"{value:.{TABLE_DIGITS}g}"
