@@ -177,3 +177,26 @@ def test_blend_errors_say_what_to_do(final):
         blend_shapes(straight, final, keyframes=((1.0, straight),))
     with pytest.raises(ConfigError, match=r"q must lie in \[0, 1\], got 1.5"):
         blend_shapes(straight, final).curve_at(1.5)
+
+
+@pytest.mark.parametrize(
+    ("spec", "words"),
+    [
+        (InitialSpec(kind="arc"), "kind: arc needs initial.bend_radius_mm"),
+        (InitialSpec(kind="file"), "kind: file needs initial.centerline"),
+        (InitialSpec(kind="file", points=np.arange(12.0).reshape(4, 3), length_mm=10.0),
+         "initial.length_mm = 10 applies to kind straight or arc"),
+        (InitialSpec(kind="straight", length_mm=-1.0), "initial.length_mm must be > 0 mm, got -1"),
+        (InitialSpec(kind="coil"), "initial.kind must be one of straight, arc, file, got 'coil'"),
+    ],
+)
+def test_initial_spec_errors_name_the_field(final, spec, words):
+    with pytest.raises(ConfigError, match=words):
+        build_initial_shape(final, spec)
+
+
+def test_stats_over_a_range_shorter_than_a_dense_step(final):
+    shape = blend_shapes(straight_initial_shape(final), final)
+    stats = shape.stats_at(1.0, (0.5, 0.5001))
+    np.testing.assert_allclose(stats.length_mm, 0.0001 * final.length, rtol=1e-9, atol=0)
+    np.testing.assert_allclose(stats.curvature_max_per_mm, 1 / RADIUS, rtol=1e-6, atol=0)

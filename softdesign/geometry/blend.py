@@ -116,7 +116,7 @@ class BlendedShape:
         """Length, stretch range and curvature range at q over ``l_range`` (dense grid)."""
         curve = self.smooth_curve_at(q)
         l = self.keys[-1].dense_l()
-        l = l[(l >= l_range[0]) & (l <= l_range[1])]
+        l = np.unique(np.concatenate([l[(l > l_range[0]) & (l < l_range[1])], l_range]))
         stretch = curve.speed(l) / self.keys[0].speed(l) if q > 0.0 else np.ones(len(l))
         kappa = curve.curvature(l)
         s = curve.arc_length(np.array(l_range, float))

@@ -74,7 +74,7 @@ class CurveReport:
     spacing_mm: float
     max_curvature_per_mm: float
     max_curvature_l: float
-    max_abs_torsion_per_mm: float
+    max_abs_torsion_per_mm: float  # where kappa >= FRENET_KAPPA_TOL (0 on a straight curve)
     max_abs_torsion_l: float
 
 
@@ -146,9 +146,10 @@ class SmoothCurve:
     def dense_l(self) -> FloatArray:
         """Uniform evaluation grid containing ``l_grid``: DENSE_PER_INTERVAL per interval, steps <= DENSE_STEP_MM."""
         intervals = len(self.l_grid) - 1
-        step = self.length / intervals
-        factor = max(DENSE_PER_INTERVAL, int(np.ceil(step / DENSE_STEP_MM)))
-        return np.linspace(0.0, 1.0, intervals * factor + 1)
+        factor = max(DENSE_PER_INTERVAL, int(np.ceil(self.length / intervals / DENSE_STEP_MM)))
+        # built from l_grid itself so that every sample (and knot) is bit-for-bit a dense point
+        inner = self.l_grid[:-1, None] + np.diff(self.l_grid)[:, None] * (np.arange(factor) / factor)
+        return np.concatenate([inner.ravel(), self.l_grid[-1:]])
 
     def report(self) -> CurveReport:
         """Length, sample count and spacing, max curvature and max |torsion| (on the dense grid)."""

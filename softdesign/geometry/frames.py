@@ -190,8 +190,7 @@ class FramedSpline:
         if self.mode == "frenet":
             return frenet_frames(self.curve, l, self.label)
         # one double-reflection step from the dense sample at or before l
-        step = self.dense_l[1] - self.dense_l[0]
-        start = np.clip(np.floor(l / step).astype(np.int64), 0, len(self.dense_l) - 2)
+        start = np.clip(np.searchsorted(self.dense_l, l, side="right") - 1, 0, len(self.dense_l) - 2)
         l_start = self.dense_l[start]
         tangents = self.curve.tangents(np.concatenate([l_start, l]))
         rotations = reflection_rotations_between(

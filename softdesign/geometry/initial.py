@@ -87,6 +87,11 @@ def build_initial_shape(
     if spec.kind == "file":
         if spec.points is None:
             raise ConfigError("initial.kind: file needs initial.centerline (a path to the q = 0 centerline)")
+        if spec.length_mm is not None:
+            raise ConfigError(
+                f"initial.length_mm = {spec.length_mm:g} applies to kind straight or arc; a kind: file shape "
+                "keeps the length of its centerline - remove length_mm"
+            )
         return initial_shape_from_polyline(final, spec.points, options, spec.align_base, spec.roll_rad)
     raise ConfigError(f"initial.kind must be one of straight, arc, file, got {spec.kind!r}")
 
