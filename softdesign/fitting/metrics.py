@@ -133,24 +133,26 @@ def _gauss_newton_step(residual: Points, du: Points, dv: Points) -> FloatArray:
 
 
 def _damped_update(curve, spline, p, start, step, dist):
-    """Take the Gauss-Newton step, halving it (up to 8 times) where it does not reduce the distance."""
+    """Take the Gauss-Newton step, halving it (up to 8 times) for the points where it does not help.
+
+    A point whose step never reduces the distance stays where it was (it has converged).
+    """
     l0, a0 = start
-    scale = np.ones(len(l0))
+    l_out, a_out = l0.copy(), a0.copy()
+    pending = np.arange(len(l0))
+    scale = 1.0
     for _ in range(8):
-        l = np.clip(l0 + scale * step[:, 0], 0.0, 1.0)
-        a = a0 + scale * step[:, 1]
-        surface, du, dv = _surface_and_tangents(curve, spline, l, a)
-        d = np.linalg.norm(p - surface, axis=1)
-        worse = d > dist
-        if not worse.any():
+        l = np.clip(l0[pending] + scale * step[pending, 0], 0.0, 1.0)
+        a = a0[pending] + scale * step[pending, 1]
+        d = np.linalg.norm(p[pending] - surface_points(curve, spline, l, a), axis=1)
+        better = d <= dist[pending]
+        l_out[pending[better]], a_out[pending[better]] = l[better], a[better]
+        pending = pending[~better]
+        if pending.size == 0:
             break
-        scale = np.where(worse, 0.5 * scale, scale)
-    keep = d <= dist
-    out_l, out_a = np.where(keep, l, l0), np.where(keep, a, a0)
-    if not keep.all():
-        surface, du, dv = _surface_and_tangents(curve, spline, out_l, out_a)
-        d = np.linalg.norm(p - surface, axis=1)
-    return out_l, out_a, surface, du, dv, d
+        scale *= 0.5
+    surface, du, dv = _surface_and_tangents(curve, spline, l_out, a_out)
+    return l_out, a_out, surface, du, dv, np.linalg.norm(p - surface, axis=1)
 
 
 def summarize_distances(distance: FloatArray) -> FitMetrics:
