@@ -11,7 +11,9 @@ What is compared, and against which tolerance (:class:`CheckOptions`):
   transform (mm, ``distance_mm``), angle of the rotation between the two
   transforms (rad, ``rotation_rad``), link length and POE theta1 (mm,
   ``distance_mm``), POE theta2 (rad, ``rotation_rad``); the same for each
-  pose's ``base_to_tip``; the frame convention must match;
+  pose's ``base_to_tip`` and ``base_to_world`` (where present); the frame
+  convention must match.  A pose is matched by its q, one value or one per
+  link as the kinematics stage writes it;
 - the fit metrics ``manifest.json: metrics.fit.*_mm`` (``distance_mm``).
 
 Any change beyond tolerance fails, an improvement included: a reference is
@@ -60,6 +62,8 @@ GOLDEN = "golden.json"
 FIT_KEYS = ("rms_mm", "p95_mm", "p99_mm", "max_mm", "holdout_rms_mm")
 #: Decimals of q that identify a pose (q values are written as the case file gives them).
 Q_DECIMALS = 9
+#: Chain-level transforms of a pose, compared like link transforms when either side has them.
+POSE_TRANSFORMS = ("base_to_tip", "base_to_world")
 
 Value = Optional[float | bool | str]
 
@@ -277,7 +281,7 @@ def compare_fit(build_manifest: dict, ref_manifest: dict, tolerance_mm: float, n
     ours = _fit_metrics(build_manifest, "build " + MANIFEST)
     theirs = _fit_metrics(ref_manifest, "reference " + MANIFEST)
     if ours is None and theirs is None:
-        notes.append("no fit metrics on either side (a case without a surface): not compared")
+        notes.append("no metrics.fit on either side (no fit stage, or a case without a surface): not compared")
         return []
     if ours is None or theirs is None:
         return [_missing("fit", "metrics.fit", in_build=ours is not None)]
@@ -310,30 +314,31 @@ def pose_difference(pose: np.ndarray, ref_pose: np.ndarray) -> tuple[float, floa
 
 
 def compare_kinematics(build: dict, ref: dict, options: CheckOptions, where: str = KINEMATICS) -> list[Figure]:
-    """Figures of two ``kinematics.json`` objects: frames, then per q each link and base_to_tip."""
+    """Figures of two ``kinematics.json`` objects: frames, then per q each link and the chain transforms."""
     frames_ok = build.get("frames") == ref.get("frames")
     figures = [Figure("kinematics", "frames", None, None, frames_ok, build.get("frames"), ref.get("frames"))]
     ours, theirs = _keyed(build, "poses", "q", where), _keyed(ref, "poses", "q", "reference " + where)
-    for q in sorted(set(ours) | set(theirs)):
-        item = f"kinematics q={q:g}"
+    for q in sorted(set(ours) | set(theirs), key=_numeric_order):
+        item = f"kinematics q={q}"
         if q not in ours or q not in theirs:
             figures.append(_missing(item, "pose", in_build=q in ours))
             continue
-        figures += _pose_figures(item, ours[q], theirs[q], options, f"{where}: pose q={q:g}")
+        figures += _pose_figures(item, ours[q], theirs[q], options, f"{where}: pose q={q}")
     return figures
 
 
 def _pose_figures(item: str, pose: dict, ref_pose: dict, options: CheckOptions, where: str) -> list[Figure]:
     ours, theirs = _keyed(pose, "links", "index", where), _keyed(ref_pose, "links", "index", "reference " + where)
     figures: list[Figure] = []
-    for index in sorted(set(ours) | set(theirs)):
+    for index in sorted(set(ours) | set(theirs), key=_numeric_order):
         link_item = f"{item} link {index}"
         if index not in ours or index not in theirs:
             figures.append(_missing(link_item, "link", in_build=index in ours))
             continue
         figures += _link_figures(link_item, ours[index], theirs[index], options, f"{where} link {index}")
-    tip = (pose.get("base_to_tip"), ref_pose.get("base_to_tip"))
-    figures += _transform_figures(f"{item} base_to_tip", *tip, options, f"{where} base_to_tip")
+    for key in POSE_TRANSFORMS:
+        if pose.get(key) is not None or ref_pose.get(key) is not None:
+            figures += _transform_figures(f"{item} {key}", pose.get(key), ref_pose.get(key), options, f"{where} {key}")
     return figures
 
 
@@ -373,18 +378,25 @@ def _compare_kinematics_files(
     return compare_kinematics(_read_json(ours), _read_json(theirs), options, ours.as_posix())
 
 
-def _keyed(parent: dict, field_name: str, key: str, where: str) -> dict[float, dict]:
-    """``parent[field_name]`` (a list of objects) keyed by each object's number ``key`` (q rounded)."""
+def _keyed(parent: dict, field_name: str, key: str, where: str) -> dict[str, dict]:
+    """``parent[field_name]`` (a list of objects) keyed by the text of each one's ``key`` (a number or numbers)."""
     entries = parent.get(field_name)
     if not isinstance(entries, list):
         raise InputDataError(f"{where}: '{field_name}' must be a list, got {type(entries).__name__}")
-    out: dict[float, dict] = {}
+    out: dict[str, dict] = {}
     for i, entry in enumerate(entries):
         value = entry.get(key) if isinstance(entry, dict) else None
-        if not _is_number(value):
-            raise InputDataError(f"{where}: {field_name}[{i}].{key} must be a number, got {value!r}")
-        out[round(value, Q_DECIMALS)] = entry
+        values = value if isinstance(value, list) and value else [value]
+        if not all(_is_number(v) for v in values):
+            raise InputDataError(f"{where}: {field_name}[{i}].{key} must be a number or numbers, got {value!r}")
+        # One q per link, all equal, is the same pose as that single q: name it once.
+        texts = [f"{round(v, Q_DECIMALS):.12g}" for v in values]
+        out[texts[0] if len(set(texts)) == 1 else ",".join(texts)] = entry
     return out
+
+
+def _numeric_order(key: str) -> list[float]:
+    return [float(part) for part in key.split(",")]
 
 
 def _pose(value: Any, where: str) -> np.ndarray:

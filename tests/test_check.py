@@ -68,7 +68,8 @@ def kinematics_payload() -> dict:
             poe = {"theta1": theta1, "xi1": (pose[:3, 3] / theta1).tolist(),
                    "theta2": theta2, "omega": [-1.0, 0.0, 0.0] if theta2 else None}
             links.append({"index": index, "length": LINK_LENGTH_MM, "transform": pose.tolist(), "poe": poe})
-        poses.append({"q": q, "links": links, "base_to_tip": tip.tolist()})
+        # As the kinematics stage writes it: one q per link, and the base placed in the patient's frame.
+        poses.append({"q": [q, q], "links": links, "base_to_tip": tip.tolist(), "base_to_world": np.eye(4).tolist()})
     links = [{"index": i, "l_start": i / 2, "l_end": (i + 1) / 2} for i in range(2)]
     return {"frames": "rmf", "links": links, "poses": poses}
 
@@ -139,7 +140,7 @@ def test_a_build_passes_against_itself_with_every_item_compared(build, reference
     items = {f["item"] for f in payload["figures"]}
     assert {"meshes/q_0.000.stl", "meshes/q_0.500.stl", "meshes/q_0.500.ply", "fit"} <= items
     assert {f"kinematics q={q:g} link {i}" for q in Q_VALUES for i in range(2)} <= items
-    assert {f"kinematics q={q:g} base_to_tip" for q in Q_VALUES} <= items
+    assert {f"kinematics q={q:g} {key}" for q in Q_VALUES for key in ("base_to_tip", "base_to_world")} <= items
     for line in result.stdout.splitlines()[1:len(payload["figures"]) + 1]:
         assert re.search(r"\sPASS(\s|$)", line) and "FAIL" not in line, line
 
@@ -216,6 +217,20 @@ def test_a_link_rotation_fails_past_the_rotation_tolerance_only(build, reference
     assert (code == 0) is passes and rotation["passed"] is passes
 
 
+def test_poses_match_by_q_given_once_or_per_link(build, reference):
+    def per_link(payload):
+        payload["poses"][1]["q"] = 0.5  # the same pose as [0.5, 0.5]
+        payload["poses"][2]["q"] = [0.25, 1.0]  # a different pose
+
+    edit_json(build / "kinematics.json", per_link)
+    result = run_check(build, reference)
+    assert result.exit_code == 1, result.output
+    assert failed_lines(result.output) == [
+        "kinematics q=0.25,1: pose build present, reference missing",
+        "kinematics q=1: pose build missing, reference present",
+    ]
+
+
 def test_fit_metrics_moved_or_missing_fail(build, reference):
     edit_json(build / "manifest.json", lambda m: m["metrics"]["fit"].update(p99_mm=FIT["p99_mm"] + 2 * TOL_MM))
     result = run_check(build, reference)
@@ -231,7 +246,7 @@ def test_fit_absent_on_both_sides_is_noted_not_failed(build, reference):
         edit_json(folder / "manifest.json", lambda m: m["metrics"].pop("fit"))
     result = run_check(build, reference)
     assert result.exit_code == 0, result.output
-    assert "note: no fit metrics on either side" in result.output
+    assert "note: no metrics.fit on either side" in result.output
 
 
 @pytest.mark.parametrize(
