@@ -17,10 +17,10 @@ smoothing 1e-5: 1.0 mm x 24: 0.036, 1.5 x 24: 0.039, 2.0 x 16: 0.045, 3.0 x 16:
 0.056; it keeps falling as the knots approach the mesh's 0.97 mm edges, where
 there are fewer than two points per coefficient.  1.5 mm x 24 (about 1.5 edges
 each way, 3 points per coefficient) is the default; ``auto`` picks 1.0 here.
-Smoothing: across the other iliac's opening (no wall data all around for ~13 mm of the
-path, 30..43 mm from the inlet, where up to 186 degrees of the circle are empty) the fitted rho stays inside the observed
-4.2..8.3 mm for smoothing >= 1e-5 but overshoots to 9.1 mm at 1e-6; larger
-values cost accuracy (RMS 0.028 at 1e-5, 0.045 at 1e-4, 0.078 at 1e-3).
+Smoothing: across the other iliac's opening (30..43 mm from the inlet, where
+up to 186 degrees of the circle have no wall of path 0) the fitted rho stays
+inside the observed 4.2..8.3 mm for smoothing >= 1e-5 but overshoots to 9.1 mm
+at 1e-6; larger values cost accuracy (RMS 0.028 at 1e-5, 0.045 at 1e-4, 0.078 at 1e-3).
 """
 
 from __future__ import annotations

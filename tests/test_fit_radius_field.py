@@ -48,7 +48,8 @@ def test_constant_initial_and_the_blend_between_shapes():
     l, angle = np.linspace(0.0, 1.0, 21), np.linspace(-np.pi, np.pi, 11)
     np.testing.assert_allclose(field.evaluate_grid(0.0, l, angle), 2.0, rtol=0, atol=VALUE_TOL_MM)
     rho_f = field.evaluate_grid(1.0, l, angle)
-    np.testing.assert_allclose(field.evaluate_grid(0.25, l, angle), 0.75 * 2.0 + 0.25 * rho_f, rtol=0, atol=VALUE_TOL_MM)
+    blend = field.evaluate_grid(0.25, l, angle)
+    np.testing.assert_allclose(blend, 0.75 * 2.0 + 0.25 * rho_f, rtol=0, atol=VALUE_TOL_MM)
     first = l <= 0.4 - 1e-12
     np.testing.assert_allclose(rho_f[first], final[0].evaluate_grid(l[first], angle), rtol=0, atol=VALUE_TOL_MM)
     with pytest.raises(FitError, match="radius_mm must be > 0 mm, got -1"):
@@ -108,6 +109,7 @@ def test_a_tube_that_folds_names_the_place_and_the_fix():
                  "resample.smoothing_mm", "resample.end_straight_mm", "smaller radius"):
         assert part in message
     # Within the limit: the report gives the maximum, 15 mm / 20 mm at the tip.
-    assert check_self_folding(curve, _round_field(lambda l: 10.0 + 5.0 * l)).max_rho_kappa == pytest.approx(0.75, abs=1e-12)
+    report = check_self_folding(curve, _round_field(lambda l: 10.0 + 5.0 * l))
+    assert report.max_rho_kappa == pytest.approx(0.75, abs=1e-12)
     with pytest.raises(FitError, match="rho reaches -2 mm"):
         check_self_folding(curve, _round_field(lambda l: 2.0 - 4.0 * l))

@@ -95,9 +95,9 @@ def closest_surface_points(
         if idx.size == 0:
             break
         step = _gauss_newton_step(p[idx] - surface[idx], du[idx], dv[idx])
-        l_new, a_new, s_new, du_new, dv_new, d_new = _damped_update(curve, spline, p[idx], (l[idx], a[idx]), step, dist[idx])
-        moved = np.linalg.norm(s_new - surface[idx], axis=1)
-        l[idx], a[idx], surface[idx], du[idx], dv[idx], dist[idx] = l_new, a_new, s_new, du_new, dv_new, d_new
+        update = _damped_update(curve, spline, p[idx], (l[idx], a[idx]), step, dist[idx])
+        moved = np.linalg.norm(update[2] - surface[idx], axis=1)
+        l[idx], a[idx], surface[idx], du[idx], dv[idx], dist[idx] = update
         active[idx[moved <= CLOSEST_TOL_MM]] = False
     return dist, l, a
 

@@ -126,10 +126,10 @@ class RadiusField:
         """The inverse of :meth:`to_arrays` (accepts the mapping ``np.load`` returns)."""
         breaks = np.array(arrays["breaks"], float)
         count = len(breaks) - 1
-        final = tuple(RadiusSpline.from_arrays(arrays[f"link{j}_knots"], arrays[f"link{j}_final"]) for j in range(count))
-        initial = tuple(
-            RadiusSpline.from_arrays(arrays[f"link{j}_knots"], arrays[f"link{j}_initial"]) for j in range(count)
-        )
+        final = tuple(RadiusSpline.from_arrays(arrays[f"link{j}_knots"], arrays[f"link{j}_final"])
+                      for j in range(count))
+        initial = tuple(RadiusSpline.from_arrays(arrays[f"link{j}_knots"], arrays[f"link{j}_initial"])
+                        for j in range(count))
         return cls(breaks, final, initial)
 
 

@@ -1,0 +1,121 @@
+"""Step 4 of the method on one path, in one call: project, select, fit, measure, check, blend.
+
+This is the whole fit stage without files or printing, for the pipeline to
+call with the case's settings and to record :meth:`WallFit.summary` in the
+manifest.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from softdesign.fitting.bspline_surface import FitSettings, SurfaceFit, fit_radius_surface
+from softdesign.fitting.metrics import (
+    FitMetrics,
+    HoldoutReport,
+    HoldoutSettings,
+    choose_knot_spacing,
+    holdout_rms,
+    measure_fit,
+)
+from softdesign.fitting.projection import PolarPoints, project_points
+from softdesign.fitting.radius_field import FoldReport, RadiusField, check_self_folding
+from softdesign.fitting.selection import NetworkContext, SelectionSettings, WallSelection, select_wall_points
+from softdesign.types import FramedCurve
+
+
+@dataclass(frozen=True)
+class WallFitOptions:
+    """Everything the fit stage is told.
+
+    Attributes
+    ----------
+    fit : spline space, penalty and link breaks (its spacing is ignored when ``auto_spacing``)
+    auto_spacing : choose the knot spacing by hold-out (``knot_spacing_mm: auto``)
+    selection : thresholds of the point selection
+    holdout : folds, and the spacings ``auto`` tries
+    initial_radius_mm : constant rho0; None for the axially symmetric mean of the fit
+    fold_limit : the largest rho * kappa allowed at q = 1
+    """
+
+    fit: FitSettings = field(default_factory=FitSettings)
+    auto_spacing: bool = False
+    selection: SelectionSettings = field(default_factory=SelectionSettings)
+    holdout: HoldoutSettings = field(default_factory=HoldoutSettings)
+    initial_radius_mm: float | None = None
+    fold_limit: float = 1.0
+
+
+@dataclass(frozen=True)
+class WallFit:
+    """The fit stage's results (all points, selection, splines, metrics, checks, radius field)."""
+
+    polar: PolarPoints
+    selection: WallSelection
+    settings: FitSettings
+    spacing_scores: dict[float, float]
+    surface: SurfaceFit
+    metrics: FitMetrics
+    holdout: HoldoutReport
+    folding: FoldReport
+    field: RadiusField
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready figures for the manifest (mm, rad; snake_case keys)."""
+        return {
+            "points": dict(self.selection.counts),
+            "settings": {"knot_spacing_mm": self.settings.knot_spacing_mm,
+                         "angular_intervals": self.settings.angular_intervals,
+                         "smoothing": self.settings.smoothing, "breaks": list(self.settings.breaks)},
+            "knot_spacing_scores_mm": {f"{k:g}": v for k, v in self.spacing_scores.items()},
+            "distance": self.metrics.as_dict(),
+            "holdout_rms_mm": self.holdout.rms_mm,
+            "holdout_fold_rms_mm": self.holdout.fold_rms_mm.tolist(),
+            "radial_rms_mm": self.surface.radial_rms_mm,
+            "joint_value_jump_mm": self.surface.joint_value_jump_mm.tolist(),
+            "joint_slope_jump": self.surface.joint_slope_jump.tolist(),
+            "max_rho_kappa": self.folding.max_rho_kappa,
+            "max_rho_kappa_at": {"l": self.folding.l, "arc_mm": self.folding.arc_mm, "angle": self.folding.angle},
+            "min_rho_mm": self.folding.min_rho_mm,
+        }
+
+
+def fit_wall(
+    curve: FramedCurve,
+    vertices: npt.ArrayLike,
+    network: NetworkContext,
+    options: WallFitOptions,
+    rng: np.random.Generator,
+) -> WallFit:
+    """Fit the wall of one path: rho(l, a) per link, its quality, and the radius field rho(q).
+
+    Parameters
+    ----------
+    curve : the path's smooth framed centerline at q = 1
+    vertices : (n, 3) float, mm, the surface's vertices
+    network : the path's polyline, the other polylines, inscribed radii
+    options : settings of every step
+    rng : draws the hold-out folds
+
+    Raises
+    ------
+    FitError
+        The wall does not surround the path, the solve fails, or the tube folds at q = 1.
+    """
+    polar = project_points(curve, vertices)
+    selection = select_wall_points(polar, curve.length, network, options.selection)
+    kept = polar.subset(selection.keep)
+    settings, scores = options.fit, {}
+    if options.auto_spacing:
+        spacing, scores = choose_knot_spacing(curve, kept, settings, rng, options.holdout)
+        settings = replace(settings, knot_spacing_mm=spacing)
+    surface = fit_radius_surface(kept, curve.length, settings)
+    metrics = measure_fit(curve, surface.whole, kept)
+    holdout = holdout_rms(curve, kept, settings, rng, options.holdout.folds)
+    radius = RadiusField.from_links(settings.breaks, surface.links, options.initial_radius_mm)
+    folding = check_self_folding(curve, radius, q=1.0, limit=options.fold_limit)
+    return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius)
