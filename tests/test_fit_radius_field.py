@@ -113,3 +113,25 @@ def test_a_tube_that_folds_names_the_place_and_the_fix():
     assert report.max_rho_kappa == pytest.approx(0.75, abs=1e-12)
     with pytest.raises(FitError, match="rho reaches -2 mm"):
         check_self_folding(curve, _round_field(lambda l: 2.0 - 4.0 * l))
+
+
+def test_an_initial_surface_fitted_with_the_final_layout_blends_with_it():
+    # rho0 from another surface: fit it on its own curve but with the final path's length and settings,
+    # so both share knots; then rho(q) blends the two fitted shapes.
+    from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
+    from softdesign.fitting.projection import project_points
+    from tests.fit_analytic import Line, grid_parameters, tube_points
+
+    final_curve, initial_curve = Arc(20.0, 2.0), Line(35.0)
+    settings = FitSettings(breaks=(0.0, 0.4, 1.0))
+    l, a = grid_parameters(50, 30, np.random.default_rng(2))
+    final = fit_radius_surface(project_points(final_curve, tube_points(final_curve, l, a, 3.0 + l)),
+                               final_curve.length, settings)
+    initial = fit_radius_surface(project_points(initial_curve, tube_points(initial_curve, l, a, 2.0 + 0 * l)),
+                                 final_curve.length, settings)
+    field = RadiusField(np.array(settings.breaks), final.links, initial.links)
+    grid_l = np.linspace(0.0, 1.0, 11)
+    # Both shapes have no penalty energy, so both fits are exact (to the projection's 1e-10 mm Newton
+    # tolerance); the blend at q = 0.5 is (2 + 3 + l) / 2.
+    expected = np.repeat((2.5 + grid_l / 2)[:, None], 2, axis=1)
+    np.testing.assert_allclose(field.evaluate_grid(0.5, grid_l, [0.0, 2.0]), expected, rtol=0, atol=1e-9)
