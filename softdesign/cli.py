@@ -13,7 +13,7 @@ from typing import Annotated, Optional
 import typer
 
 from softdesign.cli_support import emit_json, note, run_guarded
-from softdesign.errors import SoftdesignError
+from softdesign.check_cli import check
 from softdesign.pcc_cli import pcc_app
 
 app = typer.Typer(
@@ -22,30 +22,19 @@ app = typer.Typer(
     help="Patient-specific soft actuators from VMTK vessel exports.",
 )
 app.add_typer(pcc_app, name="pcc")
+app.command()(check)
 
 CaseArg = Annotated[Path, typer.Argument(help="The case file (YAML).", show_default=False)]
 OutOpt = Annotated[Optional[Path], typer.Option("--out", "-o", help="Build folder [default: build/<name>].")]
 ForceOpt = Annotated[bool, typer.Option("--force", help="Redo every stage, ignoring the cache.")]
 
 
-def _build_dir(case, out: Optional[Path]) -> Path:
-    return out if out is not None else Path("build") / case.name
-
-
 def _run(case_file: Path, out: Optional[Path], target: str | None, force: bool):
     """Load the case and run the stages through ``target``; returns (case, build_dir, results, runs)."""
-    from softdesign.config import load_case
-    from softdesign.pipeline.run import RunOptions, run_stages
-    from softdesign.pipeline.stages import STAGES, input_files, stages_through
+    from softdesign.pipeline.api import build_through
 
-    case = load_case(case_file)
-    build_dir = _build_dir(case, out)
-    stages = STAGES if target is None else stages_through(target)
-    try:
-        results, runs = run_stages(case, build_dir, stages, input_files(case), RunOptions(force=force, progress=note))
-    except SoftdesignError as err:
-        raise type(err)(f"{case_file}: {err}") from err
-    return case, build_dir, results, runs
+    outcome = build_through(case_file, out, target, force, progress=note)
+    return outcome.case, outcome.build_dir, outcome.results, outcome.runs
 
 
 def _report(build_dir: Path, runs) -> None:

@@ -17,7 +17,7 @@ import numpy as np
 from softdesign.config import Case
 from softdesign.geometry.blend import BlendedShape, blend_shapes
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline, smooth_curve_from_samples
-from softdesign.geometry.initial import InitialSpec, build_initial_shape
+from softdesign.geometry.initial import InitialSpec, build_initial_shape, initial_shape_from_polyline
 from softdesign.pipeline.ingest import IngestResult
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 
@@ -56,7 +56,11 @@ def run_blend(case: Case, ingest: IngestResult) -> BlendResult:
         align_base=case.initial.align_base,
     )
     initial = build_initial_shape(final, spec, same_grid)
-    keyframes = tuple((q, smooth_curve_from_polyline(p.points, same_grid)) for q, p in ingest.keyframes)
+    # keyframes share the final shape's base point and tangent, so the actuator's base stays put
+    keyframes = tuple(
+        (q, initial_shape_from_polyline(final, p.points, same_grid, case.initial.align_base))
+        for q, p in ingest.keyframes
+    )
     shape = blend_shapes(initial, final, keyframes, case.blend, case.frames)
     return BlendResult(shape, _summary(case, shape))
 

@@ -1,0 +1,45 @@
+"""One call for commands: load a case and run its stages through a target, cached."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
+
+from softdesign.config import Case, load_case
+from softdesign.errors import SoftdesignError
+from softdesign.pipeline.run import RunOptions, StageRun, run_stages
+from softdesign.pipeline.stages import STAGES, input_files, stages_through
+
+
+@dataclass(frozen=True)
+class BuildOutcome:
+    """What a run produced: the case, where, each stage's result and what ran."""
+
+    case: Case
+    build_dir: Path
+    results: dict[str, Any]
+    runs: list[StageRun]
+
+
+def default_build_dir(case: Case, out: Path | None) -> Path:
+    """``out``, else ``build/<name>`` under the current directory (DESIGN.md)."""
+    return out if out is not None else Path("build") / case.name
+
+
+def build_through(
+    case_file: Path,
+    out: Path | None = None,
+    target: str | None = None,
+    force: bool = False,
+    progress: Callable[[str], None] = lambda line: None,
+) -> BuildOutcome:
+    """Run the stages up to ``target`` (every stage when None); errors name the case file."""
+    case = load_case(case_file)
+    build_dir = default_build_dir(case, out)
+    stages = STAGES if target is None else stages_through(target)
+    try:
+        results, runs = run_stages(case, build_dir, stages, input_files(case), RunOptions(force=force, progress=progress))
+    except SoftdesignError as err:
+        raise type(err)(f"{case_file}: {err}") from err
+    return BuildOutcome(case, build_dir, results, runs)
