@@ -87,6 +87,18 @@ def blend(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> No
 
 
 @app.command()
+def fit(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:
+    """Fit rho(l, a) per link to the wall; print the metrics table (true distances, hold-out)."""
+    _stage_command(case_file, out, "fit", force)
+
+
+@app.command()
+def export(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:
+    """Checked watertight solids of S(q) at every export q (STL and the other formats asked for)."""
+    _stage_command(case_file, out, "export", force)
+
+
+@app.command()
 def kinematics(
     case_file: CaseArg,
     out: OutOpt = None,

@@ -35,7 +35,7 @@ def test_defaults_are_filled_in_and_paths_are_relative_to_the_case(tmp_path):
     assert case.units == "mm"
     assert case.frames == "rmf" and case.blend == "linear"
     assert case.links.count == 4
-    assert case.fit.knot_spacing_mm == 2.0 and case.fit.angular_intervals == 16
+    assert case.fit.knot_spacing_mm == 1.5 and case.fit.angular_intervals == 24
     assert case.export.q_values() == [0.0, 0.5, 1.0]
     assert case.final.centerline == sub / "../data/cl.vtp"
     assert case.resolved()["final"]["centerline"] == "../data/cl.vtp"

@@ -112,6 +112,16 @@ class RadiusField:
             out[rows] = self.link_spline(int(j), q).evaluate_grid(l[rows], a, dl, da)
         return out
 
+    def evaluate_pairs(self, q: float, l: npt.ArrayLike, a: npt.ArrayLike) -> FloatArray:
+        """rho(q) at paired points (l_i, a_i), (n,) mm; each l in its own link."""
+        l, a = (np.asarray(v, float).reshape(-1) for v in (l, a))
+        out = np.empty(len(l))
+        owner = self.link_of(l)
+        for j in np.unique(owner):
+            rows = owner == j
+            out[rows] = self.link_spline(int(j), q).evaluate(l[rows], a[rows])
+        return out
+
     def to_arrays(self) -> dict[str, FloatArray]:
         """Plain arrays for ``np.savez``: ``breaks`` and ``link{j}_knots|final|initial``."""
         out = {"breaks": np.array(self.breaks, float)}

@@ -37,6 +37,7 @@ class Stage:
     load : (build_dir, results of upstream stages) -> result, for a skipped stage
     describe : result -> short human summary lines
     metrics : result -> JSON-ready figures for the manifest
+    figures : result -> {output path: figures} merged into the manifest's outputs
     """
 
     name: str
@@ -48,6 +49,7 @@ class Stage:
     load: Callable[[Path, Results], Any]
     describe: Callable[[Any], list[str]]
     metrics: Callable[[Any], dict[str, Any]]
+    figures: Callable[[Any], dict[str, dict[str, Any]]] = lambda result: {}
 
 
 @dataclass
@@ -154,7 +156,11 @@ def build_manifest(
     staging: Staging,
 ) -> dict[str, Any]:
     """The manifest: software, inputs with sha256, resolved case, stages, metrics, outputs."""
-    outputs = _all_outputs(build_dir, stages, staging)
+    figures: dict[str, dict[str, Any]] = {}
+    for stage in stages:
+        if stage.name in results:
+            figures.update(stage.figures(results[stage.name]))
+    outputs = [{**entry, **figures.get(entry["path"], {})} for entry in _all_outputs(build_dir, stages, staging)]
     return {
         "software": {"softdesign": __version__},
         "case": case.resolved(),

@@ -6,7 +6,7 @@ from pathlib import Path
 from typing import Any
 
 from softdesign.config import Case
-from softdesign.pipeline import blend_stage, ingest, kinematics_stage
+from softdesign.pipeline import blend_stage, export_stage, fit_stage, ingest, kinematics_stage
 from softdesign.pipeline.run import Results, Stage
 
 
@@ -63,8 +63,33 @@ KINEMATICS = Stage(
     metrics=lambda result: {"links": len(result.document["links"]), "file": kinematics_stage.FILE},
 )
 
+FIT = Stage(
+    name="fit",
+    version=fit_stage.VERSION,
+    sections=("fit", "initial"),
+    upstream=("ingest", "kinematics"),
+    compute=lambda case, results: fit_stage.run_fit(case, results["ingest"], results["kinematics"]),
+    write=fit_stage.write_fit,
+    load=lambda build_dir, results: fit_stage.load_fit(build_dir),
+    describe=fit_stage.describe_fit,
+    metrics=fit_stage.fit_metrics,
+)
+
+EXPORT = Stage(
+    name="export",
+    version=export_stage.VERSION,
+    sections=("export",),
+    upstream=("kinematics", "fit"),
+    compute=lambda case, results: export_stage.run_export(case, results["kinematics"], results["fit"]),
+    write=export_stage.write_export,
+    load=lambda build_dir, results: export_stage.load_export(build_dir),
+    describe=export_stage.describe_export,
+    metrics=lambda result: {k: v for k, v in result.summary.items() if k != "meshes"},
+    figures=export_stage.output_figures,
+)
+
 #: Every stage, in build order.
-STAGES: list[Stage] = [INGEST, BLEND, KINEMATICS]
+STAGES: list[Stage] = [INGEST, BLEND, KINEMATICS, FIT, EXPORT]
 
 
 def stages_through(name: str) -> list[Stage]:

@@ -1,0 +1,69 @@
+"""The body S(q, l, a) = c(q, l) + rho(q, l, a) (cos a N + sin a B) sampled for meshing and integration.
+
+Joins a framed centerline at one q with the radius field: rings on an l grid
+(arc-length spacing, joints and ends included once) for the tessellation, and
+the same quantities at any l for the volume integral, so the mesh and the
+integral it is checked against see one surface.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from softdesign.fitting.radius_field import RadiusField
+from softdesign.geometry.frames import FramedSpline
+from softdesign.meshing.tessellate import TubeSections, l_grid_from_spacing
+from softdesign.meshing.volume import SectionField, Stations, angle_grid
+from softdesign.types import FloatArray
+
+
+def curvature_components(curve: FramedSpline, l: FloatArray, frames: FloatArray) -> FloatArray:
+    """(k1, k2) = (T'.N, T'.B) per unit arc length, (n, 2) 1/mm."""
+    kvec = curve.curve.curvature_vectors(l)
+    return np.column_stack([np.einsum("ni,ni->n", kvec, frames[:, :, 0]), np.einsum("ni,ni->n", kvec, frames[:, :, 1])])
+
+
+def body_stations(curve: FramedSpline, field: RadiusField, q: float, angular_count: int) -> SectionField:
+    """The body at q as a function of l (for :func:`~softdesign.meshing.volume.integrate_body`)."""
+    a = angle_grid(angular_count)
+
+    def stations(l: npt.ArrayLike) -> Stations:
+        l = np.asarray(l, float)
+        speed = curve.curve.speed(l)
+        rho_l = field.evaluate_grid(q, l, a, dl=1)
+        return Stations(
+            rho=field.evaluate_grid(q, l, a),
+            rho_s=rho_l / speed[:, None],
+            curvature=curvature_components(curve, l, curve.frames(l)),
+            speed=speed,
+        )
+
+    return stations
+
+
+def body_breaks(field: RadiusField) -> FloatArray:
+    """Every l where the integrand may not be smooth: link joints and the radius splines' knots."""
+    knots = np.concatenate([np.asarray(s.knots) for s in field.final] + [np.asarray(field.breaks)])
+    return np.unique(np.clip(knots, 0.0, 1.0))
+
+
+def body_sections(
+    curve: FramedSpline, field: RadiusField, q: float, spacing_mm: float, angular_count: int
+) -> TubeSections:
+    """Rings of the body at q about ``spacing_mm`` apart, every joint included once."""
+    l_dense = curve.curve.dense_l()
+    s_dense = curve.curve.arc_length(l_dense)
+    l = l_grid_from_spacing(l_dense, s_dense, field.breaks, spacing_mm)
+    st = body_stations(curve, field, q, angular_count)(l)
+    frames = curve.frames(l)
+    return TubeSections(
+        q=float(q),
+        l=l,
+        centers=curve.points(l),
+        frames=frames,
+        rho=st.rho,
+        s=curve.curve.arc_length(l),
+        rho_s=st.rho_s,
+        curvature=st.curvature,
+    )

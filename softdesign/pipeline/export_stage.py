@@ -1,0 +1,161 @@
+"""Stage 5, export: a checked watertight solid of S(q) at every export q, in every format.
+
+Each mesh is built by :func:`softdesign.meshing.solids.build_solid` and
+checked before it is kept (watertight, consistently wound, one body, the
+expected Euler characteristic, volume within 0.5 % of the volume integrated
+from the spline surface by Gauss-Legendre quadrature in l and the trapezoid
+rule in the angle).  Outputs: ``meshes/q_0.500.stl`` (and .ply with region
+labels, .obj, .glb when asked) and ``centerlines/q_0.500.vtp`` carrying the
+frames (N, B, T) and the axial stretch, for VMTK, ParaView and 3D Slicer.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from softdesign.config import Case
+from softdesign.io.mesh_files import mesh_bytes
+from softdesign.io.polylines_vtp import write_polylines_vtp
+from softdesign.meshing.body import body_breaks, body_sections, body_stations
+from softdesign.meshing.checks import check_solid
+from softdesign.meshing.solids import Solid, build_solid
+from softdesign.meshing.volume import BodySpec, integrate_body
+from softdesign.pipeline.fit_stage import FitResult
+from softdesign.pipeline.kinematics_stage import KinematicsResult
+from softdesign.pipeline.store import Staging
+
+VERSION = 1
+SUMMARY = "export/summary.json"
+
+
+@dataclass(frozen=True)
+class ExportedMesh:
+    """One checked solid at one q, with its figures."""
+
+    q: float
+    solid: Solid
+    figures: dict[str, Any]
+    centerline: dict[str, np.ndarray]
+
+
+@dataclass(frozen=True)
+class ExportResult:
+    """Every exported solid (None after a cached load) and the figures per output file."""
+
+    meshes: tuple[ExportedMesh, ...]
+    summary: dict[str, Any]
+
+
+def mesh_name(q: float, fmt: str) -> str:
+    """``meshes/q_0.500.stl``: three decimals, as DESIGN.md names them."""
+    return f"meshes/q_{q:.3f}.{fmt}"
+
+
+def body_spec(case: Case) -> BodySpec:
+    """The case's export keys as a solid specification."""
+    e = case.export
+    return BodySpec(offset_mm=e.offset_mm, wall_mm=e.wall_mm or 0.0, port_mm=e.port_mm or 0.0)
+
+
+def solid_at(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case) -> ExportedMesh:
+    """Build and check the solid of S(q).
+
+    Raises
+    ------
+    MeshError
+        Naming q and l: a fold, a wall too thick, or a failed check (with figures).
+    """
+    curve = kinematics.chain.shape.curve_at(q)
+    e = case.export
+    spec = body_spec(case)
+    solid = build_solid(body_sections(curve, fit.field, q, e.spacing_mm, e.angular_count), spec)
+    integral = integrate_body(body_stations(curve, fit.field, q, e.angular_count), body_breaks(fit.field), spec)
+    report = check_solid(solid.vertices, solid.faces, solid.expectation(integral.volume), label=f"q={q:.3f}")
+    figures = {
+        "q": q,
+        "kind": solid.kind,
+        "vertices": report.vertices,
+        "faces": report.faces,
+        "volume_mm3": report.volume,
+        "volume_expected_mm3": report.volume_expected,
+        "volume_rel_error": report.volume_rel_error,
+        "area_mm2": report.area,
+        "area_expected_mm2": integral.area,
+        "watertight": report.watertight,
+        "winding_consistent": report.winding_consistent,
+        "bodies": report.bodies,
+        "euler": report.euler,
+        "max_rho_kappa": solid.max_rho_kappa,
+    }
+    return ExportedMesh(q, solid, figures, centerline_arrays(kinematics, q))
+
+
+def centerline_arrays(kinematics: KinematicsResult, q: float) -> dict[str, np.ndarray]:
+    """c(q, l) on the final shape's sample grid with l, the frames (N, B, T) and the axial stretch."""
+    shape = kinematics.chain.shape
+    curve = shape.curve_at(q)
+    l = shape.keys[-1].l_grid
+    frames = curve.frames(l)
+    return {
+        "points": curve.points(l),
+        "l": l,
+        "N": frames[:, :, 0],
+        "B": frames[:, :, 1],
+        "T": frames[:, :, 2],
+        "Stretch": curve.curve.speed(l) / shape.keys[0].speed(l),
+    }
+
+
+def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult) -> ExportResult:
+    """A checked solid at every export q."""
+    meshes = tuple(solid_at(kinematics, fit, q, case) for q in case.export.q_values())
+    summary = {
+        "formats": list(case.export.formats),
+        "spec": {"offset_mm": case.export.offset_mm, "wall_mm": case.export.wall_mm, "port_mm": case.export.port_mm},
+        "resolution": {"spacing_mm": case.export.spacing_mm, "angular_count": case.export.angular_count},
+        "volume_method": "Gauss-Legendre in l (8 points between knots and joints) x trapezoid in angle",
+        "meshes": {mesh_name(m.q, fmt): m.figures for m in meshes for fmt in case.export.formats},
+    }
+    return ExportResult(meshes, summary)
+
+
+def write_export(result: ExportResult, staging: Staging) -> None:
+    """Stage every mesh file, the centerline of every q, and the figures."""
+    for mesh in result.meshes:
+        for fmt in result.summary["formats"]:
+            regions = mesh.solid.regions if fmt == "ply" else None
+            staging.write_bytes(mesh_name(mesh.q, fmt), mesh_bytes(mesh.solid.vertices, mesh.solid.faces, fmt, regions))
+        relative = f"centerlines/q_{mesh.q:.3f}.vtp"
+        arrays = {k: [v] for k, v in mesh.centerline.items() if k != "points"}
+        write_polylines_vtp(staging.staged_path(relative), [mesh.centerline["points"]], arrays)
+        staging.record(relative)
+    staging.write_json(SUMMARY, result.summary)
+
+
+def load_export(build_dir: Path) -> ExportResult:
+    """The figures of a kept export (the meshes stay on disk)."""
+    summary = json.loads((Path(build_dir) / SUMMARY).read_text(encoding="utf-8"))
+    return ExportResult((), summary)
+
+
+def describe_export(result: ExportResult) -> list[str]:
+    """One line per mesh file."""
+    lines = []
+    for name, f in result.summary["meshes"].items():
+        lines.append(
+            f"{name}: {f['faces']} faces, volume {f['volume_mm3']:.2f} mm3 "
+            f"({100 * f['volume_rel_error']:+.3f}% vs integral), area {f['area_mm2']:.2f} mm2, "
+            f"watertight {f['watertight']}, max rho*kappa {f['max_rho_kappa']:.3f}"
+        )
+    return lines
+
+
+def output_figures(result: ExportResult) -> dict[str, dict[str, Any]]:
+    """Per output file: counts, volume, area, watertight (for the manifest's outputs)."""
+    keys = ("vertices", "faces", "volume_mm3", "area_mm2", "watertight")
+    return {name: {k: f[k] for k in keys} for name, f in result.summary["meshes"].items()}

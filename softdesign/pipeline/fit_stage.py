@@ -1,0 +1,144 @@
+"""Stage 4, fit: the wall's rho(l, a) per link at q = 1, its quality, and the radius field rho(q).
+
+Kept in the build folder: ``fit/surface.npz`` (the radius field: per link
+knots, final and initial coefficients), ``fit/points.npz`` (every projected
+surface point with its selection reason and residual, for reports) and
+``fit/summary.json`` (counts, settings, true-distance metrics, hold-out,
+joint jumps, rho * kappa at q = 1).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from softdesign.config import Case
+from softdesign.errors import ConfigError
+from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
+from softdesign.fitting.metrics import HoldoutSettings
+from softdesign.fitting.projection import project_points
+from softdesign.fitting.radius_field import RadiusField
+from softdesign.fitting.selection import NetworkContext, SelectionSettings, inscribed_profile
+from softdesign.fitting.wall_fit import WallFitOptions, fit_wall
+from softdesign.pipeline.ingest import IngestResult
+from softdesign.pipeline.kinematics_stage import KinematicsResult
+from softdesign.pipeline.store import Staging, load_npz, npz_bytes
+
+VERSION = 1
+#: Seed of the hold-out folds: the same case always gets the same folds.
+HOLDOUT_SEED = 4
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """The radius field and the figures of the fit."""
+
+    field: RadiusField
+    summary: dict[str, Any]
+    points: dict[str, np.ndarray]
+
+
+def run_fit(case: Case, ingest: IngestResult, kinematics: KinematicsResult) -> FitResult:
+    """Fit the wall of the selected path and build rho(q) for every link."""
+    if len(ingest.faces) == 0:
+        raise ConfigError("final.surface is required to fit the actuator's surface; add it to the case file")
+    chain = kinematics.chain
+    curve = chain.shape.curve_at(1.0)
+    path = ingest.path
+    inscribed = (None, None) if path.radius is None else inscribed_profile(curve, path.points, path.radius)
+    network = NetworkContext(path.points, tuple(p.points for p in ingest.others), *inscribed)
+    fit = case.fit
+    auto = fit.knot_spacing_mm == "auto"
+    settings = FitSettings(1.0 if auto else fit.knot_spacing_mm, fit.angular_intervals, fit.smoothing, tuple(chain.breaks))
+    options = WallFitOptions(
+        fit=settings,
+        auto_spacing=auto,
+        selection=SelectionSettings(outlier_factor=fit.outlier_factor),
+        holdout=HoldoutSettings(folds=fit.holdout_folds),
+        initial_radius_mm=case.initial.radius_mm,
+    )
+    wall = fit_wall(curve, ingest.vertices, network, options, np.random.default_rng(HOLDOUT_SEED))
+    field = wall.field
+    if ingest.initial_surface is not None:
+        field = _with_fitted_initial(chain, wall.settings, ingest.initial_surface[0], wall.field)
+    summary = {**wall.summary(), "initial_radius": _initial_kind(case)}
+    residual = wall.polar.rho - field.evaluate_pairs(1.0, wall.polar.l, wall.polar.angle)
+    points = {
+        "l": wall.polar.l,
+        "angle": wall.polar.angle,
+        "rho": wall.polar.rho,
+        "residual": residual,
+        "reason": wall.selection.reason,
+    }
+    return FitResult(field, summary, points)
+
+
+def _with_fitted_initial(chain, settings: FitSettings, vertices: np.ndarray, final: RadiusField) -> RadiusField:
+    """rho0 from ``initial.surface``: projected on the q = 0 centerline and fitted with the final's layout."""
+    initial_curve = chain.shape.curve_at(0.0)
+    polar = project_points(initial_curve, vertices)
+    inside = polar.subset(polar.end_side == 0)
+    initial = fit_radius_surface(inside, chain.shape.keys[-1].length, settings)
+    return RadiusField(final.breaks, final.final, initial.links)
+
+
+def _initial_kind(case: Case) -> str:
+    if case.initial.radius_mm is not None:
+        return f"constant {case.initial.radius_mm:g} mm"
+    return "fitted initial.surface" if case.initial.surface is not None else "axially symmetric mean of the fit"
+
+
+def write_fit(result: FitResult, staging: Staging) -> None:
+    """Keep the radius field, the points and the figures."""
+    staging.write_bytes("fit/surface.npz", npz_bytes(**result.field.to_arrays()))
+    staging.write_bytes("fit/points.npz", npz_bytes(**result.points))
+    staging.write_json("fit/summary.json", result.summary)
+
+
+def load_fit(build_dir: Path) -> FitResult:
+    """The kept radius field and figures."""
+    root = Path(build_dir) / "fit"
+    field = RadiusField.from_arrays(load_npz(root / "surface.npz"))
+    summary = json.loads((root / "summary.json").read_text(encoding="utf-8"))
+    return FitResult(field, summary, load_npz(root / "points.npz"))
+
+
+def fit_metrics(result: FitResult) -> dict[str, Any]:
+    """The manifest's fit block: true distances (mm), hold-out, counts, joints, rho * kappa."""
+    s = result.summary
+    d = s["distance"]
+    return {
+        "rms_mm": d["rms_mm"],
+        "p95_mm": d["p95_mm"],
+        "p99_mm": d["p99_mm"],
+        "max_mm": d["max_mm"],
+        "holdout_rms_mm": s["holdout_rms_mm"],
+        "points": s["points"],
+        "settings": s["settings"],
+        "joint_value_jump_mm": max(s["joint_value_jump_mm"], default=0.0),
+        "joint_slope_jump": max(s["joint_slope_jump"], default=0.0),
+        "max_rho_kappa": s["max_rho_kappa"],
+    }
+
+
+def describe_fit(result: FitResult) -> list[str]:
+    """The metrics table."""
+    m = fit_metrics(result)
+    p = m["points"]
+    st = m["settings"]
+    return [
+        f"points: {p['input']} input, {p['kept']} kept; dropped: other branch {p['other_branch']}, "
+        f"cap {p['cap']}, outlier {p['outlier']}",
+        f"spline: knots every {st['knot_spacing_mm']:g} mm, {st['angular_intervals']} angular intervals, "
+        f"smoothing {st['smoothing']:g}",
+        "true distance to the fitted surface (mm):",
+        f"  RMS {m['rms_mm']:.4f}  p95 {m['p95_mm']:.4f}  p99 {m['p99_mm']:.4f}  max {m['max_mm']:.4f}",
+        f"  hold-out RMS ({result.summary['points']['kept']} points, k-fold) {m['holdout_rms_mm']:.4f}",
+        f"joints: value jump {m['joint_value_jump_mm']:.2e} mm, slope jump {m['joint_slope_jump']:.2e}",
+        f"max rho * kappa at q = 1: {m['max_rho_kappa']:.3f} (folds at 1; every export q is checked at export)",
+        f"radius at q = 0: {result.summary['initial_radius']}",
+    ]
