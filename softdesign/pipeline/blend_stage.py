@@ -2,7 +2,8 @@
 
 Kept in the build folder: ``blend/curves.npz`` (each key shape's samples at
 equal arc length; the quintic spline through them is rebuilt exactly on
-load) and ``blend/summary.json`` (per path and per export q figures).
+load) and ``blend/summary.json`` (the final path's figures and the linear
+blend's shortening).
 """
 
 from __future__ import annotations
@@ -67,20 +68,6 @@ def run_blend(case: Case, ingest: IngestResult) -> BlendResult:
 
 def _summary(case: Case, shape: BlendedShape) -> dict[str, Any]:
     final = shape.keys[-1].report()
-    per_q = []
-    for q in case.export.q_values():
-        curve = shape.curve_at(q)  # builds the frames: a flip or an undefined Frenet frame fails here
-        stats = shape.stats_at(q)
-        per_q.append(
-            {
-                "q": q,
-                "length_mm": stats.length_mm,
-                "stretch_min": stats.stretch_min,
-                "stretch_max": stats.stretch_max,
-                "curvature_max_per_mm": stats.curvature_max_per_mm,
-                "max_frame_step_rad": curve.max_frame_step,
-            }
-        )
     shortening = shape.shortening()
     return {
         "mode": shape.mode,
@@ -95,7 +82,6 @@ def _summary(case: Case, shape: BlendedShape) -> dict[str, Any]:
             "max_abs_torsion_l": final.max_abs_torsion_l,
         },
         "initial_length_mm": shape.keys[0].length,
-        "per_q": per_q,
         "shortening": {
             "q_at_min": shortening.q_at_min,
             "min_length_mm": shortening.min_length_mm,
@@ -133,11 +119,6 @@ def describe_blend(result: BlendResult) -> list[str]:
         f"max curvature {f['max_curvature_per_mm']:.4f} /mm, max |torsion| {f['max_abs_torsion_per_mm']:.4f} /mm",
         f"blend {s['mode']}, frames {s['frames']}; initial length {s['initial_length_mm']:.2f} mm",
     ]
-    for row in s["per_q"]:
-        lines.append(
-            f"  q = {row['q']:.3f}: length {row['length_mm']:.2f} mm, stretch {row['stretch_min']:.4f}"
-            f"..{row['stretch_max']:.4f}, max curvature {row['curvature_max_per_mm']:.4f} /mm"
-        )
     sh = s["shortening"]
     lines.append(f"shortest shape: {sh['min_length_mm']:.2f} mm at q = {sh['q_at_min']:.3f} ({100 * sh['ratio']:.2f}% shorter)")
     return lines

@@ -25,7 +25,8 @@ from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.selection import NetworkContext, SelectionSettings, inscribed_profile
 from softdesign.fitting.wall_fit import WallFitOptions, fit_wall
 from softdesign.pipeline.ingest import IngestResult
-from softdesign.pipeline.kinematics_stage import KinematicsResult
+from softdesign.pipeline.blend_stage import BlendResult
+from softdesign.pipeline.kinematics_stage import chain_for_case
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 
 VERSION = 1
@@ -42,11 +43,11 @@ class FitResult:
     points: dict[str, np.ndarray]
 
 
-def run_fit(case: Case, ingest: IngestResult, kinematics: KinematicsResult) -> FitResult:
+def run_fit(case: Case, ingest: IngestResult, blend: BlendResult) -> FitResult:
     """Fit the wall of the selected path and build rho(q) for every link."""
     if len(ingest.faces) == 0:
         raise ConfigError("final.surface is required to fit the actuator's surface; add it to the case file")
-    chain = kinematics.chain
+    chain = chain_for_case(case, blend)
     curve = chain.shape.curve_at(1.0)
     path = ingest.path
     inscribed = (None, None) if path.radius is None else inscribed_profile(curve, path.points, path.radius)

@@ -87,6 +87,20 @@ def pose_document(chain: LinkChain, q: float | list[float]) -> dict[str, Any]:
     }
 
 
+def shape_figures(chain: LinkChain, q: float) -> dict[str, Any]:
+    """The whole centerline at q: length, stretch range, max curvature, largest frame step."""
+    curve = chain.shape.curve_at(q)  # builds the frames: a flip or an undefined Frenet frame fails here
+    stats = chain.shape.stats_at(q)
+    return {
+        "q": q,
+        "length_mm": stats.length_mm,
+        "stretch_min": stats.stretch_min,
+        "stretch_max": stats.stretch_max,
+        "curvature_max_per_mm": stats.curvature_max_per_mm,
+        "max_frame_step_rad": curve.max_frame_step,
+    }
+
+
 def run_kinematics(case: Case, blend: BlendResult) -> KinematicsResult:
     """Link transforms and POE at every export q."""
     chain = chain_for_case(case, blend)
@@ -97,6 +111,7 @@ def run_kinematics(case: Case, blend: BlendResult) -> KinematicsResult:
         "links": [
             {"index": j, "l_start": float(chain.breaks[j]), "l_end": float(chain.breaks[j + 1])} for j in range(chain.count)
         ],
+        "per_q": [shape_figures(chain, q) for q in case.export.q_values()],
         "poses": [pose_document(chain, q) for q in case.export.q_values()],
     }
     return KinematicsResult(chain, document)
@@ -117,6 +132,12 @@ def load_kinematics(build_dir: Path, blend: BlendResult) -> KinematicsResult:
 def describe_kinematics(result: KinematicsResult) -> list[str]:
     """One line per export q and link."""
     lines = [f"{len(result.document['links'])} link(s), frames {result.document['frames']}"]
+    for row in result.document["per_q"]:
+        lines.append(
+            f"  q = {row['q']:.3f}: length {row['length_mm']:.2f} mm, stretch {row['stretch_min']:.4f}"
+            f"..{row['stretch_max']:.4f}, max curvature {row['curvature_max_per_mm']:.4f} /mm, "
+            f"largest frame step {row['max_frame_step_rad']:.2e} rad"
+        )
     for pose in result.document["poses"]:
         for link in pose["links"]:
             p = link["poe"]

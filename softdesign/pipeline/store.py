@@ -1,10 +1,11 @@
 """The build folder: staged atomic writes, canonical JSON, hashes.
 
-A run writes every new file into a staging folder inside the build folder
-and moves the files into place only when the whole run has succeeded
-(``manifest.json`` last).  A run that fails, or is killed, leaves the
-previous good build untouched; its staging folder is removed on failure and
-ignored (and cleared by the next run) after a kill.
+A run writes every new file into a staging folder beside the build folder
+(``.<name>.staging-XXXX`` in the same parent, so renames stay on one file
+system) and moves the files into place only when the whole run has
+succeeded (``manifest.json`` last).  A run that fails, or is killed, leaves
+the previous good build folder untouched; its staging folder is removed on
+failure, or cleared by the next run after a kill.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-STAGING_PREFIX = ".staging-"
+STAGING_PREFIX = ".staging-"  # after ".<build folder name>"
 MANIFEST = "manifest.json"
 
 
@@ -79,10 +80,12 @@ class Staging:
         self.written: dict[str, str] = {}
 
     def __enter__(self) -> "Staging":
-        self.build_dir.mkdir(parents=True, exist_ok=True)
-        for stale in self.build_dir.glob(STAGING_PREFIX + "*"):
+        parent = self.build_dir.resolve().parent
+        parent.mkdir(parents=True, exist_ok=True)
+        prefix = f".{self.build_dir.name}{STAGING_PREFIX}"
+        for stale in parent.glob(prefix + "*"):
             shutil.rmtree(stale, ignore_errors=True)
-        self.root = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=self.build_dir))
+        self.root = Path(tempfile.mkdtemp(prefix=prefix, dir=parent))
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
@@ -122,6 +125,7 @@ class Staging:
         if self.root is None:
             raise RuntimeError("Staging used outside its with-block")
         ordered = sorted(self.written, key=lambda rel: (rel == MANIFEST, rel))
+        self.build_dir.mkdir(parents=True, exist_ok=True)
         for relative in ordered:
             target = self.build_dir / relative
             target.parent.mkdir(parents=True, exist_ok=True)

@@ -1,0 +1,178 @@
+"""The build folder: caching by content hash, same bytes for the same inputs, atomic runs."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from softdesign.cli import app
+
+runner = CliRunner()
+REPO = Path(__file__).resolve().parents[1]
+STAGES = ["ingest", "blend", "kinematics", "fit", "export"]
+
+
+def snapshot(folder: Path) -> dict[str, str]:
+    """Every file under ``folder`` with its sha256."""
+    return {
+        str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file()
+    }
+
+
+def statuses(output: str) -> dict[str, str]:
+    """{stage: 'ran' | 'skipped'} from a build's report lines."""
+    found = {}
+    for line in output.splitlines():
+        if line.startswith("[") and "]" in line:
+            name, rest = line[1:].split("]", 1)
+            found[name] = rest.split()[0]
+    return found
+
+
+@pytest.fixture
+def demo_case(tmp_path) -> Path:
+    """A copy of configs/demo.yaml pointing at the committed sample data, coarse enough to be quick."""
+    case = yaml.safe_load((REPO / "configs" / "demo.yaml").read_text())
+    for key in ("centerline", "surface"):
+        case["final"][key] = str((REPO / "configs" / case["final"][key]).resolve())
+    case["export"] = {"q": [0, 1], "angular_count": 48, "spacing_mm": 1.0}
+    path = tmp_path / "demo.yaml"
+    path.write_text(yaml.safe_dump(case, sort_keys=False))
+    return path
+
+
+def build(case: Path, out: Path, *extra: str) -> str:
+    result = runner.invoke(app, ["build", str(case), "--out", str(out), *extra])
+    assert result.exit_code == 0, result.output
+    return result.output
+
+
+def edit(case: Path, section: str, **values) -> None:
+    data = yaml.safe_load(case.read_text())
+    data[section] = {**(data.get(section) or {}), **values}
+    case.write_text(yaml.safe_dump(data, sort_keys=False))
+
+
+def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_path):
+    out = tmp_path / "build"
+    assert statuses(build(demo_case, out)) == dict.fromkeys(STAGES, "ran")
+    assert statuses(build(demo_case, out)) == dict.fromkeys(STAGES, "skipped")
+    edit(demo_case, "fit", smoothing=2.0e-5)
+    assert statuses(build(demo_case, out)) == {
+        "ingest": "skipped", "blend": "skipped", "kinematics": "skipped", "fit": "ran", "export": "ran"
+    }
+    edit(demo_case, "export", q=[0, 0.5, 1])
+    assert statuses(build(demo_case, out)) == {
+        "ingest": "skipped", "blend": "skipped", "kinematics": "ran", "fit": "skipped", "export": "ran"
+    }
+    assert statuses(build(demo_case, out, "--force")) == dict.fromkeys(STAGES, "ran")
+
+
+def test_a_stale_output_is_not_reused_because_it_exists(demo_case, tmp_path):
+    out = tmp_path / "build"
+    build(demo_case, out)
+    (out / "fit" / "surface.npz").write_bytes(b"tampered")
+    assert statuses(build(demo_case, out))["fit"] == "ran"
+
+
+def test_same_inputs_give_the_same_bytes(demo_case, tmp_path):
+    first, second = tmp_path / "a", tmp_path / "b"
+    build(demo_case, first)
+    build(demo_case, second, "--force")
+    one, two = snapshot(first), snapshot(second)
+    assert one.keys() == two.keys()
+    manifest = json.loads((first / "manifest.json").read_text())
+    listed = {entry["path"]: entry["sha256"] for entry in manifest["outputs"]}
+    assert {"meshes/q_0.000.stl", "meshes/q_1.000.stl", "kinematics.json"} <= listed.keys()
+    for name, digest in listed.items():
+        assert one[name] == two[name] == digest, name
+    # the manifest differs only by its timing block
+    strip = [json.loads((f / "manifest.json").read_text()) for f in (first, second)]
+    for m in strip:
+        m.pop("timing_s")
+    assert strip[0] == strip[1]
+
+
+def test_manifest_records_inputs_case_metrics_and_outputs(demo_case, tmp_path):
+    out = tmp_path / "build"
+    build(demo_case, out)
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert [i["path"].rsplit("/", 1)[-1] for i in manifest["inputs"]] == ["centerline.vtp", "surface.stl"]
+    assert all(len(i["sha256"]) == 64 for i in manifest["inputs"])
+    assert manifest["case"]["fit"]["knot_spacing_mm"] == 1.5  # defaults filled in
+    assert set(manifest["timing_s"]) == set(STAGES)
+    fit = manifest["metrics"]["fit"]
+    assert 0 < fit["p95_mm"] <= fit["p99_mm"] <= fit["max_mm"] and 0 < fit["rms_mm"] <= fit["max_mm"]
+    meshes = [o for o in manifest["outputs"] if o["path"].startswith("meshes/")]
+    assert len(meshes) == 2
+    for mesh in meshes:
+        assert mesh["watertight"] is True and mesh["volume_mm3"] > 0 and mesh["area_mm2"] > 0
+        assert mesh["faces"] > 0 and mesh["vertices"] > 0
+
+
+def test_a_failed_run_leaves_the_previous_build_untouched(demo_case, tmp_path, monkeypatch):
+    out = tmp_path / "build"
+    build(demo_case, out)
+    before = snapshot(out)
+    edit(demo_case, "fit", smoothing=3.0e-5)
+    from softdesign.pipeline import export_stage
+
+    calls = []
+
+    def failing(*args, **kwargs):
+        calls.append(1)
+        if len(calls) > 1:
+            raise OSError("disk full (simulated)")
+        return original(*args, **kwargs)
+
+    original = export_stage.mesh_bytes
+    monkeypatch.setattr(export_stage, "mesh_bytes", failing)
+    result = runner.invoke(app, ["build", str(demo_case), "--out", str(out)])
+    assert result.exit_code != 0 and len(calls) == 2
+    assert snapshot(out) == before
+    assert not list(tmp_path.glob(".build.staging-*"))
+
+
+KILL_MID_EXPORT = """
+import os, signal, sys
+import softdesign.pipeline.export_stage as export_stage
+original = export_stage.mesh_bytes
+calls = []
+def killing(*args, **kwargs):
+    calls.append(1)
+    if len(calls) > 1:
+        os.kill(os.getpid(), signal.SIGKILL)
+    return original(*args, **kwargs)
+export_stage.mesh_bytes = killing
+from softdesign.cli import app
+sys.argv = ["softdesign"] + sys.argv[1:]
+app()
+"""
+
+
+def test_a_build_killed_mid_export_leaves_the_previous_build_unchanged(demo_case, tmp_path):
+    out = tmp_path / "build"
+    build(demo_case, out)
+    before = snapshot(out)
+    edit(demo_case, "export", angular_count=56)
+    killed = subprocess.run(
+        [sys.executable, "-c", KILL_MID_EXPORT, "build", str(demo_case), "--out", str(out)],
+        capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(REPO)}, timeout=300,
+    )
+    assert killed.returncode == -9, killed.stderr
+    assert snapshot(out) == before
+    # the next run clears the dead run's staging folder and builds normally
+    assert statuses(build(demo_case, out))["export"] == "ran"
+    assert not list(tmp_path.glob(".build.staging-*"))
+    shutil.rmtree(out)
