@@ -12,7 +12,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from softdesign.cli_support import emit_json, note, run_guarded
+from softdesign.cli_support import StageProgress, emit_json, run_guarded
 from softdesign.check_cli import check
 from softdesign.pcc_cli import pcc_app
 
@@ -33,7 +33,7 @@ def _run(case_file: Path, out: Optional[Path], target: str | None, force: bool):
     """Load the case and run the stages through ``target``; returns (case, build_dir, results, runs)."""
     from softdesign.pipeline.api import build_through
 
-    outcome = build_through(case_file, out, target, force, progress=note)
+    outcome = build_through(case_file, out, target, force, progress=StageProgress())
     return outcome.case, outcome.build_dir, outcome.results, outcome.runs
 
 

@@ -18,6 +18,34 @@ def note(message: str) -> None:
     typer.echo(message, err=True)
 
 
+class StageProgress:
+    """Progress of a build on stderr: a bar on a terminal, plain lines otherwise (logs, make -j).
+
+    Reads the ``[done/total] message`` lines the pipeline runner emits.
+    """
+
+    WIDTH = 24
+
+    def __init__(self, stream=None) -> None:
+        self.stream = stream if stream is not None else sys.stderr
+        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+
+    def __call__(self, line: str) -> None:
+        if not self.tty:
+            self.stream.write(line + "\n")
+            return
+        counts, _, message = line.partition("] ")
+        done, _, total = counts.lstrip("[").partition("/")
+        if not (done.isdigit() and total.isdigit()):
+            self.stream.write(line + "\n")
+            return
+        filled = self.WIDTH * int(done) // max(int(total), 1)
+        bar = "#" * filled + "-" * (self.WIDTH - filled)
+        end = "\n" if int(done) == int(total) and not message.endswith("running") else ""
+        self.stream.write(f"\r[{bar}] {done}/{total} {message:<60.60}{end}")
+        self.stream.flush()
+
+
 def emit_json(payload: dict[str, Any]) -> None:
     """Print one JSON object on stdout, keys in a fixed order."""
     typer.echo(json.dumps(payload, indent=2, allow_nan=False))

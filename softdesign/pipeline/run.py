@@ -116,14 +116,25 @@ def run_stages(
     keys: dict[str, str] = {}
     runs: list[StageRun] = []
     with Staging(build_dir) as staging:
-        for stage in stages:
+        for index, stage in enumerate(stages):
             upstream = [keys[u] for u in stage.upstream]
             keys[stage.name] = stage_key(stage, case, upstream, input_hashes if not stage.upstream else [])
-            runs.append(_run_one(stage, case, build_dir, keys[stage.name], results, staging, options))
+            step = RunOptions(options.force, _counted(options.progress, index, len(stages)))
+            runs.append(_run_one(stage, case, build_dir, keys[stage.name], results, staging, step))
         manifest = build_manifest(case, build_dir, stages, runs, results, inputs, input_hashes, staging)
         staging.write_json(MANIFEST, manifest)
         staging.commit()
     return results, runs
+
+
+def _counted(progress: Callable[[str], None], index: int, total: int) -> Callable[[str], None]:
+    """Prefix progress lines with ``[done/total]`` (a terminal renders them as a bar)."""
+
+    def report(line: str) -> None:
+        done = index + (0 if line.endswith("running") else 1)
+        progress(f"[{done}/{total}] {line}")
+
+    return report
 
 
 def _run_one(
