@@ -5,6 +5,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -32,12 +33,7 @@ def snapshot(folder: Path) -> dict[str, str]:
 
 def statuses(output: str) -> dict[str, str]:
     """{stage: 'ran' | 'skipped'} from a build's report lines."""
-    found = {}
-    for line in output.splitlines():
-        if line.startswith("[") and "]" in line:
-            name, rest = line[1:].split("]", 1)
-            found[name] = rest.split()[0]
-    return found
+    return dict(re.findall(r"^\[([a-z]+)\] (ran|skipped)", output, flags=re.MULTILINE))
 
 
 @pytest.fixture
