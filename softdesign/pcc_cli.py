@@ -8,7 +8,6 @@ from __future__ import annotations
 import csv
 import io
 import math
-import os
 from pathlib import Path
 from typing import Annotated, NamedTuple, Optional
 
@@ -17,6 +16,7 @@ import typer
 
 from softdesign.cli_support import emit_json, note, run_guarded
 from softdesign.errors import ConfigError, InputDataError, SoftdesignError
+from softdesign.io.atomic import write_bytes_atomically
 
 CONVENTION = (
     "Encoders at 90, 210, 330 degrees from the section's base x axis, d mm from the backbone; "
@@ -261,13 +261,7 @@ def read_readings(path: Path, max_rate: float | None = None) -> Readings:
 
 def _write_text_atomically(path: Path, text: str) -> Path:
     """Write ``text`` under a temporary name beside ``path``, then rename it to ``path``."""
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        temporary.write_text(text)
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)
-    return path
+    return write_bytes_atomically(path, text.encode("utf-8"))
 
 
 def _csv_text(header: list[str], rows: list[list]) -> str:

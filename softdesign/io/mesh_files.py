@@ -7,10 +7,11 @@ mesh always gives the same file.  PLY keeps a per-face ``region`` label
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
+
+from softdesign.io.atomic import write_bytes_atomically
 
 MESH_FORMATS = ("stl", "ply", "obj", "glb")
 
@@ -33,11 +34,4 @@ def mesh_bytes(vertices: np.ndarray, faces: np.ndarray, file_type: str, regions:
 def write_mesh(path: str | Path, vertices: np.ndarray, faces: np.ndarray, regions: np.ndarray | None = None) -> Path:
     """Write a mesh (format from the suffix) under a temporary name, then rename."""
     path = Path(path)
-    data = mesh_bytes(vertices, faces, path.suffix.lower().lstrip("."), regions)
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        temporary.write_bytes(data)
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)
-    return path
+    return write_bytes_atomically(path, mesh_bytes(vertices, faces, path.suffix.lower().lstrip("."), regions))

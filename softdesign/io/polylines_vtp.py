@@ -9,7 +9,6 @@ renamed, so a reader never sees half a file.
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 from typing import Sequence
 
@@ -17,6 +16,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import InputDataError
+from softdesign.io.atomic import atomic_target
 
 
 def write_polylines_vtp(
@@ -134,15 +134,11 @@ def _write_atomically(poly, path: Path) -> None:
 
     if not path.parent.is_dir():
         raise OSError(f"{path}: the folder {path.parent} does not exist; create it first")
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     writer = vtk.vtkXMLPolyDataWriter()
-    writer.SetFileName(str(temporary))
     writer.SetInputData(poly)
     writer.SetDataModeToBinary()
     writer.SetCompressorTypeToZLib()
-    try:
+    with atomic_target(path) as temporary:
+        writer.SetFileName(str(temporary))
         if writer.Write() != 1:
             raise OSError(f"{path}: vtk could not write the file (is the folder writable?)")
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)
