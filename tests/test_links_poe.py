@@ -23,6 +23,8 @@ from softdesign.kinematics.poe import (
     twist_from_pose,
 )
 
+from .seed_transforms import rot_z, seed_chain
+
 #: The issue's bound on reproducing S_T_E from its POE split (we reach rounding).
 POE_TOL = 1e-9
 #: Rounding-level agreement of exact compositions.
@@ -30,28 +32,6 @@ ROUND_TOL = 1e-12
 
 
 # --- seed 003's transform, written out independently of the package -------------------------------------
-def rot_z(a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
-
-
-def rot_y(a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, 0, s, 0], [0, 1, 0, 0], [-s, 0, c, 0], [0, 0, 0, 1.0]])
-
-
-def trans_z(d: float) -> np.ndarray:
-    out = np.eye(4)
-    out[2, 3] = d
-    return out
-
-
-def pcc_transform(kappa: float, phi: float, length: float) -> np.ndarray:
-    """Rz(phi) Ry(theta/2) Tz(2 sin(theta/2) / kappa) Ry(theta/2) Rz(-phi), theta = kappa * length."""
-    theta = kappa * length
-    return rot_z(phi) @ rot_y(theta / 2) @ trans_z(2 * np.sin(theta / 2) / kappa) @ rot_y(theta / 2) @ rot_z(-phi)
-
-
 #: (kappa 1/mm, phi rad, length mm) of each arc; joints of moderate curvature jump (0.035 and 0.047 /mm).
 ARCS = ((0.05, 0.4, 20.0), (0.07, 0.9, 15.0), (0.04, 0.2, 20.0))
 #: Sample step of the dense polyline and of the resampling, mm.
@@ -74,8 +54,8 @@ def arcs_case():
     pose, points, joints = base, [], [base]
     for kappa, phi, length in ARCS:
         s = np.linspace(0, length, int(round(length / STEP_MM)) + 1)[:-1]
-        points += [(pose @ pcc_transform(kappa, phi, si))[:3, 3] if si > 0 else pose[:3, 3] for si in s]
-        pose = pose @ pcc_transform(kappa, phi, length)
+        points += [(pose @ seed_chain(kappa, phi, si))[:3, 3] if si > 0 else pose[:3, 3] for si in s]
+        pose = pose @ seed_chain(kappa, phi, length)
         joints.append(pose)
     points.append(pose[:3, 3])
     curve = smooth_curve_from_polyline(np.array(points), CurveOptions(spacing_mm=STEP_MM, smoothing_mm=0.0))
@@ -93,7 +73,7 @@ def test_rmf_link_transforms_equal_seed_003_arcs(arcs_case):
     jumps = [0.0, *curvature_jumps(), 0.0]
     transforms = link_transforms(framed, breaks)
     for j, (kappa, phi, length) in enumerate(ARCS):
-        expected = pcc_transform(kappa, phi, length)
+        expected = seed_chain(kappa, phi, length)
         # A quintic spline cannot follow a curvature jump dk: its tangent at a joint is off by about
         # c * h * dk, c ~ 0.13 measured (by scaling, a constant of the spline); we allow 0.25 * h * dk
         # at each end of the link, here 0.7e-4 to 1.0e-4 rad.
@@ -126,7 +106,7 @@ def test_frenet_link_transforms_show_phi_zero_on_every_arc(arcs_case):
         transform = link_transforms(framed, [l_s, l_e])[0]
         p = transform[:3, 3]
         np.testing.assert_allclose(np.arctan2(p[1], p[0]), 0.0, rtol=0, atol=1e-7)
-        expected = pcc_transform(kappa, 0.0, length - 2 * inset)
+        expected = seed_chain(kappa, 0.0, length - 2 * inset)
         np.testing.assert_allclose(p, expected[:3, 3], rtol=0, atol=1e-6 * length)
         # the Frenet normal comes from c'', one order less accurate than the tangent: 4e-8 measured
         np.testing.assert_allclose(transform[:3, :3], expected[:3, :3], rtol=0, atol=1e-7)

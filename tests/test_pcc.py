@@ -8,6 +8,8 @@ import pytest
 from softdesign.errors import ConfigError, InputDataError
 from softdesign.kinematics import pcc
 
+from .seed_transforms import rot_y, rot_z, seed_chain
+
 #: Agreement of two exact computations of the same length, mm (double rounding on ~500 mm).
 LENGTH_TOL_MM = 1e-9
 #: Same for curvatures, 1/mm.
@@ -28,29 +30,6 @@ SEED_CHAINS = {
 
 
 # -- independent constructions, written from the seed's text, not from the module --------------
-
-
-def rot_z(angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
-
-
-def rot_y(angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, 0, s, 0], [0, 1, 0, 0], [-s, 0, c, 0], [0, 0, 0, 1.0]])
-
-
-def trans_z(distance: float) -> np.ndarray:
-    out = np.eye(4)
-    out[2, 3] = distance
-    return out
-
-
-def seed_chain(kappa: float, phi: float, length: float) -> np.ndarray:
-    """Seed section 3.2's five steps as elementary matrices, chord from eq. 7 (r = 1/kappa)."""
-    theta = kappa * length
-    chord = 2.0 / kappa * np.sin(theta / 2)
-    return rot_z(phi) @ rot_y(theta / 2) @ trans_z(chord) @ rot_y(theta / 2) @ rot_z(-phi)
 
 
 def seed_kappa(l1: float, l2: float, l3: float, d: float) -> float:
