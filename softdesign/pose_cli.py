@@ -1,0 +1,186 @@
+"""`softdesign pose CASE.yaml --q Q -o FILE`: the body with one q per link, checked and written.
+
+Parsing, the build folder, files and printing live here; the geometry is
+:mod:`softdesign.meshing.pose_body`.  :mod:`softdesign.cli` registers the
+command with ``app.command()(pose)``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+from typing import Annotated, Any, Optional
+
+import typer
+
+from softdesign.cli_support import emit_json, note, run_guarded
+from softdesign.errors import ConfigError, SoftdesignError
+
+QOpt = Annotated[
+    str,
+    typer.Option("--q", help="One q for every link ('0.5') or one per link ('0.2,0.8,1'), each in [0, 1].",
+                 show_default=False),
+]
+OutputOpt = Annotated[
+    Path,
+    typer.Option("--output", "-o", help="Mesh file to write; its suffix picks the format (.stl .ply .obj .glb).",
+                 show_default=False),
+]
+BuildOpt = Annotated[Optional[Path], typer.Option("--out", help="Build folder (default: build/<name>).")]
+ForceOpt = Annotated[bool, typer.Option("--force", help="Redo every stage, ignoring the cache.")]
+JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")]
+CaseArg = Annotated[Path, typer.Argument(help="The case file (YAML).", show_default=False)]
+
+Q_FIX = "give one q for every link (e.g. 0.5) or one per link separated by commas (e.g. 0.2,0.8,1), each in [0, 1]"
+
+
+def q_values_from_text(text: str) -> list[float]:
+    """Parse ``--q`` into a list of q values, each finite and in [0, 1].
+
+    Raises
+    ------
+    ConfigError
+        An empty entry, a non-number, or a value outside [0, 1].
+    """
+    values = []
+    for i, part in enumerate(text.split(","), start=1):
+        try:
+            value = float(part)
+        except ValueError:
+            raise ConfigError(f"--q: value {i} '{part.strip()}' of {text!r} is not a number; {Q_FIX}") from None
+        if not (math.isfinite(value) and 0.0 <= value <= 1.0):
+            raise ConfigError(f"--q: value {i} of {text!r} is {part.strip()}, expected a number in [0, 1]; {Q_FIX}")
+        values.append(value)
+    return values
+
+
+def mesh_format_of(path: Path) -> str:
+    """The mesh format named by ``path``'s suffix; ConfigError for an unknown one or a missing folder."""
+    from softdesign.io.mesh_files import MESH_FORMATS
+
+    fmt = path.suffix.lower().lstrip(".")
+    if fmt not in MESH_FORMATS:
+        raise ConfigError(
+            f"-o {path}: unknown mesh format '{path.suffix or '(no suffix)'}', expected one of "
+            + ", ".join(f".{f}" for f in MESH_FORMATS)
+            + "; name the file e.g. pose.stl"
+        )
+    if not path.parent.is_dir():
+        raise ConfigError(f"-o {path}: the folder {path.parent} does not exist; create it first")
+    return fmt
+
+
+def _refuse_hollow(case_file: Path) -> None:
+    from softdesign.config import load_case
+
+    export = load_case(case_file).export
+    if export.wall_mm is not None:
+        raise ConfigError(
+            f"{case_file}: export.wall_mm = {export.wall_mm:g} asks for a hollow actuator, but pose builds "
+            "solid bodies (offset_mm included) only; run pose on a copy of the case without export.wall_mm "
+            "and export.port_mm"
+        )
+
+
+def pose_payload(body: Any, output: Path) -> dict[str, Any]:
+    """The JSON object of ``pose``: q, each link's {S} in world, each joint's step, the solid's figures."""
+    report = body.report
+    return {
+        "q": body.q.tolist(),
+        "output": str(output),
+        "links": [
+            {"index": k.index, "q": k.q, "l_start": k.l_start, "l_end": k.l_end, "length": k.length_mm,
+             "start_to_world": (k.start2world + 0.0).tolist(), "volume_mm3": k.volume_expected}
+            for k in body.links
+        ],
+        "joints": [
+            {"index": j.index, "l": j.l, "max_step_mm": j.max_step_mm, "shared_vertices": j.shared_vertices,
+             "crossings": j.crossings, "annulus_faces": j.annulus_faces, "annulus_area_mm2": j.annulus_area_mm2}
+            for j in body.joints
+        ],
+        "volume_mm3": report.volume,
+        "volume_expected_mm3": report.volume_expected,
+        "volume_rel_error": report.volume_rel_error,
+        "area_mm2": report.area,
+        "vertices": report.vertices,
+        "faces": report.faces,
+        "watertight": report.watertight,
+        "winding_consistent": report.winding_consistent,
+        "bodies": report.bodies,
+        "max_rho_kappa": body.max_rho_kappa,
+    }
+
+
+def _print_pose(payload: dict[str, Any], seconds: float) -> None:
+    typer.echo("q = [" + ", ".join(f"{v:g}" for v in payload["q"]) + f"] ({len(payload['links'])} links)")
+    for k in payload["links"]:
+        x, y, z = (row[3] for row in k["start_to_world"][:3])
+        typer.echo(
+            f"link {k['index']}: q {k['q']:.3f}, l {k['l_start']:.3f}..{k['l_end']:.3f}, length {k['length']:.3f} mm, "
+            f"{{S}} at ({x:.3f}, {y:.3f}, {z:.3f}) mm"
+        )
+    for j in payload["joints"]:
+        where = f"joint {j['index']}|{j['index'] + 1} at l {j['l']:.3f}:"
+        if j["annulus_faces"] == 0:
+            typer.echo(f"{where} rings shared (no radial step)")
+            continue
+        typer.echo(
+            f"{where} radial step up to {j['max_step_mm']:.4f} mm, closed by an annulus of {j['annulus_faces']} "
+            f"faces ({j['annulus_area_mm2']:.3f} mm2, {j['crossings']} crossing(s), "
+            f"{j['shared_vertices']} shared vertices)"
+        )
+    typer.echo(
+        f"volume {payload['volume_mm3']:.2f} mm3 ({100 * payload['volume_rel_error']:+.3f}% vs the links' integral "
+        f"{payload['volume_expected_mm3']:.2f} mm3), area {payload['area_mm2']:.2f} mm2, {payload['faces']} faces, "
+        f"{'watertight' if payload['watertight'] else 'NOT watertight'}, {payload['bodies']} body, "
+        f"max rho*kappa {payload['max_rho_kappa']:.3f}"
+    )
+    typer.echo(f"wrote {payload['output']} ({seconds:.2f} s)")
+
+
+def _make_pose(case_file: Path, q: list[float], out: Optional[Path], force: bool) -> Any:
+    """Build (cached) through every stage, then the pose body; errors name the case file."""
+    from softdesign.meshing.pose_body import PoseSpec, pose_body
+    from softdesign.pipeline.api import build_through
+
+    outcome = build_through(case_file, out, None, force, progress=note)
+    chain, field = outcome.results["kinematics"].chain, outcome.results["fit"].field
+    if len(q) not in (1, chain.count):
+        raise ConfigError(f"--q: {len(q)} values for {chain.count} links in {case_file}; {Q_FIX}")
+    export = outcome.case.export
+    try:
+        return pose_body(chain, field, q, PoseSpec(export.spacing_mm, export.angular_count, export.offset_mm))
+    except SoftdesignError as err:
+        raise type(err)(f"{case_file}: {err}") from err
+
+
+def pose(
+    case_file: CaseArg,
+    q: QOpt,
+    output: OutputOpt,
+    out: BuildOpt = None,
+    force: ForceOpt = False,
+    as_json: JsonOpt = False,
+) -> None:
+    """The body with one q per link (each link's surface at its own q, placed by the links before it)."""
+
+    def action() -> None:
+        from softdesign.io.mesh_files import write_mesh
+
+        start = time.perf_counter()
+        q_values = q_values_from_text(q)
+        fmt = mesh_format_of(output)
+        _refuse_hollow(case_file)
+        body = _make_pose(case_file, q_values, out, force)
+        try:
+            write_mesh(output, body.vertices, body.faces, body.regions if fmt == "ply" else None)
+        except OSError as err:
+            raise ConfigError(f"-o {output}: cannot write the mesh ({err.strerror}); choose a writable path") from err
+        payload = pose_payload(body, output)
+        if as_json:
+            emit_json(payload)
+        else:
+            _print_pose(payload, time.perf_counter() - start)
+
+    run_guarded(action)
