@@ -24,3 +24,15 @@ test: $(STAMP)
 
 clean:
 	rm -rf build .pytest_cache
+
+# `make golden`: build the sample cohort afresh and store its references in
+# tests/golden/ (manifests, kinematics, decimated meshes, versions, case hashes).
+# Run it only when a change to the meshes is intended; `make test` checks
+# fresh builds against them.
+.PHONY: golden
+golden: $(STAMP)
+	rm -rf build/golden-cohort
+	$(MAKE) cohort COHORT=configs/cohort COHORT_BUILD=build/golden-cohort
+	$(BIN)/python pipelines/golden.py --cohort configs/cohort --build build/golden-cohort --out tests/golden
+
+include pipelines/cohort.mk
