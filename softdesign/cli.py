@@ -15,6 +15,7 @@ import typer
 from softdesign.cli_support import StageProgress, emit_json, run_guarded
 from softdesign.check_cli import check
 from softdesign.pcc_cli import pcc_app
+from softdesign.pose_cli import pose
 
 app = typer.Typer(
     add_completion=False,
@@ -23,9 +24,10 @@ app = typer.Typer(
 )
 app.add_typer(pcc_app, name="pcc")
 app.command()(check)
+app.command()(pose)
 
 CaseArg = Annotated[Path, typer.Argument(help="The case file (YAML).", show_default=False)]
-OutOpt = Annotated[Optional[Path], typer.Option("--out", "-o", help="Build folder [default: build/<name>].")]
+OutOpt = Annotated[Optional[Path], typer.Option("--out", "-o", help="Build folder (default: build/<name>).")]
 ForceOpt = Annotated[bool, typer.Option("--force", help="Redo every stage, ignoring the cache.")]
 
 

@@ -26,7 +26,8 @@ from softdesign.geometry.initial import straight_initial_shape
 from softdesign.kinematics.links import LinkChain
 from softdesign.meshing.checks import inspect_mesh
 from softdesign.meshing.compare import compare_meshes
-from softdesign.meshing.pose_body import JOINT_STEP_REGION, PoseSpec, pose_body, radii_on_rays, stitch_joint
+from softdesign.meshing.pose_body import PoseSpec, pose_body, radii_on_rays, stitch_joint
+from softdesign.meshing.tessellate import Region
 from softdesign.pose_cli import pose
 
 app = typer.Typer(add_completion=False)
@@ -169,7 +170,7 @@ def test_straight_and_arc_links_placed_by_hand(chain, q, joint, tip, step_sign):
     (step,) = body.joints
     assert step.annulus_faces == 128 and step.crossings == 0 and step.shared_vertices == 0
     np.testing.assert_allclose(step.max_step_mm, 1.0, rtol=0, atol=ROUND_TOL)
-    annulus = body.faces[body.regions == JOINT_STEP_REGION]
+    annulus = body.faces[body.regions == Region.JOINT_STEP]
     corners = body.vertices[annulus]
     normals = 0.5 * np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     along = normals @ second.start2world[:3, 2]
@@ -183,7 +184,7 @@ def test_straight_and_arc_links_placed_by_hand(chain, q, joint, tip, step_sign):
 def test_equal_radii_at_a_joint_share_the_ring(chain):
     body = pose_body(chain, radius_field(lambda a: np.full_like(a, 3.0), initial_radius=3.0), (0, 1), PoseSpec(0.5, 64))
     (step,) = body.joints
-    assert step.shared_vertices == 64 and step.annulus_faces == 0 and not np.any(body.regions == JOINT_STEP_REGION)
+    assert step.shared_vertices == 64 and step.annulus_faces == 0 and not np.any(body.regions == Region.JOINT_STEP)
     rings = sum(link.sweep.xy.shape[0] for link in body.links)
     assert body.vertices.shape[0] == (rings - 1) * 64 + 2  # one joint ring, two cap centres
 
@@ -265,7 +266,7 @@ def test_mixed_q_steps_are_closed_by_a_reported_annulus(demo, tmp_path):
     field, na = demo.results["fit"].field, demo.case.export.angular_count
     a = 2 * np.pi * np.arange(na) / na
     body = pose_body(demo.results["kinematics"].chain, field, q, PoseSpec(demo.case.export.spacing_mm, na))
-    annulus = body.vertices[body.faces[body.regions == JOINT_STEP_REGION]]
+    annulus = body.vertices[body.faces[body.regions == Region.JOINT_STEP]]
     joints = [link.start2world for link in body.links[1:]]
     nearest = np.argmin([np.linalg.norm(annulus.mean(axis=1) - pose[:3, 3], axis=1) for pose in joints], axis=0)
     for j, (joint, pose) in enumerate(zip(payload["joints"], joints)):

@@ -58,8 +58,6 @@ from softdesign.types import POINT_TOL_MM, FloatArray, IntArray, Pose
 
 #: Joint ring vertices closer than this are shared, mm (placement round-off is ~1e-13 mm).
 JOINT_MERGE_TOL_MM = POINT_TOL_MM
-#: Face label of a joint's annulus, next to the values of :class:`~softdesign.meshing.tessellate.Region`.
-JOINT_STEP_REGION = 6
 
 
 @dataclass(frozen=True)
@@ -333,7 +331,7 @@ def _assemble(links: list[PoseLink], stitches: list[JointStitch]) -> tuple[Float
             faces = _split_edge(faces, ring_b[k], ring_b[k1], x)
         split_halves = np.full(faces.shape[0] - regions.size, Region.WALL, np.int8)
         faces = np.vstack([faces, np.concatenate([ring_a, ring_b, crossing_ids])[stitch.triangles]])
-        annulus = np.full(stitch.triangles.shape[0], JOINT_STEP_REGION, np.int8)
+        annulus = np.full(stitch.triangles.shape[0], Region.JOINT_STEP, np.int8)
         regions = np.concatenate([regions, split_halves, annulus])
         remap = np.concatenate([remap, crossing_ids])
         remap[ring_a[stitch.merged]] = ring_b[stitch.merged]

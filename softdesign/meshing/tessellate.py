@@ -51,6 +51,7 @@ class Region(IntEnum):
     CHAMBER = 3
     CHAMBER_CAP = 4
     PORT = 5
+    JOINT_STEP = 6  # the annulus closing a radius step between links at different q (pose)
 
 
 @dataclass(frozen=True)

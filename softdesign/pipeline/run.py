@@ -178,7 +178,11 @@ def build_manifest(
         "inputs": [
             {"path": case.resolved_path(p), "sha256": h, "bytes": p.stat().st_size} for p, h in zip(inputs, input_hashes)
         ],
-        "stages": [{"name": r.name, "status": r.status, "key": r.key} for r in runs],
+        "stages": [{"name": r.name, "status": r.status, "key": r.key} for r in runs]
+        + [
+            {"name": name, "status": "kept from an earlier run", "key": _read_record(build_dir / name / "stage.json").get("key")}
+            for name in sorted(_kept_stage_names(build_dir) - {r.name for r in runs})
+        ],
         "timing_s": {r.name: round(r.seconds, 3) for r in runs},
         "metrics": {s.name: s.metrics(results[s.name]) for s in stages if s.name in results},
         "outputs": outputs,
@@ -186,10 +190,24 @@ def build_manifest(
 
 
 def _all_outputs(build_dir: Path, stages: list[Stage], staging: Staging) -> list[dict[str, Any]]:
+    """Outputs recorded by this run's stages, and by earlier runs' stages still in the folder."""
     found: dict[str, str] = {}
+    for name in sorted(_kept_stage_names(build_dir) - {s.name for s in stages}):
+        found.update(_read_record(build_dir / name / "stage.json").get("outputs", {}))
     for stage in stages:
         record = staging.written.get(f"{stage.name}/stage.json")
-        source = json.loads(staging.staged_path(f"{stage.name}/stage.json").read_text()) if record else _recorded(build_dir, stage)
+        source = _read_record(staging.staged_path(f"{stage.name}/stage.json")) if record else _recorded(build_dir, stage)
         if source:
             found.update(source.get("outputs", {}))
     return [{"path": rel, "sha256": sha} for rel, sha in sorted(found.items())]
+
+
+def _kept_stage_names(build_dir: Path) -> set[str]:
+    return {p.parent.name for p in build_dir.glob("*/stage.json")} if build_dir.is_dir() else set()
+
+
+def _read_record(file: Path) -> dict[str, Any]:
+    try:
+        return json.loads(file.read_text(encoding="utf-8"))
+    except (OSError, json.JSONDecodeError):
+        return {}
