@@ -1,0 +1,108 @@
+"""Reload a build folder for the report: the manifest and every stage's kept result.
+
+The report reads only what ``softdesign build`` (or a stage command) kept:
+``manifest.json``, ``ingest/``, ``blend/``, ``kinematics.json`` (these three
+are required), ``fit/`` and ``export/`` with ``meshes/`` (optional: a folder
+built only through ``softdesign kinematics`` gets a report without them).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from softdesign.errors import InputDataError
+from softdesign.pipeline.blend_stage import BlendResult, load_blend
+from softdesign.pipeline.export_stage import load_export, mesh_name
+from softdesign.pipeline.fit_stage import FitResult, load_fit
+from softdesign.pipeline.ingest import IngestResult, load_ingest
+from softdesign.pipeline.kinematics_stage import FILE as KINEMATICS_FILE
+from softdesign.pipeline.kinematics_stage import KinematicsResult, load_kinematics
+from softdesign.pipeline.store import MANIFEST
+
+
+@dataclass(frozen=True)
+class BuildData:
+    """Everything the report draws from one build folder.
+
+    Attributes
+    ----------
+    build_dir : the build folder
+    manifest : ``manifest.json`` as loaded
+    ingest, blend, kinematics : the kept stage results (the link chain is rebuilt)
+    fit : the kept fit (radius field, points, summary), or None when not built
+    export_summary : ``export/summary.json``, or None when not built
+    """
+
+    build_dir: Path
+    manifest: dict[str, Any]
+    ingest: IngestResult
+    blend: BlendResult
+    kinematics: KinematicsResult
+    fit: FitResult | None
+    export_summary: dict[str, Any] | None
+
+    @property
+    def name(self) -> str:
+        """The case's name."""
+        return str(self.manifest.get("case", {}).get("name", self.build_dir.name))
+
+    @property
+    def export_q(self) -> list[float]:
+        """The export q values, in the order of ``kinematics.json`` (one q for every link)."""
+        return [float(pose["q"][0]) for pose in self.kinematics.document["poses"]]
+
+    @property
+    def link_count(self) -> int:
+        """Number of links."""
+        return self.kinematics.chain.count
+
+    def mesh_file(self, q: float) -> Path | None:
+        """The exported STL at ``q``, or None when that q was not exported as STL."""
+        if self.export_summary is None:
+            return None
+        relative = mesh_name(q, "stl")
+        file = self.build_dir / relative
+        return file if relative in self.export_summary.get("meshes", {}) and file.is_file() else None
+
+
+def load_build(build_dir: str | Path) -> BuildData:
+    """Reload ``build_dir`` for the report.
+
+    Raises
+    ------
+    InputDataError
+        The folder, its manifest or a required stage's files are missing or unreadable.
+    """
+    root = Path(build_dir)
+    fix = f"build it first: softdesign build CASE.yaml --out {root}"
+    if not (root / MANIFEST).is_file():
+        raise InputDataError(f"{root}: not a build folder (no {MANIFEST}); {fix}")
+    try:
+        manifest = json.loads((root / MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, json.JSONDecodeError) as err:
+        raise InputDataError(f"{root / MANIFEST}: unreadable ({err}); {fix}") from err
+    required = ("ingest/summary.json", "ingest/path.npz", "blend/curves.npz", "blend/summary.json", KINEMATICS_FILE)
+    missing = [rel for rel in required if not (root / rel).is_file()]
+    if missing:
+        raise InputDataError(
+            f"{root}: missing {', '.join(missing)}; the report needs ingest, blend and kinematics; {fix}"
+        )
+    try:
+        ingest = load_ingest(root)
+        blend = load_blend(root)
+        kinematics = load_kinematics(root, blend)
+        fit = load_fit(root) if _has(root, "fit/surface.npz", "fit/points.npz", "fit/summary.json") else None
+        export = load_export(root).summary if _has(root, "export/summary.json") else None
+    except (OSError, KeyError, ValueError, json.JSONDecodeError) as err:
+        raise InputDataError(
+            f"{root}: a stage's kept files are unreadable ({type(err).__name__}: {err}); {fix} --force"
+        ) from err
+    return BuildData(root, manifest, ingest, blend, kinematics, fit, export)
+
+
+def _has(root: Path, *relative: str) -> bool:
+    return all((root / rel).is_file() for rel in relative)
+

@@ -1,0 +1,152 @@
+"""The report page: one HTML file with inline CSS that shows the images kept beside it.
+
+Nothing is fetched from the network (no scripts, fonts or style sheets from
+elsewhere); every image is a relative link to a file in the same folder.
+Every text is HTML-escaped.  Key figures carry ``data-pointer`` (the JSON
+pointer into ``manifest.json``) and ``data-value`` (the exact JSON value) on
+their value cell.  The page holds no date or time: the same build gives the
+same bytes.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from html import escape
+from typing import Any
+
+from softdesign.report.plotting import Picture
+from softdesign.report.tables import Check, KeyFigure, format_value
+
+STYLE = """
+body { font-family: system-ui, -apple-system, "Segoe UI", Helvetica, Arial, sans-serif; margin: 1.5em auto;
+       max-width: 1240px; padding: 0 1em; color: #222; line-height: 1.4; }
+h1 { margin-bottom: 0.2em; } h2 { border-bottom: 1px solid #ccc; padding-bottom: 0.2em; margin-top: 1.8em; }
+nav a { margin-right: 1em; } figure { margin: 1em 0; } img { max-width: 100%; height: auto; border: 1px solid #eee; }
+figcaption, .note { color: #555; font-size: 0.92em; } .note { margin: 0.4em 0; }
+table { border-collapse: collapse; margin: 0.8em 0 1.4em; font-size: 0.9em; }
+th, td { border: 1px solid #ddd; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }
+th { background: #f4f4f4; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
+td.hash { font-family: ui-monospace, Menlo, Consolas, monospace; font-size: 0.85em; word-break: break-all; }
+td.pass { color: #1a7f37; font-weight: 600; } td.fail { color: #c62828; font-weight: 600; }
+caption { text-align: left; font-weight: 600; padding-bottom: 0.3em; }
+"""
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One table cell: its text, a CSS class and extra attributes (name, value)."""
+
+    text: str
+    css: str = ""
+    attributes: tuple[tuple[str, str], ...] = ()
+
+
+@dataclass(frozen=True)
+class Table:
+    """A captioned table of cells."""
+
+    caption: str
+    header: tuple[str, ...]
+    rows: list[tuple[Cell, ...]]
+
+
+@dataclass(frozen=True)
+class Section:
+    """One numbered part of the page."""
+
+    anchor: str
+    title: str
+    notes: list[str] = field(default_factory=list)
+    pictures: list[Picture] = field(default_factory=list)
+    tables: list[Table] = field(default_factory=list)
+
+
+def key_figure_table(figures: list[KeyFigure]) -> Table:
+    """Key figures with their exact value and manifest pointer on the value cell."""
+    rows = []
+    for f in figures:
+        numeric = isinstance(f.value, (int, float)) and not isinstance(f.value, bool)
+        exact = json.dumps(f.value, allow_nan=False)
+        trace = (("data-pointer", f.pointer), ("data-value", exact))
+        value = Cell(format_value(f.value), "num" if numeric else "", trace)
+        rows.append((Cell(f.label), value, Cell(f.unit), Cell(f.pointer, "hash")))
+    return Table("Key figures of manifest.json", ("figure", "value", "unit", "where in manifest.json"), rows)
+
+
+def check_table(checks: list[Check]) -> Table:
+    """Every check with its status."""
+    rows = [
+        (Cell(c.subject), Cell(c.name), Cell(c.found), Cell(c.required),
+         Cell("pass", "pass") if c.passed else Cell("FAIL", "fail"))
+        for c in checks
+    ]
+    passed = sum(c.passed for c in checks)
+    return Table(f"Checks: {passed} of {len(checks)} passed", ("subject", "check", "found", "required", "status"), rows)
+
+
+def plain_table(caption: str, header: tuple[str, ...], rows: list[tuple[str, ...]], css: tuple[str, ...] = ()) -> Table:
+    """A table of plain texts; ``css`` gives a class per column."""
+    classes = css or ("",) * len(header)
+    return Table(caption, header, [tuple(Cell(text, c) for text, c in zip(row, classes)) for row in rows])
+
+
+def _attributes(pairs: tuple[tuple[str, str], ...]) -> str:
+    return "".join(f' {name}="{escape(value, quote=True)}"' for name, value in pairs)
+
+
+def _table_html(table: Table) -> str:
+    head = "".join(f"<th>{escape(h)}</th>" for h in table.header)
+    body = []
+    for row in table.rows:
+        cells = "".join(
+            f"<td{_attributes(((('class', c.css),) if c.css else ()) + c.attributes)}>{escape(c.text)}</td>"
+            for c in row
+        )
+        body.append(f"<tr>{cells}</tr>")
+    return f"<table><caption>{escape(table.caption)}</caption>\n<tr>{head}</tr>\n" + "\n".join(body) + "\n</table>"
+
+
+def _picture_html(p: Picture) -> str:
+    return (
+        f'<figure><img src="{escape(p.name, quote=True)}" width="{p.size[0]}" height="{p.size[1]}" '
+        f'alt="{escape(p.title, quote=True)}">\n<figcaption>{escape(p.caption)}</figcaption></figure>'
+    )
+
+
+def _section_html(number: int, section: Section) -> str:
+    parts = [f'<section id="{escape(section.anchor, quote=True)}">', f"<h2>{number} {escape(section.title)}</h2>"]
+    parts += [f'<p class="note">{escape(note)}</p>' for note in section.notes]
+    for picture in section.pictures:
+        parts += [f"<h3>{escape(picture.title)}</h3>", _picture_html(picture)]
+    parts += [_table_html(t) for t in section.tables]
+    return "\n".join(parts + ["</section>"])
+
+
+def render_page(title: str, summary: list[str], sections: list[Section]) -> str:
+    """The whole page as text."""
+    nav = " ".join(
+        f'<a href="#{escape(s.anchor, quote=True)}">{k} {escape(s.title)}</a>' for k, s in enumerate(sections, 1)
+    )
+    body = "\n".join(_section_html(k, s) for k, s in enumerate(sections, 1))
+    lines = "".join(f"<p>{escape(line)}</p>" for line in summary)
+    return (
+        '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
+        f'<meta name="viewport" content="width=device-width, initial-scale=1">\n<title>{escape(title)}</title>\n'
+        f"<style>{STYLE}</style>\n</head>\n<body>\n<h1>{escape(title)}</h1>\n{lines}\n<nav>{nav}</nav>\n{body}\n"
+        "</body>\n</html>\n"
+    )
+
+
+def referenced_files(page: str) -> list[str]:
+    """Every ``src`` and ``href`` value of the page except in-page anchors (for checks and tests)."""
+    from html.parser import HTMLParser
+
+    found: list[str] = []
+
+    class _Links(HTMLParser):
+        def handle_starttag(self, tag: str, attrs: list[tuple[str, Any]]) -> None:
+            found.extend(v for k, v in attrs if k in ("src", "href") and v and not v.startswith("#"))
+
+    _Links().feed(page)
+    return found

@@ -1,0 +1,118 @@
+"""matplotlib without pyplot: Agg figures, fixed styling, reproducible PNG bytes.
+
+Figures are made with :class:`matplotlib.figure.Figure` on an Agg canvas, so
+nothing depends on a display, a backend setting or pyplot's global state.
+A PNG's pixel size is its figure size in inches times :data:`DPI` (no tight
+bounding box), so the page can state every image's size in advance.  PNG
+metadata carries no software version or time: the same build gives the same
+bytes.
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+from typing import Iterator
+
+import numpy as np
+
+#: Resolution of every PNG, dots per inch.
+DPI = 100
+#: rcParams for every figure: fixed font and sizes, a fixed SVG hash salt (reproducible if ever saved as SVG).
+STYLE = {
+    "font.family": "DejaVu Sans",
+    "font.size": 8.5,
+    "axes.titlesize": 9.5,
+    "axes.labelsize": 8.5,
+    "legend.fontsize": 7.5,
+    "xtick.labelsize": 7.5,
+    "ytick.labelsize": 7.5,
+    "svg.hashsalt": "softdesign-report",
+    "path.simplify": True,
+    "figure.dpi": DPI,
+}
+#: Colours of the frame axes in triads: N, B, T as red, green, blue (x, y, z by habit).
+TRIAD_COLOURS = ("#d62728", "#2ca02c", "#1f77b4")
+#: Link colours (up to six links; more take evenly spaced colours of "plasma"): kept apart from the triads'.
+LINK_PALETTE = ("#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf")
+
+
+@dataclass(frozen=True)
+class Picture:
+    """One rendered image for the page.
+
+    Attributes
+    ----------
+    name : file name inside ``report/`` (``morph.png``)
+    data : the encoded image
+    size : (width, height) in pixels
+    title, caption : what the page says above and below it
+    """
+
+    name: str
+    data: bytes
+    size: tuple[int, int]
+    title: str
+    caption: str
+
+
+def new_figure(size_in: tuple[float, float]):
+    """An empty Agg figure of ``size_in`` inches (width, height) with :data:`STYLE` applied."""
+    import matplotlib
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    with matplotlib.rc_context(STYLE):
+        figure = Figure(figsize=size_in, dpi=DPI, layout="constrained")
+    FigureCanvasAgg(figure)
+    return figure
+
+
+def styled():
+    """Context manager applying :data:`STYLE` while artists are created and drawn."""
+    import matplotlib
+
+    return matplotlib.rc_context(STYLE)
+
+
+def pixel_size(size_in: tuple[float, float]) -> tuple[int, int]:
+    """Pixel (width, height) of a PNG of a figure of ``size_in`` inches at :data:`DPI`."""
+    return int(round(size_in[0] * DPI)), int(round(size_in[1] * DPI))
+
+
+def png_bytes(figure) -> bytes:
+    """The figure as PNG bytes, without software or time metadata (reproducible)."""
+    buffer = io.BytesIO()
+    with styled():
+        figure.savefig(buffer, format="png", dpi=DPI, metadata={"Software": None})
+    return buffer.getvalue()
+
+
+def picture(name: str, figure, size_in: tuple[float, float], title: str, caption: str) -> Picture:
+    """Render ``figure`` to a :class:`Picture` (and release the figure's memory)."""
+    data = png_bytes(figure)
+    figure.clear()
+    return Picture(name, data, pixel_size(size_in), title, caption)
+
+
+def link_colours(count: int) -> list[tuple[float, float, float, float]]:
+    """One distinct colour per link, none of them the triads' red, green or blue."""
+    import matplotlib
+
+    if count <= len(LINK_PALETTE):
+        return [matplotlib.colors.to_rgba(c) for c in LINK_PALETTE[:count]]
+    cmap = matplotlib.colormaps["plasma"]
+    return [cmap(v) for v in np.linspace(0.0, 0.9, count)]
+
+
+def grid_shape(count: int, max_columns: int = 4) -> tuple[int, int]:
+    """(rows, columns) of a near-square grid of ``count`` panels, at most ``max_columns`` wide."""
+    columns = min(max(count, 1), max_columns)
+    return int(np.ceil(max(count, 1) / columns)), columns
+
+
+def panels(figure, count: int, max_columns: int = 4, **kwargs) -> Iterator:
+    """``count`` axes in a :func:`grid_shape` grid, in reading order; unused cells stay empty."""
+    rows, columns = grid_shape(count, max_columns)
+    for k in range(count):
+        yield figure.add_subplot(rows, columns, k + 1, **kwargs)

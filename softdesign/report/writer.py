@@ -1,0 +1,204 @@
+"""Write ``BUILD_DIR/report/``: every figure, the GIF and ``index.html``, all at once.
+
+The files are written into a hidden temporary folder beside ``report/`` and
+moved into place only when all of them exist: a failed or killed run leaves
+the previous report as it was (a killed run's temporary folder is removed by
+a later run once it is an hour old).  The build folder's stage outputs and
+manifest are only read.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import time
+import uuid
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from softdesign.errors import ConfigError
+from softdesign.report import animation, fit_figures, kinematics_figures, morph_figures, surface_figures
+from softdesign.report.build_folder import BuildData, load_build
+from softdesign.report.html_page import (
+    Section,
+    check_table,
+    key_figure_table,
+    plain_table,
+    referenced_files,
+    render_page,
+)
+from softdesign.report.plotting import pixel_size
+from softdesign.report.tables import (
+    Check,
+    fit_checks,
+    input_rows,
+    key_figures,
+    mesh_checks,
+    output_checks,
+    software_rows,
+)
+
+REPORT_DIR = "report"
+PAGE = "index.html"
+TEMP_PREFIX = ".report-"
+#: A temporary report folder older than this (s) is a killed run's leftover.
+STALE_SECONDS = 3600.0
+NO_FIT = (
+    "no fit in this build folder (built only through kinematics): surfaces and fit quality are left out; "
+    "run softdesign build"
+)
+NO_EXPORT = "no export in this build folder: no mesh checks; run softdesign build"
+#: Pixel (width, height) of every image the report can hold.
+EXPECTED_SIZES = {
+    "morph.png": pixel_size(morph_figures.SIZE_IN),
+    "surfaces.png": pixel_size(surface_figures.SIZE_IN),
+    "fit_residuals.png": pixel_size(fit_figures.RESIDUAL_SIZE_IN),
+    "fit_distances.png": pixel_size(fit_figures.DISTANCE_SIZE_IN),
+    "kinematics.png": pixel_size(kinematics_figures.SIZE_IN),
+    "pcc_chambers.png": pixel_size(kinematics_figures.PCC_SIZE_IN),
+    "morph.gif": pixel_size(animation.SIZE_IN),
+}
+
+
+@dataclass(frozen=True)
+class ReportOptions:
+    """What to draw: PCC chamber distance(s) d in mm (None: no PCC panel), q samples, GIF frames."""
+
+    pcc_d: tuple[float, ...] | None = None
+    q_samples: int = kinematics_figures.Q_SAMPLES
+    gif_frames: int = animation.FRAMES
+
+
+@dataclass(frozen=True)
+class ReportResult:
+    """Where the page is, each file's size in bytes, the checks' tally and what was left out."""
+
+    page: Path
+    files: dict[str, int]
+    checks_passed: int
+    checks_total: int
+    notes: list[str] = field(default_factory=list)
+
+
+def write_report(build_dir: str | Path, options: ReportOptions = ReportOptions()) -> ReportResult:
+    """Draw the report of ``build_dir`` into ``build_dir/report/`` (replacing an older one).
+
+    Raises
+    ------
+    InputDataError
+        ``build_dir`` is not a build folder or a required stage's files are missing.
+    SoftdesignError
+        A PCC design fails (e.g. a bad ``pcc_d``).
+    """
+    data = load_build(build_dir)
+    sections, checks, notes = report_sections(data, options)
+    passed = sum(c.passed for c in checks)
+    summary = _summary(data, passed, len(checks))
+    page = render_page(f"softdesign report: {data.name}", summary, sections)
+    files = {p.name: p.data for s in sections for p in s.pictures}
+    files[PAGE] = page.encode("utf-8")
+    missing = sorted(set(referenced_files(page)) - set(files))
+    if missing:
+        raise RuntimeError(f"report page links to files it does not write: {missing}")  # a bug, not a user error
+    target = Path(build_dir) / REPORT_DIR
+    commit_folder(target, files)
+    return ReportResult(target / PAGE, {k: len(v) for k, v in sorted(files.items())}, passed, len(checks), notes)
+
+
+def report_sections(data: BuildData, options: ReportOptions) -> tuple[list[Section], list[Check], list[str]]:
+    """The six sections of the page, every check, and the notes on what was left out."""
+    notes: list[str] = []
+    morph = Section("morph", "The morph", pictures=[morph_figures.morph_picture(data.kinematics.chain, data.export_q)])
+    surfaces, fit = Section("surfaces", "The surfaces"), Section("fit", "Fit quality")
+    if data.fit is None:
+        notes.append(NO_FIT)
+        surfaces.notes.append(NO_FIT)
+        fit.notes.append(NO_FIT)
+    else:
+        surfaces.pictures.append(surface_figures.surface_picture(data))
+        distances = fit_figures.true_distances(data)
+        fit.pictures.extend([fit_figures.residual_picture(data), fit_figures.distance_picture(data, distances)])
+    kinematics = _kinematics_section(data, options, notes)
+    field = data.fit.field if data.fit is not None else None
+    gif = animation.morph_gif(data.kinematics.chain, field, options.gif_frames)
+    tables, checks = _tables_section(data)
+    if data.export_summary is None:
+        notes.append(NO_EXPORT)
+        tables.notes.append(NO_EXPORT)
+    sections = [morph, surfaces, fit, kinematics, tables, Section("animation", "The morph, animated", pictures=[gif])]
+    return sections, checks, notes
+
+
+def _kinematics_section(data: BuildData, options: ReportOptions, notes: list[str]) -> Section:
+    series = kinematics_figures.kinematics_series(data.kinematics.chain, data.export_q, options.q_samples)
+    section = Section("kinematics", "Kinematics over q", pictures=[kinematics_figures.kinematics_picture(series)])
+    if options.pcc_d is None:
+        section.notes.append("PCC chamber lengths: not drawn; give --pcc-d D (mm, one or one per link) to add them.")
+        return section
+    try:
+        import softdesign.kinematics.pcc_fit  # noqa: F401  (the PCC design module is optional)
+    except ImportError:
+        note = "PCC chamber lengths: left out, this installation has no PCC design (softdesign.kinematics.pcc_fit)."
+        section.notes.append(note)
+        notes.append(note)
+        return section
+    if len(options.pcc_d) not in (1, data.link_count):
+        raise ConfigError(
+            f"--pcc-d: got {len(options.pcc_d)} distances, the build has {data.link_count} link(s); "
+            f"give one value for every link or {data.link_count}, one per link"
+        )
+    d = options.pcc_d[0] if len(options.pcc_d) == 1 else list(options.pcc_d)
+    picture, design_notes = kinematics_figures.pcc_picture(data.kinematics.chain, series, d)
+    section.pictures.append(picture)
+    section.notes.extend(design_notes)
+    return section
+
+
+def _tables_section(data: BuildData) -> tuple[Section, list[Check]]:
+    checks = mesh_checks(data.export_summary) + fit_checks(data.fit.summary if data.fit else None)
+    checks += output_checks(data.build_dir, data.manifest)
+    stages = [(s["name"], s["status"], f"{data.manifest.get('timing_s', {}).get(s['name'], 0.0):.3f}")
+              for s in data.manifest.get("stages", [])]
+    tables = [
+        key_figure_table(key_figures(data.manifest)),
+        plain_table("Inputs", ("file (as the case names it)", "sha256", "bytes"), input_rows(data.manifest),
+                    ("", "hash", "num")),
+        plain_table("Software", ("package", "version", "where"), software_rows(data.manifest)),
+        plain_table("Stages of the last run", ("stage", "status", "time (s)"), stages, ("", "", "num")),
+        check_table(checks),
+    ]
+    notes = [f"ingest: {n}" for n in data.ingest.notes]
+    return Section("tables", "Figures, inputs, software and checks", notes=notes, tables=tables), checks
+
+
+def _summary(data: BuildData, passed: int, total: int) -> list[str]:
+    blend = data.blend.summary
+    q_text = ", ".join(f"{q:g}" for q in data.export_q)
+    return [
+        f"Case {data.name}: {data.link_count} link(s), {blend['mode']} blend, {blend['frames']} frames, "
+        f"export q = {q_text}. Build folder: {data.build_dir.name}.",
+        f"Checks: {passed} of {total} passed.",
+    ]
+
+
+def commit_folder(target: Path, files: dict[str, bytes]) -> None:
+    """Write ``files`` into a temporary folder beside ``target``, then swap it in for ``target``."""
+    parent = target.parent
+    for stale in parent.glob(TEMP_PREFIX + "*"):
+        if time.time() - stale.stat().st_mtime > STALE_SECONDS:
+            shutil.rmtree(stale, ignore_errors=True)
+    temp = parent / f"{TEMP_PREFIX}{os.getpid()}-{uuid.uuid4().hex[:12]}"
+    temp.mkdir()  # unlike mkdtemp, honours the umask: the report is as readable as the rest of the build
+    old = temp.with_name(temp.name + "-old")
+    try:
+        for name, data in sorted(files.items()):
+            (temp / name).write_bytes(data)
+        if target.exists():
+            os.rename(target, old)
+        os.rename(temp, target)
+    except BaseException:
+        if old.exists() and not target.exists():
+            os.rename(old, target)
+        shutil.rmtree(temp, ignore_errors=True)
+        raise
+    shutil.rmtree(old, ignore_errors=True)
