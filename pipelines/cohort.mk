@@ -51,6 +51,9 @@ $(COHORT_BUILD)/.deps/%.mk: $(COHORT_DIR)/%.yaml | $(COHORT_NEEDS)
 
 # The input lists are read (and remade first when stale) only when a cohort is being built.
 ifneq ($(filter cohort,$(MAKECMDGOALS)),)
+ifeq ($(COHORT_CASES),)
+$(error COHORT=$(COHORT): no *.yaml case files there; give COHORT=DIR, a folder of case files)
+endif
 -include $(COHORT_DEPS)
 endif
 

@@ -28,9 +28,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Optional, Sequence
 
-from softdesign.config import load_case
 from softdesign.errors import ConfigError
-from softdesign.pipeline.ingest import input_fields
 from softdesign.pipeline.store import MANIFEST
 
 CASE_SUFFIX = ".yaml"
@@ -114,6 +112,10 @@ def case_inputs(case_file: Path) -> list[Path]:
     ConfigError
         The case file is missing or invalid.
     """
+    # imported here: `run` and `summary` start once per case and need neither pydantic nor vtk
+    from softdesign.config import load_case
+    from softdesign.pipeline.ingest import input_fields
+
     return [path for _, path in input_fields(load_case(case_file))]
 
 
