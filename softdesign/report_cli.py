@@ -1,0 +1,73 @@
+"""`softdesign report BUILD_DIR`: the HTML page of plots of a build (and the hook for `build --report`).
+
+Parsing and printing live here; the report is :mod:`softdesign.report.writer`.
+Register with ``app.command()(report)`` in :mod:`softdesign.cli`; ``build
+--report`` calls :func:`report_after_build` with the build folder.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from softdesign.cli_support import note, run_guarded
+from softdesign.errors import ConfigError
+
+
+def pcc_d_from_text(text: str | None) -> tuple[float, ...] | None:
+    """Parse ``--pcc-d``: one distance in mm for every link ("15") or one per link ("15,14,13"), each > 0."""
+    if text is None:
+        return None
+    fix = 'give the chambers\' distance from the backbone in mm, one value ("15") or one per link ("15,14,13")'
+    values = []
+    for part in text.split(","):
+        try:
+            value = float(part)
+        except ValueError:
+            raise ConfigError(f"--pcc-d: '{part.strip()}' is not a number; {fix}") from None
+        if not (math.isfinite(value) and value > 0):
+            raise ConfigError(f"--pcc-d: got {part.strip()}, expected a finite distance > 0 mm; {fix}")
+        values.append(value)
+    return tuple(values)
+
+
+def report_after_build(build_dir: Path, pcc_d: str | None = None) -> None:
+    """Write the report of ``build_dir`` and print where it is (stdout) and what was left out (stderr)."""
+    from softdesign.report.writer import ReportOptions, write_report
+
+    options = ReportOptions(pcc_d=pcc_d_from_text(pcc_d))
+    start = time.perf_counter()
+    result = write_report(build_dir, options)
+    seconds = time.perf_counter() - start
+    for line in result.notes:
+        note(f"report: {line}")
+    size = sum(result.files.values())
+    typer.echo(
+        f"report: {result.page} ({len(result.files)} files, {size / 1e6:.2f} MB, "
+        f"checks {result.checks_passed}/{result.checks_total} passed, {seconds:.1f} s)"
+    )
+
+
+def report(
+    build_dir: Annotated[Path, typer.Argument(help="The build folder (made by softdesign build).", show_default=False)],
+    pcc_d: Annotated[
+        Optional[str],
+        typer.Option(
+            "--pcc-d",
+            help='Add the PCC chamber lengths over q: chamber distance from the backbone in mm, one value ("15") '
+            'or one per link ("15,14,13").',
+            show_default=False,
+        ),
+    ] = None,
+) -> None:
+    """Write BUILD_DIR/report/index.html: the morph, surfaces, fit quality, kinematics, figures and checks, a GIF.
+
+    Exit 0 when the page is written, 2 for a folder that is not a build or a
+    bad option, 1 when drawing fails.  The page and its images replace an
+    older report in one step; nothing else in the folder changes.
+    """
+    run_guarded(lambda: report_after_build(build_dir, pcc_d))
