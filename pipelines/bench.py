@@ -1,0 +1,554 @@
+"""Benchmark of `softdesign build`: wall time and peak memory per stage, against the I/O floor.
+
+Cases: the sample case (configs/demo.yaml); the VMTK aorta (path 0 of
+../shared/data/vmtk-aorta, when present); and a scaled synthetic vessel
+generated here (a long tortuous tube, 6 links), built at several input sizes
+and frame counts to measure how time grows.
+
+How it measures
+    Every build runs in a fresh Python process (``--worker``) into a fresh
+    temporary folder through ``run_stages(..., RunOptions(force=True))``, so
+    nothing is cached.  Heavy libraries are imported before the clock starts
+    (import time is printed apart).  A stage's time is its compute plus its
+    writes (what ``run_stages`` times); "total" is the whole ``run_stages``
+    call (input hashing, manifest and commit included).  Peak memory is the
+    kernel's peak resident set size (VmHWM) of the build process, reset at
+    the start of every stage through /proc/self/clear_refs: it counts every
+    allocation (numpy, vtk, manifold3d, scipy's C code alike), not only
+    Python's, and costs nothing while the stage runs.
+I/O floor
+    With trimesh alone: read the input STL (``trimesh.load``, which merges
+    vertices as the build's reader does) and write STL meshes of the sizes
+    the build wrote (the build's own meshes, re-read untimed).  The ingest
+    row compares with the read, the export row with the writes, the total
+    with both.
+
+Usage: ``python pipelines/bench.py [--triangles 250000,500000,1000000]
+[--frames 11,41] [--profile] [--keep DIR]``; ``make bench`` runs the defaults.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Sequence
+
+REPO = Path(__file__).resolve().parents[1]
+DEMO_CASE = REPO / "configs" / "demo.yaml"
+AORTA_DIR = REPO.parent / "shared" / "data" / "vmtk-aorta"
+STAGE_NAMES = ("ingest", "blend", "kinematics", "fit", "export")
+MIB = 1024.0 * 1024.0
+
+#: Targets of the scaled case (issue 5, item 9).
+TARGET_FLOOR_RATIO = 3.0
+TARGET_PEAK_MIB = 2048.0
+#: Time ~ size^e counts as linear up to this e (timings on a shared machine jitter by ~10 %).
+LINEAR_EXPONENT_MAX = 1.15
+#: The scaled case's links and default sizes.
+SYNTHETIC_LINKS = 6
+DEFAULT_TRIANGLES = (250_000, 500_000, 1_000_000)
+DEFAULT_FRAMES = (11, 41)
+#: The stages whose work grows with each size (the others do not depend on it).
+SCALES_WITH = {"triangles": ("ingest", "fit"), "frames": ("blend", "kinematics", "export")}
+#: The I/O floor is the best of this many tries.
+FLOOR_REPEATS = 2
+#: Per profiled stage: how many functions are listed, and the smallest share of the build worth listing.
+PROFILE_ROWS = 6
+PROFILE_MIN_SHARE = 0.05
+
+
+# ---------------------------------------------------------------- worker side
+
+
+class PeakMemory:
+    """Peak RSS of this process since the last reset (Linux: VmHWM and /proc/self/clear_refs)."""
+
+    def __init__(self) -> None:
+        self.resettable = True
+
+    def reset(self) -> None:
+        try:
+            Path("/proc/self/clear_refs").write_text("5")
+        except OSError:
+            self.resettable = False  # peaks then only ever grow: per-stage figures become upper bounds
+
+    @staticmethod
+    def peak_mib() -> float:
+        status = Path("/proc/self/status").read_text()
+        return int(re.search(r"VmHWM:\s+(\d+)\s+kB", status).group(1)) / 1024.0
+
+    @staticmethod
+    def current_mib() -> float:
+        status = Path("/proc/self/status").read_text()
+        return int(re.search(r"VmRSS:\s+(\d+)\s+kB", status).group(1)) / 1024.0
+
+
+class StageClock:
+    """Wall time, CPU time and peak RSS of each stage, marked from wrapped stage callables.
+
+    With ``profile_dir`` each stage is also profiled on its own (``<stage>.prof``); its
+    figures are then inflated by the profiler and only the hot-spot listing should use them.
+    """
+
+    def __init__(self, memory: PeakMemory, profile_dir: Path | None = None) -> None:
+        self.memory = memory
+        self.profile_dir = profile_dir
+        self.rows: dict[str, dict[str, float]] = {}
+        self.overall_peak = 0.0
+        self._start: tuple[float, float] = (0.0, 0.0)
+        self._profiler = None
+
+    def begin(self, name: str) -> None:
+        self.overall_peak = max(self.overall_peak, self.memory.peak_mib())
+        self.memory.reset()
+        if self.profile_dir is not None:
+            import cProfile
+
+            self._profiler = cProfile.Profile()
+            self._profiler.enable()
+        self._start = (time.perf_counter(), time.process_time())
+
+    def end(self, name: str) -> None:
+        wall, cpu = time.perf_counter() - self._start[0], time.process_time() - self._start[1]
+        if self._profiler is not None:
+            self._profiler.disable()
+            self._profiler.dump_stats(str(self.profile_dir / f"{name}.prof"))
+            self._profiler = None
+        peak = self.memory.peak_mib()
+        self.overall_peak = max(self.overall_peak, peak)
+        self.rows[name] = {"wall_s": wall, "cpu_s": cpu, "peak_mib": peak}
+
+
+def measured(stages: list, clock: StageClock) -> list:
+    """The stages with compute and write wrapped so that ``clock`` sees each stage begin and end."""
+    import dataclasses
+
+    def wrap(stage):
+        def compute(case, results):
+            clock.begin(stage.name)
+            return stage.compute(case, results)
+
+        def write(result, staging):
+            stage.write(result, staging)
+            clock.end(stage.name)
+
+        return dataclasses.replace(stage, compute=compute, write=write)
+
+    return [wrap(stage) for stage in stages]
+
+
+def import_heavy_libraries() -> float:
+    """Import what the stages import lazily, so that no stage is charged for it; seconds taken."""
+    start = time.perf_counter()
+    import manifold3d  # noqa: F401
+    import scipy.interpolate  # noqa: F401
+    import scipy.sparse.linalg  # noqa: F401
+    import scipy.spatial  # noqa: F401
+    import trimesh  # noqa: F401
+    import vtk  # noqa: F401
+
+    from softdesign.pipeline import stages  # noqa: F401
+
+    return time.perf_counter() - start
+
+
+def io_floor(surface: Path, meshes: list[Path], scratch: Path) -> dict[str, float]:
+    """Seconds to read the input STL and to write STL meshes of the sizes the build wrote, with trimesh.
+
+    Each is the best of FLOOR_REPEATS tries (a floor is what the machine can do at best); every
+    write starts from plain arrays, as the build's writer does, so no cached normals are reused.
+    """
+    import numpy as np
+    import trimesh
+
+    reads = []
+    for _ in range(FLOOR_REPEATS):
+        start = time.perf_counter()
+        trimesh.load(str(surface), force="mesh")
+        reads.append(time.perf_counter() - start)
+    scratch.mkdir(parents=True, exist_ok=True)
+    writes = [0.0] * FLOOR_REPEATS
+    for k, path in enumerate(meshes):
+        loaded = trimesh.load(str(path), force="mesh", process=False)  # untimed: only its size matters
+        vertices, faces = np.array(loaded.vertices), np.array(loaded.faces)
+        for attempt in range(FLOOR_REPEATS):
+            start = time.perf_counter()
+            trimesh.Trimesh(vertices, faces, process=False).export(str(scratch / f"mesh_{k}.stl"))
+            writes[attempt] += time.perf_counter() - start
+    return {"read_s": min(reads), "write_s": min(writes)}
+
+
+def run_worker(case_file: Path, out_dir: Path, profile_dir: Path | None) -> dict[str, Any]:
+    """Build ``case_file`` into ``out_dir`` (forced), then measure the I/O floor; returns the figures.
+
+    With ``profile_dir``, every stage is profiled into ``profile_dir/<stage>.prof``.
+    """
+    import_s = import_heavy_libraries()
+    from softdesign.config import load_case
+    from softdesign.pipeline.run import RunOptions, run_stages
+    from softdesign.pipeline.stages import STAGES, input_files
+
+    case = load_case(case_file)
+    memory = PeakMemory()
+    clock = StageClock(memory, profile_dir)
+    baseline = memory.current_mib()
+    memory.reset()
+    start = time.perf_counter(), time.process_time()
+    run_stages(case, out_dir / "build", measured(STAGES, clock), input_files(case), RunOptions(force=True))
+    total = {"wall_s": time.perf_counter() - start[0], "cpu_s": time.process_time() - start[1]}
+    total["peak_mib"] = max(clock.overall_peak, memory.peak_mib())
+    manifest = json.loads((out_dir / "build" / "manifest.json").read_text())
+    meshes = [o for o in manifest["outputs"] if o["path"].startswith("meshes/") and o["path"].endswith(".stl")]
+    floor = io_floor(case.final.surface, [out_dir / "build" / o["path"] for o in meshes], out_dir / "floor")
+    surface = manifest["metrics"]["ingest"]["surface"]
+    return {
+        "import_s": import_s,
+        "baseline_mib": baseline,
+        "peak_resettable": memory.resettable,
+        "stages": clock.rows,
+        "total": total,
+        "input": {"triangles": surface["faces"], "vertices": surface["vertices"]},
+        "output": {"meshes": len(meshes), "triangles": sum(o["faces"] for o in meshes)},
+        "floor": floor,
+    }
+
+
+# ---------------------------------------------------------------- cases
+
+
+@dataclass(frozen=True)
+class BenchCase:
+    """One build to measure: a label, its case file, and its size for the scaling fits."""
+
+    label: str
+    case_file: Path
+    triangles: int = 0
+    frames: int = 0
+
+
+def aorta_case(folder: Path) -> BenchCase | None:
+    """The VMTK aorta, path 0 of aorta-centerline.vtp with the capped aorta-surface.stl, default settings."""
+    if not AORTA_DIR.is_dir():
+        return None
+    folder.mkdir(parents=True, exist_ok=True)
+    case = folder / "aorta.yaml"
+    case.write_text(
+        "name: aorta\nunits: mm\nfinal:\n"
+        f"  centerline: {AORTA_DIR / 'aorta-centerline.vtp'}\n"
+        f"  surface: {AORTA_DIR / 'aorta-surface.stl'}\n"
+        "  path: 0\n"
+    )
+    return BenchCase("VMTK aorta (path 0, capped surface)", case)
+
+
+def write_synthetic_inputs(folder: Path, triangles: int) -> None:
+    """The synthetic vessel's centerline.vtp and binary surface.stl with at least ``triangles`` faces."""
+    from softdesign.geometry.synthetic_vessel import make_synthetic_vessel
+    from softdesign.io.mesh_files import write_mesh
+    from softdesign.io.polylines_vtp import write_polylines_vtp
+    from softdesign.meshing.synthetic_surface import synthetic_surface
+
+    folder.mkdir(parents=True, exist_ok=True)
+    vessel = make_synthetic_vessel()
+    radius = {"MaximumInscribedSphereRadius": [vessel.inscribed_radius()]}
+    write_polylines_vtp(folder / "centerline.vtp", [vessel.points], radius)
+    vertices, faces = synthetic_surface(vessel, triangles)
+    write_mesh(folder / "surface.stl", vertices, faces)
+
+
+def synthetic_case(folder: Path, triangles: int, frames: int) -> BenchCase:
+    """A case on the synthetic inputs in ``folder`` (written once per size) with ``frames`` export frames."""
+    if not (folder / "surface.stl").is_file():
+        write_synthetic_inputs(folder, triangles)
+    case = folder / f"frames_{frames}.yaml"
+    case.write_text(
+        f"name: synthetic-{triangles}-{frames}\nunits: mm\n"
+        "final: {centerline: centerline.vtp, surface: surface.stl, path: 0}\n"
+        "initial: {kind: straight}\n"
+        "resample: {spacing_mm: 0.5, smoothing_mm: 0.05, end_straight_mm: 0.0}\n"
+        f"links: {{count: {SYNTHETIC_LINKS}}}\n"
+        f"export: {{frames: {frames}}}\n"
+    )
+    return BenchCase(f"synthetic {triangles / 1e6:g}M triangles, {frames} frames", case, triangles, frames)
+
+
+def measure(case: BenchCase, scratch: Path, profile_dir: Path | None = None) -> dict[str, Any]:
+    """Run the worker on ``case`` in a fresh process; its figures, with the label and sizes."""
+    out_dir = Path(tempfile.mkdtemp(prefix="run-", dir=scratch))
+    command = [sys.executable, str(Path(__file__).resolve()), "--worker", str(case.case_file), str(out_dir)]
+    if profile_dir is not None:
+        profile_dir.mkdir(parents=True, exist_ok=True)
+        command += ["--profile-dir", str(profile_dir)]
+    done = subprocess.run(command, capture_output=True, text=True, cwd=REPO)
+    shutil.rmtree(out_dir, ignore_errors=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"{case.label}: the build failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
+    figures = json.loads(done.stdout.strip().splitlines()[-1])
+    return {**figures, "label": case.label, "size": {"triangles": case.triangles, "frames": case.frames}}
+
+
+# ---------------------------------------------------------------- tables
+
+
+def ratio_text(value: float, floor: float | None) -> str:
+    """``value / floor`` as ``12.3x``, or a dash when there is no floor."""
+    return "-" if not floor else f"{value / floor:.1f}x"
+
+
+def stage_table(result: dict[str, Any]) -> list[str]:
+    """Per stage: wall s, CPU s, peak RSS MiB, I/O floor s and build/floor."""
+    floor = result["floor"]
+    floors = {"ingest": floor["read_s"], "export": floor["write_s"], "total": floor["read_s"] + floor["write_s"]}
+    i, o = result["input"], result["output"]
+    lines = [
+        f"{result['label']}",
+        f"  input {i['triangles']:,} triangles ({i['vertices']:,} vertices); writes {o['meshes']} STL meshes, "
+        f"{o['triangles']:,} triangles; imports before the clock {result['import_s']:.2f} s, "
+        f"RSS after imports {result['baseline_mib']:.0f} MiB",
+        f"  {'stage':<11}{'wall s':>9}{'cpu s':>9}{'peak MiB':>10}{'floor s':>9}{'build/floor':>13}",
+    ]
+    rows = [(name, result["stages"][name]) for name in STAGE_NAMES] + [("total", result["total"])]
+    for name, row in rows:
+        f = floors.get(name)
+        floor_text = "-" if f is None else f"{f:.2f}"
+        lines.append(
+            f"  {name:<11}{row['wall_s']:>9.2f}{row['cpu_s']:>9.2f}{row['peak_mib']:>10.0f}"
+            f"{floor_text:>9}{ratio_text(row['wall_s'], f):>13}"
+        )
+    return lines
+
+
+def scaling_table(results: Sequence[dict[str, Any]]) -> list[str]:
+    """One row per synthetic run: size, per-stage wall s, total, peak, floor and ratio."""
+    head = f"  {'triangles':>11}{'frames':>7}" + "".join(f"{n:>11}" for n in STAGE_NAMES)
+    lines = [head + f"{'total s':>10}{'peak MiB':>10}{'floor s':>9}{'ratio':>8}"]
+    for r in results:
+        floor = r["floor"]["read_s"] + r["floor"]["write_s"]
+        cells = "".join(f"{r['stages'][n]['wall_s']:>11.2f}" for n in STAGE_NAMES)
+        lines.append(
+            f"  {r['input']['triangles']:>11,}{r['size']['frames']:>7}{cells}{r['total']['wall_s']:>10.2f}"
+            f"{r['total']['peak_mib']:>10.0f}{floor:>9.2f}{ratio_text(r['total']['wall_s'], floor):>8}"
+        )
+    return lines
+
+
+def linear_fit(x: Sequence[float], y: Sequence[float]) -> tuple[float, float]:
+    """Least-squares slope and intercept of y = a + b x."""
+    n = len(x)
+    mx, my = sum(x) / n, sum(y) / n
+    sxx = sum((xi - mx) ** 2 for xi in x)
+    slope = sum((xi - mx) * (yi - my) for xi, yi in zip(x, y)) / sxx if sxx > 0 else float("nan")
+    return slope, my - slope * mx
+
+
+def step_slope_ratio(x: Sequence[float], y: Sequence[float]) -> float | None:
+    """Slope of the last step over the slope of the first (1 = linear, > 1 grows faster); None for < 3 points."""
+    if len(x) < 3:
+        return None
+    first = (y[1] - y[0]) / (x[1] - x[0])
+    last = (y[-1] - y[-2]) / (x[-1] - x[-2])
+    return last / first if first > 0 else float("inf")
+
+
+def growth_exponent(x: Sequence[float], y: Sequence[float]) -> float:
+    """Least-squares slope of log y on log x: 1 = time in proportion to size, > 1 faster than linear."""
+    return linear_fit([math.log(v) for v in x], [math.log(max(v, 1e-9)) for v in y])[0]
+
+
+def seconds(result: dict[str, Any], stage: str, clock: str = "wall_s") -> float:
+    """Seconds (``wall_s`` or ``cpu_s``) of a stage, or of the whole build for ``total``."""
+    return result["total"][clock] if stage == "total" else result["stages"][stage][clock]
+
+
+def growth_lines(results: Sequence[dict[str, Any]], key: str, unit: str, scale: float) -> tuple[list[str], bool | None]:
+    """Slope of each stage's time against size ``key`` (divided by ``scale``), and whether growth is linear.
+
+    Linearity is judged on the CPU time of the stages that do the size-dependent work
+    (SCALES_WITH[key]; CPU time is less disturbed than wall time by other jobs on the machine):
+    the exponent of time against size (log-log least squares over every size) must not exceed
+    LINEAR_EXPONENT_MAX.  A fixed part makes it less than 1, which is not a fault.
+    """
+    runs = sorted(results, key=lambda r: r["size"][key])
+    x = [r["size"][key] / scale for r in runs]
+    if len(set(x)) < 2:
+        return [], None
+    lines = [f"    {'stage':<11}{'wall s per ' + unit:>24}{'cpu s per ' + unit:>24}{'wall intercept s':>18}"]
+    for stage in (*STAGE_NAMES, "total"):
+        slope, intercept = linear_fit(x, [seconds(r, stage) for r in runs])
+        cpu_slope = linear_fit(x, [seconds(r, stage, "cpu_s") for r in runs])[0]
+        lines.append(f"    {stage:<11}{slope:>24.3f}{cpu_slope:>24.3f}{intercept:>18.2f}")
+    name = " + ".join(SCALES_WITH[key])
+    y = {c: [sum(seconds(r, s, c) for s in SCALES_WITH[key]) for r in runs] for c in ("wall_s", "cpu_s")}
+    exponent = {c: growth_exponent(x, v) for c, v in y.items()}
+    lines.append(
+        f"    {name}: time ratio {y['wall_s'][-1] / y['wall_s'][0]:.2f} wall, {y['cpu_s'][-1] / y['cpu_s'][0]:.2f} cpu, "
+        f"for a size ratio {x[-1] / x[0]:.2f}; time ~ size^{exponent['wall_s']:.2f} wall, "
+        f"^{exponent['cpu_s']:.2f} cpu (1 = linear)"
+    )
+    ratio = step_slope_ratio(x, y["cpu_s"])
+    if ratio is not None:
+        lines.append(f"    {name}: cpu slope of the last step / of the first = {ratio:.2f} (1 = linear)")
+    return lines, exponent["cpu_s"] <= LINEAR_EXPONENT_MAX
+
+
+def verdict(ok: bool | None) -> str:
+    """met / MISSED / not measured."""
+    return "not measured" if ok is None else ("met" if ok else "MISSED")
+
+
+def target_lines(scaled: dict[str, Any] | None, linear_triangles: bool | None, linear_frames: bool | None) -> list[str]:
+    """The issue's targets for the scaled case, each with its figure and verdict."""
+    if scaled is None:
+        return ["  scaled case not run"]
+    floor = scaled["floor"]["read_s"] + scaled["floor"]["write_s"]
+    ratio = scaled["total"]["wall_s"] / floor
+    peak = scaled["total"]["peak_mib"]
+    return [
+        f"  build / I/O floor     {ratio:7.1f}x   target <= {TARGET_FLOOR_RATIO:g}x      {verdict(ratio <= TARGET_FLOOR_RATIO)}",
+        f"  peak memory           {peak:7.0f} MiB target < {TARGET_PEAK_MIB:.0f} MiB  {verdict(peak < TARGET_PEAK_MIB)}",
+        f"  linear in triangles   cpu time ~ size^e, e <= {LINEAR_EXPONENT_MAX:g}    {verdict(linear_triangles)}",
+        f"  linear in frames      cpu time ~ size^e, e <= {LINEAR_EXPONENT_MAX:g}    {verdict(linear_frames)}",
+    ]
+
+
+def profile_lines(profile_dir: Path, rows: int = PROFILE_ROWS) -> list[str]:
+    """Per stage worth it: the functions with the largest cumulative and own time, as % of the whole build."""
+    import pstats
+
+    stats = {n: pstats.Stats(str(profile_dir / f"{n}.prof")).stats for n in STAGE_NAMES}
+    # pstats entries: (file, line, name) -> (primitive calls, calls, own s, cumulative s, callers)
+    spent = {n: max(v[3] for v in entries.values()) for n, entries in stats.items()}
+    build = sum(spent.values())
+    lines = [f"  profiled build: {build:.1f} s under cProfile; shares are of that"]
+    for name in STAGE_NAMES:
+        if spent[name] < PROFILE_MIN_SHARE * build:
+            continue
+        lines.append(f"  {name}: {spent[name]:.1f} s ({100 * spent[name] / build:.0f}%)")
+        inner = [(k, v) for k, v in stats[name].items() if v[3] < 0.95 * spent[name] and not k[0].endswith("bench.py")]
+        for title, column in (("cumulative", 3), ("own", 2)):
+            lines.append(f"    by {title} time:")
+            for (file, line, func), entry in sorted(inner, key=lambda kv: -kv[1][column])[:rows]:
+                lines.append(
+                    f"      {100 * entry[column] / build:5.1f}%  {entry[column]:7.2f} s  {entry[1]:>7} calls  "
+                    f"{_short(file)}:{line} {func}"
+                )
+    return lines
+
+
+def _short(file: str) -> str:
+    return file.split("site-packages/")[-1].split("/work/main/")[-1]
+
+
+# ---------------------------------------------------------------- driver
+
+
+def header_lines() -> list[str]:
+    """Machine, load and method, so that figures can be compared across runs."""
+    import platform
+
+    import numpy
+
+    load = ", ".join(f"{v:.2f}" for v in os.getloadavg())
+    return [
+        f"softdesign benchmark: {os.cpu_count()} cores, load average {load} (other jobs inflate wall times; "
+        f"compare cpu s), Python {platform.python_version()}, numpy {numpy.__version__}",
+        "each build: a fresh process, a fresh folder, every stage forced (run_stages, RunOptions(force=True)); "
+        "peak = the process's peak RSS during the stage (VmHWM, reset per stage), every allocation counted",
+        "I/O floor: trimesh alone reads the input STL (ingest) and writes STL meshes of the sizes the build "
+        "wrote (export); total = both",
+    ]
+
+
+def synthetic_plan(folder: Path, triangles: Sequence[int], frames: Sequence[int]) -> list[BenchCase]:
+    """Every size at the most frames, and every frame count at the most triangles, small first."""
+    top_t, top_f = max(triangles), max(frames)
+    sizes = sorted({(t, top_f) for t in triangles} | {(top_t, f) for f in frames})
+    return [synthetic_case(folder / f"synthetic_{t}", t, f) for t, f in sizes]
+
+
+def emit(lines: Sequence[str]) -> None:
+    print("\n".join(lines), flush=True)
+
+
+def run_synthetic(plan: list[BenchCase], scratch: Path) -> list[dict[str, Any]]:
+    """Measure every synthetic run, telling stderr as each one ends."""
+    results = []
+    for case in plan:
+        start = time.perf_counter()
+        results.append(measure(case, scratch))
+        print(f"  ({case.label}: measured in {time.perf_counter() - start:.0f} s)", file=sys.stderr, flush=True)
+    return results
+
+
+def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
+    """Measure and print every case, the scaling of the synthetic case and the targets."""
+    started = time.perf_counter()
+    emit(header_lines() + [""])
+    emit(stage_table(measure(BenchCase("sample case (configs/demo.yaml)", DEMO_CASE), scratch)) + [""])
+    aorta = aorta_case(scratch / "aorta")
+    if aorta is None:
+        emit([f"VMTK aorta: skipped, {AORTA_DIR} not found", ""])
+    else:
+        emit(stage_table(measure(aorta, scratch)) + [""])
+    plan = synthetic_plan(scratch, args.triangles, args.frames)
+    results = run_synthetic(plan, scratch)
+    top_t, top_f = max(args.triangles), max(args.frames)
+    scaled = next(r for r in results if r["size"] == {"triangles": top_t, "frames": top_f})
+    emit([f"scaled case ({SYNTHETIC_LINKS} links):"] + stage_table(scaled) + [""])
+    emit(["scaled case at every size (wall s per stage):"] + scaling_table(results) + [""])
+    by_t, linear_t = growth_lines([r for r in results if r["size"]["frames"] == top_f], "triangles", "M triangles", 1e6)
+    by_f, linear_f = growth_lines([r for r in results if r["size"]["triangles"] == top_t], "frames", "frame", 1.0)
+    emit([f"growth with input triangles ({top_f} frames), least-squares slope per stage (M = million):"] + by_t)
+    emit([f"growth with frames ({top_t:,} triangles requested), least-squares slope per stage:"] + by_f + [""])
+    emit([f"targets, scaled case ({scaled['label']}):"] + target_lines(scaled, linear_t, linear_f))
+    if args.profile:
+        profile_dir = scratch / "profile"
+        measure(next(c for c in plan if (c.triangles, c.frames) == (top_t, top_f)), scratch, profile_dir)
+        emit(["", "hot spots of the scaled case (cProfile per stage; times inflated by the profiler):"] + profile_lines(profile_dir))
+    emit(["", f"benchmark took {time.perf_counter() - started:.0f} s"])
+
+
+def parse_counts(text: str) -> list[int]:
+    """``250000,500000`` -> [250000, 500000]."""
+    values = [int(v) for v in text.split(",") if v.strip()]
+    if not values or min(values) < 1:
+        raise argparse.ArgumentTypeError(f"expected positive integers separated by commas, got {text!r}")
+    return values
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--triangles", type=parse_counts, default=list(DEFAULT_TRIANGLES), help="synthetic input sizes")
+    parser.add_argument("--frames", type=parse_counts, default=list(DEFAULT_FRAMES), help="synthetic frame counts")
+    parser.add_argument("--profile", action="store_true", help="also profile the scaled case and list hot spots")
+    parser.add_argument("--keep", type=Path, help="work in this folder and keep it (default: a temporary folder)")
+    parser.add_argument("--worker", nargs=2, type=Path, metavar=("CASE", "OUT"), help=argparse.SUPPRESS)
+    parser.add_argument("--profile-dir", type=Path, help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.worker:
+        print(json.dumps(run_worker(args.worker[0], args.worker[1], args.profile_dir)))
+        return 0
+    if min(args.frames) < 2:
+        parser.error("--frames: each count must be >= 2 (both ends are exported)")
+    scratch = args.keep or Path(tempfile.mkdtemp(prefix="softdesign-bench-"))
+    scratch.mkdir(parents=True, exist_ok=True)
+    try:
+        run_benchmark(args, scratch)
+    finally:
+        if args.keep is None:
+            shutil.rmtree(scratch, ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
