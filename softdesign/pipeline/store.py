@@ -67,6 +67,20 @@ def load_npz(path: Path) -> dict[str, np.ndarray]:
         return {k: data[k] for k in data.files}
 
 
+def _owner_alive(suffix: str) -> bool:
+    """Whether the run that made a staging folder (``<pid>-<random>``) is still running here."""
+    pid = suffix.split("-", 1)[0]
+    if not pid.isdigit():
+        return False
+    try:
+        os.kill(int(pid), 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
 class Staging:
     """Files of one run, written under a staging folder and committed together.
 
@@ -84,8 +98,9 @@ class Staging:
         parent.mkdir(parents=True, exist_ok=True)
         prefix = f".{self.build_dir.name}{STAGING_PREFIX}"
         for stale in parent.glob(prefix + "*"):
-            shutil.rmtree(stale, ignore_errors=True)
-        self.root = Path(tempfile.mkdtemp(prefix=prefix, dir=parent))
+            if not _owner_alive(stale.name.removeprefix(prefix)):
+                shutil.rmtree(stale, ignore_errors=True)
+        self.root = Path(tempfile.mkdtemp(prefix=f"{prefix}{os.getpid()}-", dir=parent))
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
