@@ -22,6 +22,12 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest
 
+# `make bench`: per-stage time and peak memory of forced builds (sample case,
+# VMTK aorta when ../shared/data is there, scaled synthetic case) against the
+# I/O floor, with slopes against triangles and frames; about 5-7 minutes.
+bench: $(STAMP)
+	$(BIN)/python pipelines/bench.py
+
 clean:
 	rm -rf build .pytest_cache
 
