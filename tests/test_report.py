@@ -417,3 +417,17 @@ def test_tube_vertices_lie_at_the_fitted_radius_and_face_outwards(demo):
     normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     outward = tri.mean(axis=1) - curve.points(face_l)
     assert np.all(np.einsum("ij,ij->i", normals, outward) > 0.0)
+
+
+def test_a_killed_runs_temporary_folder_is_removed_a_running_ones_kept(tmp_path):
+    import subprocess
+    import sys
+
+    finished = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    dead = tmp_path / f".report-{finished.stdout.strip()}-abc"  # that process has exited
+    alive = tmp_path / f".report-{__import__('os').getpid()}-def"  # this test's own process
+    for folder in (dead, alive):
+        folder.mkdir()
+        (folder / PAGE).write_bytes(b"half written")
+    commit_folder(tmp_path / REPORT_DIR, {PAGE: b"page"})
+    assert not dead.exists() and alive.exists()

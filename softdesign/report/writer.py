@@ -3,7 +3,7 @@
 The files are written into a hidden temporary folder beside ``report/`` and
 moved into place only when all of them exist: a failed or killed run leaves
 the previous report as it was (a killed run's temporary folder is removed by
-a later run once it is an hour old).  The build folder's stage outputs and
+a later run).  The build folder's stage outputs and
 manifest are only read.
 """
 
@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import time
 import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -41,8 +40,6 @@ from softdesign.report.tables import (
 REPORT_DIR = "report"
 PAGE = "index.html"
 TEMP_PREFIX = ".report-"
-#: A temporary report folder older than this (s) is a killed run's leftover.
-STALE_SECONDS = 3600.0
 NO_FIT = (
     "no fit in this build folder (built only through kinematics): surfaces and fit quality are left out; "
     "run softdesign build"
@@ -182,10 +179,14 @@ def _summary(data: BuildData, passed: int, total: int) -> list[str]:
 
 
 def commit_folder(target: Path, files: dict[str, bytes]) -> None:
-    """Write ``files`` into a temporary folder beside ``target``, then swap it in for ``target``."""
+    """Write ``files`` into a temporary folder beside ``target``, then swap it in for ``target``.
+
+    Temporary folders are named ``.report-<pid>-<random>``; one whose process
+    is gone is a killed run's leftover and is removed.
+    """
     parent = target.parent
     for stale in parent.glob(TEMP_PREFIX + "*"):
-        if time.time() - stale.stat().st_mtime > STALE_SECONDS:
+        if not _process_alive(stale.name.removeprefix(TEMP_PREFIX).split("-", 1)[0]):
             shutil.rmtree(stale, ignore_errors=True)
     temp = parent / f"{TEMP_PREFIX}{os.getpid()}-{uuid.uuid4().hex[:12]}"
     temp.mkdir()  # unlike mkdtemp, honours the umask: the report is as readable as the rest of the build
@@ -202,3 +203,16 @@ def commit_folder(target: Path, files: dict[str, bytes]) -> None:
         shutil.rmtree(temp, ignore_errors=True)
         raise
     shutil.rmtree(old, ignore_errors=True)
+
+
+def _process_alive(pid: str) -> bool:
+    """Whether process ``pid`` (digits) runs on this machine."""
+    if not pid.isdigit():
+        return False
+    try:
+        os.kill(int(pid), 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True  # it exists, owned by someone else
+    return True
