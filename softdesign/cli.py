@@ -16,6 +16,7 @@ from softdesign.cli_support import StageProgress, emit_json, run_guarded
 from softdesign.check_cli import check
 from softdesign.pcc_cli import pcc_app
 from softdesign.pose_cli import pose
+from softdesign.report_cli import report, report_after_build
 
 app = typer.Typer(
     add_completion=False,
@@ -25,10 +26,12 @@ app = typer.Typer(
 app.add_typer(pcc_app, name="pcc")
 app.command()(check)
 app.command()(pose)
+app.command()(report)
 
 CaseArg = Annotated[Path, typer.Argument(help="The case file (YAML).", show_default=False)]
 OutOpt = Annotated[Optional[Path], typer.Option("--out", "-o", help="Build folder (default: build/<name>).")]
 ForceOpt = Annotated[bool, typer.Option("--force", help="Redo every stage, ignoring the cache.")]
+ReportOpt = Annotated[bool, typer.Option("--report", help="Then write BUILD/report/index.html (softdesign report).")]
 
 
 def _run(case_file: Path, out: Optional[Path], target: str | None, force: bool):
@@ -71,9 +74,16 @@ def validate(case_file: CaseArg) -> None:
 
 
 @app.command()
-def build(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:
-    """Run every stage (unchanged stages are skipped) and write the manifest."""
-    _stage_command(case_file, out, None, force)
+def build(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False, with_report: ReportOpt = False) -> None:
+    """Run every stage (unchanged stages are skipped) and write the manifest; --report adds the HTML report."""
+
+    def action() -> None:
+        _, build_dir, _, runs = _run(case_file, out, None, force)
+        _report(build_dir, runs)
+        if with_report:
+            report_after_build(build_dir)
+
+    run_guarded(action)
 
 
 @app.command()
