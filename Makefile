@@ -16,8 +16,9 @@ $(STAMP): pyproject.toml
 	touch $@
 
 demo: $(STAMP)
-	$(BIN)/softdesign build configs/demo.yaml
-	@echo "Results: build/demo/ (manifest.json and the stage folders)"
+	$(BIN)/softdesign build configs/demo.yaml --report
+	@echo "Results in build/demo/: meshes/q_*.stl (the actuator at each q), kinematics.json,"
+	@echo "manifest.json, and the report to open in a browser: build/demo/report/index.html"
 
 test: $(STAMP)
 	$(BIN)/python -m pytest
