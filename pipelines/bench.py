@@ -242,10 +242,11 @@ def aorta_case(folder: Path) -> BenchCase | None:
         return None
     folder.mkdir(parents=True, exist_ok=True)
     case = folder / "aorta.yaml"
-    case.write_text(
+    quoted = {name: json.dumps(str(AORTA_DIR / name)) for name in ("aorta-centerline.vtp", "aorta-surface.stl")}
+    case.write_text(  # JSON strings are YAML strings: any path survives quoting
         "name: aorta\nunits: mm\nfinal:\n"
-        f"  centerline: {AORTA_DIR / 'aorta-centerline.vtp'}\n"
-        f"  surface: {AORTA_DIR / 'aorta-surface.stl'}\n"
+        f"  centerline: {quoted['aorta-centerline.vtp']}\n"
+        f"  surface: {quoted['aorta-surface.stl']}\n"
         "  path: 0\n"
     )
     return BenchCase("VMTK aorta (path 0, capped surface)", case)
@@ -320,7 +321,7 @@ def stage_table(result: dict[str, Any]) -> list[str]:
     rows = [(name, result["stages"][name]) for name in STAGE_NAMES] + [("total", result["total"])]
     for name, row in rows:
         f = floors.get(name)
-        floor_text = "-" if f is None else f"{f:.2f}"
+        floor_text = "-" if f is None else f"{f:.3f}"
         lines.append(
             f"  {name:<11}{row['wall_s']:>9.2f}{row['cpu_s']:>9.2f}{row['peak_mib']:>10.0f}"
             f"{floor_text:>9}{ratio_text(row['wall_s'], f):>13}"
@@ -337,7 +338,7 @@ def scaling_table(results: Sequence[dict[str, Any]]) -> list[str]:
         cells = "".join(f"{r['stages'][n]['wall_s']:>11.2f}" for n in STAGE_NAMES)
         lines.append(
             f"  {r['input']['triangles']:>11,}{r['size']['frames']:>7}{cells}{r['total']['wall_s']:>10.2f}"
-            f"{r['total']['peak_mib']:>10.0f}{floor:>9.2f}{ratio_text(r['total']['wall_s'], floor):>8}"
+            f"{r['total']['peak_mib']:>10.0f}{floor:>9.3f}{ratio_text(r['total']['wall_s'], floor):>8}"
         )
     return lines
 
@@ -510,7 +511,10 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
     by_f, linear_f = growth_lines([r for r in results if r["size"]["triangles"] == top_t], "frames", "frame", 1.0)
     emit([f"growth with input triangles ({top_f} frames), least-squares slope per stage (M = million):"] + by_t)
     emit([f"growth with frames ({top_t:,} triangles requested), least-squares slope per stage:"] + by_f + [""])
-    emit([f"targets, scaled case ({scaled['label']}):"] + target_lines(scaled, linear_t, linear_f))
+    targets = target_lines(scaled, linear_t, linear_f)
+    emit([f"targets, scaled case ({scaled['label']}):"] + targets)
+    if any(line.endswith("MISSED") for line in targets) and not args.profile:
+        emit(["  hot spots per stage: python pipelines/bench.py --profile (adds one profiled build of the scaled case)"])
     if args.profile:
         profile_dir = scratch / "profile"
         measure(next(c for c in plan if (c.triangles, c.frames) == (top_t, top_f)), scratch, profile_dir)
@@ -544,6 +548,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     scratch.mkdir(parents=True, exist_ok=True)
     try:
         run_benchmark(args, scratch)
+    except RuntimeError as err:  # a build failed: its message carries the worker's stderr
+        print(f"bench: {err}", file=sys.stderr)
+        return 1
     finally:
         if args.keep is None:
             shutil.rmtree(scratch, ignore_errors=True)

@@ -48,8 +48,8 @@ def test_stage_table_has_every_stage_the_total_and_the_ratio_to_the_floor(bench)
     lines = bench.stage_table(result)
     rows = {line.split()[0]: line.split() for line in lines[3:]}
     assert list(rows) == [*bench.STAGE_NAMES, "total"]
-    assert rows["ingest"][-2:] == ["0.50", "2.0x"]  # 1.0 s against a 0.5 s read
-    assert rows["export"][-2:] == ["0.25", "2.0x"]
+    assert rows["ingest"][-2:] == ["0.500", "2.0x"]  # 1.0 s against a 0.5 s read
+    assert rows["export"][-2:] == ["0.250", "2.0x"]
     assert rows["fit"][-2:] == ["-", "-"]  # no I/O floor for a stage that reads and writes nothing required
     assert rows["total"][-1] == f"{result['total']['wall_s'] / 0.75:.1f}x"
 
