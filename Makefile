@@ -25,7 +25,8 @@ test: $(STAMP)
 
 # `make bench`: per-stage time and peak memory of forced builds (sample case,
 # VMTK aorta when ../shared/data is there, scaled synthetic case) against the
-# I/O floor, with slopes against triangles and frames; about 5-7 minutes.
+# I/O floor, with slopes against triangles and frames; about 3-4 minutes on a
+# quiet machine (`--profile` adds per-stage hot spots).
 bench: $(STAMP)
 	$(BIN)/python pipelines/bench.py
 
