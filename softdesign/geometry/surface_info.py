@@ -50,7 +50,10 @@ def describe_surface(vertices: FloatArray, faces: IntArray) -> SurfaceInfo:
     """Topology summary of a triangle mesh (vertices (V, 3) mm, faces (F, 3))."""
     faces = np.asarray(faces, np.int64)
     edges = np.sort(faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-    unique, counts = np.unique(edges, axis=0, return_counts=True)
+    # one int64 key per undirected edge: a 1-D unique is ~8x faster than unique(axis=0)
+    n = max(int(len(vertices)), int(faces.max(initial=-1)) + 1)
+    keys, counts = np.unique(edges[:, 0] * n + edges[:, 1], return_counts=True)
+    unique = np.column_stack([keys // n, keys % n])
     boundary = unique[counts == 1]
     loops = 0
     if len(boundary):
