@@ -48,22 +48,31 @@ def body_breaks(field: RadiusField) -> FloatArray:
     return np.unique(np.clip(knots, 0.0, 1.0))
 
 
-def body_sections(
-    curve: FramedSpline, field: RadiusField, q: float, spacing_mm: float, angular_count: int
-) -> TubeSections:
-    """Rings of the body at q about ``spacing_mm`` apart, every joint included once."""
+def export_l_grid(curve: FramedSpline, field: RadiusField, spacing_mm: float) -> FloatArray:
+    """The export's ring parameters at this q: about ``spacing_mm`` apart, every joint once."""
     l_dense = curve.curve.dense_l()
-    s_dense = curve.curve.arc_length(l_dense)
-    l = l_grid_from_spacing(l_dense, s_dense, field.breaks, spacing_mm)
-    st = body_stations(curve, field, q, angular_count)(l)
+    return l_grid_from_spacing(l_dense, curve.curve.arc_length(l_dense), field.breaks, spacing_mm)
+
+
+def sections_on_grid(curve: FramedSpline, q: float, l: FloatArray, rho: FloatArray, rho_l: FloatArray) -> TubeSections:
+    """Rings at ``l`` with radii ``rho`` (n, na) mm and their l-derivative ``rho_l`` (mm per unit l)."""
     frames = curve.frames(l)
     return TubeSections(
         q=float(q),
         l=l,
         centers=curve.points(l),
         frames=frames,
-        rho=st.rho,
+        rho=rho,
         s=curve.curve.arc_length(l),
-        rho_s=st.rho_s,
-        curvature=st.curvature,
+        rho_s=rho_l / curve.curve.speed(l)[:, None],
+        curvature=curvature_components(curve, l, frames),
     )
+
+
+def body_sections(
+    curve: FramedSpline, field: RadiusField, q: float, spacing_mm: float, angular_count: int
+) -> TubeSections:
+    """Rings of the body at q about ``spacing_mm`` apart, every joint included once."""
+    l = export_l_grid(curve, field, spacing_mm)
+    a = angle_grid(angular_count)
+    return sections_on_grid(curve, q, l, field.evaluate_grid(q, l, a), field.evaluate_grid(q, l, a, dl=1))

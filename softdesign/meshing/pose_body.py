@@ -41,7 +41,7 @@ from softdesign.fitting.radius_field import RadiusField
 from softdesign.geometry.frames import FramedSpline
 from softdesign.kinematics.links import LinkChain
 from softdesign.kinematics.poe import inverse_pose
-from softdesign.meshing.body import body_breaks, body_stations, curvature_components
+from softdesign.meshing.body import body_breaks, body_stations, export_l_grid, sections_on_grid
 from softdesign.meshing.checks import Expectation, MeshReport, check_solid
 from softdesign.meshing.solids import manifold_from_mesh
 from softdesign.meshing.tessellate import (
@@ -49,7 +49,6 @@ from softdesign.meshing.tessellate import (
     Sweep,
     TubeMesh,
     TubeSections,
-    l_grid_from_spacing,
     sweep_from_sections,
     tessellate,
 )
@@ -167,23 +166,12 @@ def link_sections(curve: FramedSpline, field: RadiusField, link: int, q: float, 
     included), and rho comes from the link's own spline, so with every q equal the pieces are the
     export's rings (a joint ring once from each side).
     """
-    l_dense = curve.curve.dense_l()
-    l_all = l_grid_from_spacing(l_dense, curve.curve.arc_length(l_dense), field.breaks, spec.spacing_mm)
+    l_all = export_l_grid(curve, field, spec.spacing_mm)
     lo, hi = field.breaks[link], field.breaks[link + 1]
     l = l_all[(l_all >= lo) & (l_all <= hi)]
     a = angle_grid(spec.angular_count)
     spline = field.link_spline(link, q)
-    frames = curve.frames(l)
-    return TubeSections(
-        q=float(q),
-        l=l,
-        centers=curve.points(l),
-        frames=frames,
-        rho=spline.evaluate_grid(l, a),
-        s=curve.curve.arc_length(l),
-        rho_s=spline.evaluate_grid(l, a, dl=1) / curve.curve.speed(l)[:, None],
-        curvature=curvature_components(curve, l, frames),
-    )
+    return sections_on_grid(curve, q, l, spline.evaluate_grid(l, a), spline.evaluate_grid(l, a, dl=1))
 
 
 def radii_on_rays(xy: npt.ArrayLike) -> FloatArray:

@@ -67,9 +67,8 @@ def load_npz(path: Path) -> dict[str, np.ndarray]:
         return {k: data[k] for k in data.files}
 
 
-def _owner_alive(suffix: str) -> bool:
-    """Whether the run that made a staging folder (``<pid>-<random>``) is still running here."""
-    pid = suffix.split("-", 1)[0]
+def process_alive(pid: str) -> bool:
+    """Whether process ``pid`` (digits) runs on this machine (the owner of a staging folder)."""
     if not pid.isdigit():
         return False
     try:
@@ -77,7 +76,7 @@ def _owner_alive(suffix: str) -> bool:
     except ProcessLookupError:
         return False
     except PermissionError:
-        return True
+        return True  # it exists, owned by someone else
     return True
 
 
@@ -98,7 +97,7 @@ class Staging:
         parent.mkdir(parents=True, exist_ok=True)
         prefix = f".{self.build_dir.name}{STAGING_PREFIX}"
         for stale in parent.glob(prefix + "*"):
-            if not _owner_alive(stale.name.removeprefix(prefix)):
+            if not process_alive(stale.name.removeprefix(prefix).split("-", 1)[0]):
                 shutil.rmtree(stale, ignore_errors=True)
         self.root = Path(tempfile.mkdtemp(prefix=f"{prefix}{os.getpid()}-", dir=parent))
         return self

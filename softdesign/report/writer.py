@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from softdesign.errors import ConfigError
+from softdesign.pipeline.store import process_alive
 from softdesign.report import animation, fit_figures, kinematics_figures, morph_figures, surface_figures
 from softdesign.report.build_folder import BuildData, load_build
 from softdesign.report.html_page import (
@@ -186,7 +187,7 @@ def commit_folder(target: Path, files: dict[str, bytes]) -> None:
     """
     parent = target.parent
     for stale in parent.glob(TEMP_PREFIX + "*"):
-        if not _process_alive(stale.name.removeprefix(TEMP_PREFIX).split("-", 1)[0]):
+        if not process_alive(stale.name.removeprefix(TEMP_PREFIX).split("-", 1)[0]):
             shutil.rmtree(stale, ignore_errors=True)
     temp = parent / f"{TEMP_PREFIX}{os.getpid()}-{uuid.uuid4().hex[:12]}"
     temp.mkdir()  # unlike mkdtemp, honours the umask: the report is as readable as the rest of the build
@@ -203,16 +204,3 @@ def commit_folder(target: Path, files: dict[str, bytes]) -> None:
         shutil.rmtree(temp, ignore_errors=True)
         raise
     shutil.rmtree(old, ignore_errors=True)
-
-
-def _process_alive(pid: str) -> bool:
-    """Whether process ``pid`` (digits) runs on this machine."""
-    if not pid.isdigit():
-        return False
-    try:
-        os.kill(int(pid), 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True  # it exists, owned by someone else
-    return True
