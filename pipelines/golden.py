@@ -59,18 +59,13 @@ def read_mesh(path: Path) -> tuple[np.ndarray, np.ndarray]:
 def decimate(vertices: np.ndarray, faces: np.ndarray, reduction: float) -> tuple[np.ndarray, np.ndarray]:
     """The mesh with about ``reduction`` of its faces removed by quadric error decimation."""
     import vtk
-    from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray, vtk_to_numpy
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    from softdesign.io.vtk_polydata import polydata_from_triangles
 
     if reduction <= 0.0:
         return vertices, faces
-    poly = vtk.vtkPolyData()
-    points = vtk.vtkPoints()
-    points.SetData(numpy_to_vtk(np.ascontiguousarray(vertices), deep=True))
-    poly.SetPoints(points)
-    cells = vtk.vtkCellArray()
-    offsets = np.arange(0, 3 * len(faces) + 1, 3, dtype=np.int64)
-    cells.SetData(numpy_to_vtkIdTypeArray(offsets, deep=True), numpy_to_vtkIdTypeArray(faces.reshape(-1).copy(), deep=True))
-    poly.SetPolys(cells)
+    poly = polydata_from_triangles(vertices, faces)
     decimation = vtk.vtkQuadricDecimation()
     decimation.SetInputData(poly)
     decimation.SetTargetReduction(reduction)

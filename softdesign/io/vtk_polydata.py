@@ -103,3 +103,20 @@ def triangles_from_polydata(poly) -> tuple[np.ndarray, np.ndarray]:
     vertices = vtk_to_numpy(out.GetPoints().GetData()).astype(np.float64)
     return vertices, conn.reshape(-1, 3)
 
+
+
+def polydata_from_triangles(vertices: np.ndarray, faces: np.ndarray):
+    """A ``vtkPolyData`` of a triangle mesh: vertices (V, 3) float, faces (F, 3) int."""
+    import vtk
+    from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+
+    poly = vtk.vtkPolyData()
+    points = vtk.vtkPoints()
+    points.SetData(numpy_to_vtk(np.ascontiguousarray(vertices, dtype=np.float64), deep=True))
+    poly.SetPoints(points)
+    cells = vtk.vtkCellArray()
+    offsets = np.arange(0, 3 * len(faces) + 1, 3, dtype=np.int64)
+    connectivity = np.ascontiguousarray(np.asarray(faces).reshape(-1), dtype=np.int64)
+    cells.SetData(numpy_to_vtkIdTypeArray(offsets, deep=True), numpy_to_vtkIdTypeArray(connectivity, deep=True))
+    poly.SetPolys(cells)
+    return poly

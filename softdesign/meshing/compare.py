@@ -199,19 +199,10 @@ def _one_way(
 def _squared_distances(points: FloatArray, vertices: FloatArray, faces: IntArray) -> FloatArray:
     """Exact squared distance (mm^2) from each point (n, 3) to the closest point on a triangle mesh."""
     import vtk
-    from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
 
-    poly = vtk.vtkPolyData()
-    vtk_points = vtk.vtkPoints()
-    vtk_points.SetData(numpy_to_vtk(np.ascontiguousarray(vertices), deep=True))
-    poly.SetPoints(vtk_points)
-    cells = vtk.vtkCellArray()
-    offsets = np.arange(0, 3 * len(faces) + 1, 3, dtype=np.int64)
-    cells.SetData(
-        numpy_to_vtkIdTypeArray(offsets, deep=True),
-        numpy_to_vtkIdTypeArray(np.ascontiguousarray(faces.reshape(-1), dtype=np.int64), deep=True),
-    )
-    poly.SetPolys(cells)
+    from softdesign.io.vtk_polydata import polydata_from_triangles
+
+    poly = polydata_from_triangles(vertices, faces)
     locator = vtk.vtkStaticCellLocator()
     locator.SetDataSet(poly)
     locator.BuildLocator()
