@@ -122,6 +122,33 @@ def test_polyline_distance_is_to_the_end_clamped_segments():
                                atol=DISTANCE_TOL_MM)
 
 
+def test_polyline_distance_is_the_least_over_every_segment_on_a_folded_uneven_polyline():
+    # Pruning by nearest midpoints must not change a distance: a hairpin whose two legs pass 0.3 mm
+    # apart, segments from 0.01 to 12 mm long, points near and far, compared with every segment.
+    rng = np.random.default_rng(7)
+    t = np.concatenate([np.linspace(0.0, np.pi, 300), [np.pi + 0.001, 4.0, 7.0]])
+    polyline = np.column_stack([20.0 * np.cos(t), 0.15 * np.sign(np.cos(t)) + np.sin(t), t])
+    points = np.concatenate([polyline[::7] + rng.normal(scale=0.2, size=(len(polyline[::7]), 3)),
+                             rng.normal(scale=15.0, size=(400, 3))])
+    start, edge = polyline[:-1], np.diff(polyline, axis=0)
+    u = np.clip(np.einsum("nsj,sj->ns", points[:, None] - start, edge) / np.sum(edge**2, axis=1), 0.0, 1.0)
+    brute = np.min(np.linalg.norm(points[:, None] - (start + u[:, :, None] * edge), axis=2), axis=1)
+    np.testing.assert_allclose(polyline_distances(points, polyline), brute, rtol=0, atol=DISTANCE_TOL_MM)
+    some = rng.random(len(edge)) < 0.5
+    brute_some = np.min(np.linalg.norm(points[:, None] - (start + u[:, :, None] * edge)[:, some], axis=2), axis=1)
+    np.testing.assert_allclose(polyline_distances(points, polyline, some), brute_some, rtol=0, atol=DISTANCE_TOL_MM)
+
+
+def test_a_path_alone_has_no_other_branch_points():
+    parts = _surface()
+    points = np.concatenate([parts["kept"], parts["other_branch"]])
+    curve = Line(80.0)
+    path, _ = _y_network()
+    selection = select_wall_points(project_points(curve, points), curve.length, NetworkContext(path),
+                                   SelectionSettings(outlier_factor=100.0))
+    assert selection.counts["other_branch"] == 0
+
+
 def test_inscribed_profile_is_sorted_by_l_and_checked():
     path = np.column_stack([np.zeros(5), np.zeros(5), [80.0, 60.0, 40.0, 20.0, 0.0]])
     l, r = inscribed_profile(Line(80.0), path, np.array([5.0, 4.0, 3.0, 2.0, 1.0]))

@@ -24,14 +24,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from softdesign.errors import ConfigError, InputDataError
 from softdesign.fitting.projection import PolarPoints, project_points
 from softdesign.types import FloatArray, FramedCurve, Points
 
 REASONS = ("other_branch", "cap", "outlier")
-#: Points per chunk in the brute-force point-to-polyline distance (bounds memory to ~10 MB).
-_CHUNK = 2048
+#: Segments first tried per point in the point-to-polyline distance (a wall point's nearest
+#: segment is among its ~2 sqrt(radius / segment length) nearest midpoints: 16 covers 10 mm at 0.2 mm).
+_FIRST_K = 16
+#: Point-segment pairs per chunk of that distance (bounds its memory to ~100 MB).
+_CHUNK_ENTRIES = 1 << 20
 
 
 @dataclass(frozen=True)
@@ -135,8 +139,10 @@ def select_wall_points(
 
 def other_branch_mask(points: Points, network: NetworkContext, shared_tol_mm: float) -> np.ndarray:
     """(n,) bool: the point is nearer another polyline's own (unshared) part than the path."""
-    to_path = polyline_distances(points, network.path)
     nearer = np.zeros(len(points), bool)
+    if not network.others:
+        return nearer
+    to_path = polyline_distances(points, network.path)
     for other in network.others:
         other = np.asarray(other, float)
         on_path = polyline_distances(other, network.path) <= shared_tol_mm
@@ -149,12 +155,19 @@ def other_branch_mask(points: Points, network: NetworkContext, shared_tol_mm: fl
 def polyline_distances(points: Points, polyline: Points, segments: np.ndarray | None = None) -> FloatArray:
     """Distance from each point to the nearest point of a polyline's segments (ends clamped), mm.
 
+    Exact, without measuring every point against every segment: each point is
+    measured against the segments whose midpoints are its k nearest; every
+    other segment is at least (k-th midpoint distance - largest half segment)
+    away, so when the best distance found is within that bound it is the
+    minimum.  The points it does not settle are retried with a larger k.
+
     Parameters
     ----------
     points : (n, 3) mm
     polyline : (m, 3) mm, m >= 1
     segments : (m - 1,) bool, the segments to use (default all)
     """
+    points = np.asarray(points, float)
     polyline = np.asarray(polyline, float)
     if len(polyline) == 1:
         return np.linalg.norm(points - polyline[0], axis=1)
@@ -163,13 +176,34 @@ def polyline_distances(points: Points, polyline: Points, segments: np.ndarray | 
         start, end = start[segments], end[segments]
     edge = end - start
     edge2 = np.maximum(np.einsum("ij,ij->i", edge, edge), np.finfo(float).tiny)
+    tree = cKDTree(0.5 * (start + end))
+    half_max = 0.5 * float(np.sqrt(edge2.max()))
     out = np.empty(len(points))
-    for lo in range(0, len(points), _CHUNK):
-        p = points[lo : lo + _CHUNK, None, :]
-        t = np.clip(np.einsum("nsj,sj->ns", p - start[None], edge) / edge2, 0.0, 1.0)
-        nearest = start[None] + t[:, :, None] * edge[None]
-        out[lo : lo + _CHUNK] = np.sqrt(np.min(np.sum((p - nearest) ** 2, axis=2), axis=1))
+    pending, k = np.arange(len(points)), min(_FIRST_K, len(start))
+    while pending.size:
+        best, kth = _nearest_segment_distances(points[pending], start, edge, edge2, tree, k)
+        settled = (k == len(start)) | (best <= kth - half_max)
+        out[pending[settled]] = best[settled]
+        pending, k = pending[~settled], min(4 * k, len(start))
     return out
+
+
+def _nearest_segment_distances(
+    points: Points, start: Points, edge: Points, edge2: FloatArray, tree: cKDTree, k: int
+) -> tuple[FloatArray, FloatArray]:
+    """Least distance to the k segments with the nearest midpoints, and the k-th midpoint distance (mm)."""
+    best, kth = np.empty(len(points)), np.empty(len(points))
+    chunk = max(1, _CHUNK_ENTRIES // k)
+    for lo in range(0, len(points), chunk):
+        p = points[lo : lo + chunk]
+        mid_distance, index = tree.query(p, k=k, workers=-1)
+        mid_distance, index = mid_distance.reshape(len(p), k), index.reshape(len(p), k)
+        near_start, near_edge = start[index], edge[index]
+        t = np.clip(np.einsum("nkj,nkj->nk", p[:, None, :] - near_start, near_edge) / edge2[index], 0.0, 1.0)
+        nearest = near_start + t[:, :, None] * near_edge
+        best[lo : lo + chunk] = np.sqrt(np.min(np.sum((p[:, None, :] - nearest) ** 2, axis=2), axis=1))
+        kth[lo : lo + chunk] = mid_distance[:, -1]
+    return best, kth
 
 
 def _reference_radius(
