@@ -32,6 +32,22 @@ def test_open_basis_matches_scipy(deriv):
     np.testing.assert_allclose(mine[:-1], ref, rtol=0, atol=DERIV_TOL if deriv else VALUE_TOL)
 
 
+def test_values_and_slopes_together_are_the_separate_ones():
+    knots = bb.open_knots([0.0, 0.3, 1.0], [3, 5])
+    x = np.linspace(0.0, 1.0, 57)
+    index, values, slopes = bb.open_local_and_slope(knots, x)
+    for deriv, together in ((0, values), (1, slopes)):
+        alone_index, alone = bb.open_local(knots, x, deriv)
+        np.testing.assert_array_equal(index, alone_index)
+        np.testing.assert_array_equal(together, alone)
+    angle = np.linspace(-7.0, 7.0, 61)
+    index, values, slopes = bb.periodic_local_and_slope(7, angle)
+    for deriv, together in ((0, values), (1, slopes)):
+        alone_index, alone = bb.periodic_local(7, angle, deriv)
+        np.testing.assert_array_equal(index, alone_index)
+        np.testing.assert_array_equal(together, alone)
+
+
 def test_open_knots_put_every_break_in_and_divide_links_evenly():
     knots = bb.open_knots([0.0, 0.3, 1.0], [3, 5])
     inner = knots[bb.DEGREE + 1 : -bb.DEGREE - 1]

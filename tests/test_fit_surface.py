@@ -99,6 +99,17 @@ def test_links_split_from_one_fit_match_it_and_join_in_value_and_slope():
     np.testing.assert_array_equal(again[2].coefficients, fit.links[2].coefficients)
 
 
+def test_values_and_slopes_in_one_pass_are_the_separate_evaluations():
+    polar = _polar(Line(30.0), lambda l, a: _ellipse(l, a))
+    spline = fit_radius_surface(polar, 30.0, FitSettings()).whole
+    rng = np.random.default_rng(5)
+    l, a = rng.random(300), rng.uniform(-10.0, 10.0, 300)
+    together = spline.evaluate_with_slopes(l, a)
+    alone = (spline.evaluate(l, a), spline.evaluate(l, a, dl=1), spline.evaluate(l, a, da=1))
+    for t, s in zip(together, alone):  # the same products summed in another order: rounding of ~100 (mm per unit l)
+        np.testing.assert_allclose(t, s, rtol=0, atol=SPLIT_TOL_MM)
+
+
 def test_a_wall_with_a_hole_stays_bounded_thanks_to_the_penalty():
     curve = Line(40.0)
     polar = _polar(curve, _ellipse)

@@ -91,17 +91,32 @@ def _basis_values(knots: FloatArray, x: FloatArray, span: IntArray, degree: int)
     """Cox-de Boor triangle: the degree + 1 nonzero functions of ``degree`` at ``span``."""
     values = np.ones((len(x), 1))
     for j in range(1, degree + 1):
-        offsets = np.arange(1, j + 1)
-        left = x[:, None] - knots[span[:, None] + 1 - offsets]
-        right = knots[span[:, None] + offsets] - x[:, None]
-        new = np.zeros((len(x), j + 1))
-        for r in range(j):
-            denom = right[:, r] + left[:, j - r - 1]
-            temp = np.divide(values[:, r], denom, out=np.zeros_like(denom), where=denom > 0)
-            new[:, r] += right[:, r] * temp
-            new[:, r + 1] = left[:, j - r - 1] * temp
-        values = new
+        values = _raise_degree(knots, x, span, values, j)
     return values
+
+
+def _raise_degree(knots: FloatArray, x: FloatArray, span: IntArray, values: FloatArray, j: int) -> FloatArray:
+    """One row of the Cox-de Boor triangle: the j + 1 functions of degree j from the j of degree j - 1."""
+    offsets = np.arange(1, j + 1)
+    left = x[:, None] - knots[span[:, None] + 1 - offsets]
+    right = knots[span[:, None] + offsets] - x[:, None]
+    new = np.zeros((len(x), j + 1))
+    for r in range(j):
+        denom = right[:, r] + left[:, j - r - 1]
+        temp = np.divide(values[:, r], denom, out=np.zeros_like(denom), where=denom > 0)
+        new[:, r] += right[:, r] * temp
+        new[:, r + 1] = left[:, j - r - 1] * temp
+    return new
+
+
+def nonzero_basis_and_slope(knots: FloatArray, x: FloatArray, span: IntArray) -> tuple[FloatArray, FloatArray]:
+    """Values and first derivatives (n, DEGREE + 1) of the basis functions nonzero in ``span``.
+
+    The same numbers as ``nonzero_basis`` with deriv 0 and 1, sharing the
+    lower-degree functions both are built from.
+    """
+    lower = _basis_values(knots, x, span, DEGREE - 1)
+    return _raise_degree(knots, x, span, lower, DEGREE), _raise_derivative(knots, lower, span, DEGREE - 1)
 
 
 def _raise_derivative(knots: FloatArray, lower: FloatArray, span: IntArray, degree: int) -> FloatArray:
@@ -136,6 +151,21 @@ def periodic_local(intervals: int, angle: npt.ArrayLike, deriv: int = 0) -> tupl
     values = nonzero_basis(periodic_knots(intervals), wrapped, span, deriv)
     # M >= 4 keeps the DEGREE + 1 indices of a row distinct.
     return np.mod(span[:, None] - DEGREE + np.arange(DEGREE + 1), intervals), values
+
+
+def open_local_and_slope(knots: FloatArray, x: npt.ArrayLike) -> tuple[IntArray, FloatArray, FloatArray]:
+    """Indices (n, DEGREE + 1), values and first derivatives of the open basis nonzero at x."""
+    x = np.asarray(x, float).reshape(-1)
+    span = open_spans(knots, x)
+    return (span[:, None] - DEGREE + np.arange(DEGREE + 1), *nonzero_basis_and_slope(knots, x, span))
+
+
+def periodic_local_and_slope(intervals: int, angle: npt.ArrayLike) -> tuple[IntArray, FloatArray, FloatArray]:
+    """Indices (n, DEGREE + 1), mod M, values and first derivatives of the periodic basis at the angles."""
+    angle = np.asarray(angle, float).reshape(-1)
+    span, wrapped = periodic_spans(intervals, angle)
+    values, slopes = nonzero_basis_and_slope(periodic_knots(intervals), wrapped, span)
+    return np.mod(span[:, None] - DEGREE + np.arange(DEGREE + 1), intervals), values, slopes
 
 
 def open_basis_matrix(knots: FloatArray, x: npt.ArrayLike, deriv: int = 0) -> sp.csr_matrix:

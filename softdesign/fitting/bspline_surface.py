@@ -112,6 +112,16 @@ class RadiusSpline:
         local = self.coefficients[il[:, :, None], ia[:, None, :]]
         return np.einsum("nr,ns,nrs->n", vl, va, local).reshape(l.shape)
 
+    def evaluate_with_slopes(self, l: npt.ArrayLike, a: npt.ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """rho, d rho / dl and d rho / da at paired (l, a) (n,), in one pass over the coefficients."""
+        l, a = (np.asarray(v, float).reshape(-1) for v in np.broadcast_arrays(l, a))
+        il, vl, dvl = bb.open_local_and_slope(self.knots, l)
+        ia, va, dva = bb.periodic_local_and_slope(self.angular_intervals, a)
+        local = self.coefficients[il[:, :, None], ia[:, None, :]]
+        around = np.einsum("nrs,ns->nr", local, va)
+        return (np.einsum("nr,nr->n", vl, around), np.einsum("nr,nr->n", dvl, around),
+                np.einsum("nr,nrs,ns->n", vl, local, dva))
+
     def evaluate_grid(self, l: npt.ArrayLike, a: npt.ArrayLike, dl: int = 0, da: int = 0) -> FloatArray:
         """Values on the grid l (p,) x a (m,), returns (p, m), mm."""
         left = bb.open_basis_matrix(self.knots, l, dl)
