@@ -1,7 +1,7 @@
 """Analytic framed curves for the fitting tests (exact positions, derivatives and frames).
 
 Each class follows ``softdesign.types.FramedCurve``: normalized arc length
-l in [0, 1], frames with columns (N, B, T), rotation-minimizing.
+l in [0, 1], frames with columns (N, B, T), rotation-minimizing (except ``FrenetHelix``).
 """
 
 from __future__ import annotations
@@ -137,3 +137,16 @@ def grid_parameters(n_l: int, n_a: int, rng: np.random.Generator, l_range=(0.0, 
     l = (np.arange(n_l)[:, None] + rng.random((n_l, n_a))) / n_l * (hi - lo) + lo
     a = (np.arange(n_a)[None, :] + rng.random((n_l, n_a))) / n_a * 2 * np.pi - np.pi
     return l.ravel(), a.ravel()
+
+
+@dataclass(frozen=True)
+class FrenetHelix(Helix):
+    """The same helix with its Frenet frame (N towards the axis), which twists about T at the torsion."""
+
+    def frames(self, l):
+        t = self.t_total * _l(l)
+        w = self.speed
+        tangent = np.column_stack([-self.r * np.sin(t), self.r * np.cos(t), np.full_like(t, self.h)]) / w
+        normal = np.column_stack([-np.cos(t), -np.sin(t), np.zeros_like(t)])
+        binormal = np.column_stack([self.h * np.sin(t), -self.h * np.cos(t), np.full_like(t, self.r)]) / w
+        return np.stack([normal, binormal, tangent], axis=2)

@@ -2,7 +2,9 @@
 
 The fitted surface at q = 1 is ``S(l, a) = c(l) + rho(l, a) (cos a N(l) + sin a B(l))``.
 The distance of a point p to it is ``min |p - S(l, a)|``, found by damped
-Gauss-Newton on (l, a) from the point's own projection (l, a): the radial
+Gauss-Newton on (l, a) from the point's own projection (l, a), with the
+surface's tangents exact (the frames' l derivative from c', c'' and their
+measured twist, see :func:`frame_twist_table`): the radial
 residual ``rho_p - rho(l_p, a_p)`` over-states the distance wherever the wall
 is inclined to the radial direction, so it is never reported as the error.
 
@@ -21,12 +23,16 @@ from softdesign.fitting.bspline_surface import FitSettings, RadiusSpline, fit_ra
 from softdesign.fitting.projection import PolarPoints
 from softdesign.types import FloatArray, FramedCurve, Points
 
-#: Gauss-Newton stops when every (l, a) step moves the surface point less than this, mm.
-CLOSEST_TOL_MM = 1e-9
-#: Hard stop on Gauss-Newton steps (it converges in 3-5 from the projection).
+#: Gauss-Newton stops when a point's (l, a) step moves its surface point less than this, mm.  The
+#: distance is stationary at the closest point and the steps shrink quadratically, so the distances
+#: reported are far closer than this (1e-14 mm on the closed forms in tests/test_fit_metrics.py).
+CLOSEST_TOL_MM = 1e-6
+#: Hard stop on Gauss-Newton steps (from the projection, 2-3 for most points, ~10 for the slowest).
 CLOSEST_MAX_STEPS = 30
-#: Step in normalized l for the central difference of the frames (their derivative is not in the protocol).
+#: Step in normalized l of the central differences that measure the frames' twist (not in the protocol).
 FRAME_DIFF_STEP = 1e-6
+#: Spacing of the samples of the frames' twist, interpolated linearly in between, mm.
+TWIST_SPACING_MM = 0.1
 #: Knot spacings (mm) tried by ``knot_spacing_mm: auto``.
 AUTO_SPACINGS_MM = (1.0, 1.5, 2.0, 3.0, 4.0)
 
@@ -78,45 +84,80 @@ def surface_points(curve: FramedCurve, spline: RadiusSpline, l: FloatArray, angl
 
 
 def closest_surface_points(
-    curve: FramedCurve, spline: RadiusSpline, polar: PolarPoints
+    curve: FramedCurve, spline: RadiusSpline, polar: PolarPoints, start: tuple[FloatArray, FloatArray] | None = None
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Closest point on the fitted surface to each point, from its projection.
+    """Closest point on the fitted surface to each point, from its projection (or from ``start``).
+
+    Parameters
+    ----------
+    curve : the centerline at q = 1
+    spline : rho(l, a), anything with ``evaluate(l, a, dl, da)``
+    polar : the points, with their projection (l, angle) on ``curve``
+    start : (l (n,), angle (n,)) to start from instead, e.g. the closest points on a nearby surface
 
     Returns
     -------
     distance (n,) mm, l (n,) and angle (n,) rad of the closest surface point.
     """
-    p, l, a = polar.points, polar.l.copy(), polar.angle.copy()
-    surface, du, dv = _surface_and_tangents(curve, spline, l, a)
+    p = polar.points
+    l, a = (polar.l.copy(), polar.angle.copy()) if start is None else (np.array(start[0], float), np.array(start[1], float))
+    twist = frame_twist_table(curve)
+    surface, du, dv = _surface_and_tangents(curve, spline, twist, l, a)
     dist = np.linalg.norm(p - surface, axis=1)
     active = np.ones(len(l), bool)
     for _ in range(CLOSEST_MAX_STEPS):
         idx = np.flatnonzero(active)
         if idx.size == 0:
             break
+        current = (l[idx], a[idx], surface[idx], du[idx], dv[idx], dist[idx])
         step = _gauss_newton_step(p[idx] - surface[idx], du[idx], dv[idx])
-        update = _damped_update(curve, spline, p[idx], (l[idx], a[idx]), step, dist[idx])
+        update = _damped_update(curve, spline, twist, p[idx], current, step)
         moved = np.linalg.norm(update[2] - surface[idx], axis=1)
         l[idx], a[idx], surface[idx], du[idx], dv[idx], dist[idx] = update
         active[idx[moved <= CLOSEST_TOL_MM]] = False
     return dist, l, a
 
 
-def _surface_and_tangents(curve: FramedCurve, spline: RadiusSpline, l: FloatArray, a: FloatArray):
-    """S, dS/dl and dS/da at (l, a); the frames' l derivative by a central difference."""
-    lo = np.clip(l - FRAME_DIFF_STEP, 0.0, 1.0)
-    hi = np.clip(l + FRAME_DIFF_STEP, 0.0, 1.0)
+def frame_twist_table(curve: FramedCurve) -> tuple[FloatArray, FloatArray]:
+    """Normalized l (k,) and the frames' twist ``w = dN/dl . B`` (k,) rad per unit l, for interpolation.
+
+    A frame field with T = c'/|c'| turns as ``N' = -(N . T') T + w B`` and
+    ``B' = -(B . T') T - w N``: the bending part is exact from c' and c'',
+    the twist w is the frame mode's (0 for rotation-minimizing frames, the
+    torsion times |c'| for Frenet).  It is measured once per curve by central
+    differences on a grid ``TWIST_SPACING_MM`` apart, not assumed.
+    """
+    count = max(int(np.ceil(curve.length / TWIST_SPACING_MM)), 16) + 1
+    l = np.linspace(0.0, 1.0, count)
+    lo, hi = np.clip(l - FRAME_DIFF_STEP, 0.0, 1.0), np.clip(l + FRAME_DIFF_STEP, 0.0, 1.0)
+    normal_change = (curve.frames(hi)[:, :, 0] - curve.frames(lo)[:, :, 0]) / (hi - lo)[:, None]
+    return l, np.einsum("ni,ni->n", normal_change, curve.frames(l)[:, :, 1])
+
+
+def _surface_and_tangents(curve: FramedCurve, spline: RadiusSpline, twist, l: FloatArray, a: FloatArray):
+    """S, dS/dl and dS/da at (l, a), with the frames' l derivative from c', c'' and the twist table."""
     frames = curve.frames(l)
-    dframes = (curve.frames(hi) - curve.frames(lo)) / (hi - lo)[:, None, None]
+    normal, binormal, tangent = frames[:, :, 0], frames[:, :, 1], frames[:, :, 2]
+    d1, d2 = curve.derivative(l, 1), curve.derivative(l, 2)
+    speed = np.linalg.norm(d1, axis=1)
+    tangent_change = (d2 - np.einsum("ni,ni->n", d2, tangent)[:, None] * tangent) / speed[:, None]
+    w = np.interp(l, *twist)[:, None]
+    normal_change = -np.einsum("ni,ni->n", normal, tangent_change)[:, None] * tangent + w * binormal
+    binormal_change = -np.einsum("ni,ni->n", binormal, tangent_change)[:, None] * tangent - w * normal
     cos, sin = np.cos(a)[:, None], np.sin(a)[:, None]
-    direction = cos * frames[:, :, 0] + sin * frames[:, :, 1]
-    rho = spline.evaluate(l, a)[:, None]
+    direction = cos * normal + sin * binormal
+    rho, rho_l, rho_a = (v[:, None] for v in _radius_and_slopes(spline, l, a))
     surface = curve.points(l) + rho * direction
-    d_dir_l = cos * dframes[:, :, 0] + sin * dframes[:, :, 1]
-    d_dir_a = -sin * frames[:, :, 0] + cos * frames[:, :, 1]
-    du = curve.derivative(l, 1) + spline.evaluate(l, a, dl=1)[:, None] * direction + rho * d_dir_l
-    dv = spline.evaluate(l, a, da=1)[:, None] * direction + rho * d_dir_a
-    return surface, du, dv
+    d_dir_l = cos * normal_change + sin * binormal_change
+    d_dir_a = -sin * normal + cos * binormal
+    return surface, d1 + rho_l * direction + rho * d_dir_l, rho_a * direction + rho * d_dir_a
+
+
+def _radius_and_slopes(spline, l: FloatArray, a: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """rho, d rho / dl, d rho / da: in one pass for a RadiusSpline, else by ``evaluate`` (e.g. a radius field)."""
+    if isinstance(spline, RadiusSpline):
+        return spline.evaluate_with_slopes(l, a)
+    return spline.evaluate(l, a), spline.evaluate(l, a, dl=1), spline.evaluate(l, a, da=1)
 
 
 def _gauss_newton_step(residual: Points, du: Points, dv: Points) -> FloatArray:
@@ -132,27 +173,29 @@ def _gauss_newton_step(residual: Points, du: Points, dv: Points) -> FloatArray:
     return np.where(np.isfinite(step), step, 0.0)
 
 
-def _damped_update(curve, spline, p, start, step, dist):
+def _damped_update(curve, spline, twist, p, current, step):
     """Take the Gauss-Newton step, halving it (up to 8 times) for the points where it does not help.
 
+    ``current`` is (l, a, S, dS/dl, dS/da, distance); returns the same at the new (l, a).
     A point whose step never reduces the distance stays where it was (it has converged).
     """
-    l0, a0 = start
-    l_out, a_out = l0.copy(), a0.copy()
+    l0, a0, dist0 = current[0], current[1], current[5]
+    out = tuple(v.copy() for v in current)
     pending = np.arange(len(l0))
     scale = 1.0
     for _ in range(8):
         l = np.clip(l0[pending] + scale * step[pending, 0], 0.0, 1.0)
         a = a0[pending] + scale * step[pending, 1]
-        d = np.linalg.norm(p[pending] - surface_points(curve, spline, l, a), axis=1)
-        better = d <= dist[pending]
-        l_out[pending[better]], a_out[pending[better]] = l[better], a[better]
+        surface, du, dv = _surface_and_tangents(curve, spline, twist, l, a)
+        d = np.linalg.norm(p[pending] - surface, axis=1)
+        better = d <= dist0[pending]
+        for target, value in zip(out, (l, a, surface, du, dv, d)):
+            target[pending[better]] = value[better]
         pending = pending[~better]
         if pending.size == 0:
             break
         scale *= 0.5
-    surface, du, dv = _surface_and_tangents(curve, spline, l_out, a_out)
-    return l_out, a_out, surface, du, dv, np.linalg.norm(p - surface, axis=1)
+    return out
 
 
 def summarize_distances(distance: FloatArray) -> FitMetrics:
