@@ -116,6 +116,32 @@ def test_holdout_of_an_exact_shape_is_zero_and_of_noise_is_the_noise():
     assert report.fold_rms_mm.shape == (5,)
 
 
+def test_holdout_starts_anywhere_and_samples_only_large_inputs_by_the_seed():
+    curve = Line(30.0)
+    rng = np.random.default_rng(12)
+    l, a = grid_parameters(60, 40, rng)
+    noisy = project_points(curve, tube_points(curve, l, a, 3.0 + 0.5 * l + rng.normal(0, 0.05, l.size)))
+    full = holdout_rms(curve, noisy, FitSettings(), np.random.default_rng(0))
+    assert full.points == len(noisy)
+    # Starting from the closest points on the fit to all points changes the steps, not the distances.
+    _, l_fit, a_fit = closest_surface_points(curve, fit_radius_surface(noisy, 30.0, FitSettings()).whole, noisy)
+    warm = holdout_rms(curve, noisy, FitSettings(), np.random.default_rng(0), start=(l_fit, a_fit))
+    np.testing.assert_allclose(warm.fold_rms_mm, full.fold_rms_mm, rtol=0, atol=DISTANCE_TOL_MM)
+    # Up to max_points nothing is drawn: the folds, so the figures, are those of every point.
+    same = holdout_rms(curve, noisy, FitSettings(), np.random.default_rng(0), HoldoutSettings(max_points=len(noisy)))
+    np.testing.assert_array_equal(same.fold_rms_mm, full.fold_rms_mm)
+    small = HoldoutSettings(max_points=1200)
+    sampled = [holdout_rms(curve, noisy, FitSettings(), np.random.default_rng(seed), small) for seed in (0, 0, 1)]
+    assert sampled[0].points == 1200
+    np.testing.assert_array_equal(sampled[0].fold_rms_mm, sampled[1].fold_rms_mm)
+    assert not np.array_equal(sampled[0].fold_rms_mm, sampled[2].fold_rms_mm)
+    # Still bounded below by the noise; 960 points per fit for ~520 coefficients over-fit more (~1.4 sigma),
+    # which is why only inputs far denser than the knots are sampled (HOLDOUT_MAX_POINTS).
+    assert 0.05 <= sampled[0].rms_mm <= 1.5 * 0.05
+    with pytest.raises(ConfigError, match="max_points must be an integer >= 2 x folds"):
+        HoldoutSettings(max_points=3)
+
+
 def test_auto_spacing_rejects_knots_too_coarse_for_the_shape():
     # An axial ripple of 8 mm wavelength: 8 mm knots cannot follow it, 1-2 mm knots can.
     curve = Line(48.0)

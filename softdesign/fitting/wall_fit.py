@@ -19,8 +19,9 @@ from softdesign.fitting.metrics import (
     HoldoutReport,
     HoldoutSettings,
     choose_knot_spacing,
+    closest_surface_points,
     holdout_rms,
-    measure_fit,
+    summarize_distances,
 )
 from softdesign.fitting.projection import PolarPoints, project_points
 from softdesign.fitting.radius_field import FoldReport, RadiusField, check_self_folding
@@ -37,7 +38,7 @@ class WallFitOptions:
     fit : spline space, penalty and link breaks (its spacing is ignored when ``auto_spacing``)
     auto_spacing : choose the knot spacing by hold-out (``knot_spacing_mm: auto``)
     selection : thresholds of the point selection
-    holdout : folds, and the spacings ``auto`` tries
+    holdout : folds, the spacings ``auto`` tries, and the most points the hold-out uses
     initial_radius_mm : constant rho0; None for the axially symmetric mean of the fit
     fold_limit : the largest rho * kappa allowed at q = 1
     """
@@ -75,6 +76,7 @@ class WallFit:
             "distance": self.metrics.as_dict(),
             "holdout_rms_mm": self.holdout.rms_mm,
             "holdout_fold_rms_mm": self.holdout.fold_rms_mm.tolist(),
+            "holdout_points": self.holdout.points,
             "radial_rms_mm": self.surface.radial_rms_mm,
             "joint_value_jump_mm": self.surface.joint_value_jump_mm.tolist(),
             "joint_slope_jump": self.surface.joint_slope_jump.tolist(),
@@ -114,8 +116,9 @@ def fit_wall(
         spacing, scores = choose_knot_spacing(curve, kept, settings, rng, options.holdout)
         settings = replace(settings, knot_spacing_mm=spacing)
     surface = fit_radius_surface(kept, curve.length, settings)
-    metrics = measure_fit(curve, surface.whole, kept)
-    holdout = holdout_rms(curve, kept, settings, rng, options.holdout.folds)
+    distance, l, angle = closest_surface_points(curve, surface.whole, kept)
+    metrics = summarize_distances(distance)
+    holdout = holdout_rms(curve, kept, settings, rng, options.holdout, start=(l, angle))
     radius = RadiusField.from_links(settings.breaks, surface.links, options.initial_radius_mm)
     folding = check_self_folding(curve, radius, q=1.0, limit=options.fold_limit)
     return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius)
