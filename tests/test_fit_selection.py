@@ -105,6 +105,49 @@ def test_the_far_dome_of_the_other_branch_is_the_other_branch_not_the_path():
     assert selection.counts["other_branch"] == len(dome)
 
 
+def _flat_capped_tube(overshoot_mm):
+    """Labelled points of a round tube z in [0, 60] mm closed by flat caps, shifted ``overshoot_mm`` along +z.
+
+    Wall: rings every mm (the rims at z = 0 and 60 included), 24 angles.  Each cap: a hub vertex
+    on the axis and rings at 1/4, 1/2 and 0.7 of the radius, as flat capping with inner rings makes.
+    The path runs from z = 0 to 60 + 2 overshoot: the caps lie that far inside its ends.
+    """
+    z_axis = np.array([0.0, 0.0, 1.0])
+    rims = [_ring([0.0, 0.0, z], z_axis, RADIUS, 24) for z in (0.0, 60.0)]
+    wall = np.concatenate([_ring([0.0, 0.0, z], z_axis, RADIUS, 24) for z in range(1, 60)])
+    caps = np.concatenate([np.concatenate([[[0.0, 0.0, z]], *(_ring([0.0, 0.0, z], z_axis, f * RADIUS, 24)
+                                                               for f in (0.25, 0.5, 0.7))]) for z in (0.0, 60.0)])
+    shift = np.array([0.0, 0.0, overshoot_mm])
+    return {"wall": wall + shift, "rim": np.concatenate(rims) + shift, "cap": caps + shift}, Line(60.0 + 2 * overshoot_mm)
+
+
+@pytest.mark.parametrize("with_radius", [True, False], ids=["inscribed_radius", "local_median"])
+@pytest.mark.parametrize("overshoot_mm", [0.0, 0.05, 0.3])
+def test_flat_caps_with_a_hub_on_the_axis_are_caps(overshoot_mm, with_radius):
+    # At 0 the caps lie in the end planes (feet clamped to the ends); at 0.05 and 0.3 mm the path runs
+    # through them, as a smoothed centerline does, and only "inside the wall beside the end" finds them.
+    parts, curve = _flat_capped_tube(overshoot_mm)
+    points = np.concatenate(list(parts.values()))
+    path = curve.points(np.linspace(0.0, 1.0, 61))
+    inscribed = inscribed_profile(curve, path, np.full(61, RADIUS)) if with_radius else (None, None)
+    selection = select_wall_points(project_points(curve, points), curve.length, NetworkContext(path, (), *inscribed))
+    labels = np.concatenate([np.full(len(p), name) for name, p in parts.items()])
+    assert np.all(selection.reason[labels == "cap"] == 2)  # hubs and rings: 2 x (1 + 3 x 24)
+    assert np.all(selection.keep[labels == "wall"])
+    # The rims are wall and cap at once: dropped with their cap where it is in the end plane, else kept.
+    rims = 0 if overshoot_mm > 0 else 48
+    assert selection.counts == {"input": len(points), "kept": 59 * 24 + 48 - rims, "other_branch": 0,
+                                "cap": 146 + rims, "outlier": 0}
+
+
+def test_a_point_near_the_axis_is_an_outlier():
+    parts = _surface()
+    hubs = np.array([[0.0, 0.0, 20.0], [0.5, 0.0, 30.0], [0.0, -1.4, 60.0]])  # below RADIUS / 2 = 1.5 mm
+    selection = _select({**parts, "near_axis": hubs})
+    assert selection.counts["outlier"] == len(parts["outlier"]) + 3
+    np.testing.assert_array_equal(selection.reason[-3:], 3)
+
+
 def test_end_margin_moves_wall_near_the_ends_to_caps():
     parts = _surface()
     selection = _select(parts, SelectionSettings(end_margin_mm=3.0))
@@ -158,3 +201,5 @@ def test_inscribed_profile_is_sorted_by_l_and_checked():
         inscribed_profile(Line(80.0), path, np.array([5.0, 4.0, 0.0, 2.0, 1.0]))
     with pytest.raises(ConfigError, match="outlier_factor must be > 1, got 0.5"):
         SelectionSettings(outlier_factor=0.5)
+    with pytest.raises(ConfigError, match="cap_inner_fraction in \\(0, 1\\), got 1.0, 1.2"):
+        SelectionSettings(cap_inner_fraction=1.2)

@@ -12,11 +12,20 @@ Each point is dropped for the first reason that applies, in this order:
     its foot point on the path is at, or beyond, an end of the path (within
     ``end_margin_mm``).  VMTK caps are rounded domes that meet the wall at a
     shallow angle, so no crease-angle rule finds them; every dome point lies
-    past the end of the centerline it caps.
+    past the end of the centerline it caps.  A flat cap that the (smoothed)
+    centerline reaches or runs through has its points' feet inside the path
+    instead, each (p - c) square to T like a wall point's: what gives its
+    hub and rings away is that they lie inside the wall beside them.  So,
+    within ``cap_zone_radii`` reference radii of an end, a point is a cap
+    point too when its rho is below ``cap_inner_fraction`` times the median
+    rho of the points in the same angular sector over the next such length.
 ``outlier``
-    rho exceeds ``outlier_factor`` times the ``MaximumInscribedSphereRadius``
-    interpolated at the foot point, or, without it, times the median rho of
-    the kept points within ``median_window_mm`` of arc length.
+    rho is above ``outlier_factor`` times the reference radius, or below the
+    reference divided by it: the ``MaximumInscribedSphereRadius``
+    interpolated at the foot point, or, without it, the median rho of the
+    kept points within ``median_window_mm`` of arc length.  (A wall point
+    never lies near the centerline: one there leaves residuals of about the
+    radius and drags the fit with it.)
 """
 
 from __future__ import annotations
@@ -31,6 +40,9 @@ from softdesign.fitting.projection import PolarPoints, project_points
 from softdesign.types import FloatArray, FramedCurve, Points
 
 REASONS = ("other_branch", "cap", "outlier")
+#: Angular sectors in which the wall beside an end zone is measured (22.5 degrees each: an elliptical
+#: section's radius changes little across one).
+CAP_SECTORS = 16
 #: Segments first tried per point in the point-to-polyline distance (a wall point's nearest
 #: segment is among its ~2 sqrt(radius / segment length) nearest midpoints: 16 covers 10 mm at 0.2 mm).
 _FIRST_K = 16
@@ -44,20 +56,32 @@ class SelectionSettings:
 
     Attributes
     ----------
-    outlier_factor : rho above this many times the reference radius is an outlier (> 1)
+    outlier_factor : rho above this many times the reference radius, or below it divided by this,
+        is an outlier (> 1)
     median_window_mm : arc-length window of the local median rho, mm (used without radii)
     end_margin_mm : foot points this close to an end count as cap points, mm (>= 0)
     shared_tol_mm : another polyline's points this close to the path are shared trunk, mm
+    cap_zone_radii : length of each end zone, in reference radii at that end (> 0)
+    cap_inner_fraction : in an end zone, rho below this fraction of the wall beside it is a cap (0..1)
     """
 
+    # cap_inner_fraction: on the VMTK aorta (both surfaces) every wall point within a radius of an end
+    # keeps rho above 0.83 of the wall beside it; a flat cap's hub and rings inside 3/4 of it go.
     outlier_factor: float = 2.0
     median_window_mm: float = 5.0
     end_margin_mm: float = 0.0
     shared_tol_mm: float = 0.05
+    cap_zone_radii: float = 1.0
+    cap_inner_fraction: float = 0.75
 
     def __post_init__(self) -> None:
         if not self.outlier_factor > 1.0:
             raise ConfigError(f"fit.outlier_factor must be > 1, got {self.outlier_factor}")
+        if not (self.cap_zone_radii > 0 and 0 < self.cap_inner_fraction < 1):
+            raise ConfigError(
+                "selection: cap_zone_radii must be > 0 and cap_inner_fraction in (0, 1), got "
+                f"{self.cap_zone_radii}, {self.cap_inner_fraction}"
+            )
         if not (self.median_window_mm > 0 and self.end_margin_mm >= 0 and self.shared_tol_mm >= 0):
             raise ConfigError(
                 "selection: median_window_mm must be > 0 and end_margin_mm, shared_tol_mm >= 0, got "
@@ -130,8 +154,11 @@ def select_wall_points(
     s = polar.l * length_mm
     at_end = (polar.end_side != 0) | (s <= settings.end_margin_mm) | (length_mm - s <= settings.end_margin_mm)
     reason[(reason == 0) & at_end] = 2
-    reference = _reference_radius(polar, reason == 0, length_mm, network, settings)
-    reason[(reason == 0) & (polar.rho > settings.outlier_factor * reference)] = 3
+    profile = _reference_profile(polar, reason == 0, length_mm, network, settings)
+    reason[(reason == 0) & inside_end_walls(polar, reason == 0, length_mm, profile, settings)] = 2
+    reference = np.interp(polar.l, *profile)
+    far = (polar.rho > settings.outlier_factor * reference) | (polar.rho < reference / settings.outlier_factor)
+    reason[(reason == 0) & far] = 3
     counts = {"input": len(polar), "kept": int(np.count_nonzero(reason == 0))}
     counts.update({name: int(np.count_nonzero(reason == k + 1)) for k, name in enumerate(REASONS)})
     return WallSelection(reason, counts)
@@ -206,14 +233,48 @@ def _nearest_segment_distances(
     return best, kth
 
 
-def _reference_radius(
+def inside_end_walls(
+    polar: PolarPoints,
+    candidate: np.ndarray,
+    length_mm: float,
+    profile: tuple[FloatArray, FloatArray],
+    settings: SelectionSettings,
+) -> np.ndarray:
+    """(n,) bool: near an end, the point lies well inside the wall beside it (a flat cap's hub or rings).
+
+    Parameters
+    ----------
+    polar : the projected points
+    candidate : (n,) bool, the points still kept (they alone measure the wall)
+    length_mm : arc length of the path, mm
+    profile : normalized l (k,) and reference radius (k,) mm, the end zones' length scale
+    settings : ``cap_zone_radii`` and ``cap_inner_fraction``
+    """
+    s = polar.l * length_mm
+    sector = np.minimum((np.mod(polar.angle, 2.0 * np.pi) * (CAP_SECTORS / (2.0 * np.pi))).astype(int), CAP_SECTORS - 1)
+    inside = np.zeros(len(polar), bool)
+    for end_l, to_end in ((0.0, s), (1.0, length_mm - s)):
+        zone = settings.cap_zone_radii * float(np.interp(end_l, *profile))
+        beside = candidate & (to_end > zone) & (to_end <= 2.0 * zone)
+        wall = np.full(CAP_SECTORS, np.nan)  # a sector with no wall beside the zone drops nothing
+        for k in np.unique(sector[beside]):
+            wall[k] = np.median(polar.rho[beside & (sector == k)])
+        inside |= candidate & (to_end <= zone) & (polar.rho < settings.cap_inner_fraction * wall[sector])
+    return inside
+
+
+def _reference_profile(
     polar: PolarPoints, candidate: np.ndarray, length_mm: float, network: NetworkContext, settings: SelectionSettings
-) -> FloatArray:
-    """The radius rho is compared with: inscribed radius at the foot point, else the local median."""
+) -> tuple[FloatArray, FloatArray]:
+    """Normalized l (k,) and radius (k,) mm that rho is compared with, for ``np.interp``.
+
+    The inscribed-sphere radii when the network has them, else the median rho
+    of the candidates in bins ``median_window_mm`` long (inf without candidates).
+    """
     if network.inscribed_l is not None and network.inscribed_radius is not None:
-        return np.interp(polar.l, network.inscribed_l, network.inscribed_radius)
+        return np.asarray(network.inscribed_l, float), np.asarray(network.inscribed_radius, float)
     if not candidate.any():
-        return np.full(len(polar), np.inf)
+        return np.array([0.0, 1.0]), np.full(2, np.inf)
     bins = max(1, int(round(length_mm / settings.median_window_mm)))
     index = np.minimum((polar.l * bins).astype(int), bins - 1)
     centres, medians = [], []
@@ -222,4 +283,4 @@ def _reference_radius(
         if rows.any():
             centres.append((k + 0.5) / bins)
             medians.append(np.median(polar.rho[rows]))
-    return np.interp(polar.l, centres, medians)
+    return np.array(centres), np.array(medians)
