@@ -147,7 +147,8 @@ def _safeguarded_step(
     hi = np.where(slope > 0.0, x, hi)
     with np.errstate(divide="ignore", invalid="ignore"):
         newton = x - slope / curvature
-    ok = (curvature > 0.0) & (newton > lo) & (newton < hi)
+    # The closed bracket: a root reached exactly becomes a bracket end (lo or hi) on the next step.
+    ok = (curvature > 0.0) & (newton >= lo) & (newton <= hi)
     x_new = np.where(ok, newton, 0.5 * (lo + hi))
     x_new = np.where(slope == 0.0, x, x_new)
     return x_new, lo, hi
