@@ -8,6 +8,7 @@ import pytest
 from softdesign.errors import ConfigError
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
 from softdesign.fitting.metrics import (
+    CLOSEST_TOL_MM,
     frame_twist_table,
     surface_points,
     HoldoutSettings,
@@ -21,7 +22,7 @@ from softdesign.fitting.metrics import (
 from softdesign.fitting.projection import project_points
 from tests.fit_analytic import Arc, FrenetHelix, Helix, Line, grid_parameters, tube_points
 
-#: Gauss-Newton stops at 1e-6 mm steps, converging quadratically: the distances here come out within
+#: Gauss-Newton stops at 1e-5 mm steps, past which the distance barely moves: the distances here come out within
 #: ~1e-13 mm of the closed forms (the fitted shapes are exact to ~1e-12 mm).
 DISTANCE_TOL_MM = 1e-8
 
@@ -69,7 +70,8 @@ def test_frame_twist_is_zero_for_rotation_minimizing_frames_and_the_torsion_for_
 @pytest.mark.parametrize("curve", [Helix(8.0, 3.0, 1.5), FrenetHelix(8.0, 3.0, 1.5)], ids=["rmf", "frenet"])
 def test_closest_points_see_the_surface_square_on_around_a_twisting_frame(curve):
     # An oval tube on a helix: at the closest point p - S is normal to the surface (tangents by central
-    # differences of S).  With the Frenet frames' twist left out the residual keeps a 0.018 mm tangential part.
+    # differences of S), up to where Gauss-Newton stops (a step under CLOSEST_TOL_MM leaves ~1e-6 mm here).
+    # With the Frenet frames' twist left out the residual keeps a 0.018 mm tangential part.
     rho_of = lambda l, a: 2.0 + 0.4 * np.cos(2 * a) + 0.3 * l  # noqa: E731
     fit = _fitted(curve, rho_of, FitSettings(knot_spacing_mm=1.0, smoothing=0.0), grid=(160, 48))
     _, _, polar = _off_surface(curve, rho_of, lambda rng, n: rng.uniform(-0.5, 0.5, n))
@@ -78,7 +80,7 @@ def test_closest_points_see_the_surface_square_on_around_a_twisting_frame(curve)
     for dl, da in ((h, 0.0), (0.0, h)):
         tangent = surface_points(curve, fit.whole, l + dl, a + da) - surface_points(curve, fit.whole, l - dl, a - da)
         along = np.einsum("ni,ni->n", residual, tangent) / np.linalg.norm(tangent, axis=1)
-        np.testing.assert_allclose(along, 0.0, rtol=0, atol=1e-6)
+        np.testing.assert_allclose(along, 0.0, rtol=0, atol=CLOSEST_TOL_MM)
 
 
 def test_summary_of_known_distances():
