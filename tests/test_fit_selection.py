@@ -118,7 +118,8 @@ def _flat_capped_tube(overshoot_mm):
     caps = np.concatenate([np.concatenate([[[0.0, 0.0, z]], *(_ring([0.0, 0.0, z], z_axis, f * RADIUS, 24)
                                                                for f in (0.25, 0.5, 0.7))]) for z in (0.0, 60.0)])
     shift = np.array([0.0, 0.0, overshoot_mm])
-    return {"wall": wall + shift, "rim": np.concatenate(rims) + shift, "cap": caps + shift}, Line(60.0 + 2 * overshoot_mm)
+    parts = {"wall": wall + shift, "rim": np.concatenate(rims) + shift, "cap": caps + shift}
+    return parts, Line(60.0 + 2 * overshoot_mm)
 
 
 @pytest.mark.parametrize("with_radius", [True, False], ids=["inscribed_radius", "local_median"])

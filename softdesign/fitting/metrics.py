@@ -110,7 +110,8 @@ def closest_surface_points(
     distance (n,) mm, l (n,) and angle (n,) rad of the closest surface point.
     """
     p = polar.points
-    l, a = (polar.l.copy(), polar.angle.copy()) if start is None else (np.array(start[0], float), np.array(start[1], float))
+    l, a = (polar.l, polar.angle) if start is None else start
+    l, a = np.array(l, float), np.array(a, float)
     twist = frame_twist_table(curve)
     surface, du, dv = _surface_and_tangents(curve, spline, twist, l, a)
     dist = np.linalg.norm(p - surface, axis=1)
