@@ -212,11 +212,12 @@ def design_matrix(knots: FloatArray, intervals: int, l: FloatArray, angle: Float
     il, vl = bb.open_local(knots, l)
     ia, va = bb.periodic_local(intervals, angle)
     k = bb.DEGREE + 1
-    rows = np.repeat(np.arange(len(il)), k * k)
     cols = (il[:, :, None] * intervals + ia[:, None, :]).ravel()
     vals = (vl[:, :, None] * va[:, None, :]).ravel()
     n_basis = len(knots) - bb.DEGREE - 1
-    return sp.csr_matrix((vals, (rows, cols)), shape=(len(il), n_basis * intervals))
+    # Every row holds k * k distinct columns (M >= 4), so the CSR arrays are written out directly.
+    indptr = np.arange(0, k * k * len(il) + 1, k * k, dtype=np.int64)
+    return sp.csr_matrix((vals, cols, indptr), shape=(len(il), n_basis * intervals))
 
 
 def roughness_matrix(knots: FloatArray, intervals: int, ratio: float) -> sp.csr_matrix:
