@@ -29,7 +29,7 @@ from softdesign.pipeline.blend_stage import BlendResult
 from softdesign.pipeline.kinematics_stage import chain_for_case
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 
-VERSION = 1
+VERSION = 2  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
 #: Seed of the hold-out folds: the same case always gets the same folds.
 HOLDOUT_SEED = 4
 
@@ -118,6 +118,7 @@ def fit_metrics(result: FitResult) -> dict[str, Any]:
         "p99_mm": d["p99_mm"],
         "max_mm": d["max_mm"],
         "holdout_rms_mm": s["holdout_rms_mm"],
+        "holdout_points": s["holdout_points"],
         "points": s["points"],
         "settings": s["settings"],
         "joint_value_jump_mm": max(s["joint_value_jump_mm"], default=0.0),
@@ -138,7 +139,7 @@ def describe_fit(result: FitResult) -> list[str]:
         f"smoothing {st['smoothing']:g}",
         "true distance to the fitted surface (mm):",
         f"  RMS {m['rms_mm']:.4f}  p95 {m['p95_mm']:.4f}  p99 {m['p99_mm']:.4f}  max {m['max_mm']:.4f}",
-        f"  hold-out RMS ({result.summary['points']['kept']} points, k-fold) {m['holdout_rms_mm']:.4f}",
+        f"  hold-out RMS ({result.summary['holdout_points']} points, k-fold) {m['holdout_rms_mm']:.4f}",
         f"joints: value jump {m['joint_value_jump_mm']:.2e} mm, slope jump {m['joint_slope_jump']:.2e}",
         f"max rho * kappa at q = 1: {m['max_rho_kappa']:.3f} (folds at 1; every export q is checked at export)",
         f"radius at q = 0: {result.summary['initial_radius']}",
