@@ -269,7 +269,7 @@ def test_mixed_q_steps_are_closed_by_a_reported_annulus(demo, tmp_path):
     annulus = body.vertices[body.faces[body.regions == Region.JOINT_STEP]]
     joints = [link.start2world for link in body.links[1:]]
     nearest = np.argmin([np.linalg.norm(annulus.mean(axis=1) - pose[:3, 3], axis=1) for pose in joints], axis=0)
-    for j, (joint, pose) in enumerate(zip(payload["joints"], joints)):
+    for j, (joint, joint_pose) in enumerate(zip(payload["joints"], joints)):
         l = field.breaks[j + 1]
         end = field.link_spline(j, q[j]).evaluate_grid([l], a)[0]
         start = field.link_spline(j + 1, q[j + 1]).evaluate_grid([l], a)[0]
@@ -277,7 +277,7 @@ def test_mixed_q_steps_are_closed_by_a_reported_annulus(demo, tmp_path):
         np.testing.assert_allclose(joint["max_step_mm"], np.max(np.abs(end - start)), rtol=0, atol=PLACEMENT_TOL_MM)
         corners = annulus[nearest == j]
         assert len(corners) == joint["annulus_faces"] > 0
-        center, axis = pose[:3, 3], pose[:3, 2]
+        center, axis = joint_pose[:3, 3], joint_pose[:3, 2]
         np.testing.assert_allclose((corners.reshape(-1, 3) - center) @ axis, 0.0, rtol=0, atol=PLACEMENT_TOL_MM)
         # flat, wound outward (+T where link j is the wider), covering exactly the step between the rings
         along = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]) @ axis / 2

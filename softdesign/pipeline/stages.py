@@ -7,7 +7,7 @@ from typing import Any
 
 from softdesign.config import Case
 from softdesign.pipeline import blend_stage, export_stage, fit_stage, ingest, kinematics_stage
-from softdesign.pipeline.run import Results, Stage
+from softdesign.pipeline.run import Stage
 
 
 def _ingest_describe(result: ingest.IngestResult) -> list[str]:
