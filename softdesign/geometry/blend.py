@@ -99,17 +99,28 @@ class BlendedShape:
     frames: FrameMode
     base_normal: FloatArray
     _intrinsic: _Intrinsic | None = field(default=None, repr=False)
+    # c(q, .) and its frames are pure functions of q; links, stats and exports ask for the
+    # same q many times, so each is built once (the shape is immutable)
+    _smooth: dict[float, SmoothCurve] = field(default_factory=dict, repr=False, compare=False)
+    _framed: dict[float, FramedSpline] = field(default_factory=dict, repr=False, compare=False)
 
     def smooth_curve_at(self, q: float) -> SmoothCurve:
         """The centerline c(q, .) as a :class:`SmoothCurve` (no frames)."""
-        a, w = self._segment(q)
-        if self.mode == "linear":
-            return _linear(self.keys[a], self.keys[a + 1], w)
-        return _integrate_intrinsic(self.keys[0], self._intrinsic, a, w)
+        q = float(q)
+        if q not in self._smooth:
+            a, w = self._segment(q)
+            if self.mode == "linear":
+                self._smooth[q] = _linear(self.keys[a], self.keys[a + 1], w)
+            else:
+                self._smooth[q] = _integrate_intrinsic(self.keys[0], self._intrinsic, a, w)
+        return self._smooth[q]
 
     def curve_at(self, q: float) -> FramedSpline:
         """The centerline with its frames at q (a ``types.FramedCurve``)."""
-        return framed_curve(self.smooth_curve_at(q), self.frames, self.base_normal, label=f"q = {q:g}")
+        q = float(q)
+        if q not in self._framed:
+            self._framed[q] = framed_curve(self.smooth_curve_at(q), self.frames, self.base_normal, label=f"q = {q:g}")
+        return self._framed[q]
 
     def stats_at(self, q: float, l_range: tuple[float, float] = (0.0, 1.0)) -> BlendStats:
         """Length, stretch range and curvature range at q over ``l_range`` (dense grid)."""
