@@ -112,16 +112,23 @@ class Helix:
         z = np.full_like(t, self.h if order == 1 else 0.0)
         return k * np.column_stack([self.r * np.cos(ang), self.r * np.sin(ang), z])
 
-    def frames(self, l):
+    def frenet_frames(self, l):
+        """The Frenet frames (N towards the axis), (n, 3, 3)."""
         t = self.t_total * _l(l)
         w = self.speed
         tangent = np.column_stack([-self.r * np.sin(t), self.r * np.cos(t), np.full_like(t, self.h)]) / w
         normal = np.column_stack([-np.cos(t), -np.sin(t), np.zeros_like(t)])
         binormal = np.column_stack([self.h * np.sin(t), -self.h * np.cos(t), np.full_like(t, self.r)]) / w
+        return np.stack([normal, binormal, tangent], axis=2)
+
+    def frames(self, l):
+        """Rotation-minimizing frames: the Frenet frame turned back by the accumulated torsion."""
+        frenet = self.frenet_frames(l)
+        normal, binormal = frenet[:, :, 0], frenet[:, :, 1]
         theta = -self.torsion * self.length * _l(l)
         u = np.cos(theta)[:, None] * normal + np.sin(theta)[:, None] * binormal
         v = np.cos(theta)[:, None] * binormal - np.sin(theta)[:, None] * normal
-        return np.stack([u, v, tangent], axis=2)
+        return np.stack([u, v, frenet[:, :, 2]], axis=2)
 
 
 def tube_points(curve, l, angle, rho) -> np.ndarray:
@@ -144,9 +151,4 @@ class FrenetHelix(Helix):
     """The same helix with its Frenet frame (N towards the axis), which twists about T at the torsion."""
 
     def frames(self, l):
-        t = self.t_total * _l(l)
-        w = self.speed
-        tangent = np.column_stack([-self.r * np.sin(t), self.r * np.cos(t), np.full_like(t, self.h)]) / w
-        normal = np.column_stack([-np.cos(t), -np.sin(t), np.zeros_like(t)])
-        binormal = np.column_stack([self.h * np.sin(t), -self.h * np.cos(t), np.full_like(t, self.r)]) / w
-        return np.stack([normal, binormal, tangent], axis=2)
+        return self.frenet_frames(l)
