@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from softdesign.errors import ConfigError
-from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
+from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface, fold_fits
 from softdesign.fitting.metrics import (
     CLOSEST_TOL_MM,
     frame_twist_table,
@@ -16,6 +16,8 @@ from softdesign.fitting.metrics import (
     closest_surface_points,
     fold_labels,
     holdout_rms,
+    holdout_sample,
+    measure_distances,
     measure_fit,
     summarize_distances,
 )
@@ -89,7 +91,57 @@ def test_summary_of_known_distances():
     assert metrics.max_mm == 4.0 and metrics.count == 2
     spread = summarize_distances(np.arange(101.0))
     assert (spread.p95_mm, spread.p99_mm) == (95.0, 99.0)
-    assert set(spread.as_dict()) == {"rms_mm", "p95_mm", "p99_mm", "max_mm", "count"}
+    assert set(spread.as_dict()) == {"rms_mm", "p95_mm", "p99_mm", "max_mm", "count", "total"}
+    assert spread.as_dict()["total"] == 101
+
+
+def _noisy_tube(sigma=0.05, seed=12, outliers=()):
+    """2400 points on a cone with noise; the points at the indices ``outliers`` stand 0.6 mm out."""
+    curve = Line(30.0)
+    rng = np.random.default_rng(seed)
+    l, a = grid_parameters(60, 40, rng)
+    rho = 3.0 + 0.5 * l + rng.normal(0, sigma, l.size)
+    rho[list(outliers)] += 0.6
+    return curve, project_points(curve, tube_points(curve, l, a, rho))
+
+
+def test_radial_residual_bounds_the_true_distance_from_above():
+    # p and S(l_p, a_p) lie on one ray from c(l_p): their distance is |rho_p - rho(l_p, a_p)| >= the least.
+    curve, noisy = _noisy_tube(sigma=0.2)
+    fit = fit_radius_surface(noisy, curve.length, FitSettings())
+    true = closest_surface_points(curve, fit.whole, noisy)[0]
+    radial = np.abs(noisy.rho - fit.whole.evaluate(noisy.l, noisy.angle))
+    assert np.all(true <= radial + 1e-12)
+    assert np.mean(true < radial - 1e-6) > 0.5  # a bound, not the same figure
+
+
+def test_distances_of_a_large_input_come_from_a_sample_and_the_max_from_every_point():
+    # Three outliers where the seeded sample of 400 will not look (the draw depends on the count only).
+    missed = np.setdiff1d(np.arange(2400), holdout_sample(2400, 400, np.random.default_rng(0)))[[0, 700, 1900]]
+    curve, noisy = _noisy_tube(outliers=missed)
+    spline = fit_radius_surface(noisy, curve.length, FitSettings()).whole
+    every = closest_surface_points(curve, spline, noisy)[0]
+    whole = measure_distances(curve, spline, noisy, np.random.default_rng(0))
+    assert whole.metrics == measure_fit(curve, spline, noisy) and len(whole.sample) == len(noisy)
+    sampled = measure_distances(curve, spline, noisy, np.random.default_rng(0), max_points=400)
+    m = sampled.metrics
+    assert (m.count, m.total, len(sampled.distance)) == (400, len(noisy), 400)
+    np.testing.assert_array_equal(sampled.distance, every[sampled.sample])
+    # The outliers are not in the sample; the maximum is still theirs, exactly.
+    assert m.max_mm == every.max() and every.max() > sampled.distance.max() + 0.3
+    # RMS over 400 of 2400 points: within ~10 % of the RMS of all points but the outliers.
+    assert m.rms_mm == pytest.approx(np.sqrt(np.mean(every[every < 0.4] ** 2)), rel=0.1)
+    again = measure_distances(curve, spline, noisy, np.random.default_rng(0), max_points=400)
+    np.testing.assert_array_equal(again.sample, sampled.sample)
+
+
+def test_fold_fits_equal_fresh_fits_on_the_other_folds():
+    curve, noisy = _noisy_tube()
+    labels = fold_labels(len(noisy), 4, np.random.default_rng(3))
+    for k, spline in enumerate(fold_fits(noisy, curve.length, FitSettings(), labels)):
+        fresh = fit_radius_surface(noisy.subset(labels != k), curve.length, FitSettings()).whole
+        np.testing.assert_array_equal(spline.knots, fresh.knots)
+        np.testing.assert_allclose(spline.coefficients, fresh.coefficients, rtol=0, atol=1e-10)
 
 
 def test_folds_are_balanced_and_reproducible_from_the_seed():

@@ -35,7 +35,7 @@ import scipy.sparse.linalg as spla
 from softdesign.errors import ConfigError, FitError
 from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.projection import PolarPoints
-from softdesign.types import FloatArray
+from softdesign.types import FloatArray, IntArray
 
 #: Defaults, from the VMTK aorta (see the note in tests/test_fit_aorta.py): knots every 1.5 mm
 #: and 24 around (about 1.5 mesh edges each way), and the smallest smoothing that keeps the
@@ -124,9 +124,8 @@ class RadiusSpline:
 
     def evaluate_grid(self, l: npt.ArrayLike, a: npt.ArrayLike, dl: int = 0, da: int = 0) -> FloatArray:
         """Values on the grid l (p,) x a (m,), returns (p, m), mm."""
-        left = bb.open_basis_matrix(self.knots, l, dl)
-        right = bb.periodic_basis_matrix(self.angular_intervals, a, da)
-        return np.asarray(left @ (right @ self.coefficients.T).T)
+        along = bb.open_local(self.knots, l, dl)
+        return grid_from_local(self.coefficients, along, bb.periodic_local(self.angular_intervals, a, da))
 
     def to_arrays(self) -> dict[str, FloatArray]:
         """Plain arrays for ``np.savez``: ``knots`` and ``coefficients``."""
@@ -136,6 +135,34 @@ class RadiusSpline:
     def from_arrays(cls, knots: npt.ArrayLike, coefficients: npt.ArrayLike) -> "RadiusSpline":
         """The inverse of :meth:`to_arrays`."""
         return cls(np.array(knots, float), np.array(coefficients, float))
+
+
+def grid_from_local(
+    coefficients: FloatArray, along: tuple[IntArray, FloatArray], around: tuple[IntArray, FloatArray]
+) -> FloatArray:
+    """``sum_rs B_r(l_p) P_s(a_m) C[i_pr, j_ms]`` on the grid l (p,) x a (m,), (p, m).
+
+    Parameters
+    ----------
+    coefficients : (n, M) float, C
+    along : indices (p, DEGREE + 1) and values of the open basis at l, from :func:`bspline_basis.open_local`
+    around : the same (m, DEGREE + 1) for the periodic basis at a, from :func:`bspline_basis.periodic_local`
+
+    The products are added in ascending basis index, first around then along,
+    starting from zero: the order of the sparse ``B (P C^T)^T`` this replaces,
+    so the values are the same to the last bit.  Dense gathers of the DEGREE + 1
+    local terms skip building sparse matrices, which cost most of a call.
+    """
+    rows_l, values_l = along
+    order = np.argsort(around[0], axis=1, kind="stable")
+    rows_a, values_a = (np.take_along_axis(v, order, axis=1) for v in around)
+    inner = np.zeros((coefficients.shape[0], rows_a.shape[0]))  # (n, m): sum over the periodic basis
+    for s in range(rows_a.shape[1]):
+        inner += coefficients[:, rows_a[:, s]] * values_a[:, s]
+    out = np.zeros((rows_l.shape[0], rows_a.shape[0]))
+    for r in range(rows_l.shape[1]):
+        out += values_l[:, r, None] * inner[rows_l[:, r]]
+    return out
 
 
 @dataclass(frozen=True)
@@ -184,27 +211,64 @@ def fit_radius_surface(polar: PolarPoints, length_mm: float, settings: FitSettin
         and some coefficients have no data; the solve is not finite.
     """
     check_surrounds(polar, length_mm, settings)
-    knots = bb.open_knots(settings.breaks, intervals_per_link(length_mm, settings))
+    knots = path_knots(length_mm, settings)
     design = design_matrix(knots, settings.angular_intervals, polar.l, polar.angle)
+    if settings.smoothing == 0:
+        _check_supported(design, knots, settings.angular_intervals, length_mm)
     scale = float(np.median(polar.rho))
-    n = len(polar)
-    normal = (design.T @ design) / n
+    coef = _solve(design.T @ design, design.T @ polar.rho, len(polar), knots, scale, length_mm, settings)
+    whole = RadiusSpline(knots, coef.reshape(-1, settings.angular_intervals))
+    links = split_at_breaks(whole, settings.breaks)
+    value_jump, slope_jump = joint_jumps(links, length_mm)
+    residual = polar.rho - design @ coef
+    return SurfaceFit(whole, links, value_jump, slope_jump, scale, float(np.sqrt(np.mean(residual**2))), len(polar))
+
+
+def fold_fits(polar: PolarPoints, length_mm: float, settings: FitSettings, labels: np.ndarray) -> list[RadiusSpline]:
+    """The whole-path spline fitted to the points outside each fold in turn (fold k: ``labels != k``).
+
+    The same penalized least squares as :func:`fit_radius_surface` (penalty scale from each
+    training set's median rho), assembled once: fold k's normal equations are those of every
+    point minus the rows of fold k, equal to a fresh assembly up to rounding.
+    """
+    knots = path_knots(length_mm, settings)
+    design = design_matrix(knots, settings.angular_intervals, polar.l, polar.angle)
+    rows = [np.flatnonzero(labels == k) for k in range(int(labels.max()) + 1)]
+    parts = [(design[r].T @ design[r], design[r].T @ polar.rho[r]) for r in rows]
+    gram, moment = sum(p[0] for p in parts), sum(p[1] for p in parts)
+    splines = []
+    for held, (fold_gram, fold_moment) in zip(rows, parts):
+        train = np.ones(len(polar), bool)
+        train[held] = False
+        scale = float(np.median(polar.rho[train]))
+        coef = _solve(gram - fold_gram, moment - fold_moment, int(train.sum()), knots, scale, length_mm, settings)
+        splines.append(RadiusSpline(knots, coef.reshape(-1, settings.angular_intervals)))
+    return splines
+
+
+def path_knots(length_mm: float, settings: FitSettings) -> FloatArray:
+    """The open knot vector in l of the whole path: whole intervals per link, every break a knot."""
+    return bb.open_knots(settings.breaks, intervals_per_link(length_mm, settings))
+
+
+def _solve(gram, moment, count: int, knots: FloatArray, scale: float, length_mm: float, settings: FitSettings):
+    """Coefficients minimizing ``|A c - rho|^2 / n + smoothing * c^T P c`` from ``A^T A`` and ``A^T rho``.
+
+    Raises
+    ------
+    FitError
+        The system is singular (no penalty and coefficients without data).
+    """
+    normal = gram / count
     if settings.smoothing > 0:
         normal = normal + settings.smoothing * roughness_matrix(knots, settings.angular_intervals, scale / length_mm)
-    else:
-        _check_supported(design, knots, settings.angular_intervals, length_mm)
-    rhs = design.T @ polar.rho / n
-    coef = spla.spsolve(sp.csc_matrix(normal), rhs)
+    coef = spla.spsolve(sp.csc_matrix(normal), moment / count)
     if not np.all(np.isfinite(coef)):
         raise FitError(
             f"surface fit: the least-squares system is singular (fit.smoothing = {settings.smoothing}); "
             f"expected wall points all around the path; set fit.smoothing > 0 (default {DEFAULT_SMOOTHING:g})"
         )
-    whole = RadiusSpline(knots, coef.reshape(-1, settings.angular_intervals))
-    links = split_at_breaks(whole, settings.breaks)
-    value_jump, slope_jump = joint_jumps(links, length_mm)
-    residual = polar.rho - design @ coef
-    return SurfaceFit(whole, links, value_jump, slope_jump, scale, float(np.sqrt(np.mean(residual**2))), n)
+    return coef
 
 
 def design_matrix(knots: FloatArray, intervals: int, l: FloatArray, angle: FloatArray) -> sp.csr_matrix:

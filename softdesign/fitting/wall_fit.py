@@ -19,9 +19,8 @@ from softdesign.fitting.metrics import (
     HoldoutReport,
     HoldoutSettings,
     choose_knot_spacing,
-    closest_surface_points,
     holdout_rms,
-    summarize_distances,
+    measure_distances,
 )
 from softdesign.fitting.projection import PolarPoints, project_points
 from softdesign.fitting.radius_field import FoldReport, RadiusField, check_self_folding
@@ -110,15 +109,19 @@ def fit_wall(
     """
     polar = project_points(curve, vertices)
     selection = select_wall_points(polar, curve.length, network, options.selection)
-    kept = polar.subset(selection.keep)
+    # in order along the path: every later evaluation then reads the splines' pieces in turn
+    kept_index = np.flatnonzero(selection.keep)
+    kept = polar.subset(kept_index[np.argsort(polar.l[kept_index], kind="stable")])
     settings, scores = options.fit, {}
     if options.auto_spacing:
         spacing, scores = choose_knot_spacing(curve, kept, settings, rng, options.holdout)
         settings = replace(settings, knot_spacing_mm=spacing)
     surface = fit_radius_surface(kept, curve.length, settings)
-    distance, l, angle = closest_surface_points(curve, surface.whole, kept)
-    metrics = summarize_distances(distance)
-    holdout = holdout_rms(curve, kept, settings, rng, options.holdout, start=(l, angle))
+    measured = measure_distances(curve, surface.whole, kept, rng)
+    # the hold-out folds are dealt from the measured points, each starting from its closest point
+    holdout = holdout_rms(curve, kept.subset(measured.sample), settings, rng, options.holdout,
+                          start=(measured.l, measured.angle))
+    metrics = measured.metrics
     radius = RadiusField.from_links(settings.breaks, surface.links, options.initial_radius_mm)
     folding = check_self_folding(curve, radius, q=1.0, limit=options.fold_limit)
     return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius)
