@@ -88,7 +88,9 @@ def project_points(curve: FramedCurve, points: npt.ArrayLike) -> PolarPoints:
             "check the surface file"
         )
     l = foot_parameters(curve, points)
-    origin, frames = curve.points(l), curve.frames(l)
+    order = np.argsort(l, kind="stable")  # the curve evaluated in order along it, then put back
+    origin, frames = np.empty_like(points), np.empty((len(l), 3, 3))
+    origin[order], frames[order] = curve.points(l[order]), curve.frames(l[order])
     offset = points - origin
     local = np.einsum("nij,ni->nj", frames, offset)
     tangent_part = curve.derivative(np.array([0.0, 1.0]))
@@ -108,6 +110,16 @@ def foot_parameters(curve: FramedCurve, points: Points) -> FloatArray:
     count = max(int(np.ceil(curve.length / SEED_SPACING_MM)), 8) + 1
     grid = np.linspace(0.0, 1.0, count)
     nearest = cKDTree(curve.points(grid)).query(points)[1]
+    # solved in order along the curve (each evaluation then reads its polynomial pieces in turn)
+    order = np.argsort(nearest, kind="stable")
+    l = np.empty(len(points))
+    l[order] = _refined_feet(curve, points[order], grid, nearest[order])
+    return l
+
+
+def _refined_feet(curve: FramedCurve, points: Points, grid: FloatArray, nearest: np.ndarray) -> FloatArray:
+    """Safeguarded Newton from the nearest samples ``grid[nearest]`` to each point's foot, clamped to [0, 1]."""
+    count = len(grid)
     lo = grid[np.maximum(nearest - 1, 0)]
     hi = grid[np.minimum(nearest + 1, count - 1)]
     slope_lo, slope_hi = _slope(curve, points, lo), _slope(curve, points, hi)
