@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import pickle
 
 import numpy as np
 import pytest
@@ -135,3 +136,39 @@ def test_an_initial_surface_fitted_with_the_final_layout_blends_with_it():
     # tolerance); the blend at q = 0.5 is (2 + 3 + l) / 2.
     expected = np.repeat((2.5 + grid_l / 2)[:, None], 2, axis=1)
     np.testing.assert_allclose(field.evaluate_grid(0.5, grid_l, [0.0, 2.0]), expected, rtol=0, atol=1e-9)
+
+
+def test_grid_evaluation_adds_as_the_sparse_basis_product_does():
+    """Dense local sums give the bits of ``B (P C^T)^T`` with sparse basis matrices, derivatives included."""
+    rng = np.random.default_rng(4)
+    for intervals in (4, 7, 24):
+        knots = bb.open_knots([0.0, 0.3, 1.0], [3, 5])
+        spline = RadiusSpline(knots, rng.normal(3.0, 0.5, (len(knots) - 4, intervals)))
+        l, angle = np.append(rng.uniform(0, 1, 30), [0.0, 0.3, 1.0]), rng.uniform(-7, 7, 17)
+        for dl, da in ((0, 0), (1, 0), (2, 1), (0, 2)):
+            left = bb.open_basis_matrix(knots, l, dl)
+            right = bb.periodic_basis_matrix(intervals, angle, da)
+            np.testing.assert_array_equal(spline.evaluate_grid(l, angle, dl, da),
+                                          left @ (right @ spline.coefficients.T).T)
+
+
+def test_blend_grid_is_the_blend_of_the_end_grids_cached_or_not(monkeypatch):
+    field = RadiusField.from_links((0.0, 0.4, 1.0), _random_links())
+    l, angle = np.linspace(0.0, 1.0, 41), np.linspace(0.0, 2 * np.pi, 16, endpoint=False)
+    for dl in (0, 1):
+        # blending values instead of coefficients: equal up to rounding of O(5 mm) (or O(50 mm/l)) values
+        np.testing.assert_allclose(field.blend_grid(0.3, l, angle, dl), field.evaluate_grid(0.3, l, angle, dl),
+                                   rtol=0, atol=10 * VALUE_TOL_MM)
+    cached = field.blend_grid(0.7, l, angle, dl=1)
+    fresh = RadiusField.from_arrays(field.to_arrays())
+    np.testing.assert_array_equal(fresh.blend_grid(0.7, l, angle, dl=1), cached)
+    initial, final = field.end_grids(l, angle)
+    assert not initial.flags.writeable and not final.flags.writeable
+    np.testing.assert_array_equal(initial, field.evaluate_grid(0.0, l, angle))
+    # the cache stays within its budget (least recently used first out) and out of pickles
+    monkeypatch.setattr("softdesign.fitting.radius_field.GRID_CACHE_BYTES", 2 * initial.nbytes * 2)
+    for count in range(5, 9):
+        field.end_grids(np.linspace(0.0, 1.0, count), angle)
+    field.end_grids(l, angle)
+    assert sum(g.nbytes for g in field._grid_cache.values()) <= 4 * initial.nbytes
+    assert "_grid_cache" not in pickle.loads(pickle.dumps(field)).__dict__

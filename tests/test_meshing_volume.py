@@ -160,6 +160,26 @@ def test_l_at_arclength_inverts_a_nonuniform_speed():
     np.testing.assert_allclose(l_at_arclength(field, [0.0, 1.0], 0.75 + 0.75**3), 0.75, rtol=0, atol=1e-12)
 
 
+def test_arc_lengths_use_the_fields_speed_alone_when_it_has_one():
+    """A hollow body's chamber ends come from s(l) only: a field with ``speed`` is not asked for radii there."""
+    body = Body(circular_arc(30.0, 1.0), 2.0)
+    plain = body.field(NA)
+    calls = []
+
+    class WithSpeed:
+        def __call__(self, l):
+            calls.append(np.size(l))
+            return plain(l)
+
+        def speed(self, l):
+            return plain(l).speed
+
+    spec = BodySpec(wall_mm=0.5, port_mm=0.4)
+    breaks = [0.0, 0.5, 1.0]
+    assert integrate_body(WithSpeed(), breaks, spec) == integrate_body(plain, breaks, spec)
+    assert len(calls) == 2  # the whole body's nodes and the chamber's, nothing for the Newton steps
+
+
 def test_l_at_arclength_refuses_a_length_beyond_the_curve():
     with pytest.raises(ValueError, match="outside"):
         l_at_arclength(Body(straight_line(10.0), 1.0).field(8), [0.0, 1.0], 11.0)

@@ -140,11 +140,11 @@ class RadiusSpline:
 def grid_from_local(
     coefficients: FloatArray, along: tuple[IntArray, FloatArray], around: tuple[IntArray, FloatArray]
 ) -> FloatArray:
-    """``sum_rs B_r(l_p) P_s(a_m) C[i_pr, j_ms]`` on the grid l (p,) x a (m,), (p, m).
+    """``sum_rs B_r(l_p) P_s(a_m) C[i_pr, j_ms]`` on the grid l (p,) x a (m,), (..., p, m).
 
     Parameters
     ----------
-    coefficients : (n, M) float, C
+    coefficients : (..., n, M) float, C; leading axes stack surfaces on the same knots
     along : indices (p, DEGREE + 1) and values of the open basis at l, from :func:`bspline_basis.open_local`
     around : the same (m, DEGREE + 1) for the periodic basis at a, from :func:`bspline_basis.periodic_local`
 
@@ -156,12 +156,13 @@ def grid_from_local(
     rows_l, values_l = along
     order = np.argsort(around[0], axis=1, kind="stable")
     rows_a, values_a = (np.take_along_axis(v, order, axis=1) for v in around)
-    inner = np.zeros((coefficients.shape[0], rows_a.shape[0]))  # (n, m): sum over the periodic basis
+    lead = coefficients.shape[:-2]
+    inner = np.zeros(lead + (coefficients.shape[-2], rows_a.shape[0]))  # (..., n, m): sum over the periodic basis
     for s in range(rows_a.shape[1]):
-        inner += coefficients[:, rows_a[:, s]] * values_a[:, s]
-    out = np.zeros((rows_l.shape[0], rows_a.shape[0]))
+        inner += coefficients[..., rows_a[:, s]] * values_a[:, s]
+    out = np.zeros(lead + (rows_l.shape[0], rows_a.shape[0]))
     for r in range(rows_l.shape[1]):
-        out += values_l[:, r, None] * inner[rows_l[:, r]]
+        out += values_l[:, r, None] * inner[..., rows_l[:, r], :]
     return out
 
 

@@ -8,6 +8,8 @@ integral it is checked against see one surface.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import numpy.typing as npt
 
@@ -24,22 +26,39 @@ def curvature_components(curve: FramedSpline, l: FloatArray, frames: FloatArray)
     return np.column_stack([np.einsum("ni,ni->n", kvec, frames[:, :, 0]), np.einsum("ni,ni->n", kvec, frames[:, :, 1])])
 
 
-def body_stations(curve: FramedSpline, field: RadiusField, q: float, angular_count: int) -> SectionField:
-    """The body at q as a function of l (for :func:`~softdesign.meshing.volume.integrate_body`)."""
-    a = angle_grid(angular_count)
+@dataclass(frozen=True)
+class BodyStations:
+    """The body at q as a function of l (a :data:`~softdesign.meshing.volume.SectionField`).
 
-    def stations(l: npt.ArrayLike) -> Stations:
+    rho comes from :meth:`~softdesign.fitting.radius_field.RadiusField.blend_grid`:
+    the quadrature nodes do not depend on q, so rho0 and rhof there are
+    evaluated once for every q.  :meth:`speed` alone serves the arc lengths.
+    """
+
+    curve: FramedSpline
+    field: RadiusField
+    q: float
+    angles: FloatArray
+
+    def __call__(self, l: npt.ArrayLike) -> Stations:
         l = np.asarray(l, float)
-        speed = curve.curve.speed(l)
-        rho_l = field.evaluate_grid(q, l, a, dl=1)
+        speed = self.curve.curve.speed(l)
+        rho_l = self.field.blend_grid(self.q, l, self.angles, dl=1)
         return Stations(
-            rho=field.evaluate_grid(q, l, a),
+            rho=self.field.blend_grid(self.q, l, self.angles),
             rho_s=rho_l / speed[:, None],
-            curvature=curvature_components(curve, l, curve.frames(l)),
+            curvature=curvature_components(self.curve, l, self.curve.frames(l)),
             speed=speed,
         )
 
-    return stations
+    def speed(self, l: npt.ArrayLike) -> FloatArray:
+        """ds/dl at l, mm: the stations' speed without the radii."""
+        return self.curve.curve.speed(np.asarray(l, float))
+
+
+def body_stations(curve: FramedSpline, field: RadiusField, q: float, angular_count: int) -> SectionField:
+    """The body at q as a function of l (for :func:`~softdesign.meshing.volume.integrate_body`)."""
+    return BodyStations(curve, field, q, angle_grid(angular_count))
 
 
 def body_breaks(field: RadiusField) -> FloatArray:

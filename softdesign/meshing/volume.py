@@ -91,7 +91,8 @@ class Stations:
     speed: FloatArray
 
 
-#: Evaluates the body at an array of l values; a pure function of l.
+#: Evaluates the body at an array of l values; a pure function of l.  It may also have a
+#: method ``speed(l)`` giving ``Stations.speed`` alone, which arc lengths then use.
 SectionField = Callable[[FloatArray], Stations]
 
 
@@ -255,13 +256,19 @@ def _sub_breaks(breaks: FloatArray, lo: float, hi: float) -> FloatArray:
     return np.concatenate([[lo], inside, [hi]])
 
 
+def _speed(field: SectionField, l: FloatArray) -> FloatArray:
+    """ds/dl at l, mm: from the field's ``speed`` method when it has one (no radii needed)."""
+    speed = getattr(field, "speed", None)
+    return speed(l) if callable(speed) else field(l).speed
+
+
 def arclength_at(field: SectionField, breaks: npt.ArrayLike, l: float, order: int = GAUSS_ORDER) -> float:
     """Arc length from ``breaks[0]`` to ``l``, mm (Gauss-Legendre on ds/dl)."""
     breaks = np.asarray(breaks, float)
     if l <= breaks[0]:
         return 0.0
     nodes, weights = gauss_legendre_nodes(_sub_breaks(breaks, breaks[0], l), order)
-    return float(weights @ field(nodes).speed)
+    return float(weights @ _speed(field, nodes))
 
 
 def l_at_arclength(field: SectionField, breaks: npt.ArrayLike, s: float, order: int = GAUSS_ORDER) -> float:
@@ -275,7 +282,7 @@ def l_at_arclength(field: SectionField, breaks: npt.ArrayLike, s: float, order: 
         miss = arclength_at(field, breaks, l, order) - s
         if abs(miss) <= NEWTON_RTOL * length:
             break
-        l = float(np.clip(l - miss / field(np.array([l])).speed[0], breaks[0], breaks[-1]))
+        l = float(np.clip(l - miss / _speed(field, np.array([l]))[0], breaks[0], breaks[-1]))
     return l
 
 
@@ -311,8 +318,13 @@ def integrate_body(
         channel ``pi (port_mm/2)^2 wall_mm`` through the base cap.
     """
     breaks = np.asarray(breaks, float)
-    length = arclength_at(field, breaks, breaks[-1], order)
-    volume = _sweep_integral(field, breaks, (breaks[0], breaks[-1]), spec.offset_mm, order)
+    # length, volume and area over the whole span share one evaluation of the field, at the
+    # nodes arclength_at and _sweep_integral would pick (the breaks are their own sub-breaks)
+    nodes, weights = gauss_legendre_nodes(breaks, order)
+    st = field(nodes)
+    length = float(weights @ st.speed)
+    ds = weights * st.speed
+    volume = sweep_volume(section_curves(st.rho, st.rho_s, st.curvature, spec.offset_mm), st.curvature, ds)
     if spec.wall_mm > 0:
         w = spec.wall_mm
         span = (l_at_arclength(field, breaks, w, order), l_at_arclength(field, breaks, length - w, order))
@@ -320,8 +332,6 @@ def integrate_body(
         volume -= np.pi * (spec.port_mm / 2.0) ** 2 * w
     area = None
     if spec.offset_mm == 0 and spec.wall_mm == 0:
-        nodes, weights = gauss_legendre_nodes(breaks, order)
-        st = field(nodes)
         caps = section_area(field(breaks[[0, -1]]).rho).sum()
-        area = tube_lateral_area(st.rho, st.rho_s, st.curvature, weights * st.speed) + float(caps)
+        area = tube_lateral_area(st.rho, st.rho_s, st.curvature, ds) + float(caps)
     return BodyIntegrals(float(volume), area, length)
