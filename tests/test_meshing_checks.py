@@ -126,3 +126,87 @@ def test_volume_check_catches_a_mesh_one_percent_too_large():
 def test_report_is_json_ready():
     data = inspect_mesh(CUBE_VERTICES, CUBE_FACES, 8.0).as_dict()
     assert json.loads(json.dumps(data))["volume_rel_error"] == pytest.approx(0.0, abs=ROUNDOFF)
+
+
+def test_edge_shared_by_four_faces_is_not_watertight():
+    """Two cubes sharing one edge: every half-edge has a reverse, but that edge has four faces."""
+    second = CUBE_VERTICES + [2.0, 2.0, 0.0]  # its edge x = y = 0 lies on the first cube's edge x = y = 2
+    vertices = np.vstack([CUBE_VERTICES, second])
+    faces = np.vstack([CUBE_FACES, CUBE_FACES + 8])
+    shared = {0: 6, 1: 7}  # second cube's (0, 0, z) are the first cube's (2, 2, z)
+    faces[len(CUBE_FACES):] = np.vectorize(lambda i: shared.get(i - 8, i))(faces[len(CUBE_FACES):])
+    report = inspect_mesh(vertices, faces)
+    assert not report.watertight and not report.winding_consistent and report.shells == 1
+    with pytest.raises(MeshError, match="not watertight"):
+        check_solid(vertices, faces)
+
+
+def test_a_repeated_face_is_not_watertight():
+    faces = np.vstack([CUBE_FACES, CUBE_FACES[:1]])
+    assert not inspect_mesh(CUBE_VERTICES, faces).watertight
+
+
+def _reference_topology(faces: np.ndarray, n_vertices: int) -> tuple[bool, bool, bool, int, int]:
+    """watertight, winding consistent, vertex manifold, shells, Euler characteristic, straight from the definitions."""
+    half = [(int(f[p]), int(f[(p + 1) % 3])) for f in faces for p in range(3)]
+    undirected = {}
+    for a, b in half:
+        undirected[min(a, b), max(a, b)] = undirected.get((min(a, b), max(a, b)), 0) + 1
+    watertight = len(half) > 0 and all(c == 2 for c in undirected.values())
+    consistent = watertight and len(set(half)) == len(half)
+    manifold = False
+    if consistent:
+        manifold = True
+        for v in {int(i) for i in faces.ravel()}:
+            around = [f for f in faces if v in f]
+            # faces around v are one fan when sharing an edge through v joins them all
+            reached, todo = {0}, [0]
+            while todo:
+                f = set(map(int, around[todo.pop()]))
+                for k, g in enumerate(around):
+                    if k not in reached and len(f & set(map(int, g))) == 2:
+                        reached.add(k)
+                        todo.append(k)
+            manifold &= len(reached) == len(around)
+    parent = list(range(n_vertices))
+
+    def root(i):
+        while parent[i] != i:
+            i = parent[i]
+        return i
+
+    for a, b in half:
+        parent[root(a)] = root(b)
+    used = {int(i) for i in faces.ravel()}
+    shells = len({root(i) for i in used})
+    return watertight, consistent, manifold, shells, len(used) - len(undirected) + len(faces)
+
+
+@pytest.mark.parametrize("fault", ["none", "drop", "flip", "repeat", "merge", "two_shells", "unused", "shuffle"])
+def test_topology_checks_agree_with_their_definitions(fault):
+    """Seeded faults on a torus: each check against a direct count from the module's definitions."""
+    rng = np.random.default_rng(7)
+    vertices, faces = _torus_grid(8, 6)
+    for _ in range(5):
+        f, v = faces.copy(), vertices.copy()
+        if fault == "drop":
+            f = np.delete(f, rng.integers(len(f), size=2), axis=0)
+        elif fault == "flip":
+            i = rng.integers(len(f), size=2)
+            f[i] = f[i, ::-1]
+        elif fault == "repeat":
+            f = np.vstack([f, f[rng.integers(len(f), size=1)]])
+        elif fault == "merge":
+            a, b = rng.choice(len(v), size=2, replace=False)
+            f[f == a] = b  # a pinched vertex (or, for neighbours, collapsed faces)
+        elif fault == "two_shells":
+            f, v = np.vstack([f, f[:, ::-1] + len(v)]), np.vstack([v, 0.5 * v])
+        elif fault == "unused":
+            perm = rng.permutation(len(v) + 3)
+            v = np.vstack([v, np.zeros((3, 3))])[np.argsort(perm)]
+            f = perm[f]
+        elif fault == "shuffle":
+            f = np.roll(f[rng.permutation(len(f))], 1, axis=1)
+        report = inspect_mesh(v, f)
+        got = (report.watertight, report.winding_consistent, report.vertex_manifold, report.shells, report.euler)
+        assert got == _reference_topology(f, len(v))

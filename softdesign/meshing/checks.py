@@ -21,7 +21,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 import numpy.typing as npt
-from scipy.sparse import coo_matrix
+from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
 from softdesign.errors import MeshError
@@ -77,53 +77,90 @@ class Expectation:
     volume_rtol: float = VOLUME_RTOL
 
 
-def _edges(faces: IntArray, n_vertices: int) -> tuple[IntArray, IntArray, bool, bool, int]:
-    """Half-edges sorted by key (their order and keys), watertight, winding consistent, undirected edge count.
+def _edges(faces: IntArray, n_vertices: int) -> tuple[IntArray | None, bool, bool, int]:
+    """Each half-edge's twin (None unless the winding is consistent), watertight, winding consistent, edge count.
 
-    Half-edge j = 3f + p runs from faces[f, p] to faces[f, (p + 1) % 3]; its key is a * V + b.
+    Half-edge j = 3f + p runs a = faces[f, p] -> b = faces[f, (p + 1) % 3]; its key
+    2 (min(a, b) V + max(a, b)) + (a > b) puts the half-edges of one undirected edge
+    next to each other once sorted.  Watertight: the sorted keys come in pairs of
+    one edge each.  Consistent: each pair is a -> b and b -> a (keys 2k and 2k + 1),
+    which then are each other's twins.
     """
-    half = faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
-    undirected = np.sort(np.minimum(half[:, 0], half[:, 1]) * n_vertices + np.maximum(half[:, 0], half[:, 1]))
-    starts = np.flatnonzero(np.concatenate([[True], undirected[1:] != undirected[:-1]]))
-    counts = np.diff(np.append(starts, undirected.size))
-    directed = half[:, 0] * n_vertices + half[:, 1]
-    order = np.argsort(directed, kind="stable")
-    keys = directed[order]
-    watertight = bool(np.all(counts == 2))
-    # two half-edges on each edge with distinct keys can only be a -> b and b -> a
-    consistent = watertight and bool(np.all(keys[1:] != keys[:-1]))
-    return order, keys, watertight, consistent, int(starts.size)
+    start, end = faces.ravel(), np.roll(faces, -1, axis=1).ravel()
+    key = 2 * (np.minimum(start, end) * n_vertices + np.maximum(start, end)) + (start > end)
+    order = np.argsort(key, kind="stable")  # a tessellation's keys come in long sorted runs
+    keys = key[order]
+    edge = keys >> 1
+    new_edge = edge[1:] != edge[:-1]
+    watertight = keys.size > 0 and keys.size % 2 == 0 and not new_edge[0::2].any() and bool(new_edge[1::2].all())
+    consistent = watertight and bool(np.all(keys[0::2] != keys[1::2]))
+    n_edges = int(np.count_nonzero(new_edge)) + 1
+    if not consistent:
+        return None, watertight, consistent, n_edges
+    twin = np.empty_like(order)
+    twin[order[0::2]] = order[1::2]
+    twin[order[1::2]] = order[0::2]
+    return twin, watertight, consistent, n_edges
 
 
-def _vertex_manifold(faces: IntArray, order: IntArray, keys: IntArray, n_vertices: int, used: int) -> bool:
-    """True when the face corners around each vertex join into a single fan (needs consistent winding).
+def _vertex_manifold(twin: IntArray, used: int) -> bool:
+    """True when the faces around each vertex join into a single fan (needs consistent winding).
 
-    Half-edge j = 3f + p runs a -> b; its twin b -> a is half-edge 3g + p'; the
-    corners of a in f (3f + p) and in g (3g + (p' + 1) % 3) are neighbours in a's fan.
+    Half-edge j = 3f + p runs a -> b; the next half-edge of f leaves b, and its
+    twin, in the neighbouring face around b, ends at b again.  Repeating that
+    step walks once round the faces of b that share edges with f: one cycle
+    per fan, so a 2-manifold has exactly as many cycles as used vertices.
     """
-    half = faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
-    twin = order[np.searchsorted(keys, half[:, 1] * n_vertices + half[:, 0])]
-    neighbour = 3 * (twin // 3) + (twin % 3 + 1) % 3
-    n = twin.size
-    graph = coo_matrix((np.ones(n), (np.arange(n), neighbour)), shape=(n, n))
+    step = np.roll(twin.reshape(-1, 3), -1, axis=1).ravel()  # twin of the next half-edge
+    n = step.size
+    graph = csr_matrix((np.ones(n), step, np.arange(n + 1)), shape=(n, n))  # row j: the one step from j
     fans = connected_components(graph, directed=False)[0]
     return fans == used
 
 
-def _shells(vertices: FloatArray, faces: IntArray, used: IntArray) -> tuple[int, FloatArray]:
-    """Number of connected shells and each shell's signed volume (mm^3)."""
-    n = vertices.shape[0]
-    rows = faces[:, [0, 1, 2]].ravel()
-    cols = faces[:, [1, 2, 0]].ravel()
-    graph = coo_matrix((np.ones(rows.size), (rows, cols)), shape=(n, n))
-    _, labels = connected_components(graph, directed=False)
-    relabel = np.unique(labels[used], return_inverse=True)[1]  # components numbered over used vertices
+def _shells(faces: IntArray, corners: FloatArray, n_vertices: int, used: IntArray) -> tuple[int, FloatArray]:
+    """Number of connected shells and each shell's signed volume (mm^3), corners (F, 3, 3) mm about the centroid."""
+    n, count_faces = n_vertices, faces.shape[0]
+    # one graph of vertices (nodes 0 .. V-1, so components are numbered as over vertices alone)
+    # and faces (nodes V ..), each face joined to its three vertices: CSR rows without a sort
+    indptr = np.concatenate([np.zeros(n, np.int64), np.arange(0, faces.size + 1, 3)])
+    graph = csr_matrix((np.ones(faces.size), faces.ravel(), indptr), shape=(n + count_faces, n + count_faces))
+    labels = connected_components(graph, directed=False)[1][:n]
+    # components numbered over used vertices (when all are used, they already are)
+    relabel = labels if used.size == n else np.unique(labels[used], return_inverse=True)[1]
     shell_of_vertex = np.zeros(n, np.int64)
     shell_of_vertex[used] = relabel
-    p = vertices - vertices[used].mean(axis=0)
-    tet = np.einsum("ij,ij->i", p[faces[:, 0]], np.cross(p[faces[:, 1]], p[faces[:, 2]])) / 6.0
+    tet = np.einsum("ij,ij->i", corners[:, 0], _cross(corners[:, 1], corners[:, 2])) / 6.0
     count = int(relabel.max()) + 1 if used.size else 0
     return count, np.bincount(shell_of_vertex[faces[:, 0]], weights=tet, minlength=count)
+
+
+def _cross(u: FloatArray, v: FloatArray) -> FloatArray:
+    """Row-wise u x v of (n, 3) arrays: np.cross's products in its order, without its generality's overhead."""
+    out = np.empty(u.shape)
+    for i, (j, k) in enumerate(((1, 2), (2, 0), (0, 1))):
+        np.subtract(u[:, j] * v[:, k], u[:, k] * v[:, j], out=out[:, i])
+    return out
+
+
+def _face_sizes(corners: FloatArray) -> tuple[FloatArray, float]:
+    """Twice the area of each face (F,) and the mean squared edge length, mm^2, from corners (F, 3, 3) mm.
+
+    Sums of three squares are added x + y, then + z, as ``np.linalg.norm`` and
+    ``np.sum`` over a last axis of 3 add them; whole columns at a time are cheaper.
+    """
+    p0, p1, p2 = corners[:, 0], corners[:, 1], corners[:, 2]
+    normal = _cross(p1 - p0, p2 - p0)
+    normal *= normal
+    double_area = np.sqrt(normal[:, 0] + normal[:, 1] + normal[:, 2])
+    if not corners.size:
+        return double_area, 0.0
+    edge_sq = np.empty(corners.shape[:2])  # (F, 3), edges p0 p1, p1 p2, p2 p0
+    for i, (a, b) in enumerate(((p0, p1), (p1, p2), (p2, p0))):
+        d = b - a
+        d *= d
+        edge_sq[:, i] = d[:, 0] + d[:, 1] + d[:, 2]
+    return double_area, float(np.mean(edge_sq))
 
 
 def inspect_mesh(
@@ -149,12 +186,12 @@ def inspect_mesh(
         raise ValueError("faces refer to vertices that do not exist")
     n = vertices.shape[0]
     used = np.flatnonzero(np.bincount(faces.ravel(), minlength=n))
-    order, keys, watertight, consistent, n_edges = _edges(faces, n)
-    manifold = consistent and _vertex_manifold(faces, order, keys, n, used.size)
-    cross = np.cross(vertices[faces[:, 1]] - vertices[faces[:, 0]], vertices[faces[:, 2]] - vertices[faces[:, 0]])
-    double_area = np.linalg.norm(cross, axis=1)
-    edge_sq = np.mean(np.sum(np.diff(vertices[faces[:, [0, 1, 2, 0]]], axis=1) ** 2, axis=-1)) if faces.size else 0.0
-    shells, shell_volume = _shells(vertices, faces, used)
+    twin, watertight, consistent, n_edges = _edges(faces, n)
+    manifold = consistent and _vertex_manifold(twin, used.size)
+    corners = np.take(vertices, faces, axis=0)  # (F, 3, 3); take gathers rows faster than vertices[faces]
+    double_area, edge_sq = _face_sizes(corners)
+    centroid = (vertices if used.size == n else vertices[used]).mean(axis=0)
+    shells, shell_volume = _shells(faces, corners - centroid, n, used)
     volume = float(shell_volume.sum())
     rel = None if volume_expected is None else volume / volume_expected - 1.0
     return MeshReport(
