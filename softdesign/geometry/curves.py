@@ -34,6 +34,7 @@ from softdesign.types import FRENET_KAPPA_TOL, POINT_TOL_MM, FloatArray, Points
 DEGREE = 5
 #: Gauss-Legendre nodes per interval for arc-length integrals.
 GAUSS_NODES = 8
+_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(GAUSS_NODES)
 #: Dense evaluation grid (frames, reports): at least this many per sample interval ...
 DENSE_PER_INTERVAL = 8
 #: ... and no coarser than this arc step, mm.
@@ -334,7 +335,7 @@ def _chord_spline(points: Points, smoothing_mm: float) -> tuple[BSpline, FloatAr
 
 def _speed_integral(spline: BSpline | PPoly, a: FloatArray, b: FloatArray) -> FloatArray:
     """Integral of |spline'| from a to b (element-wise), Gauss-Legendre."""
-    x, w = np.polynomial.legendre.leggauss(GAUSS_NODES)
+    x, w = _GAUSS_X, _GAUSS_W
     half = 0.5 * (np.asarray(b) - np.asarray(a))
     nodes = 0.5 * (np.asarray(a) + np.asarray(b))[..., None] + half[..., None] * x
     speed = np.linalg.norm(spline(nodes.ravel(), nu=1), axis=1).reshape(nodes.shape)
