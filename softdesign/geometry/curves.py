@@ -188,7 +188,7 @@ def piecewise_polynomial(spline: BSpline) -> PPoly:
     Boor's recursion per point and per derivative order.
     """
     coefficients = np.asarray(spline.c, float)
-    per_axis = [PPoly.from_spline(BSpline(spline.t, coefficients[:, axis], spline.k)) for axis in range(coefficients.shape[1])]
+    per_axis = [PPoly.from_spline(BSpline(spline.t, column, spline.k)) for column in coefficients.T]
     return PPoly(np.stack([p.c for p in per_axis], axis=-1), per_axis[0].x)
 
 
