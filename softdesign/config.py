@@ -148,6 +148,8 @@ class Export(_Section):
     formats: list[Literal["stl", "ply", "obj", "glb"]] = ["stl"]
     spacing_mm: float = Field(0.5, gt=0.0)
     angular_count: int = Field(64, ge=8)
+    #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...
+    split_regions: bool = False
 
     @model_validator(mode="after")
     def _q_values(self) -> "Export":

@@ -258,17 +258,21 @@ def compare_mesh_folders(
 
 
 def mesh_figures(name: str, diff: MeshDifference, options: CheckOptions, allowance: DecimationError) -> list[Figure]:
-    """The five figures of one mesh pair; tolerances widened by the reference's decimation error."""
+    """The five figures of one mesh pair (four for open surfaces: no volume); tolerances widened by the
+    reference's decimation error."""
     distance_tol = options.distance_mm + allowance.distance_max_mm
     note = "tolerance + golden.json decimation error" if allowance != DecimationError() else ""
     figures = [
         Figure(name, key, value, distance_tol, value <= distance_tol, note=note)
         for key, value in (("distance_max_mm", diff.distance_max_mm), ("distance_rms_mm", diff.distance_rms_mm))
     ]
+    closed = diff.watertight and diff.reference_watertight  # an open surface (a region file) encloses nothing
     for key, value, extra in (
         ("volume_rel_change", diff.volume_rel_change, allowance.volume_rel_change),
         ("area_rel_change", diff.area_rel_change, allowance.area_rel_change),
     ):
+        if key == "volume_rel_change" and not closed:
+            continue
         tolerance = options.rtol + extra
         figures.append(Figure(name, key, value, tolerance, abs(value) <= tolerance, note=note))
     same = diff.watertight == diff.reference_watertight

@@ -5,8 +5,11 @@ checked before it is kept (watertight, consistently wound, one body, the
 expected Euler characteristic, volume within 0.5 % of the volume integrated
 from the spline surface by Gauss-Legendre quadrature in l and the trapezoid
 rule in the angle).  Outputs: ``meshes/q_0.500.stl`` (and .ply with region
-labels, .obj, .glb when asked) and ``centerlines/q_0.500.vtp`` carrying the
-frames (N, B, T) and the axial stretch, for VMTK, ParaView and 3D Slicer.
+labels, .obj, .glb when asked), with ``export.split_regions`` one STL per face
+region as well (``meshes/q_0.500/wall.stl``, ``base_cap.stl``, ...: open
+surfaces that together tile the solid), and ``centerlines/q_0.500.vtp``
+carrying the frames (N, B, T) and the axial stretch, for VMTK, ParaView and
+3D Slicer.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from softdesign.io.mesh_files import mesh_bytes
 from softdesign.io.polylines_vtp import write_polylines_vtp
 from softdesign.meshing.body import body_breaks, body_sections, body_stations
 from softdesign.meshing.checks import check_solid
+from softdesign.meshing.regions import RegionPiece, split_by_region
 from softdesign.meshing.solids import Solid, build_solid
 from softdesign.meshing.volume import BodySpec, integrate_body
 from softdesign.pipeline.fit_stage import FitResult
@@ -41,6 +45,7 @@ class ExportedMesh:
     solid: Solid
     figures: dict[str, Any]
     centerline: dict[str, np.ndarray]
+    pieces: tuple[RegionPiece, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -54,6 +59,11 @@ class ExportResult:
 def mesh_name(q: float, fmt: str) -> str:
     """``meshes/q_0.500.stl``: three decimals, as DESIGN.md names them."""
     return f"meshes/q_{q:.3f}.{fmt}"
+
+
+def region_name(q: float, piece: RegionPiece) -> str:
+    """``meshes/q_0.500/wall.stl``: one folder per q, so ``meshes/q_*.stl`` stays the solids."""
+    return f"meshes/q_{q:.3f}/{piece.name}.stl"
 
 
 def body_spec(case: Case) -> BodySpec:
@@ -92,7 +102,8 @@ def solid_at(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case)
         "euler": report.euler,
         "max_rho_kappa": solid.max_rho_kappa,
     }
-    return ExportedMesh(q, solid, figures, centerline_arrays(kinematics, q))
+    pieces = split_by_region(solid.vertices, solid.faces, solid.regions) if e.split_regions else ()
+    return ExportedMesh(q, solid, figures, centerline_arrays(kinematics, q), pieces)
 
 
 def centerline_arrays(kinematics: KinematicsResult, q: float) -> dict[str, np.ndarray]:
@@ -121,6 +132,12 @@ def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Expo
         "volume_method": "Gauss-Legendre in l (8 points between knots and joints) x trapezoid in angle",
         "meshes": {mesh_name(m.q, fmt): m.figures for m in meshes for fmt in case.export.formats},
     }
+    if case.export.split_regions:
+        summary["regions"] = {
+            region_name(m.q, p): {"q": m.q, "region": p.name, "vertices": len(p.vertices), "faces": len(p.faces),
+                                  "area_mm2": p.area()}
+            for m in meshes for p in m.pieces
+        }
     return ExportResult(meshes, summary)
 
 
@@ -130,6 +147,8 @@ def write_export(result: ExportResult, staging: Staging) -> None:
         for fmt in result.summary["formats"]:
             regions = mesh.solid.regions if fmt == "ply" else None
             staging.write_bytes(mesh_name(mesh.q, fmt), mesh_bytes(mesh.solid.vertices, mesh.solid.faces, fmt, regions))
+        for piece in mesh.pieces:
+            staging.write_bytes(region_name(mesh.q, piece), mesh_bytes(piece.vertices, piece.faces, "stl"))
         relative = f"centerlines/q_{mesh.q:.3f}.vtp"
         arrays = {k: [v] for k, v in mesh.centerline.items() if k != "points"}
         write_polylines_vtp(staging.staged_path(relative), [mesh.centerline["points"]], arrays)
@@ -152,10 +171,16 @@ def describe_export(result: ExportResult) -> list[str]:
             f"({100 * f['volume_rel_error']:+.3f}% vs integral), area {f['area_mm2']:.2f} mm2, "
             f"watertight {f['watertight']}, max rho*kappa {f['max_rho_kappa']:.3f}"
         )
+    by_q: dict[float, list[str]] = {}
+    for f in result.summary.get("regions", {}).values():
+        by_q.setdefault(f["q"], []).append(f"{f['region']} {f['faces']} faces {f['area_mm2']:.2f} mm2")
+    lines += [f"meshes/q_{q:.3f}/ one STL per region: {', '.join(parts)}" for q, parts in by_q.items()]
     return lines
 
 
 def output_figures(result: ExportResult) -> dict[str, dict[str, Any]]:
     """Per output file: counts, volume, area, watertight (for the manifest's outputs)."""
     keys = ("vertices", "faces", "volume_mm3", "area_mm2", "watertight")
-    return {name: {k: f[k] for k in keys} for name, f in result.summary["meshes"].items()}
+    figures = {name: {k: f[k] for k in keys} for name, f in result.summary["meshes"].items()}
+    figures.update(result.summary.get("regions", {}))
+    return figures
