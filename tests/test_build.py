@@ -33,7 +33,7 @@ def snapshot(folder: Path) -> dict[str, str]:
 
 def statuses(output: str) -> dict[str, str]:
     """{stage: 'ran' | 'skipped'} from a build's report lines."""
-    return dict(re.findall(r"^\[([a-z]+)\] (ran|skipped)", output, flags=re.MULTILINE))
+    return dict(re.findall(r"^\[([a-z]+)\] (ran|skipped|kept|stale)", output, flags=re.MULTILINE))
 
 
 @pytest.fixture
@@ -73,6 +73,37 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
         "ingest": "skipped", "blend": "skipped", "kinematics": "ran", "fit": "skipped", "export": "ran"
     }
     assert statuses(build(demo_case, out, "--force")) == dict.fromkeys(STAGES, "ran")
+
+
+def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tmp_path):
+    out = tmp_path / "build"
+    build(demo_case, out)
+    meshes = {"meshes/q_0.000.stl", "meshes/q_1.000.stl"}
+
+    def run_fit() -> tuple[dict[str, str], dict]:
+        result = runner.invoke(app, ["fit", str(demo_case), "--out", str(out)])
+        assert result.exit_code == 0, result.output
+        return statuses(result.output), json.loads((out / "manifest.json").read_text())
+
+    # Nothing changed: the export on disk is what a build would make now, figures and metrics included.
+    ran, manifest = run_fit()
+    assert ran == {"ingest": "skipped", "blend": "skipped", "kinematics": "skipped", "fit": "skipped", "export": "kept"}
+    outputs = {o["path"]: o for o in manifest["outputs"]}
+    assert all(outputs[m]["watertight"] and outputs[m]["volume_mm3"] > 0 and "stale" not in outputs[m] for m in meshes)
+    assert "export" in manifest["metrics"] and "export" not in manifest["timing_s"]
+    # A new fit: the meshes on disk were made from the old one, and the manifest says so.
+    edit(demo_case, "fit", smoothing=2.0e-5)
+    ran, manifest = run_fit()
+    assert (ran["fit"], ran["export"]) == ("ran", "stale")
+    outputs = {o["path"]: o for o in manifest["outputs"]}
+    assert all(outputs[m]["stale"] is True for m in meshes) and "stale" not in outputs["fit/surface.npz"]
+    assert {"name": "export", "status": "stale"}.items() <= next(
+        s for s in manifest["stages"] if s["name"] == "export").items()
+    assert "export" not in manifest["metrics"]
+    # A build brings them up to date.
+    assert statuses(build(demo_case, out))["export"] == "ran"
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert not any(o.get("stale") for o in manifest["outputs"])
 
 
 def test_a_stale_output_is_not_reused_because_it_exists(demo_case, tmp_path):

@@ -307,6 +307,22 @@ def test_tampered_outputs_fail_their_checks(demo, tmp_path):
     assert result.checks_total - result.checks_passed == 3
 
 
+def test_a_stale_stage_is_noted_on_the_page(demo, tmp_path):
+    # what `softdesign fit` records when the export on disk was made from another fit (tests/test_build.py)
+    copy = tmp_path / "stale"
+    shutil.copytree(demo[0], copy)
+    manifest_file = copy / "manifest.json"
+    manifest = json.loads(manifest_file.read_text())
+    for stage in manifest["stages"]:
+        if stage["name"] == "export":
+            stage["status"] = "stale"
+    manifest_file.write_text(json.dumps(manifest))
+    write_report(copy, ReportOptions(gif_frames=3))
+    text = (copy / REPORT_DIR / PAGE).read_text(encoding="utf-8")
+    assert "export: out of date" in text
+    assert "out of date" not in (demo[0] / REPORT_DIR / PAGE).read_text(encoding="utf-8")
+
+
 def test_a_failed_write_leaves_the_previous_report(tmp_path):
     target = tmp_path / REPORT_DIR
     commit_folder(target, {PAGE: b"old page", "a.png": b"old image"})

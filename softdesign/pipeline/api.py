@@ -38,8 +38,10 @@ def build_through(
     case = load_case(case_file)
     build_dir = default_build_dir(case, out)
     stages = STAGES if target is None else stages_through(target)
+    later = tuple(s for s in STAGES if s not in stages)
+    options = RunOptions(force=force, progress=progress, later=later)
     try:
-        results, runs = run_stages(case, build_dir, stages, input_files(case), RunOptions(force=force, progress=progress))
+        results, runs = run_stages(case, build_dir, stages, input_files(case), options)
     except SoftdesignError as err:
         raise type(err)(f"{case_file}: {err}") from err
     return BuildOutcome(case, build_dir, results, runs)

@@ -21,6 +21,9 @@ from softdesign.config import Case
 from softdesign.pipeline.store import MANIFEST, Staging, canonical_json, sha256_bytes, sha256_file
 
 Results = dict[str, Any]
+#: Statuses of a later stage's outputs kept from an earlier run (RunOptions.later).
+KEPT = "kept"
+STALE = "stale"
 
 
 @dataclass(frozen=True)
@@ -58,7 +61,7 @@ class StageRun:
 
     name: str
     key: str
-    status: str  # "ran" | "skipped"
+    status: str  # "ran" | "skipped" | KEPT | STALE (a later stage, not run: see RunOptions.later)
     seconds: float
     lines: list[str] = field(default_factory=list)
 
@@ -100,6 +103,9 @@ class RunOptions:
 
     force: bool = False
     progress: Callable[[str], None] = lambda line: None
+    #: stages after the target: not run, but their outputs kept from an earlier run are checked
+    #: against what they would be built from now (``kept`` and loaded, or ``stale``)
+    later: tuple[Stage, ...] = ()
 
 
 def run_stages(
@@ -121,7 +127,13 @@ def run_stages(
             keys[stage.name] = stage_key(stage, case, upstream, input_hashes if not stage.upstream else [])
             step = RunOptions(options.force, _counted(options.progress, index, len(stages)))
             runs.append(_run_one(stage, case, build_dir, keys[stage.name], results, staging, step))
-        manifest = build_manifest(case, build_dir, stages, runs, results, inputs, input_hashes, staging)
+        for stage in options.later:
+            if (build_dir / stage.name / "stage.json").is_file() and all(u in keys for u in stage.upstream):
+                keys[stage.name] = stage_key(stage, case, [keys[u] for u in stage.upstream], [])
+                runs.append(_kept_run(stage, build_dir, keys[stage.name], results))
+        manifest = build_manifest(
+            case, build_dir, [*stages, *options.later], runs, results, inputs, input_hashes, staging
+        )
         staging.write_json(MANIFEST, manifest)
         staging.commit()
     return results, runs
@@ -156,6 +168,17 @@ def _run_one(
     return StageRun(stage.name, key, "ran", seconds, stage.describe(results[stage.name]))
 
 
+def _kept_run(stage: Stage, build_dir: Path, key: str, results: Results) -> StageRun:
+    """A later stage's outputs from an earlier run: ``kept`` (loaded) when built from what is there now, else ``stale``."""
+    start = time.perf_counter()
+    if _up_to_date(build_dir, stage, key):
+        results[stage.name] = stage.load(build_dir, results)
+        return StageRun(stage.name, key, KEPT, time.perf_counter() - start, stage.describe(results[stage.name]))
+    line = (f"{stage.name}/ and its outputs were built from other inputs or settings than this run's; "
+            "they are out of date: run `softdesign build` to redo them")
+    return StageRun(stage.name, key, STALE, time.perf_counter() - start, [line])
+
+
 def build_manifest(
     case: Case,
     build_dir: Path,
@@ -171,7 +194,13 @@ def build_manifest(
     for stage in stages:
         if stage.name in results:
             figures.update(stage.figures(results[stage.name]))
-    outputs = [{**entry, **figures.get(entry["path"], {})} for entry in _all_outputs(build_dir, stages, staging)]
+    stale = {r.name for r in runs if r.status == STALE}
+    outputs = [
+        {**entry, **figures.get(entry["path"], {}), **({"stale": True} if entry["stage"] in stale else {})}
+        for entry in _all_outputs(build_dir, stages, staging)
+    ]
+    for entry in outputs:
+        del entry["stage"]
     return {
         "software": {"softdesign": __version__},
         "case": case.resolved(),
@@ -183,23 +212,23 @@ def build_manifest(
             {"name": name, "status": "kept from an earlier run", "key": _read_record(build_dir / name / "stage.json").get("key")}
             for name in sorted(_kept_stage_names(build_dir) - {r.name for r in runs})
         ],
-        "timing_s": {r.name: round(r.seconds, 3) for r in runs},
+        "timing_s": {r.name: round(r.seconds, 3) for r in runs if r.status not in (KEPT, STALE)},
         "metrics": {s.name: s.metrics(results[s.name]) for s in stages if s.name in results},
         "outputs": outputs,
     }
 
 
 def _all_outputs(build_dir: Path, stages: list[Stage], staging: Staging) -> list[dict[str, Any]]:
-    """Outputs recorded by this run's stages, and by earlier runs' stages still in the folder."""
-    found: dict[str, str] = {}
+    """Outputs recorded by this run's stages, and by earlier runs' stages still in the folder, with their stage."""
+    found: dict[str, tuple[str, str]] = {}
     for name in sorted(_kept_stage_names(build_dir) - {s.name for s in stages}):
-        found.update(_read_record(build_dir / name / "stage.json").get("outputs", {}))
+        found.update((rel, (name, sha)) for rel, sha in _read_record(build_dir / name / "stage.json").get("outputs", {}).items())
     for stage in stages:
         record = staging.written.get(f"{stage.name}/stage.json")
         source = _read_record(staging.staged_path(f"{stage.name}/stage.json")) if record else _recorded(build_dir, stage)
         if source:
-            found.update(source.get("outputs", {}))
-    return [{"path": rel, "sha256": sha} for rel, sha in sorted(found.items())]
+            found.update((rel, (stage.name, sha)) for rel, sha in source.get("outputs", {}).items())
+    return [{"path": rel, "sha256": sha, "stage": name} for rel, (name, sha) in sorted(found.items())]
 
 
 def _kept_stage_names(build_dir: Path) -> set[str]:

@@ -46,6 +46,8 @@ NO_FIT = (
     "run softdesign build"
 )
 NO_EXPORT = "no export in this build folder: no mesh checks; run softdesign build"
+STALE_NOTE = ("out of date: its outputs here were built from other inputs or settings than the stages before it; "
+              "run softdesign build")
 #: Pixel (width, height) of every image the report can hold.
 EXPECTED_SIZES = {
     "morph.png": pixel_size(morph_figures.SIZE_IN),
@@ -166,6 +168,7 @@ def _tables_section(data: BuildData) -> tuple[Section, list[Check]]:
         check_table(checks),
     ]
     notes = [f"ingest: {n}" for n in data.ingest.notes]
+    notes += [f"{s['name']}: {STALE_NOTE}" for s in data.manifest.get("stages", []) if s.get("status") == "stale"]
     return Section("tables", "Figures, inputs, software and checks", notes=notes, tables=tables), checks
 
 
