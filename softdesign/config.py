@@ -145,7 +145,7 @@ class Export(_Section):
     offset_mm: float = 0.0
     wall_mm: float | None = Field(None, gt=0.0)
     port_mm: float | None = Field(None, gt=0.0)
-    formats: list[Literal["stl", "ply", "obj", "glb"]] = ["stl"]
+    formats: list[Literal["stl", "ply", "obj", "glb", "vtp"]] = ["stl"]
     spacing_mm: float = Field(0.5, gt=0.0)
     angular_count: int = Field(64, ge=8)
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...

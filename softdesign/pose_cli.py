@@ -166,7 +166,7 @@ def pose(
     """The body with one q per link (each link's surface at its own q, placed by the links before it)."""
 
     def action() -> None:
-        from softdesign.io.mesh_files import write_mesh
+        from softdesign.io.mesh_files import LABELLED_FORMATS, write_mesh
 
         start = time.perf_counter()
         q_values = q_values_from_text(q)
@@ -174,7 +174,7 @@ def pose(
         _refuse_hollow(case_file)
         body = _make_pose(case_file, q_values, out, force)
         try:
-            write_mesh(output, body.vertices, body.faces, body.regions if fmt == "ply" else None)
+            write_mesh(output, body.vertices, body.faces, body.regions if fmt in LABELLED_FORMATS else None)
         except OSError as err:
             raise ConfigError(f"-o {output}: cannot write the mesh ({err.strerror}); choose a writable path") from err
         payload = pose_payload(body, output)

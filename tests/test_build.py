@@ -234,3 +234,20 @@ def test_split_regions_writes_one_stl_per_region_that_tiles_each_solid(demo_case
     result = runner.invoke(app, ["check", str(out), "--reference", str(out)])
     assert result.exit_code == 0, result.output
     assert "meshes/q_1.000/wall.stl" in result.output
+
+
+def test_vtp_meshes_carry_the_region_of_every_face(demo_case, tmp_path):
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    from softdesign.io.vtk_polydata import read_polydata
+
+    edit(demo_case, "export", formats=["stl", "vtp"])
+    out = tmp_path / "out"
+    build(demo_case, out)
+    manifest = json.loads((out / "manifest.json").read_text())
+    outputs = {o["path"]: o for o in manifest["outputs"]}
+    for q in ("0.000", "1.000"):
+        poly = read_polydata(out / "meshes" / f"q_{q}.vtp")
+        regions = vtk_to_numpy(poly.GetCellData().GetArray("Region"))
+        assert len(regions) == outputs[f"meshes/q_{q}.stl"]["faces"] == outputs[f"meshes/q_{q}.vtp"]["faces"]
+        assert set(regions.tolist()) == {0, 1, 2}  # wall, base cap, tip cap

@@ -5,7 +5,7 @@ checked before it is kept (watertight, consistently wound, one body, the
 expected Euler characteristic, volume within 0.5 % of the volume integrated
 from the spline surface by Gauss-Legendre quadrature in l and the trapezoid
 rule in the angle).  Outputs: ``meshes/q_0.500.stl`` (and .ply with region
-labels, .obj, .glb when asked), with ``export.split_regions`` one STL per face
+labels, .vtp with a Region cell array, .obj, .glb when asked), with ``export.split_regions`` one STL per face
 region as well (``meshes/q_0.500/wall.stl``, ``base_cap.stl``, ...: open
 surfaces that together tile the solid), and ``centerlines/q_0.500.vtp``
 carrying the frames (N, B, T) and the axial stretch, for VMTK, ParaView and
@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from softdesign.config import Case
-from softdesign.io.mesh_files import mesh_bytes
+from softdesign.io.mesh_files import LABELLED_FORMATS, mesh_bytes
 from softdesign.io.polylines_vtp import write_polylines_vtp
 from softdesign.meshing.body import body_breaks, body_sections, body_stations
 from softdesign.meshing.checks import check_solid
@@ -145,7 +145,7 @@ def write_export(result: ExportResult, staging: Staging) -> None:
     """Stage every mesh file, the centerline of every q, and the figures."""
     for mesh in result.meshes:
         for fmt in result.summary["formats"]:
-            regions = mesh.solid.regions if fmt == "ply" else None
+            regions = mesh.solid.regions if fmt in LABELLED_FORMATS else None
             staging.write_bytes(mesh_name(mesh.q, fmt), mesh_bytes(mesh.solid.vertices, mesh.solid.faces, fmt, regions))
         for piece in mesh.pieces:
             staging.write_bytes(region_name(mesh.q, piece), mesh_bytes(piece.vertices, piece.faces, "stl"))
