@@ -1,0 +1,86 @@
+"""One whole check of a build folder against a reference: meshes, then kinematics, then fit metrics.
+
+Both folders must be build folders (a ``manifest.json``); the fit metrics are
+compared here because they live in that manifest (``metrics.fit.*_mm``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable, Optional
+
+from softdesign.errors import ConfigError, InputDataError
+from softdesign.regression.figures import CheckOptions, CheckReport, Figure, missing_figure, read_json, scalar_figure
+from softdesign.regression.kinematics import compare_kinematics_files
+from softdesign.regression.meshes import compare_mesh_folders, read_golden
+
+MANIFEST = "manifest.json"
+#: Fit metrics compared first, in this order; other ``*_mm`` keys of metrics.fit follow, sorted.
+FIT_KEYS = ("rms_mm", "p95_mm", "p99_mm", "max_mm", "holdout_rms_mm")
+
+
+def check_build(
+    build_dir: Path,
+    reference_dir: Path,
+    options: CheckOptions = CheckOptions(),
+    progress: Optional[Callable[[str], None]] = None,
+) -> CheckReport:
+    """Compare a build folder with a reference build folder.
+
+    Parameters
+    ----------
+    build_dir, reference_dir : folders holding manifest.json, meshes/ and kinematics.json
+    options : tolerances and sampling
+    progress : called with a short note per mesh (e.g. to print on stderr)
+
+    Raises
+    ------
+    ConfigError
+        A folder is missing or is not a build folder (no manifest.json).
+    InputDataError
+        A JSON file is unreadable or malformed.
+    """
+    build_dir, reference_dir = Path(build_dir), Path(reference_dir)
+    build_manifest = _read_manifest(build_dir, "BUILD_DIR")
+    ref_manifest = _read_manifest(reference_dir, "--reference")
+    golden = read_golden(reference_dir)
+    notes: list[str] = []
+    figures = compare_mesh_folders(build_dir, reference_dir, options, golden, progress)
+    if not figures:
+        notes.append("no mesh files under meshes/ on either side")
+    figures += compare_kinematics_files(build_dir, reference_dir, options, notes)
+    figures += compare_fit(build_manifest, ref_manifest, options.distance_mm, notes)
+    return CheckReport(build_dir, reference_dir, options, tuple(figures), tuple(notes))
+
+
+def compare_fit(build_manifest: dict, ref_manifest: dict, tolerance_mm: float, notes: list[str]) -> list[Figure]:
+    """Figures of ``metrics.fit.*_mm``: build minus reference, within ``tolerance_mm``."""
+    ours = _fit_metrics(build_manifest, "build " + MANIFEST)
+    theirs = _fit_metrics(ref_manifest, "reference " + MANIFEST)
+    if ours is None and theirs is None:
+        notes.append("no metrics.fit on either side (no fit stage, or a case without a surface): not compared")
+        return []
+    if ours is None or theirs is None:
+        return [missing_figure("fit", "metrics.fit", in_build=ours is not None)]
+    keys = [k for k in FIT_KEYS if k in ours or k in theirs]
+    keys += sorted(k for k in set(ours) | set(theirs) if k.endswith("_mm") and k not in FIT_KEYS)
+    return [scalar_figure("fit", key, ours.get(key), theirs.get(key), tolerance_mm) for key in keys]
+
+
+def _fit_metrics(manifest: dict, where: str) -> Optional[dict]:
+    metrics = manifest.get("metrics") or {}
+    if not isinstance(metrics, dict):
+        raise InputDataError(f"{where}: 'metrics' must be an object, got {type(metrics).__name__}")
+    fit = metrics.get("fit")
+    if fit is not None and not isinstance(fit, dict):
+        raise InputDataError(f"{where}: metrics.fit must be an object, got {type(fit).__name__}")
+    return fit
+
+
+def _read_manifest(folder: Path, what: str) -> dict:
+    if not folder.is_dir():
+        raise ConfigError(f"{what} {folder}: folder not found; give a build folder (softdesign build --out DIR)")
+    path = folder / MANIFEST
+    if not path.is_file():
+        raise ConfigError(f"{what} {folder}: not a build folder (no {MANIFEST}); give the folder a build wrote")
+    return read_json(path)
