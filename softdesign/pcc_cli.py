@@ -1,6 +1,9 @@
 """`softdesign pcc ...`: seed 003's piecewise-constant-curvature model from encoder lengths.
 
-Parsing, files and printing live here; the model is :mod:`softdesign.kinematics.pcc`.
+The ``pcc`` command group, with ``forward`` (lengths given) and ``reconstruct``
+(a readings CSV); ``design`` (a case file) is :mod:`softdesign.pcc_design_cli`
+and the options they share are :mod:`softdesign.pcc_options`.  Parsing, files
+and printing live here; the model is :mod:`softdesign.kinematics.pcc`.
 """
 
 from __future__ import annotations
@@ -15,8 +18,10 @@ import numpy as np
 import typer
 
 from softdesign.cli_support import emit_json, note, run_guarded
-from softdesign.errors import ConfigError, InputDataError, SoftdesignError
+from softdesign.errors import ConfigError, InputDataError
 from softdesign.io.atomic import write_bytes_atomically
+from softdesign.pcc_design_cli import design
+from softdesign.pcc_options import DOpt, LengthsOpt, lengths_from_text, spacing_from_text
 
 CONVENTION = (
     "Encoders at 90, 210, 330 degrees from the section's base x axis, d mm from the backbone; "
@@ -28,70 +33,6 @@ pcc_app = typer.Typer(
     no_args_is_help=True,
     help="Piecewise constant curvature from three cable-encoder lengths per section (seed 003). " + CONVENTION,
 )
-
-LengthsOpt = Annotated[
-    str,
-    typer.Option(
-        "--lengths",
-        help='Encoder lengths in mm, three per section, sections separated by ";": "120,123,124;125,123,121".',
-        show_default=False,
-    ),
-]
-DOpt = Annotated[
-    str,
-    typer.Option(
-        "--d", help='Distance of the cables from the backbone, mm: one value ("15") or one per section ("15,14,13").',
-        show_default=False,
-    ),
-]
-
-
-def _number(text: str, what: str, fix: str) -> float:
-    """``text`` as a finite float, or a ConfigError naming ``what``."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise ConfigError(f"{what}: '{text.strip()}' is not a number; {fix}") from None
-    if not math.isfinite(value):
-        raise ConfigError(f"{what}: got {text.strip()}, expected a finite number; {fix}")
-    return value
-
-
-def lengths_from_text(text: str) -> np.ndarray:
-    """Parse ``--lengths`` ("l11,l12,l13;l21,l22,l23") into a (k, 3) array, mm, each > 0."""
-    fix = 'give three lengths in mm per section, sections separated by ";", e.g. "120,123,124;125,123,121"'
-    sections = [part for part in text.split(";") if part.strip()]
-    if not sections:
-        raise ConfigError(f"--lengths: no lengths given; {fix}")
-    rows = []
-    for i, part in enumerate(sections, start=1):
-        values = part.split(",")
-        if len(values) != 3:
-            raise ConfigError(f"--lengths: section {i} has {len(values)} length(s) ('{part.strip()}'), expected 3; {fix}")
-        row = [_number(v, f"--lengths: section {i} cable {j}", fix) for j, v in enumerate(values, start=1)]
-        for j, value in enumerate(row, start=1):
-            if value <= 0:
-                raise ConfigError(f"--lengths: section {i} cable {j} is {value:g} mm, expected > 0; {fix}")
-        rows.append(row)
-    return np.array(rows, dtype=np.float64)
-
-
-def spacing_from_text(text: str, sections: int | None, where: str = "--lengths") -> np.ndarray:
-    """Parse ``--d`` into one cable distance per section, (k,) mm, each > 0.
-
-    With ``sections`` None (not known yet) the values are checked and returned as given.
-    """
-    example = ",".join(["15"] * sections) if sections else "15,14,13"
-    count = f"{sections} values, " if sections else ""
-    fix = f'give one distance in mm ("15") or one per section ({count}e.g. "{example}")'
-    values = [_number(v, f"--d value {i}", fix) for i, v in enumerate(text.split(","), start=1)]
-    if sections is not None and len(values) not in (1, sections):
-        raise ConfigError(f"--d: {len(values)} values for {sections} section(s) in {where}; {fix}")
-    for i, value in enumerate(values, start=1):
-        if value <= 0:
-            raise ConfigError(f"--d value {i}: {value:g} mm, expected > 0 (cable distance from the backbone); {fix}")
-    given = np.array(values, dtype=np.float64)
-    return given if sections is None else np.broadcast_to(given, (sections,)).copy()
 
 
 def forward_payload(lengths: np.ndarray, d: np.ndarray) -> dict:
@@ -350,76 +291,5 @@ def reconstruct(
     run_guarded(action)
 
 
-def _print_design(document: dict, case_file: Path) -> None:
-    typer.echo(f"{case_file}: one PCC arc per link; d = {', '.join(f'{v:g}' for v in document['d'])} mm")
-    head = (f"{'link':>4}  {'l range':>13}  {'kappa [1/mm]':>12}  {'phi [deg]':>9}  {'L [mm]':>8}  {'theta':>7}  "
-            f"{'chambers l1 l2 l3 [mm]':>24}  {'strain e1 e2 e3 [%]':>23}  {'max [mm]':>9}  {'rms [mm]':>9}  "
-            f"{'tip [mm]':>9}  {'tangent':>8}  {'rotation':>8}")
-    for pose in document["poses"]:
-        typer.echo(f"\nq = {pose['q']:g}")
-        typer.echo(head)
-        for k in pose["links"]:
-            chambers = " ".join(f"{v:7.3f}" for v in k["chamber_lengths"])
-            strain = " ".join(f"{100 * v:+7.2f}" for v in k["chamber_strain"])
-            typer.echo(
-                f"{k['index']:>4}  {k['l_start']:6.4f}-{k['l_end']:6.4f}  {k['kappa']:12.6f}  "
-                f"{math.degrees(k['phi']):9.3f}  {k['length']:8.3f}  {k['theta']:7.4f}  {chambers:>24}  {strain:>23}  "
-                f"{k['backbone_max_mm']:9.3g}  {k['backbone_rms_mm']:9.3g}  {k['tip_error_mm']:9.3g}  "
-                f"{k['tangent_error_rad']:8.2g}  {k['rotation_error_rad']:8.2g}"
-            )
-        w = pose["worst"]
-        typer.echo(
-            f"worst: link {w['index']}, backbone off by up to {w['backbone_max_mm']:.3g} mm "
-            f"(rms {w['backbone_rms_mm']:.3g} mm), tip {w['tip_error_mm']:.3g} mm, "
-            f"tangent {w['tangent_error_rad']:.3g} rad, rotation {w['rotation_error_rad']:.3g} rad"
-        )
-    typer.echo(f"\nangles in rad unless marked; convention: {document['convention']}")
-
-
-@pcc_app.command()
-def design(
-    case_file: Annotated[Path, typer.Argument(help="The case file (YAML).", show_default=False)],
-    d: Annotated[
-        str,
-        typer.Option("--d", help='Chamber distance from the backbone, mm: one value ("4") or one per link ("4,4,3.5").',
-                     show_default=False),
-    ],
-    json_out: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
-    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Build folder [default: build/<name>].")] = None,
-    samples: Annotated[int, typer.Option("--samples", min=3, help="Backbone samples per link for the fit.")] = 201,
-) -> None:
-    """One PCC section per link of the built design at every export q, and the chambers it needs.
-
-    Runs the build through kinematics (cached), then per export q and link fits
-    one constant-curvature arc from the link's start frame to its backbone and
-    reports kappa, phi, L, theta, the three chamber lengths (mm), their strain
-    against q = 0 and how far the arc misses the design (backbone max and RMS,
-    tip position, tangent and rotation errors).  JSON: {"d": [mm per link],
-    "poses": [{"q", "links": [{"index", "l_start", "l_end", "kappa", "phi",
-    "length", "theta", "chamber_lengths", "chamber_strain", "backbone_max_mm",
-    "backbone_rms_mm", "tip_error_mm", "tangent_error_rad",
-    "rotation_error_rad"}], "worst": {"index", and those five errors}}],
-    "convention"}.
-    """
-
-    def action() -> None:
-        from softdesign.kinematics.pcc_fit import design_document, design_sections
-        from softdesign.pipeline.api import build_through
-
-        spacing_from_text(d, None)  # numbers > 0: fail before building
-        outcome = build_through(case_file, out, target="kinematics", progress=note)
-        chain = outcome.results["kinematics"].chain
-        spacing = spacing_from_text(d, chain.count, where=f"{case_file} ({chain.count} links, one section each)")
-        try:
-            result = design_sections(chain, outcome.case.export.q_values(), spacing, samples)
-        except SoftdesignError as err:
-            raise type(err)(f"{case_file}: {err}") from err
-        for line in result.notes:
-            note(f"warning: {case_file}: {line}")
-        document = design_document(result)
-        if json_out:
-            emit_json(document)
-        else:
-            _print_design(document, case_file)
-
-    run_guarded(action)
+# Added last: `pcc --help` lists the commands in the order they are added.
+pcc_app.command()(design)

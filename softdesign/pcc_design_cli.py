@@ -1,0 +1,91 @@
+"""`softdesign pcc design CASE_FILE --d D`: one PCC section per link of a built design, and its chambers.
+
+Parsing and printing live here; the fit is :mod:`softdesign.kinematics.pcc_fit`.
+Registered on ``pcc_app`` in :mod:`softdesign.pcc_cli`.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from softdesign.cli_support import emit_json, note, run_guarded
+from softdesign.errors import SoftdesignError
+from softdesign.pcc_options import spacing_from_text
+
+
+def _print_design(document: dict, case_file: Path) -> None:
+    typer.echo(f"{case_file}: one PCC arc per link; d = {', '.join(f'{v:g}' for v in document['d'])} mm")
+    head = (f"{'link':>4}  {'l range':>13}  {'kappa [1/mm]':>12}  {'phi [deg]':>9}  {'L [mm]':>8}  {'theta':>7}  "
+            f"{'chambers l1 l2 l3 [mm]':>24}  {'strain e1 e2 e3 [%]':>23}  {'max [mm]':>9}  {'rms [mm]':>9}  "
+            f"{'tip [mm]':>9}  {'tangent':>8}  {'rotation':>8}")
+    for pose in document["poses"]:
+        typer.echo(f"\nq = {pose['q']:g}")
+        typer.echo(head)
+        for k in pose["links"]:
+            chambers = " ".join(f"{v:7.3f}" for v in k["chamber_lengths"])
+            strain = " ".join(f"{100 * v:+7.2f}" for v in k["chamber_strain"])
+            typer.echo(
+                f"{k['index']:>4}  {k['l_start']:6.4f}-{k['l_end']:6.4f}  {k['kappa']:12.6f}  "
+                f"{math.degrees(k['phi']):9.3f}  {k['length']:8.3f}  {k['theta']:7.4f}  {chambers:>24}  {strain:>23}  "
+                f"{k['backbone_max_mm']:9.3g}  {k['backbone_rms_mm']:9.3g}  {k['tip_error_mm']:9.3g}  "
+                f"{k['tangent_error_rad']:8.2g}  {k['rotation_error_rad']:8.2g}"
+            )
+        w = pose["worst"]
+        typer.echo(
+            f"worst: link {w['index']}, backbone off by up to {w['backbone_max_mm']:.3g} mm "
+            f"(rms {w['backbone_rms_mm']:.3g} mm), tip {w['tip_error_mm']:.3g} mm, "
+            f"tangent {w['tangent_error_rad']:.3g} rad, rotation {w['rotation_error_rad']:.3g} rad"
+        )
+    typer.echo(f"\nangles in rad unless marked; convention: {document['convention']}")
+
+
+def design(
+    case_file: Annotated[Path, typer.Argument(help="The case file (YAML).", show_default=False)],
+    d: Annotated[
+        str,
+        typer.Option("--d", help='Chamber distance from the backbone, mm: one value ("4") or one per link ("4,4,3.5").',
+                     show_default=False),
+    ],
+    json_out: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Build folder [default: build/<name>].")] = None,
+    samples: Annotated[int, typer.Option("--samples", min=3, help="Backbone samples per link for the fit.")] = 201,
+) -> None:
+    """One PCC section per link of the built design at every export q, and the chambers it needs.
+
+    Runs the build through kinematics (cached), then per export q and link fits
+    one constant-curvature arc from the link's start frame to its backbone and
+    reports kappa, phi, L, theta, the three chamber lengths (mm), their strain
+    against q = 0 and how far the arc misses the design (backbone max and RMS,
+    tip position, tangent and rotation errors).  JSON: {"d": [mm per link],
+    "poses": [{"q", "links": [{"index", "l_start", "l_end", "kappa", "phi",
+    "length", "theta", "chamber_lengths", "chamber_strain", "backbone_max_mm",
+    "backbone_rms_mm", "tip_error_mm", "tangent_error_rad",
+    "rotation_error_rad"}], "worst": {"index", and those five errors}}],
+    "convention"}.
+    """
+
+    def action() -> None:
+        from softdesign.kinematics.pcc_fit import design_document, design_sections
+        from softdesign.pipeline.api import build_through
+
+        spacing_from_text(d, None)  # numbers > 0: fail before building
+        outcome = build_through(case_file, out, target="kinematics", progress=note)
+        chain = outcome.results["kinematics"].chain
+        spacing = spacing_from_text(d, chain.count, where=f"{case_file} ({chain.count} links, one section each)")
+        try:
+            result = design_sections(chain, outcome.case.export.q_values(), spacing, samples)
+        except SoftdesignError as err:
+            raise type(err)(f"{case_file}: {err}") from err
+        for line in result.notes:
+            note(f"warning: {case_file}: {line}")
+        document = design_document(result)
+        if json_out:
+            emit_json(document)
+        else:
+            _print_design(document, case_file)
+
+    run_guarded(action)

@@ -1,0 +1,78 @@
+"""Options shared by the `softdesign pcc` commands: ``--lengths`` and ``--d``, declared and parsed.
+
+Parsing raises :class:`~softdesign.errors.ConfigError` naming the option and the fix.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated
+
+import numpy as np
+import typer
+
+from softdesign.errors import ConfigError
+
+LengthsOpt = Annotated[
+    str,
+    typer.Option(
+        "--lengths",
+        help='Encoder lengths in mm, three per section, sections separated by ";": "120,123,124;125,123,121".',
+        show_default=False,
+    ),
+]
+DOpt = Annotated[
+    str,
+    typer.Option(
+        "--d", help='Distance of the cables from the backbone, mm: one value ("15") or one per section ("15,14,13").',
+        show_default=False,
+    ),
+]
+
+
+def _number(text: str, what: str, fix: str) -> float:
+    """``text`` as a finite float, or a ConfigError naming ``what``."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise ConfigError(f"{what}: '{text.strip()}' is not a number; {fix}") from None
+    if not math.isfinite(value):
+        raise ConfigError(f"{what}: got {text.strip()}, expected a finite number; {fix}")
+    return value
+
+
+def lengths_from_text(text: str) -> np.ndarray:
+    """Parse ``--lengths`` ("l11,l12,l13;l21,l22,l23") into a (k, 3) array, mm, each > 0."""
+    fix = 'give three lengths in mm per section, sections separated by ";", e.g. "120,123,124;125,123,121"'
+    sections = [part for part in text.split(";") if part.strip()]
+    if not sections:
+        raise ConfigError(f"--lengths: no lengths given; {fix}")
+    rows = []
+    for i, part in enumerate(sections, start=1):
+        values = part.split(",")
+        if len(values) != 3:
+            raise ConfigError(f"--lengths: section {i} has {len(values)} length(s) ('{part.strip()}'), expected 3; {fix}")
+        row = [_number(v, f"--lengths: section {i} cable {j}", fix) for j, v in enumerate(values, start=1)]
+        for j, value in enumerate(row, start=1):
+            if value <= 0:
+                raise ConfigError(f"--lengths: section {i} cable {j} is {value:g} mm, expected > 0; {fix}")
+        rows.append(row)
+    return np.array(rows, dtype=np.float64)
+
+
+def spacing_from_text(text: str, sections: int | None, where: str = "--lengths") -> np.ndarray:
+    """Parse ``--d`` into one cable distance per section, (k,) mm, each > 0.
+
+    With ``sections`` None (not known yet) the values are checked and returned as given.
+    """
+    example = ",".join(["15"] * sections) if sections else "15,14,13"
+    count = f"{sections} values, " if sections else ""
+    fix = f'give one distance in mm ("15") or one per section ({count}e.g. "{example}")'
+    values = [_number(v, f"--d value {i}", fix) for i, v in enumerate(text.split(","), start=1)]
+    if sections is not None and len(values) not in (1, sections):
+        raise ConfigError(f"--d: {len(values)} values for {sections} section(s) in {where}; {fix}")
+    for i, value in enumerate(values, start=1):
+        if value <= 0:
+            raise ConfigError(f"--d value {i}: {value:g} mm, expected > 0 (cable distance from the backbone); {fix}")
+    given = np.array(values, dtype=np.float64)
+    return given if sections is None else np.broadcast_to(given, (sections,)).copy()
