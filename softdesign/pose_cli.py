@@ -24,7 +24,7 @@ QOpt = Annotated[
 ]
 OutputOpt = Annotated[
     Path,
-    typer.Option("--output", "-o", help="Mesh file to write; its suffix picks the format (.stl .ply .obj .glb).",
+    typer.Option("--output", "-o", help="Mesh file to write; its suffix picks the format (.stl .ply .obj .glb .vtp).",
                  show_default=False),
 ]
 BuildOpt = Annotated[Optional[Path], typer.Option("--out", help="Build folder (default: build/<name>).")]
@@ -71,18 +71,6 @@ def mesh_format_of(path: Path) -> str:
     return fmt
 
 
-def _refuse_hollow(case_file: Path) -> None:
-    from softdesign.config import load_case
-
-    export = load_case(case_file).export
-    if export.wall_mm is not None:
-        raise ConfigError(
-            f"{case_file}: export.wall_mm = {export.wall_mm:g} asks for a hollow actuator, but pose builds "
-            "solid bodies (offset_mm included) only; run pose on a copy of the case without export.wall_mm "
-            "and export.port_mm"
-        )
-
-
 def pose_payload(body: Any, output: Path) -> dict[str, Any]:
     """The JSON object of ``pose``: q, each link's {S} in world, each joint's step, the solid's figures."""
     report = body.report
@@ -96,9 +84,11 @@ def pose_payload(body: Any, output: Path) -> dict[str, Any]:
         ],
         "joints": [
             {"index": j.index, "l": j.l, "max_step_mm": j.max_step_mm, "shared_vertices": j.shared_vertices,
-             "crossings": j.crossings, "annulus_faces": j.annulus_faces, "annulus_area_mm2": j.annulus_area_mm2}
+             "crossings": j.crossings, "annulus_faces": j.annulus_faces, "annulus_area_mm2": j.annulus_area_mm2,
+             "min_wall_mm": j.min_wall_mm}
             for j in body.joints
         ],
+        "kind": body.kind,
         "volume_mm3": report.volume,
         "volume_expected_mm3": report.volume_expected,
         "volume_rel_error": report.volume_rel_error,
@@ -129,9 +119,11 @@ def _print_pose(payload: dict[str, Any], seconds: float) -> None:
             f"{where} radial step up to {j['max_step_mm']:.4f} mm, closed by an annulus of {j['annulus_faces']} "
             f"faces ({j['annulus_area_mm2']:.3f} mm2, {j['crossings']} crossing(s), "
             f"{j['shared_vertices']} shared vertices)"
+            + (f", thinnest wall {j['min_wall_mm']:.3f} mm" if j["min_wall_mm"] is not None else "")
         )
     typer.echo(
-        f"volume {payload['volume_mm3']:.2f} mm3 ({100 * payload['volume_rel_error']:+.3f}% vs the links' integral "
+        f"{payload['kind']} body: volume {payload['volume_mm3']:.2f} mm3 "
+        f"({100 * payload['volume_rel_error']:+.3f}% vs the links' integral "
         f"{payload['volume_expected_mm3']:.2f} mm3), area {payload['area_mm2']:.2f} mm2, {payload['faces']} faces, "
         f"{'watertight' if payload['watertight'] else 'NOT watertight'}, {payload['bodies']} body, "
         f"max rho*kappa {payload['max_rho_kappa']:.3f}"
@@ -150,7 +142,9 @@ def _make_pose(case_file: Path, q: list[float], out: Optional[Path], force: bool
         raise ConfigError(f"--q: {len(q)} values for {chain.count} links in {case_file}; {Q_FIX}")
     export = outcome.case.export
     try:
-        return pose_body(chain, field, q, PoseSpec(export.spacing_mm, export.angular_count, export.offset_mm))
+        spec = PoseSpec(export.spacing_mm, export.angular_count, export.offset_mm, export.wall_mm or 0.0,
+                        export.port_mm or 0.0)
+        return pose_body(chain, field, q, spec)
     except SoftdesignError as err:
         raise type(err)(f"{case_file}: {err}") from err
 
@@ -163,7 +157,10 @@ def pose(
     force: ForceOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
-    """The body with one q per link (each link's surface at its own q, placed by the links before it)."""
+    """The body with one q per link (each link's surface at its own q, placed by the links before it).
+
+    The solid is the export's: offset, or hollow with a port when the case's export section asks.
+    """
 
     def action() -> None:
         from softdesign.io.mesh_files import LABELLED_FORMATS, write_mesh
@@ -171,7 +168,6 @@ def pose(
         start = time.perf_counter()
         q_values = q_values_from_text(q)
         fmt = mesh_format_of(output)
-        _refuse_hollow(case_file)
         body = _make_pose(case_file, q_values, out, force)
         try:
             write_mesh(output, body.vertices, body.faces, body.regions if fmt in LABELLED_FORMATS else None)

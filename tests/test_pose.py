@@ -1,8 +1,9 @@
 """`softdesign pose`: the body with one q per link (the seed's S_robot).
 
 Known answers first (rings on rays, annuli between concentric and crossing rings, a straight
-link followed by an arc), then the sample case end to end: equal q reproduces the build's
-meshes, mixed q places every link on the previous link's end frame and closes each step.
+link followed by an arc, solid and hollow), then the sample case end to end: equal q reproduces
+the build's meshes (hollow ones too), mixed q places every link on the previous link's end frame
+and closes each step.
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ from softdesign.geometry.initial import straight_initial_shape
 from softdesign.kinematics.links import LinkChain
 from softdesign.meshing.checks import inspect_mesh
 from softdesign.meshing.compare import compare_meshes
-from softdesign.meshing.pose_body import PoseSpec, pose_body, radii_on_rays, stitch_joint
+from softdesign.meshing.pose_body import PoseSpec, pose_body
+from softdesign.meshing.pose_stitch import radii_on_rays, stitch_joint
 from softdesign.meshing.tessellate import Region
 from softdesign.pose_cli import pose
 
@@ -314,15 +316,75 @@ def test_unknown_output_suffix_exits_2(demo, tmp_path, name):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_hollow_case_is_refused(tmp_path):
+@pytest.fixture(scope="module")
+def hollow_case(tmp_path_factory) -> Path:
+    """The sample case with a 1 mm wall and a 1 mm port."""
     case = yaml.safe_load(DEMO.read_text())
     for key in ("centerline", "surface"):
         case["final"][key] = str((DEMO.parent / case["final"][key]).resolve())
-    case["export"]["wall_mm"] = 1.0
-    hollow = tmp_path / "hollow.yaml"
-    hollow.write_text(yaml.safe_dump(case))
-    result = runner.invoke(app, ["pose", str(hollow), "--q", "1", "-o", str(tmp_path / "p.stl")])
-    assert result.exit_code == 2 and "export.wall_mm" in result.output
+    case["export"].update(wall_mm=1.0, port_mm=1.0)
+    path = tmp_path_factory.mktemp("hollow") / "hollow.yaml"
+    path.write_text(yaml.safe_dump(case))
+    return path
+
+
+def test_hollow_pose_with_equal_q_is_the_builds_hollow_mesh(hollow_case, tmp_path):
+    out = tmp_path / "build"
+    args = ["pose", str(hollow_case), "--q", "1", "-o", str(tmp_path / "p.stl"), "--out", str(out)]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert "ported body" in result.stdout
+    mine = trimesh.load(tmp_path / "p.stl", process=True)
+    built = trimesh.load(out / "meshes/q_1.000.stl", process=True)
+    difference = compare_meshes(mine.vertices, mine.faces, built.vertices, built.faces)
+    assert difference.distance_max_mm < EQUAL_Q_TOL_MM
+    assert mine.volume == pytest.approx(built.volume, rel=1e-12) and len(mine.faces) == len(built.faces)
+
+
+def test_hollow_pose_with_mixed_q_is_one_ported_body_with_its_walls_reported(hollow_case, tmp_path):
+    out = tmp_path / "build"
+    args = ["pose", str(hollow_case), "--q", "0,1,0,1", "-o", str(tmp_path / "p.ply"), "--out", str(out), "--json"]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    import json
+
+    payload = json.loads(result.stdout)
+    assert payload["kind"] == "ported" and payload["watertight"] and payload["bodies"] == 1
+    assert abs(payload["volume_rel_error"]) < 0.005
+    for joint in payload["joints"]:  # a 1 mm wall less each joint's radial step, at the thinnest
+        assert joint["max_step_mm"] > 0.1
+        assert 1.0 - joint["max_step_mm"] - 0.01 <= joint["min_wall_mm"] <= 1.0 - joint["max_step_mm"] + 0.01
+    written = trimesh.load(tmp_path / "p.ply", process=False)
+    regions = written.metadata["_ply_raw"]["face"]["data"]["region"]
+    assert {Region.CHAMBER, Region.CHAMBER_CAP, Region.PORT, Region.JOINT_STEP} <= set(regions.tolist())
+    merged = trimesh.load(tmp_path / "p.ply", process=True)
+    assert merged.is_watertight and merged.body_count == 1 and merged.euler_number == 2
+
+
+@pytest.mark.parametrize("port_mm", [0.0, 0.5])
+def test_hollow_pose_of_a_straight_and_an_arc_link_by_hand(chain, port_mm):
+    # r 2 then r 3 (a 1 mm step), wall 1.5: the chamber is r 0.5 then 1.5, 1.5 mm short of both ends
+    field = radius_field(lambda a: np.full_like(a, 3.0), initial_radius=2.0)
+    w = 1.5
+    body = pose_body(chain, field, (0, 1), PoseSpec(0.5, 64, wall_mm=w, port_mm=port_mm))
+    chamber = np.pi * (0.5**2 + 1.5**2) * (30.0 - w)  # Pappus again for the arc's half
+    port = np.pi * (port_mm / 2) ** 2 * w
+    np.testing.assert_allclose(body.volume_expected, np.pi * (2.0**2 + 3.0**2) * 30.0 - chamber - port,
+                               rtol=0, atol=1e-6)
+    assert body.kind == ("ported" if port_mm else "hollow")
+    assert (body.report.bodies, body.report.euler) == (1, 2 if port_mm else 4)
+    assert abs(body.report.volume_rel_error) < 0.005
+    (joint,) = body.joints
+    np.testing.assert_allclose(joint.min_wall_mm, w - 1.0, rtol=0, atol=1e-9)
+
+
+def test_a_step_that_would_break_through_the_wall_is_refused(chain):
+    from softdesign.errors import MeshError
+
+    field = radius_field(lambda a: np.full_like(a, 3.0), initial_radius=2.0)
+    with pytest.raises(MeshError, match=r"joint 0\|1 at l=0.5000: the links' radii step by up to 1.000 mm, "
+                                        r"which leaves a wall of 0.100 mm of the 1.1 mm asked"):
+        pose_body(chain, field, (0, 1), PoseSpec(0.5, 64, wall_mm=1.1))
 
 
 def test_help_names_the_options():

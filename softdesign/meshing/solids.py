@@ -198,16 +198,30 @@ def build_solid(sections: TubeSections, spec: BodySpec = BodySpec()) -> Solid:
     label = f"q={sections.q:.3f}"
     outer = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
     body = tessellate(outer)
-    body_manifold, body_id = manifold_from_mesh(body.vertices, body.faces, f"{label}: body")
     if spec.wall_mm == 0:
+        manifold_from_mesh(body.vertices, body.faces, f"{label}: body")
         return Solid(body.vertices, body.faces, body.regions, 2, "solid", outer.max_rho_kappa)
     chamber = _chamber(sections, outer, spec)
-    cavity: TubeMesh = tessellate(chamber)
+    return carve_chamber(body, tessellate(chamber), outer, chamber, spec, label)
+
+
+def carve_chamber(body: TubeMesh, cavity: TubeMesh, outer: Sweep, chamber: Sweep, spec: BodySpec, label: str) -> Solid:
+    """``body`` minus ``cavity``, and minus the port when ``spec.port_mm`` > 0, with manifold3d, checked.
+
+    Parameters
+    ----------
+    body, cavity : closed meshes with their regions; the cavity's wall becomes CHAMBER and its
+        caps CHAMBER_CAP (a joint annulus stays JOINT_STEP)
+    outer, chamber : sweeps whose first rings are the base section of the body and of the
+        chamber: the port runs along the base tangent and must fit the chamber's base section
+    spec : the wall and port
+    label : names the solid in errors (e.g. ``q=0.500``)
+    """
+    body_manifold, body_id = manifold_from_mesh(body.vertices, body.faces, f"{label}: body")
     cavity_manifold, cavity_id = manifold_from_mesh(cavity.vertices, cavity.faces, f"{label}: chamber")
-    sources = {
-        body_id: body.regions,
-        cavity_id: np.where(cavity.regions == Region.WALL, Region.CHAMBER, Region.CHAMBER_CAP).astype(np.int8),
-    }
+    caps = np.isin(cavity.regions, (Region.BASE_CAP, Region.TIP_CAP))
+    labels = np.where(cavity.regions == Region.WALL, Region.CHAMBER, np.where(caps, Region.CHAMBER_CAP, cavity.regions))
+    sources = {body_id: body.regions, cavity_id: labels.astype(np.int8)}
     hollow = body_manifold - cavity_manifold
     if spec.port_mm > 0:
         port, port_id = _port(outer, chamber, spec)

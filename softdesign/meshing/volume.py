@@ -286,8 +286,8 @@ def l_at_arclength(field: SectionField, breaks: npt.ArrayLike, s: float, order: 
     return l
 
 
-def _sweep_integral(
-    field: SectionField, breaks: FloatArray, span: tuple[float, float], offset_mm: float, order: int
+def swept_volume(
+    field: SectionField, breaks: FloatArray, span: tuple[float, float], offset_mm: float, order: int = GAUSS_ORDER
 ) -> float:
     """Volume swept by the sections offset by ``offset_mm`` for l in ``span``, mm^3."""
     nodes, weights = gauss_legendre_nodes(_sub_breaks(breaks, *span), order)
@@ -319,7 +319,7 @@ def integrate_body(
     """
     breaks = np.asarray(breaks, float)
     # length, volume and area over the whole span share one evaluation of the field, at the
-    # nodes arclength_at and _sweep_integral would pick (the breaks are their own sub-breaks)
+    # nodes arclength_at and swept_volume would pick (the breaks are their own sub-breaks)
     nodes, weights = gauss_legendre_nodes(breaks, order)
     st = field(nodes)
     length = float(weights @ st.speed)
@@ -328,7 +328,7 @@ def integrate_body(
     if spec.wall_mm > 0:
         w = spec.wall_mm
         span = (l_at_arclength(field, breaks, w, order), l_at_arclength(field, breaks, length - w, order))
-        volume -= _sweep_integral(field, breaks, span, spec.offset_mm - w, order)
+        volume -= swept_volume(field, breaks, span, spec.offset_mm - w, order)
         volume -= np.pi * (spec.port_mm / 2.0) ** 2 * w
     area = None
     if spec.offset_mm == 0 and spec.wall_mm == 0:
