@@ -169,7 +169,7 @@ def _run_one(
 
 
 def _kept_run(stage: Stage, build_dir: Path, key: str, results: Results) -> StageRun:
-    """A later stage's outputs from an earlier run: ``kept`` (loaded) when built from what is there now, else ``stale``."""
+    """A later stage's outputs from an earlier run: ``kept`` (loaded) if made from what is there now, else ``stale``."""
     start = time.perf_counter()
     if _up_to_date(build_dir, stage, key):
         results[stage.name] = stage.load(build_dir, results)
@@ -222,7 +222,8 @@ def _all_outputs(build_dir: Path, stages: list[Stage], staging: Staging) -> list
     """Outputs recorded by this run's stages, and by earlier runs' stages still in the folder, with their stage."""
     found: dict[str, tuple[str, str]] = {}
     for name in sorted(_kept_stage_names(build_dir) - {s.name for s in stages}):
-        found.update((rel, (name, sha)) for rel, sha in _read_record(build_dir / name / "stage.json").get("outputs", {}).items())
+        recorded = _read_record(build_dir / name / "stage.json").get("outputs", {})
+        found.update((rel, (name, sha)) for rel, sha in recorded.items())
     for stage in stages:
         record = staging.written.get(f"{stage.name}/stage.json")
         source = _read_record(staging.staged_path(f"{stage.name}/stage.json")) if record else _recorded(build_dir, stage)
