@@ -232,18 +232,8 @@ def _chamber(sections: list[TubeSections], spec: PoseSpec, label: str) -> tuple[
             )
     if len(sweeps) == 1:
         return [trim_sweep(first, start, end)], stitches
-    sweeps[0] = _keeping_end(trim_sweep(first, start, first.s[-1]), first, at_start=False)
-    sweeps[-1] = _keeping_end(trim_sweep(last, last.s[0], end), last, at_start=True)
+    sweeps[0], sweeps[-1] = trim_sweep(first, start, first.s[-1]), trim_sweep(last, last.s[0], end)
     return sweeps, stitches
-
-
-def _keeping_end(trimmed: Sweep, original: Sweep, at_start: bool) -> Sweep:
-    """``trimmed`` with the untrimmed end ring restored bit for bit (a joint ring the stitch refers to)."""
-    k, src = (0, 0) if at_start else (-1, -1)
-    arrays = {name: np.array(getattr(trimmed, name)) for name in ("l", "s", "centers", "frames", "xy")}
-    for name, values in arrays.items():
-        values[k] = getattr(original, name)[src]
-    return replace(trimmed, **arrays)
 
 
 def _joint_wall(outer: JointStitch, inner: JointStitch, step: JointStep, spec: PoseSpec) -> float:

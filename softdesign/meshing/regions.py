@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from softdesign.meshing.compare import surface_area
 from softdesign.meshing.tessellate import Region
 from softdesign.types import FloatArray, IntArray
 
@@ -40,9 +41,7 @@ class RegionPiece:
 
     def area(self) -> float:
         """Total area of the faces, mm^2."""
-        corners = self.vertices[self.faces]
-        cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-        return float(0.5 * np.linalg.norm(cross, axis=1).sum())
+        return surface_area(self.vertices, self.faces)
 
 
 def split_by_region(

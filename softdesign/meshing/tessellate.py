@@ -321,11 +321,17 @@ def _interpolate_station(sweep: Sweep, s_at: float) -> tuple[float, FloatArray, 
 def trim_sweep(sweep: Sweep, s_start: float, s_end: float) -> Sweep:
     """The part of ``sweep`` between arc lengths ``s_start`` and ``s_end`` (mm), with end rings there.
 
-    Rings closer than ``TRIM_GAP_FRACTION`` of the local spacing to a new end are dropped.
+    Rings closer than ``TRIM_GAP_FRACTION`` of the local spacing to a new end are dropped.  An end
+    that is not moved (``s_start`` or ``s_end`` at the sweep's own end) keeps its ring bit for bit,
+    e.g. a joint ring another piece is stitched to.
     """
     if not sweep.s[0] <= s_start < s_end <= sweep.s[-1]:
         raise ValueError(f"trim range [{s_start}, {s_end}] mm must lie inside [0, {sweep.s[-1]}] mm")
-    ends = [_interpolate_station(sweep, s) for s in (s_start, s_end)]
+    ends = [
+        (sweep.l[k], sweep.centers[k], sweep.frames[k], sweep.xy[k]) if s == sweep.s[k]
+        else _interpolate_station(sweep, s)
+        for s, k in ((s_start, 0), (s_end, -1))
+    ]
     gap = TRIM_GAP_FRACTION * np.diff(sweep.s).min()
     keep = (sweep.s > s_start + gap) & (sweep.s < s_end - gap)
     parts = [
