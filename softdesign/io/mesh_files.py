@@ -47,7 +47,7 @@ def _vtp_bytes(vertices: np.ndarray, faces: np.ndarray, regions: np.ndarray | No
     import vtk
     from vtk.util.numpy_support import numpy_to_vtk
 
-    from softdesign.io.vtk_polydata import polydata_from_triangles
+    from softdesign.io.vtk_polydata import polydata_from_triangles, polydata_writer
     from softdesign.meshing.tessellate import Region
 
     poly = polydata_from_triangles(np.asarray(vertices, float), np.asarray(faces, np.int64))
@@ -60,10 +60,7 @@ def _vtp_bytes(vertices: np.ndarray, faces: np.ndarray, regions: np.ndarray | No
         for region in Region:  # value i is names[i]
             names.InsertNextValue(region.name.lower())
         poly.GetFieldData().AddArray(names)
-    writer = vtk.vtkXMLPolyDataWriter()
-    writer.SetInputData(poly)
-    writer.SetDataModeToBinary()
-    writer.SetCompressorTypeToZLib()
+    writer = polydata_writer(poly)
     writer.WriteToOutputStringOn()
     if writer.Write() != 1:
         raise OSError("vtk could not encode the mesh as .vtp")

@@ -17,6 +17,7 @@ import numpy.typing as npt
 
 from softdesign.errors import InputDataError
 from softdesign.io.atomic import atomic_target
+from softdesign.io.vtk_polydata import polydata_writer
 
 
 def write_polylines_vtp(
@@ -130,14 +131,9 @@ def _polydata(points: np.ndarray, sizes: list[int], per_point: dict, per_cell: d
 
 
 def _write_atomically(poly, path: Path) -> None:
-    import vtk
-
     if not path.parent.is_dir():
         raise OSError(f"{path}: the folder {path.parent} does not exist; create it first")
-    writer = vtk.vtkXMLPolyDataWriter()
-    writer.SetInputData(poly)
-    writer.SetDataModeToBinary()
-    writer.SetCompressorTypeToZLib()
+    writer = polydata_writer(poly)
     with atomic_target(path) as temporary:
         writer.SetFileName(str(temporary))
         if writer.Write() != 1:

@@ -120,3 +120,14 @@ def polydata_from_triangles(vertices: np.ndarray, faces: np.ndarray):
     cells.SetData(numpy_to_vtkIdTypeArray(offsets, deep=True), numpy_to_vtkIdTypeArray(connectivity, deep=True))
     poly.SetPolys(cells)
     return poly
+
+
+def polydata_writer(poly):
+    """A ``vtkXMLPolyDataWriter`` of ``poly``: binary, zlib-compressed, as VMTK writes its files."""
+    import vtk
+
+    writer = vtk.vtkXMLPolyDataWriter()
+    writer.SetInputData(poly)
+    writer.SetDataModeToBinary()
+    writer.SetCompressorTypeToZLib()
+    return writer
