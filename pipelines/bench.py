@@ -46,7 +46,7 @@ from typing import Any, Sequence
 REPO = Path(__file__).resolve().parents[1]
 DEMO_CASE = REPO / "configs" / "demo.yaml"
 AORTA_DIR = REPO.parent / "shared" / "data" / "vmtk-aorta"
-STAGE_NAMES = ("ingest", "blend", "kinematics", "fit", "export")
+STAGE_NAMES = ("ingest", "blend", "links", "kinematics", "fit", "export")
 MIB = 1024.0 * 1024.0
 
 #: Targets of the scaled case (issue 5, item 9).
@@ -195,7 +195,7 @@ def run_worker(case_file: Path, out_dir: Path, profile_dir: Path | None) -> dict
     """
     import_s = import_heavy_libraries()
     from softdesign.config import load_case
-    from softdesign.pipeline.run import RunOptions, run_stages
+    from softdesign.pipeline.runner import RunOptions, run_stages
     from softdesign.pipeline.stages import STAGES, input_files
 
     case = load_case(case_file)
@@ -254,10 +254,10 @@ def aorta_case(folder: Path) -> BenchCase | None:
 
 def write_synthetic_inputs(folder: Path, triangles: int) -> None:
     """The synthetic vessel's centerline.vtp and binary surface.stl with at least ``triangles`` faces."""
-    from softdesign.geometry.synthetic_vessel import make_synthetic_vessel
+    from softdesign.samples.synthetic_vessel import make_synthetic_vessel
     from softdesign.io.mesh_files import write_mesh
     from softdesign.io.polylines_vtp import write_polylines_vtp
-    from softdesign.meshing.synthetic_surface import synthetic_surface
+    from softdesign.samples.surfaces import synthetic_surface
 
     folder.mkdir(parents=True, exist_ok=True)
     vessel = make_synthetic_vessel()

@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 
 from softdesign.errors import SoftdesignError
-from softdesign.pipeline import cohort
+from softdesign import cohort
 
 def deps(args: argparse.Namespace) -> int:
     text = cohort.deps_text(Path(args.case), args.target, Path.cwd())
@@ -60,7 +60,7 @@ def summary(args: argparse.Namespace) -> int:
 
 
 def sample(args: argparse.Namespace) -> int:
-    from softdesign.io.cohort_files import write_cohort
+    from softdesign.samples.files import write_cohort
 
     for path in write_cohort(Path(args.out_dir)):
         print(f"wrote {path}")

@@ -36,8 +36,9 @@ import numpy as np
 
 from softdesign.io.mesh_files import write_mesh
 from softdesign.meshing.compare import MeshDifference, compare_meshes, is_watertight
-from softdesign.pipeline.cohort import STATUS_SUFFIX, cohort_cases, read_record
-from softdesign.pipeline.store import MANIFEST, sha256_file
+from softdesign.cohort import STATUS_SUFFIX, cohort_cases, read_record
+from softdesign.pipeline.layout import MANIFEST
+from softdesign.pipeline.store import sha256_file
 from softdesign.regression import GOLDEN, KINEMATICS, decimation_entry, mesh_names
 
 #: Strongest target reduction tried, and how many bisection steps find the strongest acceptable one.

@@ -9,6 +9,12 @@ A message says what went wrong, where, what was expected, what was found and
 what to do, e.g. ``case.yaml: fit.knot_spacing_mm must be > 0, got -2``.
 """
 
+from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
 
 class SoftdesignError(Exception):
     """Base class of every error softdesign reports to a user."""
@@ -38,3 +44,12 @@ class FitError(SoftdesignError):
 
 class MeshError(SoftdesignError):
     """A mesh could not be made into a valid solid."""
+
+
+@contextmanager
+def errors_named_for(source: Path | str) -> Iterator[None]:
+    """Prefix a SoftdesignError raised inside the block with ``source`` (e.g. the case file), keeping its type."""
+    try:
+        yield
+    except SoftdesignError as err:
+        raise type(err)(f"{source}: {err}") from err

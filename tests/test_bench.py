@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from softdesign.geometry.synthetic_vessel import SyntheticShape, make_synthetic_vessel
-from softdesign.meshing.synthetic_surface import grid_counts, synthetic_surface
+from softdesign.samples.synthetic_vessel import SyntheticShape, make_synthetic_vessel
+from softdesign.samples.surfaces import grid_counts, synthetic_surface
 
 BENCH_FILE = Path(__file__).resolve().parents[1] / "pipelines" / "bench.py"
 

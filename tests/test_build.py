@@ -19,7 +19,7 @@ from softdesign.cli import app
 
 runner = CliRunner()
 REPO = Path(__file__).resolve().parents[1]
-STAGES = ["ingest", "blend", "kinematics", "fit", "export"]
+STAGES = ["ingest", "blend", "links", "kinematics", "fit", "export"]
 
 
 def snapshot(folder: Path) -> dict[str, str]:
@@ -66,11 +66,22 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     assert statuses(build(demo_case, out)) == dict.fromkeys(STAGES, "skipped")
     edit(demo_case, "fit", smoothing=2.0e-5)
     assert statuses(build(demo_case, out)) == {
-        "ingest": "skipped", "blend": "skipped", "kinematics": "skipped", "fit": "ran", "export": "ran"
+        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "ran", "export": "ran"
     }
     edit(demo_case, "export", q=[0, 0.5, 1])
     assert statuses(build(demo_case, out)) == {
-        "ingest": "skipped", "blend": "skipped", "kinematics": "ran", "fit": "skipped", "export": "ran"
+        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "ran", "fit": "skipped", "export": "ran"
+    }
+    # The mesh formats are read by export alone: kinematics (and the fit) stay cached.
+    edit(demo_case, "export", formats=["stl", "ply"])
+    assert statuses(build(demo_case, out)) == {
+        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "skipped",
+        "export": "ran",
+    }
+    # New link breaks: the links, their kinematics and the per-link fit are redone; ingest and blend are not.
+    edit(demo_case, "links", count=None, breaks=[0, 0.4, 1])
+    assert statuses(build(demo_case, out)) == {
+        "ingest": "skipped", "blend": "skipped", "links": "ran", "kinematics": "ran", "fit": "ran", "export": "ran"
     }
     assert statuses(build(demo_case, out, "--force")) == dict.fromkeys(STAGES, "ran")
 
@@ -87,7 +98,10 @@ def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tm
 
     # Nothing changed: the export on disk is what a build would make now, figures and metrics included.
     ran, manifest = run_fit()
-    assert ran == {"ingest": "skipped", "blend": "skipped", "kinematics": "skipped", "fit": "skipped", "export": "kept"}
+    assert ran == {
+        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "skipped",
+        "export": "kept",
+    }
     outputs = {o["path"]: o for o in manifest["outputs"]}
     assert all(outputs[m]["watertight"] and outputs[m]["volume_mm3"] > 0 and "stale" not in outputs[m] for m in meshes)
     assert "export" in manifest["metrics"] and "export" not in manifest["timing_s"]
@@ -153,7 +167,7 @@ def test_a_failed_run_leaves_the_previous_build_untouched(demo_case, tmp_path, m
     build(demo_case, out)
     before = snapshot(out)
     edit(demo_case, "fit", smoothing=3.0e-5)
-    from softdesign.pipeline import export_stage
+    from softdesign.pipeline.stages import export as export_stage
 
     calls = []
 
@@ -173,7 +187,7 @@ def test_a_failed_run_leaves_the_previous_build_untouched(demo_case, tmp_path, m
 
 KILL_MID_EXPORT = """
 import os, signal, sys
-import softdesign.pipeline.export_stage as export_stage
+import softdesign.pipeline.stages.export as export_stage
 original = export_stage.mesh_bytes
 calls = []
 def killing(*args, **kwargs):

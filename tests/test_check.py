@@ -13,7 +13,7 @@ import trimesh
 import typer
 from typer.testing import CliRunner
 
-from softdesign.check_cli import check
+from softdesign.cli.check import check
 from softdesign.meshing.compare import compare_meshes
 from softdesign.regression import CheckOptions, check_build, decimation_entry
 

@@ -166,7 +166,7 @@ def test_consecutive_duplicates_are_removed_with_a_note(tmp_path):
 
 
 def test_the_same_vessel_in_mm_and_in_m_ingests_identically(tmp_path):
-    from softdesign.pipeline.ingest import load_ingest
+    from softdesign.pipeline.stages.ingest import load_ingest
 
     results = []
     for units, scale in (("mm", 1.0), ("m", 1e-3)):

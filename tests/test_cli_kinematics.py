@@ -43,7 +43,7 @@ def test_json_has_exactly_the_documented_keys(built):
 
 def test_equal_q_reproduces_the_blended_curve_end_to_end(built):
     from softdesign.config import load_case
-    from softdesign.pipeline.blend_stage import load_blend
+    from softdesign.pipeline.stages.blend import load_blend
 
     shape = load_blend(built).shape
     assert load_case(DEMO).export.q_values() == [0.0, 0.5, 1.0]
@@ -75,7 +75,7 @@ def test_kinematics_json_is_kept_for_every_export_q(built):
 
 @pytest.mark.parametrize(
     ("q", "message"),
-    [("0.5,2", "must lie in [0, 1]"), ("a", "expected numbers"), ("0.1,0.2", "expected one value or 4 values")],
+    [("0.5,2", "value 2 of '0.5,2' is 2, expected a number in [0, 1]"), ("a", "'a' of 'a' is not a number"), ("0.1,0.2", "expected one value or 4 values")],
 )
 def test_bad_q_exits_2(built, q, message):
     result = runner.invoke(app, ["kinematics", str(DEMO), "--out", str(built), "--q", q])

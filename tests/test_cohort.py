@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from softdesign.config import load_case
-from softdesign.geometry.cohort_vessels import COHORT_VARIANTS, make_variant_vessel, variant_named
-from softdesign.pipeline import cohort
+from softdesign.samples.cohort_vessels import COHORT_VARIANTS, make_variant_vessel, variant_named
+from softdesign import cohort
 
 REPO = Path(__file__).resolve().parents[1]
 MAKE = shutil.which("make")
@@ -29,7 +29,7 @@ MAKE_CASES = ("meander", "s_bend")
 
 def test_committed_cohort_inputs_are_the_generators_output(tmp_path):
     """data/cohort is what `make cohort-sample` writes, byte for byte (so it never goes stale)."""
-    from softdesign.io.cohort_files import write_cohort
+    from softdesign.samples.files import write_cohort
 
     written = write_cohort(tmp_path)
     assert len(written) == 2 * len(COHORT_VARIANTS)

@@ -16,7 +16,7 @@ import pytest
 from typer.testing import CliRunner
 
 from softdesign.cli import app
-from softdesign.pipeline.cohort import cohort_cases
+from softdesign.cohort import cohort_cases
 from softdesign.pipeline.store import sha256_file
 from softdesign.regression import GOLDEN, CheckOptions, mesh_names
 

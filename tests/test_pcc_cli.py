@@ -127,7 +127,7 @@ def reconstructed(tmp_path):
     readings.write_text(CSV_TEXT)
     out = tmp_path / "out"
     result = runner.invoke(
-        app, ["pcc", "reconstruct", str(readings), "--d", "15,12", "-o", str(out), "--max-rate", "100", "--points-per-section", "7"]
+        app, ["pcc", "reconstruct", str(readings), "--d", "15,12", "--shapes-dir", str(out), "--max-rate", "100", "--points-per-section", "7"]
     )
     return result, out
 
@@ -185,7 +185,7 @@ def test_reconstruct_backbones_vtp_holds_one_polyline_per_accepted_row(reconstru
 def test_reconstruct_without_max_rate_accepts_the_jump(tmp_path):
     readings = tmp_path / "readings.csv"
     readings.write_text(CSV_TEXT)
-    result = runner.invoke(app, ["pcc", "reconstruct", str(readings), "--d", "15", "-o", str(tmp_path / "out")])
+    result = runner.invoke(app, ["pcc", "reconstruct", str(readings), "--d", "15", "--shapes-dir", str(tmp_path / "out")])
     assert result.exit_code == 0, result.output
     assert "4 row(s) accepted, 2 rejected" in result.stdout
 
@@ -204,18 +204,18 @@ def test_reconstruct_without_max_rate_accepts_the_jump(tmp_path):
 def test_reconstruct_bad_file_exits_2_naming_the_file(tmp_path, text, d, message):
     readings = tmp_path / "readings.csv"
     readings.write_text(text)
-    result = runner.invoke(app, ["pcc", "reconstruct", str(readings), "--d", d, "-o", str(tmp_path / "out")])
+    result = runner.invoke(app, ["pcc", "reconstruct", str(readings), "--d", d, "--shapes-dir", str(tmp_path / "out")])
     assert result.exit_code == 2
     assert message in result.stderr
     assert "Traceback" not in result.output
 
 
 def test_reconstruct_missing_file_and_bad_rate_exit_2(tmp_path):
-    missing = runner.invoke(app, ["pcc", "reconstruct", str(tmp_path / "nope.csv"), "--d", "15", "-o", str(tmp_path)])
+    missing = runner.invoke(app, ["pcc", "reconstruct", str(tmp_path / "nope.csv"), "--d", "15", "--shapes-dir", str(tmp_path)])
     assert missing.exit_code == 2 and "nope.csv: readings file not found" in missing.stderr
     readings = tmp_path / "readings.csv"
     readings.write_text(CSV_TEXT)
-    rate = runner.invoke(app, ["pcc", "reconstruct", str(readings), "--d", "15", "-o", str(tmp_path), "--max-rate", "0"])
+    rate = runner.invoke(app, ["pcc", "reconstruct", str(readings), "--d", "15", "--shapes-dir", str(tmp_path), "--max-rate", "0"])
     assert rate.exit_code == 2 and "--max-rate must be a finite number > 0" in rate.stderr
 
 
@@ -253,7 +253,7 @@ def test_polyline_writer_rejects_mismatched_arrays(tmp_path):
 def test_reconstruct_rejects_a_row_that_goes_back_in_time(tmp_path):
     readings = tmp_path / "readings.csv"
     readings.write_text("time,a,b,c\n0,100,100,100\n0.1,100,101,102\n0.05,100,101,102\n")
-    result = runner.invoke(app, ["pcc", "reconstruct", str(readings), "--d", "10", "-o", str(tmp_path / "out")])
+    result = runner.invoke(app, ["pcc", "reconstruct", str(readings), "--d", "10", "--shapes-dir", str(tmp_path / "out")])
     assert result.exit_code == 0, result.output
     with open(tmp_path / "out" / "rejected.csv", newline="") as handle:
         rejected = list(csv.reader(handle))

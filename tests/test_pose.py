@@ -30,7 +30,7 @@ from softdesign.meshing.compare import compare_meshes
 from softdesign.meshing.pose_body import PoseSpec, pose_body
 from softdesign.meshing.pose_stitch import radii_on_rays, stitch_joint
 from softdesign.meshing.tessellate import Region
-from softdesign.pose_cli import pose
+from softdesign.cli.pose import pose
 
 app = typer.Typer(add_completion=False)
 app.command()(pose)
@@ -220,7 +220,7 @@ def demo(tmp_path_factory):
 
 
 def _run_pose(demo, q: str, output: Path, *extra: str):
-    return runner.invoke(app, ["pose", str(DEMO), "--q", q, "-o", str(output), "--out", str(demo.build_dir), *extra])
+    return runner.invoke(app, ["pose", str(DEMO), "--q", q, "--output", str(output), "--out", str(demo.build_dir), *extra])
 
 
 @pytest.mark.parametrize("q", [0.0, 0.5, 1.0])
@@ -330,7 +330,7 @@ def hollow_case(tmp_path_factory) -> Path:
 
 def test_hollow_pose_with_equal_q_is_the_builds_hollow_mesh(hollow_case, tmp_path):
     out = tmp_path / "build"
-    args = ["pose", str(hollow_case), "--q", "1", "-o", str(tmp_path / "p.stl"), "--out", str(out)]
+    args = ["pose", str(hollow_case), "--q", "1", "--output", str(tmp_path / "p.stl"), "--out", str(out)]
     result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
     assert "ported body" in result.stdout
@@ -343,7 +343,7 @@ def test_hollow_pose_with_equal_q_is_the_builds_hollow_mesh(hollow_case, tmp_pat
 
 def test_hollow_pose_with_mixed_q_is_one_ported_body_with_its_walls_reported(hollow_case, tmp_path):
     out = tmp_path / "build"
-    args = ["pose", str(hollow_case), "--q", "0,1,0,1", "-o", str(tmp_path / "p.ply"), "--out", str(out), "--json"]
+    args = ["pose", str(hollow_case), "--q", "0,1,0,1", "--output", str(tmp_path / "p.ply"), "--out", str(out), "--json"]
     result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
     import json

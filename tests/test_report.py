@@ -348,7 +348,7 @@ def test_a_build_without_fit_gets_a_report_with_the_centerline_only(tmp_path):
 
 def report_app() -> typer.Typer:
     """An app with the report command, registered the way softdesign.cli registers commands."""
-    from softdesign.report_cli import report
+    from softdesign.cli.report import report
 
     app = typer.Typer()
     app.command()(report)
@@ -369,8 +369,8 @@ def test_cli_writes_the_page_and_says_where(demo, tmp_path):
     ("args", "message"),
     [
         (["report", "{missing}"], "not a build folder (no manifest.json)"),
-        (["report", "{build}", "--pcc-d", "ten"], "--pcc-d: 'ten' is not a number"),
-        (["report", "{build}", "--pcc-d", "-3"], "expected a finite distance > 0 mm"),
+        (["report", "{build}", "--pcc-d", "ten"], "--pcc-d value 1: 'ten' is not a number"),
+        (["report", "{build}", "--pcc-d", "-3"], "--pcc-d value 1: -3 mm, expected > 0"),
         (["report", "{build}", "--pcc-d", "1,2"], "the build has 4 link(s)"),
     ],
 )

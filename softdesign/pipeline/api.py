@@ -7,8 +7,9 @@ from pathlib import Path
 from typing import Any, Callable
 
 from softdesign.config import Case, load_case
-from softdesign.errors import SoftdesignError
-from softdesign.pipeline.run import RunOptions, StageRun, run_stages
+from softdesign.errors import errors_named_for
+from softdesign.pipeline.runner import RunOptions, run_stages
+from softdesign.pipeline.stage import StageRun
 from softdesign.pipeline.stages import STAGES, input_files, stages_through
 
 
@@ -40,8 +41,6 @@ def build_through(
     stages = STAGES if target is None else stages_through(target)
     later = tuple(s for s in STAGES if s not in stages)
     options = RunOptions(force=force, progress=progress, later=later)
-    try:
+    with errors_named_for(case_file):
         results, runs = run_stages(case, build_dir, stages, input_files(case), options)
-    except SoftdesignError as err:
-        raise type(err)(f"{case_file}: {err}") from err
     return BuildOutcome(case, build_dir, results, runs)

@@ -21,8 +21,8 @@ from typing import Any
 
 import numpy as np
 
-STAGING_PREFIX = ".staging-"  # after ".<build folder name>"
-MANIFEST = "manifest.json"
+from softdesign.pipeline.layout import MANIFEST, STAGING_PREFIX
+
 
 
 def canonical_json(payload: Any) -> str:
@@ -65,6 +65,16 @@ def load_npz(path: Path) -> dict[str, np.ndarray]:
     """All arrays of an .npz file."""
     with np.load(path, allow_pickle=False) as data:
         return {k: data[k] for k in data.files}
+
+
+def read_record(file: Path) -> dict[str, Any] | None:
+    """A JSON record (e.g. ``<stage>/stage.json``) as a dict, or None when missing or unreadable."""
+    if not file.is_file():
+        return None
+    try:
+        return json.loads(file.read_text(encoding="utf-8"))
+    except (OSError, json.JSONDecodeError):
+        return None
 
 
 def process_alive(pid: str) -> bool:

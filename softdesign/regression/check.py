@@ -12,9 +12,9 @@ from typing import Callable, Optional
 from softdesign.errors import ConfigError, InputDataError
 from softdesign.regression.figures import CheckOptions, CheckReport, Figure, missing_figure, read_json, scalar_figure
 from softdesign.regression.kinematics import compare_kinematics_files
+from softdesign.pipeline.layout import MANIFEST
 from softdesign.regression.meshes import compare_mesh_folders, read_golden
 
-MANIFEST = "manifest.json"
 #: Fit metrics compared first, in this order; other ``*_mm`` keys of metrics.fit follow, sorted.
 FIT_KEYS = ("rms_mm", "p95_mm", "p99_mm", "max_mm", "holdout_rms_mm")
 

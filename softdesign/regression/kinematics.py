@@ -14,10 +14,10 @@ from typing import Any
 
 import numpy as np
 
+from softdesign.pipeline.layout import KINEMATICS
 from softdesign.errors import InputDataError
 from softdesign.regression.figures import CheckOptions, Figure, is_number, missing_figure, read_json, scalar_figure
 
-KINEMATICS = "kinematics.json"
 #: Decimals of q that identify a pose (q values are written as the case file gives them).
 Q_DECIMALS = 9
 #: Chain-level transforms of a pose, compared like link transforms when either side has them.

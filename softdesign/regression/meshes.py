@@ -14,6 +14,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from softdesign.pipeline.layout import MESHES_DIR
 from softdesign.errors import InputDataError, SoftdesignError
 from softdesign.meshing.compare import MeshDifference, compare_meshes
 from softdesign.regression.figures import CheckOptions, Figure, is_number, missing_figure, read_json
@@ -62,7 +63,7 @@ def read_golden(reference_dir: Path) -> dict[str, DecimationError]:
 
 def mesh_names(build_dir: Path) -> set[str]:
     """Mesh files under ``build_dir/meshes``, as paths relative to ``build_dir`` (``meshes/q_0.000.stl``)."""
-    root = Path(build_dir) / "meshes"
+    root = Path(build_dir) / MESHES_DIR
     if not root.is_dir():
         return set()
     found = (p for p in root.rglob("*") if p.is_file() and p.suffix.lower() in MESH_SUFFIXES)

@@ -1,8 +1,8 @@
 """Reload a build folder for the report: the manifest and every stage's kept result.
 
 The report reads only what ``softdesign build`` (or a stage command) kept:
-``manifest.json``, ``ingest/``, ``blend/``, ``kinematics.json`` (these three
-are required), ``fit/`` and ``export/`` with ``meshes/`` (optional: a folder
+``manifest.json``, ``ingest/``, ``blend/``, ``links/``, ``kinematics.json``
+(these are required), ``fit/`` and ``export/`` with ``meshes/`` (optional: a folder
 built only through ``softdesign kinematics`` gets a report without them).
 """
 
@@ -14,13 +14,14 @@ from pathlib import Path
 from typing import Any
 
 from softdesign.errors import InputDataError
-from softdesign.pipeline.blend_stage import BlendResult, load_blend
-from softdesign.pipeline.export_stage import load_export, mesh_name
-from softdesign.pipeline.fit_stage import FitResult, load_fit
-from softdesign.pipeline.ingest import IngestResult, load_ingest
-from softdesign.pipeline.kinematics_stage import FILE as KINEMATICS_FILE
-from softdesign.pipeline.kinematics_stage import KinematicsResult, load_kinematics
-from softdesign.pipeline.store import MANIFEST
+from softdesign.pipeline import layout
+from softdesign.pipeline.layout import MANIFEST
+from softdesign.pipeline.stages.blend import BlendResult, load_blend
+from softdesign.pipeline.stages.export import load_export, mesh_name
+from softdesign.pipeline.stages.fit import FitResult, load_fit
+from softdesign.pipeline.stages.ingest import IngestResult, load_ingest
+from softdesign.pipeline.stages.kinematics import KinematicsResult, load_kinematics
+from softdesign.pipeline.stages.links import load_links
 
 
 @dataclass(frozen=True)
@@ -84,18 +85,19 @@ def load_build(build_dir: str | Path) -> BuildData:
         manifest = json.loads((root / MANIFEST).read_text(encoding="utf-8"))
     except (OSError, json.JSONDecodeError) as err:
         raise InputDataError(f"{root / MANIFEST}: unreadable ({err}); {fix}") from err
-    required = ("ingest/summary.json", "ingest/path.npz", "blend/curves.npz", "blend/summary.json", KINEMATICS_FILE)
+    required = (layout.INGEST_SUMMARY, layout.INGEST_PATH, layout.BLEND_CURVES, layout.BLEND_SUMMARY, layout.LINKS,
+                layout.KINEMATICS)
     missing = [rel for rel in required if not (root / rel).is_file()]
     if missing:
         raise InputDataError(
-            f"{root}: missing {', '.join(missing)}; the report needs ingest, blend and kinematics; {fix}"
+            f"{root}: missing {', '.join(missing)}; the report needs ingest, blend, links and kinematics; {fix}"
         )
     try:
         ingest = load_ingest(root)
         blend = load_blend(root)
-        kinematics = load_kinematics(root, blend)
-        fit = load_fit(root) if _has(root, "fit/surface.npz", "fit/points.npz", "fit/summary.json") else None
-        export = load_export(root).summary if _has(root, "export/summary.json") else None
+        kinematics = load_kinematics(root, load_links(root, blend))
+        fit = load_fit(root) if _has(root, layout.FIT_SURFACE, layout.FIT_POINTS, layout.FIT_SUMMARY) else None
+        export = load_export(root).summary if _has(root, layout.EXPORT_SUMMARY) else None
     except (OSError, KeyError, ValueError, json.JSONDecodeError) as err:
         raise InputDataError(
             f"{root}: a stage's kept files are unreadable ({type(err).__name__}: {err}); {fix} --force"

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from softdesign.errors import ConfigError
+from softdesign.pipeline.layout import REPORT_DIR
 from softdesign.pipeline.store import process_alive
 from softdesign.report import animation, fit_figures, kinematics_figures, morph_figures, surface_figures
 from softdesign.report.build_folder import BuildData, load_build
@@ -38,7 +39,6 @@ from softdesign.report.tables import (
     software_rows,
 )
 
-REPORT_DIR = "report"
 PAGE = "index.html"
 TEMP_PREFIX = ".report-"
 NO_FIT = (

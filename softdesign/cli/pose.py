@@ -7,52 +7,31 @@ command with ``app.command()(pose)``.
 
 from __future__ import annotations
 
-import math
 import time
 from pathlib import Path
-from typing import Annotated, Any, Optional
+from typing import Annotated, Any
 
 import typer
 
-from softdesign.cli_support import emit_json, note, run_guarded
-from softdesign.errors import ConfigError, SoftdesignError
+from softdesign.cli.common import (
+    Q_FIX,
+    CaseArg,
+    ForceOpt,
+    JsonOpt,
+    OutOpt,
+    QOpt,
+    emit_json,
+    note,
+    q_values_from_text,
+    run_guarded,
+)
+from softdesign.errors import ConfigError, errors_named_for
 
-QOpt = Annotated[
-    str,
-    typer.Option("--q", help="One q for every link ('0.5') or one per link ('0.2,0.8,1'), each in [0, 1].",
-                 show_default=False),
-]
 OutputOpt = Annotated[
     Path,
-    typer.Option("--output", "-o", help="Mesh file to write; its suffix picks the format (.stl .ply .obj .glb .vtp).",
+    typer.Option("--output", help="Mesh file to write; its suffix picks the format (.stl .ply .obj .glb .vtp).",
                  show_default=False),
 ]
-BuildOpt = Annotated[Optional[Path], typer.Option("--out", help="Build folder (default: build/<name>).")]
-ForceOpt = Annotated[bool, typer.Option("--force", help="Redo every stage, ignoring the cache.")]
-JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")]
-CaseArg = Annotated[Path, typer.Argument(help="The case file (YAML).", show_default=False)]
-
-Q_FIX = "give one q for every link (e.g. 0.5) or one per link separated by commas (e.g. 0.2,0.8,1), each in [0, 1]"
-
-
-def q_values_from_text(text: str) -> list[float]:
-    """Parse ``--q`` into a list of q values, each finite and in [0, 1].
-
-    Raises
-    ------
-    ConfigError
-        An empty entry, a non-number, or a value outside [0, 1].
-    """
-    values = []
-    for i, part in enumerate(text.split(","), start=1):
-        try:
-            value = float(part)
-        except ValueError:
-            raise ConfigError(f"--q: value {i} '{part.strip()}' of {text!r} is not a number; {Q_FIX}") from None
-        if not (math.isfinite(value) and 0.0 <= value <= 1.0):
-            raise ConfigError(f"--q: value {i} of {text!r} is {part.strip()}, expected a number in [0, 1]; {Q_FIX}")
-        values.append(value)
-    return values
 
 
 def mesh_format_of(path: Path) -> str:
@@ -62,13 +41,24 @@ def mesh_format_of(path: Path) -> str:
     fmt = path.suffix.lower().lstrip(".")
     if fmt not in MESH_FORMATS:
         raise ConfigError(
-            f"-o {path}: unknown mesh format '{path.suffix or '(no suffix)'}', expected one of "
+            f"--output {path}: unknown mesh format '{path.suffix or '(no suffix)'}', expected one of "
             + ", ".join(f".{f}" for f in MESH_FORMATS)
             + "; name the file e.g. pose.stl"
         )
     if not path.parent.is_dir():
-        raise ConfigError(f"-o {path}: the folder {path.parent} does not exist; create it first")
+        raise ConfigError(f"--output {path}: the folder {path.parent} does not exist; create it first")
     return fmt
+
+
+def _check_build_folder_option(out: Path | None) -> None:
+    """``--out/-o`` is the build folder in every command: a mesh file name there is a mistake, say so."""
+    from softdesign.io.mesh_files import MESH_FORMATS
+
+    if out is not None and out.suffix.lower().lstrip(".") in MESH_FORMATS:
+        raise ConfigError(
+            f"--out/-o {out}: is the build folder in every softdesign command, not the mesh file; "
+            f"write the mesh with --output {out} (and give --out a folder, or leave it out for build/<name>)"
+        )
 
 
 def pose_payload(body: Any, output: Path) -> dict[str, Any]:
@@ -131,7 +121,7 @@ def _print_pose(payload: dict[str, Any], seconds: float) -> None:
     typer.echo(f"wrote {payload['output']} ({seconds:.2f} s)")
 
 
-def _make_pose(case_file: Path, q: list[float], out: Optional[Path], force: bool) -> Any:
+def _make_pose(case_file: Path, q: list[float], out: Path | None, force: bool) -> Any:
     """Build (cached) through every stage, then the pose body; errors name the case file."""
     from softdesign.meshing.pose_body import PoseSpec, pose_body
     from softdesign.pipeline.api import build_through
@@ -141,19 +131,17 @@ def _make_pose(case_file: Path, q: list[float], out: Optional[Path], force: bool
     if len(q) not in (1, chain.count):
         raise ConfigError(f"--q: {len(q)} values for {chain.count} links in {case_file}; {Q_FIX}")
     export = outcome.case.export
-    try:
+    with errors_named_for(case_file):
         spec = PoseSpec(export.spacing_mm, export.angular_count, export.offset_mm, export.wall_mm or 0.0,
                         export.port_mm or 0.0)
         return pose_body(chain, field, q, spec)
-    except SoftdesignError as err:
-        raise type(err)(f"{case_file}: {err}") from err
 
 
 def pose(
     case_file: CaseArg,
     q: QOpt,
     output: OutputOpt,
-    out: BuildOpt = None,
+    out: OutOpt = None,
     force: ForceOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
@@ -166,13 +154,14 @@ def pose(
         from softdesign.io.mesh_files import LABELLED_FORMATS, write_mesh
 
         start = time.perf_counter()
+        _check_build_folder_option(out)
         q_values = q_values_from_text(q)
         fmt = mesh_format_of(output)
         body = _make_pose(case_file, q_values, out, force)
         try:
             write_mesh(output, body.vertices, body.faces, body.regions if fmt in LABELLED_FORMATS else None)
         except OSError as err:
-            raise ConfigError(f"-o {output}: cannot write the mesh ({err.strerror}); choose a writable path") from err
+            raise ConfigError(f"--output {output}: cannot write the mesh ({err.strerror}); choose a writable path") from err
         payload = pose_payload(body, output)
         if as_json:
             emit_json(payload)

@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated
 
 import typer
 
-from softdesign.cli_support import emit_json, note, run_guarded
-from softdesign.errors import SoftdesignError
-from softdesign.pcc_options import spacing_from_text
+from softdesign.cli.common import CaseArg, JsonOpt, OutOpt, emit_json, note, run_guarded
+from softdesign.errors import errors_named_for
+from softdesign.cli.pcc_options import spacing_from_text
 
 
 def _print_design(document: dict, case_file: Path) -> None:
@@ -44,14 +44,14 @@ def _print_design(document: dict, case_file: Path) -> None:
 
 
 def design(
-    case_file: Annotated[Path, typer.Argument(help="The case file (YAML).", show_default=False)],
+    case_file: CaseArg,
     d: Annotated[
         str,
         typer.Option("--d", help='Chamber distance from the backbone, mm: one value ("4") or one per link ("4,4,3.5").',
                      show_default=False),
     ],
-    json_out: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
-    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Build folder [default: build/<name>].")] = None,
+    json_out: JsonOpt = False,
+    out: OutOpt = None,
     samples: Annotated[int, typer.Option("--samples", min=3, help="Backbone samples per link for the fit.")] = 201,
 ) -> None:
     """One PCC section per link of the built design at every export q, and the chambers it needs.
@@ -76,10 +76,8 @@ def design(
         outcome = build_through(case_file, out, target="kinematics", progress=note)
         chain = outcome.results["kinematics"].chain
         spacing = spacing_from_text(d, chain.count, where=f"{case_file} ({chain.count} links, one section each)")
-        try:
+        with errors_named_for(case_file):
             result = design_sections(chain, outcome.case.export.q_values(), spacing, samples)
-        except SoftdesignError as err:
-            raise type(err)(f"{case_file}: {err}") from err
         for line in result.notes:
             note(f"warning: {case_file}: {line}")
         document = design_document(result)

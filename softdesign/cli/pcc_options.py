@@ -1,4 +1,4 @@
-"""Options shared by the `softdesign pcc` commands: ``--lengths`` and ``--d``, declared and parsed.
+"""Options of the `softdesign pcc` commands: ``--lengths`` and ``--d``, declared and parsed.
 
 Parsing raises :class:`~softdesign.errors.ConfigError` naming the option and the fix.
 """
@@ -11,6 +11,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
+from softdesign.cli.common import distances_from_text
 from softdesign.errors import ConfigError
 
 LengthsOpt = Annotated[
@@ -61,18 +62,9 @@ def lengths_from_text(text: str) -> np.ndarray:
 
 
 def spacing_from_text(text: str, sections: int | None, where: str = "--lengths") -> np.ndarray:
-    """Parse ``--d`` into one cable distance per section, (k,) mm, each > 0.
+    """Parse ``--d`` into one cable distance per section, (k,) mm, each > 0 (the shared distance-list parser).
 
     With ``sections`` None (not known yet) the values are checked and returned as given.
     """
-    example = ",".join(["15"] * sections) if sections else "15,14,13"
-    count = f"{sections} values, " if sections else ""
-    fix = f'give one distance in mm ("15") or one per section ({count}e.g. "{example}")'
-    values = [_number(v, f"--d value {i}", fix) for i, v in enumerate(text.split(","), start=1)]
-    if sections is not None and len(values) not in (1, sections):
-        raise ConfigError(f"--d: {len(values)} values for {sections} section(s) in {where}; {fix}")
-    for i, value in enumerate(values, start=1):
-        if value <= 0:
-            raise ConfigError(f"--d value {i}: {value:g} mm, expected > 0 (cable distance from the backbone); {fix}")
-    given = np.array(values, dtype=np.float64)
-    return given if sections is None else np.broadcast_to(given, (sections,)).copy()
+    values = distances_from_text(text, "--d", "cable distance from the backbone", sections, "section", where)
+    return np.array(values, dtype=np.float64)

@@ -1,4 +1,4 @@
-"""Stage 3, kinematics: links, their S_T_E(q) and POE form at every export q.
+"""Stage 4, kinematics: the links' S_T_E(q) and POE form at every export q.
 
 ``kinematics.json`` (at the top of the build folder) holds, per export q and
 per link, the transform S_T_E = inv(F(q, l_s)) F(q, l_e) (4x4, mm), its POE
@@ -16,13 +16,14 @@ from typing import Any
 import numpy as np
 
 from softdesign.config import Case
-from softdesign.kinematics.links import LinkChain, LinkReport, link_breaks
+from softdesign.kinematics.links import LinkChain, LinkReport
 from softdesign.kinematics.poe import PoeSplit
-from softdesign.pipeline.blend_stage import BlendResult
+from softdesign.pipeline import layout
+from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.links import LinksResult
 from softdesign.pipeline.store import Staging
 
 VERSION = 1
-FILE = "kinematics.json"
 CONVENTION = (
     "F(q, l) = [[N B T c], [0 0 0 1]]; transform = S_T_E = inv(F(q, l_start)) F(q, l_end), "
     "mapping end-frame coordinates into start-frame coordinates; "
@@ -38,13 +39,6 @@ class KinematicsResult:
 
     chain: LinkChain
     document: dict[str, Any]
-
-
-def chain_for_case(case: Case, blend: BlendResult) -> LinkChain:
-    """Split the blended shape into the case's links."""
-    links = case.links
-    breaks = link_breaks(blend.shape.keys[-1].length, links.count, links.breaks, links.length_mm)
-    return LinkChain(blend.shape, breaks)
 
 
 def poe_dict(split: PoeSplit) -> dict[str, Any]:
@@ -101,9 +95,9 @@ def shape_figures(chain: LinkChain, q: float) -> dict[str, Any]:
     }
 
 
-def run_kinematics(case: Case, blend: BlendResult) -> KinematicsResult:
+def run_kinematics(case: Case, links: LinksResult) -> KinematicsResult:
     """Link transforms and POE at every export q."""
-    chain = chain_for_case(case, blend)
+    chain = links.chain
     document = {
         "frames": case.frames,
         "convention": CONVENTION,
@@ -119,14 +113,13 @@ def run_kinematics(case: Case, blend: BlendResult) -> KinematicsResult:
 
 def write_kinematics(result: KinematicsResult, staging: Staging) -> None:
     """Write ``kinematics.json``."""
-    staging.write_json(FILE, result.document)
+    staging.write_json(layout.KINEMATICS, result.document)
 
 
-def load_kinematics(build_dir: Path, blend: BlendResult) -> KinematicsResult:
-    """The document from disk and the chain rebuilt on the (already loaded) blend."""
-    document = json.loads((Path(build_dir) / FILE).read_text(encoding="utf-8"))
-    breaks = [document["links"][0]["l_start"]] + [link["l_end"] for link in document["links"]]
-    return KinematicsResult(LinkChain(blend.shape, np.array(breaks)), document)
+def load_kinematics(build_dir: Path, links: LinksResult) -> KinematicsResult:
+    """The document from disk, on the (already loaded) chain of links."""
+    document = json.loads((Path(build_dir) / layout.KINEMATICS).read_text(encoding="utf-8"))
+    return KinematicsResult(links.chain, document)
 
 
 def describe_kinematics(result: KinematicsResult) -> list[str]:
@@ -147,3 +140,16 @@ def describe_kinematics(result: KinematicsResult) -> list[str]:
                 f"stretch {link['stretch'][0]:.3f}..{link['stretch'][1]:.3f}"
             )
     return lines
+
+
+STAGE = Stage(
+    name="kinematics",
+    version=VERSION,
+    reads=("frames", "export.q", "export.frames"),
+    upstream=("links",),
+    compute=lambda case, results: run_kinematics(case, results["links"]),
+    write=write_kinematics,
+    load=lambda build_dir, results: load_kinematics(build_dir, results["links"]),
+    describe=describe_kinematics,
+    metrics=lambda result: {"links": len(result.document["links"]), "file": layout.KINEMATICS},
+)

@@ -1,4 +1,4 @@
-"""Stage 4, fit: the wall's rho(l, a) per link at q = 1, its quality, and the radius field rho(q).
+"""Stage 5, fit: the wall's rho(l, a) per link at q = 1, its quality, and the radius field rho(q).
 
 Kept in the build folder: ``fit/surface.npz`` (the radius field: per link
 knots, final and initial coefficients), ``fit/points.npz`` (every projected
@@ -24,9 +24,10 @@ from softdesign.fitting.projection import project_points
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.selection import NetworkContext, SelectionSettings, inscribed_profile
 from softdesign.fitting.wall_fit import WallFitOptions, fit_wall
-from softdesign.pipeline.ingest import IngestResult
-from softdesign.pipeline.blend_stage import BlendResult
-from softdesign.pipeline.kinematics_stage import chain_for_case
+from softdesign.pipeline import layout
+from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.ingest import IngestResult
+from softdesign.pipeline.stages.links import LinksResult
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 
 VERSION = 3  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
@@ -44,11 +45,11 @@ class FitResult:
     points: dict[str, np.ndarray]
 
 
-def run_fit(case: Case, ingest: IngestResult, blend: BlendResult) -> FitResult:
+def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     """Fit the wall of the selected path and build rho(q) for every link."""
     if len(ingest.faces) == 0:
         raise ConfigError("final.surface is required to fit the actuator's surface; add it to the case file")
-    chain = chain_for_case(case, blend)
+    chain = links.chain
     curve = chain.shape.curve_at(1.0)
     path = ingest.path
     inscribed = (None, None) if path.radius is None else inscribed_profile(curve, path.points, path.radius)
@@ -96,17 +97,17 @@ def _initial_kind(case: Case) -> str:
 
 def write_fit(result: FitResult, staging: Staging) -> None:
     """Keep the radius field, the points and the figures."""
-    staging.write_bytes("fit/surface.npz", npz_bytes(**result.field.to_arrays()))
-    staging.write_bytes("fit/points.npz", npz_bytes(**result.points))
-    staging.write_json("fit/summary.json", result.summary)
+    staging.write_bytes(layout.FIT_SURFACE, npz_bytes(**result.field.to_arrays()))
+    staging.write_bytes(layout.FIT_POINTS, npz_bytes(**result.points))
+    staging.write_json(layout.FIT_SUMMARY, result.summary)
 
 
 def load_fit(build_dir: Path) -> FitResult:
     """The kept radius field and figures."""
-    root = Path(build_dir) / "fit"
-    field = RadiusField.from_arrays(load_npz(root / "surface.npz"))
-    summary = json.loads((root / "summary.json").read_text(encoding="utf-8"))
-    return FitResult(field, summary, load_npz(root / "points.npz"))
+    root = Path(build_dir)
+    field = RadiusField.from_arrays(load_npz(root / layout.FIT_SURFACE))
+    summary = json.loads((root / layout.FIT_SUMMARY).read_text(encoding="utf-8"))
+    return FitResult(field, summary, load_npz(root / layout.FIT_POINTS))
 
 
 def fit_metrics(result: FitResult) -> dict[str, Any]:
@@ -153,3 +154,16 @@ def _sampled_note(distance: dict[str, Any]) -> str:
     if distance["count"] == total:
         return ""
     return f", RMS and percentiles over a seeded sample of {distance['count']:,} of {total:,} points, max over all"
+
+
+STAGE = Stage(
+    name="fit",
+    version=VERSION,
+    reads=("fit", "initial.radius_mm", "initial.surface"),
+    upstream=("ingest", "links"),
+    compute=lambda case, results: run_fit(case, results["ingest"], results["links"]),
+    write=write_fit,
+    load=lambda build_dir, results: load_fit(build_dir),
+    describe=describe_fit,
+    metrics=fit_metrics,
+)

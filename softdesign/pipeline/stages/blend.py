@@ -19,7 +19,9 @@ from softdesign.config import Case
 from softdesign.geometry.blend import BlendedShape, blend_shapes
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline, smooth_curve_from_samples
 from softdesign.geometry.initial import InitialSpec, build_initial_shape, initial_shape_from_polyline
-from softdesign.pipeline.ingest import IngestResult
+from softdesign.pipeline import layout
+from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.ingest import IngestResult
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 
 VERSION = 1
@@ -95,15 +97,14 @@ def write_blend(result: BlendResult, staging: Staging) -> None:
     """Keep the key shapes' samples and the figures."""
     shape = result.shape
     samples = {f"key_{k}": curve.points(curve.l_grid) for k, curve in enumerate(shape.keys)}
-    staging.write_bytes("blend/curves.npz", npz_bytes(key_q=shape.key_q, **samples))
-    staging.write_json("blend/summary.json", result.summary)
+    staging.write_bytes(layout.BLEND_CURVES, npz_bytes(key_q=shape.key_q, **samples))
+    staging.write_json(layout.BLEND_SUMMARY, result.summary)
 
 
 def load_blend(build_dir: Path) -> BlendResult:
     """Rebuild the blended shape from the kept samples (no smoothing is redone)."""
-    root = Path(build_dir) / "blend"
-    data = load_npz(root / "curves.npz")
-    summary = json.loads((root / "summary.json").read_text(encoding="utf-8"))
+    data = load_npz(Path(build_dir) / layout.BLEND_CURVES)
+    summary = json.loads((Path(build_dir) / layout.BLEND_SUMMARY).read_text(encoding="utf-8"))
     keys = [smooth_curve_from_samples(data[f"key_{k}"]) for k in range(len(data["key_q"]))]
     keyframes = tuple(zip(data["key_q"][1:-1].tolist(), keys[1:-1]))
     shape = blend_shapes(keys[0], keys[-1], keyframes, summary["mode"], summary["frames"])
@@ -122,3 +123,16 @@ def describe_blend(result: BlendResult) -> list[str]:
     sh = s["shortening"]
     lines.append(f"shortest shape: {sh['min_length_mm']:.2f} mm at q = {sh['q_at_min']:.3f} ({100 * sh['ratio']:.2f}% shorter)")
     return lines
+
+
+STAGE = Stage(
+    name="blend",
+    version=VERSION,
+    reads=("initial", "resample", "frames", "blend"),
+    upstream=("ingest",),
+    compute=lambda case, results: run_blend(case, results["ingest"]),
+    write=write_blend,
+    load=lambda build_dir, results: load_blend(build_dir),
+    describe=describe_blend,
+    metrics=lambda result: result.summary,
+)

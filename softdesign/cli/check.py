@@ -11,7 +11,7 @@ from typing import Annotated
 
 import typer
 
-from softdesign.cli_support import emit_json, note, run_guarded
+from softdesign.cli.common import emit_json, note, run_guarded
 from softdesign.regression import CheckOptions, CheckReport, Figure, check_build
 
 #: Significant digits of the figures in the table (JSON keeps full precision).

@@ -20,10 +20,11 @@ from softdesign.geometry.plausibility import check_surface_surrounds, radius_not
 from softdesign.geometry.surface_info import SurfaceInfo, describe_surface
 from softdesign.io.centerline import read_centerline_network
 from softdesign.io.surface import read_surface
+from softdesign.pipeline import layout
+from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 from softdesign.types import UNIT_SCALE_TO_MM, FloatArray
 
-STAGE = "ingest"
 VERSION = 1
 
 
@@ -155,18 +156,18 @@ def _summary(case: Case, network: CenterlineNetwork, path: SelectedPath, info: S
 
 def write_ingest(result: IngestResult, staging: Staging) -> None:
     """Keep the ingest result in the build folder (``ingest/``)."""
-    staging.write_bytes("ingest/path.npz", _path_npz(result.path))
+    staging.write_bytes(layout.INGEST_PATH, _path_npz(result.path))
     others = {f"path_{p.index}": p.points for p in result.others}
-    staging.write_bytes("ingest/network.npz", npz_bytes(**others))
-    staging.write_bytes("ingest/surface.npz", npz_bytes(vertices=result.vertices, faces=result.faces))
+    staging.write_bytes(layout.INGEST_NETWORK, npz_bytes(**others))
+    staging.write_bytes(layout.INGEST_SURFACE, npz_bytes(vertices=result.vertices, faces=result.faces))
     if result.initial_path is not None:
-        staging.write_bytes("ingest/initial_path.npz", _path_npz(result.initial_path))
+        staging.write_bytes(layout.INGEST_INITIAL_PATH, _path_npz(result.initial_path))
     for k, (q, keyframe) in enumerate(result.keyframes):
-        staging.write_bytes(f"ingest/keyframe_{k}.npz", _path_npz(keyframe, q=np.array(q)))
+        staging.write_bytes(layout.ingest_keyframe(k), _path_npz(keyframe, q=np.array(q)))
     if result.initial_surface is not None:
         v, f = result.initial_surface
-        staging.write_bytes("ingest/initial_surface.npz", npz_bytes(vertices=v, faces=f))
-    staging.write_json("ingest/summary.json", {**result.summary, "notes": list(result.notes)})
+        staging.write_bytes(layout.INGEST_INITIAL_SURFACE, npz_bytes(vertices=v, faces=f))
+    staging.write_json(layout.INGEST_SUMMARY, {**result.summary, "notes": list(result.notes)})
 
 
 def _path_npz(path: SelectedPath, **extra: np.ndarray) -> bytes:
@@ -178,23 +179,24 @@ def _path_npz(path: SelectedPath, **extra: np.ndarray) -> bytes:
 
 def load_ingest(build_dir: Path) -> IngestResult:
     """Re-read the ingest result kept in ``build_dir/ingest``."""
-    root = Path(build_dir) / "ingest"
-    path = _load_path(root / "path.npz")
-    network = load_npz(root / "network.npz")
+    root = Path(build_dir)
+    path = _load_path(root / layout.INGEST_PATH)
+    network = load_npz(root / layout.INGEST_NETWORK)
     others = tuple(
         SelectedPath(v, None, int(k.removeprefix("path_"))) for k, v in sorted(network.items())
     )
-    surface = load_npz(root / "surface.npz")
-    initial = _load_path(root / "initial_path.npz") if (root / "initial_path.npz").is_file() else None
+    surface = load_npz(root / layout.INGEST_SURFACE)
+    initial_file = root / layout.INGEST_INITIAL_PATH
+    initial = _load_path(initial_file) if initial_file.is_file() else None
     keyframes = tuple(
         (float(load_npz(f)["q"]), _load_path(f))
-        for f in sorted(root.glob("keyframe_*.npz"), key=lambda f: int(f.stem.removeprefix("keyframe_")))
+        for f in sorted(root.glob(layout.ingest_keyframe("*")), key=lambda f: int(f.stem.removeprefix("keyframe_")))
     )
     initial_surface = None
-    if (root / "initial_surface.npz").is_file():
-        data = load_npz(root / "initial_surface.npz")
+    if (root / layout.INGEST_INITIAL_SURFACE).is_file():
+        data = load_npz(root / layout.INGEST_INITIAL_SURFACE)
         initial_surface = (data["vertices"], data["faces"])
-    summary = json.loads((root / "summary.json").read_text(encoding="utf-8"))
+    summary = json.loads((root / layout.INGEST_SUMMARY).read_text(encoding="utf-8"))
     notes = tuple(summary.pop("notes", ()))
     return IngestResult(
         path, others, surface["vertices"], surface["faces"], initial, keyframes, initial_surface, summary, notes
@@ -204,3 +206,34 @@ def load_ingest(build_dir: Path) -> IngestResult:
 def _load_path(file: Path) -> SelectedPath:
     data = load_npz(file)
     return SelectedPath(data["points"], data.get("radius"), int(data["index"]))
+
+
+def describe_ingest(result: IngestResult) -> list[str]:
+    """The network's paths (the selected one starred), the surface, the units and the notes."""
+    c = result.summary["centerline"]
+    lines = [f"centerline {c['file']}: {c['polylines']} polyline(s), branch-split: {c['branch_split']}"]
+    for p in c["paths"]:
+        mark = "*" if p["path"] == c["selected"] else " "
+        lines.append(f" {mark} path {p['path']}: {p['points']} points, {p['length_mm']:.2f} mm")
+    if c["radius_range_mm"]:
+        lo, hi = c["radius_range_mm"]
+        lines.append(f"   radius {lo:.3f} .. {hi:.3f} mm (MaximumInscribedSphereRadius)")
+    s = result.summary["surface"]
+    if s:
+        kind = "capped (watertight)" if s["capped"] else f"open, {s['boundary_loops']} boundary loop(s)"
+        lines.append(f"surface {s['file']}: {s['vertices']} vertices, {s['faces']} triangles, {kind}")
+    lines.append(f"units: {result.summary['units']} (converted to mm)")
+    return lines + list(result.notes)
+
+
+STAGE = Stage(
+    name="ingest",
+    version=VERSION,
+    reads=("units", "final", "initial.kind", "initial.centerline", "initial.path", "initial.surface", "intermediate"),
+    upstream=(),
+    compute=lambda case, results: run_ingest(case),
+    write=write_ingest,
+    load=lambda build_dir, results: load_ingest(build_dir),
+    describe=describe_ingest,
+    metrics=lambda result: result.summary,
+)

@@ -29,10 +29,9 @@ from pathlib import Path
 from typing import Any, Optional, Sequence
 
 from softdesign.errors import ConfigError
-from softdesign.pipeline.store import MANIFEST
+from softdesign.pipeline.layout import EXPORT_SUMMARY, FIT_SUMMARY, KINEMATICS, MANIFEST, MESHES_DIR
 
 CASE_SUFFIX = ".yaml"
-KINEMATICS = "kinematics.json"
 LOG_SUFFIX = ".log"
 STATUS_SUFFIX = ".status.json"
 #: Longest error message kept in the summary table (the log keeps all of it).
@@ -114,7 +113,7 @@ def case_inputs(case_file: Path) -> list[Path]:
     """
     # imported here: `run` and `summary` start once per case and need neither pydantic nor vtk
     from softdesign.config import load_case
-    from softdesign.pipeline.ingest import input_fields
+    from softdesign.pipeline.stages.ingest import input_fields
 
     return [path for _, path in input_fields(load_case(case_file))]
 
@@ -231,7 +230,7 @@ def manifest_figures(build_dir: Path) -> dict[str, Any]:
     metrics = manifest["metrics"]
     fit = metrics.get("fit") or {}
     per_q = _per_q_figures(build_dir, metrics)
-    meshes = [o for o in manifest["outputs"] if o["path"].startswith("meshes/") and "volume_mm3" in o]
+    meshes = [o for o in manifest["outputs"] if o["path"].startswith(MESHES_DIR + "/") and "volume_mm3" in o]
     volumes = [float(o["volume_mm3"]) for o in meshes]
     return {
         "links": (metrics.get("kinematics") or {}).get("links", ""),
@@ -263,7 +262,7 @@ def _per_q_figures(build_dir: Path, metrics: dict) -> list[dict]:
 
 def _max_rho_kappa(fit: dict, build_dir: Path) -> Any:
     """The largest rho * kappa over the exported meshes (it folds at 1), else the fit's at q = 1."""
-    path = build_dir / "export" / "summary.json"
+    path = build_dir / EXPORT_SUMMARY
     if path.is_file():
         meshes = json.loads(path.read_text(encoding="utf-8")).get("meshes", {})
         values = [m["max_rho_kappa"] for m in meshes.values() if "max_rho_kappa" in m]
@@ -273,7 +272,7 @@ def _max_rho_kappa(fit: dict, build_dir: Path) -> Any:
 
 
 def _fit_summary(build_dir: Path) -> dict:
-    path = build_dir / "fit" / "summary.json"
+    path = build_dir / FIT_SUMMARY
     return json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
 
 

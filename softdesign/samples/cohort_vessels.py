@@ -4,8 +4,8 @@ Each :class:`VesselVariant` gives a main path (a closed-form 3-D curve named
 by ``path``), a radius tapering linearly from inlet to outlet, an elliptical
 section like the sample vessel's, and one side branch leaving the trunk
 towards ``branch_side``.  :func:`make_variant_vessel` returns the same
-:class:`~softdesign.geometry.sample_vessel.SampleVessel` the sample generator
-builds, so :func:`softdesign.meshing.sample_surface.sample_surface` makes its
+:class:`~softdesign.samples.sample_vessel.SampleVessel` the sample generator
+builds, so :func:`softdesign.samples.surfaces.sample_surface` makes its
 capped wall.  Pure geometry, mm.
 
 Paths (``s`` runs over ``[0, length_mm]`` before arc-length resampling)
@@ -23,7 +23,7 @@ from typing import Callable
 
 import numpy as np
 
-from softdesign.geometry.sample_vessel import SampleVessel, main_curve
+from softdesign.samples.sample_vessel import SampleVessel, main_curve
 from softdesign.types import FloatArray, Points
 
 #: Dense samples of a path before arc-length resampling.

@@ -6,7 +6,7 @@ radius stays well clear of folding: rho * kappa < 0.45).  The radius
 tapers linearly from ``radius_mm[0]`` to ``radius_mm[1]``; the section is
 slightly elliptical like the sample vessel's, its major axis turning
 slowly.  The size of the benchmark (triangle count of the wall) is chosen
-when the wall is tessellated (:mod:`softdesign.meshing.synthetic_surface`),
+when the wall is tessellated (:mod:`softdesign.samples.surfaces`),
 so the same vessel can be meshed at any resolution.  Pure geometry, mm.
 """
 

@@ -1,4 +1,4 @@
-"""Stage 5, export: a checked watertight solid of S(q) at every export q, in every format.
+"""Stage 6, export: a checked watertight solid of S(q) at every export q, in every format.
 
 Each mesh is built by :func:`softdesign.meshing.solids.build_solid` and
 checked before it is kept (watertight, consistently wound, one body, the
@@ -29,12 +29,13 @@ from softdesign.meshing.checks import check_solid
 from softdesign.meshing.regions import RegionPiece, split_by_region
 from softdesign.meshing.solids import Solid, build_solid
 from softdesign.meshing.volume import BodySpec, integrate_body
-from softdesign.pipeline.fit_stage import FitResult
-from softdesign.pipeline.kinematics_stage import KinematicsResult
+from softdesign.pipeline import layout
+from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.fit import FitResult
+from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 
 VERSION = 1
-SUMMARY = "export/summary.json"
 
 
 @dataclass(frozen=True)
@@ -58,12 +59,12 @@ class ExportResult:
 
 def mesh_name(q: float, fmt: str) -> str:
     """``meshes/q_0.500.stl``: three decimals, as DESIGN.md names them."""
-    return f"meshes/q_{q:.3f}.{fmt}"
+    return layout.mesh_path(q, fmt)
 
 
 def region_name(q: float, piece: RegionPiece) -> str:
     """``meshes/q_0.500/wall.stl``: one folder per q, so ``meshes/q_*.stl`` stays the solids."""
-    return f"meshes/q_{q:.3f}/{piece.name}.stl"
+    return layout.region_path(q, piece.name)
 
 
 def body_spec(case: Case) -> BodySpec:
@@ -149,16 +150,16 @@ def write_export(result: ExportResult, staging: Staging) -> None:
             staging.write_bytes(mesh_name(mesh.q, fmt), mesh_bytes(mesh.solid.vertices, mesh.solid.faces, fmt, regions))
         for piece in mesh.pieces:
             staging.write_bytes(region_name(mesh.q, piece), mesh_bytes(piece.vertices, piece.faces, "stl"))
-        relative = f"centerlines/q_{mesh.q:.3f}.vtp"
+        relative = layout.centerline_path(mesh.q)
         arrays = {k: [v] for k, v in mesh.centerline.items() if k != "points"}
         write_polylines_vtp(staging.staged_path(relative), [mesh.centerline["points"]], arrays)
         staging.record(relative)
-    staging.write_json(SUMMARY, result.summary)
+    staging.write_json(layout.EXPORT_SUMMARY, result.summary)
 
 
 def load_export(build_dir: Path) -> ExportResult:
     """The figures of a kept export (the meshes stay on disk)."""
-    summary = json.loads((Path(build_dir) / SUMMARY).read_text(encoding="utf-8"))
+    summary = json.loads((Path(build_dir) / layout.EXPORT_SUMMARY).read_text(encoding="utf-8"))
     return ExportResult((), summary)
 
 
@@ -174,7 +175,7 @@ def describe_export(result: ExportResult) -> list[str]:
     by_q: dict[float, list[str]] = {}
     for f in result.summary.get("regions", {}).values():
         by_q.setdefault(f["q"], []).append(f"{f['region']} {f['faces']} faces {f['area_mm2']:.2f} mm2")
-    lines += [f"meshes/q_{q:.3f}/ one STL per region: {', '.join(parts)}" for q, parts in by_q.items()]
+    lines += [f"{layout.region_dir(q)} one STL per region: {', '.join(parts)}" for q, parts in by_q.items()]
     return lines
 
 
@@ -184,3 +185,17 @@ def output_figures(result: ExportResult) -> dict[str, dict[str, Any]]:
     figures = {name: {k: f[k] for k in keys} for name, f in result.summary["meshes"].items()}
     figures.update(result.summary.get("regions", {}))
     return figures
+
+
+STAGE = Stage(
+    name="export",
+    version=VERSION,
+    reads=("export",),
+    upstream=("kinematics", "fit"),
+    compute=lambda case, results: run_export(case, results["kinematics"], results["fit"]),
+    write=write_export,
+    load=lambda build_dir, results: load_export(build_dir),
+    describe=describe_export,
+    metrics=lambda result: {k: v for k, v in result.summary.items() if k != "meshes"},
+    figures=output_figures,
+)

@@ -7,32 +7,20 @@ Register with ``app.command()(report)`` in :mod:`softdesign.cli`; ``build
 
 from __future__ import annotations
 
-import math
 import time
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated
 
 import typer
 
-from softdesign.cli_support import note, run_guarded
-from softdesign.errors import ConfigError
+from softdesign.cli.common import distances_from_text, note, run_guarded
 
 
 def pcc_d_from_text(text: str | None) -> tuple[float, ...] | None:
     """Parse ``--pcc-d``: one distance in mm for every link ("15") or one per link ("15,14,13"), each > 0."""
     if text is None:
         return None
-    fix = 'give the chambers\' distance from the backbone in mm, one value ("15") or one per link ("15,14,13")'
-    values = []
-    for part in text.split(","):
-        try:
-            value = float(part)
-        except ValueError:
-            raise ConfigError(f"--pcc-d: '{part.strip()}' is not a number; {fix}") from None
-        if not (math.isfinite(value) and value > 0):
-            raise ConfigError(f"--pcc-d: got {part.strip()}, expected a finite distance > 0 mm; {fix}")
-        values.append(value)
-    return tuple(values)
+    return tuple(distances_from_text(text, "--pcc-d", "chambers' distance from the backbone", item="link"))
 
 
 def report_after_build(build_dir: Path, pcc_d: str | None = None) -> None:
@@ -55,7 +43,7 @@ def report_after_build(build_dir: Path, pcc_d: str | None = None) -> None:
 def report(
     build_dir: Annotated[Path, typer.Argument(help="The build folder (made by softdesign build).", show_default=False)],
     pcc_d: Annotated[
-        Optional[str],
+        str | None,
         typer.Option(
             "--pcc-d",
             help='Add the PCC chamber lengths over q: chamber distance from the backbone in mm, one value ("15") '

@@ -12,16 +12,16 @@ import csv
 import io
 import math
 from pathlib import Path
-from typing import Annotated, NamedTuple, Optional
+from typing import Annotated, NamedTuple
 
 import numpy as np
 import typer
 
-from softdesign.cli_support import emit_json, note, run_guarded
+from softdesign.cli.common import JsonOpt, emit_json, note, run_guarded
 from softdesign.errors import ConfigError, InputDataError
 from softdesign.io.atomic import write_bytes_atomically
-from softdesign.pcc_design_cli import design
-from softdesign.pcc_options import DOpt, LengthsOpt, lengths_from_text, spacing_from_text
+from softdesign.cli.pcc_design import design
+from softdesign.cli.pcc_options import DOpt, LengthsOpt, lengths_from_text, spacing_from_text
 
 CONVENTION = (
     "Encoders at 90, 210, 330 degrees from the section's base x axis, d mm from the backbone; "
@@ -75,7 +75,7 @@ def _print_forward(payload: dict) -> None:
 def forward(
     lengths: LengthsOpt,
     d: DOpt,
-    json_out: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
+    json_out: JsonOpt = False,
 ) -> None:
     """Shape of a chain of sections from encoder lengths: kappa, phi, L, theta per section, and the tip pose.
 
@@ -245,16 +245,20 @@ def _write_backbones(path: Path, readings: Readings, arcs, points_per_section: i
 def reconstruct(
     readings_csv: Annotated[Path, typer.Argument(help="Encoder readings over time (CSV).", show_default=False)],
     d: DOpt,
-    out_dir: Annotated[Path, typer.Option("--out", "-o", help="Folder for the results (created if missing).", show_default=False)],
+    out_dir: Annotated[
+        Path,
+        typer.Option("--shapes-dir", help="Folder for the reconstructed shapes (created if missing).",
+                     show_default=False),
+    ],
     max_rate: Annotated[
-        Optional[float], typer.Option("--max-rate", help="Reject a row whose length changes faster than this, mm/s.")
+        float | None, typer.Option("--max-rate", help="Reject a row whose length changes faster than this, mm/s.")
     ] = None,
     points_per_section: Annotated[int, typer.Option("--points-per-section", min=2, help="Backbone samples per arc.")] = 21,
 ) -> None:
     """Backbone and tip pose for every row of an encoder-readings CSV.
 
     READINGS.csv has a header row, then per row a time (first column, s) and
-    three lengths (mm) per section, sections in order.  Writes, in OUT_DIR:
+    three lengths (mm) per section, sections in order.  Writes, in SHAPES_DIR:
     tips.csv (time, tip_x/y/z in mm, the tip-to-base rotation r11..r33 row by
     row, and kappa/phi/length/theta per section); backbones.vtp (one file, one
     polyline per accepted row, base to tip, with point arrays time, section,

@@ -1,0 +1,43 @@
+"""The `softdesign` command line: parse, load, call the pipeline, map errors to exit codes.
+
+Exit codes: 0 success, 1 processing failure, 2 bad usage or bad input.
+With ``--json`` a command prints one JSON object on stdout and nothing else;
+notes, progress and warnings go to stderr.
+
+One module per command family: :mod:`~softdesign.cli.build` (validate, build
+and one command per stage), :mod:`~softdesign.cli.pose`,
+:mod:`~softdesign.cli.check`, :mod:`~softdesign.cli.report`,
+:mod:`~softdesign.cli.sample` and :mod:`~softdesign.cli.pcc` (the ``pcc``
+group); what they share is :mod:`~softdesign.cli.common`.
+"""
+
+from __future__ import annotations
+
+import typer
+
+from softdesign.cli.build import blend, build, export, fit, ingest, kinematics, validate
+from softdesign.cli.check import check
+from softdesign.cli.pcc import pcc_app
+from softdesign.cli.pose import pose
+from softdesign.cli.report import report
+from softdesign.cli.sample import sample
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    help="Patient-specific soft actuators from VMTK vessel exports.",
+)
+app.add_typer(pcc_app, name="pcc")
+for command in (check, pose, report, validate, build, ingest, blend, kinematics, fit, export, sample):
+    app.command()(command)
+
+
+def main() -> None:
+    """Console-script entry point."""
+    app()
+
+
+__all__ = [
+    "app", "main", "validate", "build", "ingest", "blend", "kinematics", "fit", "export",
+    "pose", "check", "report", "sample",
+]

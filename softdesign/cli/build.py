@@ -1,0 +1,136 @@
+"""`softdesign validate|build|ingest|blend|kinematics|fit|export CASE.yaml`: the case file and its stages.
+
+Parsing and printing live here; the stages are :mod:`softdesign.pipeline`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from softdesign.cli.common import CaseArg, ForceOpt, JsonOpt, OutOpt, StageProgress, emit_json, q_values_from_text, run_guarded
+
+ReportOpt = Annotated[bool, typer.Option("--report", help="Then write BUILD/report/index.html (softdesign report).")]
+KinematicsQOpt = Annotated[
+    str | None, typer.Option("--q", help="One q for every link ('0.5') or one per link ('0.2,0.8,1'), each in [0, 1].")
+]
+#: The keys of each link in ``kinematics --q --json`` (DESIGN.md).
+KINEMATICS_LINK_KEYS = ("index", "l_start", "l_end", "length", "transform", "poe")
+
+
+def _run(case_file: Path, out: Path | None, target: str | None, force: bool):
+    """Load the case and run the stages through ``target`` (every stage when None)."""
+    from softdesign.pipeline.api import build_through
+
+    return build_through(case_file, out, target, force, progress=StageProgress())
+
+
+def _print_runs(build_dir: Path, runs) -> None:
+    for run in runs:
+        typer.echo(f"[{run.name}] {run.status} ({run.seconds:.2f} s)")
+        for line in run.lines:
+            typer.echo(f"  {line}")
+    typer.echo(f"build folder: {build_dir}")
+
+
+def _stage_command(case_file: Path, out: Path | None, target: str, force: bool) -> None:
+    def action() -> None:
+        outcome = _run(case_file, out, target, force)
+        _print_runs(outcome.build_dir, outcome.runs)
+
+    run_guarded(action)
+
+
+def validate(case_file: CaseArg) -> None:
+    """Check a case file (schema, ranges, input files present) without building."""
+
+    def action() -> None:
+        from softdesign.config import load_case
+        from softdesign.pipeline.stages import input_files
+
+        case = load_case(case_file)
+        files = input_files(case)
+        typer.echo(f"{case_file}: valid (case '{case.name}', {len(files)} input file(s) found)")
+
+    run_guarded(action)
+
+
+def build(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False, with_report: ReportOpt = False) -> None:
+    """Run every stage (unchanged stages are skipped) and write the manifest; --report adds the HTML report."""
+
+    def action() -> None:
+        from softdesign.cli.report import report_after_build
+
+        outcome = _run(case_file, out, None, force)
+        _print_runs(outcome.build_dir, outcome.runs)
+        if with_report:
+            report_after_build(outcome.build_dir)
+
+    run_guarded(action)
+
+
+def ingest(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:
+    """Read and check the inputs; keep them, in mm, under BUILD/ingest."""
+    _stage_command(case_file, out, "ingest", force)
+
+
+def blend(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:
+    """Smooth and resample the centerlines, blend c(q, l), frames; figures per export q."""
+    _stage_command(case_file, out, "blend", force)
+
+
+def fit(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:
+    """Fit rho(l, a) per link to the wall; print the metrics table (true distances, hold-out)."""
+    _stage_command(case_file, out, "fit", force)
+
+
+def export(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:
+    """Checked watertight solids of S(q) at every export q (STL and the other formats asked for)."""
+    _stage_command(case_file, out, "export", force)
+
+
+def kinematics(
+    case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False, q: KinematicsQOpt = None, as_json: JsonOpt = False
+) -> None:
+    """Links, S_T_E and POE per link; with --q, the chain at that q (one per link allowed)."""
+
+    def action() -> None:
+        from softdesign.pipeline.stages.kinematics import pose_document
+
+        q_values = None if q is None else q_values_from_text(q)
+        outcome = _run(case_file, out, "kinematics", force)
+        if q_values is None:
+            if as_json:
+                emit_json(outcome.results["kinematics"].document)
+            else:
+                _print_runs(outcome.build_dir, outcome.runs)
+            return
+        document = pose_document(outcome.results["kinematics"].chain, q_values)
+        payload = {
+            "q": document["q"],
+            "links": [{k: link[k] for k in KINEMATICS_LINK_KEYS} for link in document["links"]],
+            "base_to_tip": document["base_to_tip"],
+            "frames": outcome.case.frames,
+        }
+        if as_json:
+            emit_json(payload)
+        else:
+            _print_pose(payload)
+
+    run_guarded(action)
+
+
+def _print_pose(payload: dict[str, Any]) -> None:
+    typer.echo(f"q = {payload['q']} (frames {payload['frames']})")
+    for link in payload["links"]:
+        p = link["poe"]
+        omega = "null" if p["omega"] is None else "[" + ", ".join(f"{v:.4f}" for v in p["omega"]) + "]"
+        typer.echo(
+            f"link {link['index']} l {link['l_start']:.3f}..{link['l_end']:.3f}: length {link['length']:.3f} mm, "
+            f"theta1 {p['theta1']:.4f} mm, theta2 {p['theta2']:.5f} rad about {omega}"
+        )
+    typer.echo("base_to_tip:")
+    for row in payload["base_to_tip"]:
+        typer.echo("  " + "  ".join(f"{v:12.6f}" for v in row))

@@ -1,0 +1,146 @@
+"""What every command shares: options, parsers, error mapping, JSON output, notes on stderr.
+
+Options are declared once here (``CaseArg``, ``OutOpt``, ``ForceOpt``,
+``JsonOpt``, ``QOpt``) so that a flag means the same thing in every command:
+``--out/-o`` is always the build folder.  The two list parsers (``--q`` and
+the distance lists ``--d``/``--pcc-d``) are the only ones; they raise
+:class:`~softdesign.errors.ConfigError` naming the option and the fix.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Annotated, Any, TypeVar
+
+import typer
+
+from softdesign.errors import ConfigError, SoftdesignError
+
+T = TypeVar("T")
+
+CaseArg = Annotated[Path, typer.Argument(help="The case file (YAML).", show_default=False)]
+OutOpt = Annotated[Path | None, typer.Option("--out", "-o", help="Build folder [default: build/<name>].")]
+ForceOpt = Annotated[bool, typer.Option("--force", help="Redo every stage, ignoring the cache.")]
+JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")]
+QOpt = Annotated[
+    str,
+    typer.Option("--q", help="One q for every link ('0.5') or one per link ('0.2,0.8,1'), each in [0, 1].",
+                 show_default=False),
+]
+
+Q_FIX = "give one q for every link (e.g. 0.5) or one per link separated by commas (e.g. 0.2,0.8,1), each in [0, 1]"
+
+
+def note(message: str) -> None:
+    """Write a human note to stderr (stdout is kept for --json output)."""
+    typer.echo(message, err=True)
+
+
+def emit_json(payload: dict[str, Any]) -> None:
+    """Print one JSON object on stdout, keys in a fixed order."""
+    typer.echo(json.dumps(payload, indent=2, allow_nan=False))
+
+
+def run_guarded(action: Callable[[], T]) -> T:
+    """Run ``action``; turn a SoftdesignError into a message and its exit code.
+
+    A user error (bad case file, bad input) exits 2 and a processing failure
+    exits 1, each with a one-paragraph message and no traceback.  Anything
+    else is a bug and propagates with its traceback.
+    """
+    try:
+        return action()
+    except SoftdesignError as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(code=err.exit_code) from None
+
+
+def q_values_from_text(text: str) -> list[float]:
+    """Parse ``--q`` into a list of q values, each finite and in [0, 1].
+
+    Raises
+    ------
+    ConfigError
+        An empty entry, a non-number, or a value outside [0, 1].
+    """
+    values = []
+    for i, part in enumerate(text.split(","), start=1):
+        try:
+            value = float(part)
+        except ValueError:
+            raise ConfigError(f"--q: value {i} '{part.strip()}' of {text!r} is not a number; {Q_FIX}") from None
+        if not (math.isfinite(value) and 0.0 <= value <= 1.0):
+            raise ConfigError(f"--q: value {i} of {text!r} is {part.strip()}, expected a number in [0, 1]; {Q_FIX}")
+        values.append(value)
+    return values
+
+
+def distances_from_text(
+    text: str, option: str, what: str, count: int | None = None, item: str = "section", where: str = ""
+) -> list[float]:
+    """Parse a distance list (``--d``, ``--pcc-d``): one value in mm for every item or one per item, each > 0.
+
+    Parameters
+    ----------
+    text : the option's value, e.g. ``"15"`` or ``"15,14,13"``
+    option : the option's name for messages, e.g. ``"--d"``
+    what : what the distance is, for the fix (e.g. "cable distance from the backbone")
+    count : how many items there are, or None when not known yet (values are then only checked)
+    item, where : what an item is ("section", "link") and what they belong to, for the count message
+
+    Returns
+    -------
+    list of float, mm: ``count`` values (one given value repeated), or the values as given when ``count`` is None.
+    """
+    example = ",".join(["15"] * count) if count else "15,14,13"
+    per = f"one per {item} ({count} values, e.g. \"{example}\")" if count else f'one per {item} (e.g. "{example}")'
+    fix = f'give the {what} in mm: one value ("15") or {per}'
+    values = []
+    for i, part in enumerate(text.split(","), start=1):
+        try:
+            value = float(part)
+        except ValueError:
+            raise ConfigError(f"{option} value {i}: '{part.strip()}' is not a number; {fix}") from None
+        if not math.isfinite(value):
+            raise ConfigError(f"{option} value {i}: got {part.strip()}, expected a finite number; {fix}")
+        if value <= 0:
+            raise ConfigError(f"{option} value {i}: {value:g} mm, expected > 0; {fix}")
+        values.append(value)
+    if count is not None and len(values) not in (1, count):
+        suffix = f" in {where}" if where else ""
+        raise ConfigError(f"{option}: {len(values)} values for {count} {item}(s){suffix}; {fix}")
+    if count is not None and len(values) == 1:
+        return values * count
+    return values
+
+
+class StageProgress:
+    """Progress of a build on stderr: a bar on a terminal, plain lines otherwise (logs, make -j).
+
+    Reads the ``[done/total] message`` lines the pipeline runner emits.
+    """
+
+    WIDTH = 24
+
+    def __init__(self, stream=None) -> None:
+        self.stream = stream if stream is not None else sys.stderr
+        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+
+    def __call__(self, line: str) -> None:
+        if not self.tty:
+            self.stream.write(line + "\n")
+            return
+        counts, _, message = line.partition("] ")
+        done, _, total = counts.lstrip("[").partition("/")
+        if not (done.isdigit() and total.isdigit()):
+            self.stream.write(line + "\n")
+            return
+        filled = self.WIDTH * int(done) // max(int(total), 1)
+        bar = "#" * filled + "-" * (self.WIDTH - filled)
+        end = "\n" if int(done) == int(total) and not message.endswith("running") else ""
+        self.stream.write(f"\r[{bar}] {done}/{total} {message:<60.60}{end}")
+        self.stream.flush()
