@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import typer
 
-from softdesign.cli.build import blend, build, export, fit, ingest, kinematics, validate
+from softdesign.cli.build import blend, build, export, fit, ingest, kinematics, links, validate
 from softdesign.cli.check import check
 from softdesign.cli.pcc import pcc_app
 from softdesign.cli.pose import pose
@@ -28,7 +28,7 @@ app = typer.Typer(
     help="Patient-specific soft actuators from VMTK vessel exports.",
 )
 app.add_typer(pcc_app, name="pcc")
-for command in (check, pose, report, validate, build, ingest, blend, kinematics, fit, export, sample):
+for command in (validate, build, ingest, blend, links, kinematics, fit, export, pose, check, report, sample):
     app.command()(command)
 
 
@@ -38,6 +38,6 @@ def main() -> None:
 
 
 __all__ = [
-    "app", "main", "validate", "build", "ingest", "blend", "kinematics", "fit", "export",
+    "app", "main", "validate", "build", "ingest", "blend", "links", "kinematics", "fit", "export",
     "pose", "check", "report", "sample",
 ]

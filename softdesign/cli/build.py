@@ -1,4 +1,4 @@
-"""`softdesign validate|build|ingest|blend|kinematics|fit|export CASE.yaml`: the case file and its stages.
+"""`softdesign validate|build|ingest|blend|links|kinematics|fit|export CASE.yaml`: the case file and its stages.
 
 Parsing and printing live here; the stages are :mod:`softdesign.pipeline`.
 """
@@ -79,6 +79,11 @@ def ingest(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> N
 def blend(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:
     """Smooth and resample the centerlines, blend c(q, l), frames; figures per export q."""
     _stage_command(case_file, out, "blend", force)
+
+
+def links(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:
+    """Split the actuator into links (links.count, breaks or length_mm); keep the breaks under BUILD/links."""
+    _stage_command(case_file, out, "links", force)
 
 
 def fit(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:
