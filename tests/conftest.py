@@ -1,15 +1,12 @@
-"""Shared test fixtures: the real VMTK data beside the checkout, and small synthetic cases."""
+"""Shared fixtures: the real VMTK data beside the checkout (helpers live in tests/helpers/)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import pytest
-import yaml
 
-SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
-AORTA_DIR = SHARED_DATA / "vmtk-aorta"
+from tests.helpers.paths import AORTA_DIR
 
 
 @pytest.fixture
@@ -18,31 +15,3 @@ def aorta_dir() -> Path:
     if not AORTA_DIR.is_dir():
         pytest.skip(f"real VMTK data not found at {AORTA_DIR} (CI has ../shared beside the checkout)")
     return AORTA_DIR
-
-
-def write_case(folder: Path, name: str = "case", **sections) -> Path:
-    """Write a case file from keyword sections; returns its path."""
-    path = folder / f"{name}.yaml"
-    path.write_text(yaml.safe_dump(sections, sort_keys=False))
-    return path
-
-
-def straight_tube(folder: Path, radius: float = 3.0, length: float = 40.0, scale: float = 1.0) -> tuple[Path, Path]:
-    """A straight vessel along z: centerline .vtp (with radius) and capped surface .stl.
-
-    ``scale`` multiplies every coordinate (1e-3 writes the same vessel in metres).
-    """
-    import trimesh
-
-    from softdesign.io.polylines_vtp import write_polylines_vtp
-
-    z = np.linspace(0.0, length, 81)
-    points = np.column_stack([np.zeros_like(z), np.zeros_like(z), z]) * scale
-    centerline = folder / "centerline.vtp"
-    write_polylines_vtp(centerline, [points], {"MaximumInscribedSphereRadius": [np.full(len(z), radius * scale)]})
-    tube = trimesh.creation.cylinder(radius=radius, height=length + 2.0, sections=48)
-    tube.apply_translation([0.0, 0.0, length / 2])
-    tube.apply_scale(scale)
-    surface = folder / "surface.stl"
-    tube.export(surface)
-    return centerline, surface

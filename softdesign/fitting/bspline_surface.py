@@ -37,7 +37,7 @@ from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.projection import PolarPoints
 from softdesign.types import FloatArray, IntArray
 
-#: Defaults, from the VMTK aorta (see the note in tests/test_fit_aorta.py): knots every 1.5 mm
+#: Defaults, from the VMTK aorta (see the note in tests/fitting/test_fit_aorta.py): knots every 1.5 mm
 #: and 24 around (about 1.5 mesh edges each way), and the smallest smoothing that keeps the
 #: fit across the other iliac's opening inside the range of the observed radii.
 DEFAULT_KNOT_SPACING_MM = 1.5

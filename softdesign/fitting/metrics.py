@@ -33,7 +33,7 @@ from softdesign.types import FloatArray, FramedCurve, Points
 #: Gauss-Newton stops when a point's (l, a) step moves its surface point less than this, mm.  The
 #: distance is stationary at the closest point and what is left after such a step is a small fraction
 #: of it, so the distances are far closer than this: within 2e-12 mm of those at a 1e-10 mm stop on the
-#: VMTK aorta and the benchmark tube (1e-13 mm of the closed forms in tests/test_fit_metrics.py).
+#: VMTK aorta and the benchmark tube (1e-13 mm of the closed forms in tests/fitting/test_fit_metrics.py).
 CLOSEST_TOL_MM = 1e-5
 #: Hard stop on Gauss-Newton steps (from the projection, 2-3 for most points, ~10 for the slowest).
 CLOSEST_MAX_STEPS = 30

@@ -1,0 +1,108 @@
+"""The benchmark script's pieces on tiny inputs: tables, slopes, verdicts, the synthetic vessel, one worker run.
+
+No timing is asserted anywhere: figures are fed in by hand or only checked for shape.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from softdesign.samples.synthetic_vessel import SyntheticShape, make_synthetic_vessel
+from softdesign.samples.surfaces import grid_counts, synthetic_surface
+from tests.helpers.paths import REPO
+
+BENCH_FILE = REPO / "pipelines" / "bench.py"
+
+
+@pytest.fixture(scope="module")
+def bench():
+    spec = importlib.util.spec_from_file_location("softdesign_bench", BENCH_FILE)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up by name
+    spec.loader.exec_module(module)
+    return module
+
+
+def fake_result(bench, triangles: int, frames: int, per_stage: dict[str, float]) -> dict:
+    wall = {name: per_stage.get(name, 0.1) for name in bench.STAGE_NAMES}
+    stages = {name: {"wall_s": s, "cpu_s": 0.9 * s, "peak_mib": 300.0} for name, s in wall.items()}
+    return {
+        "label": f"fake {triangles} {frames}",
+        "import_s": 1.0,
+        "baseline_mib": 250.0,
+        "stages": stages,
+        "total": {"wall_s": sum(wall.values()), "cpu_s": 0.9 * sum(wall.values()), "peak_mib": 310.0},
+        "input": {"triangles": triangles, "vertices": triangles // 2},
+        "output": {"meshes": frames, "triangles": 1000 * frames},
+        "floor": {"read_s": 0.5, "write_s": 0.25},
+        "size": {"triangles": triangles, "frames": frames},
+    }
+
+
+def test_stage_table_has_every_stage_the_total_and_the_ratio_to_the_floor(bench):
+    result = fake_result(bench, 1000, 3, {"ingest": 1.0, "export": 0.5})
+    lines = bench.stage_table(result)
+    rows = {line.split()[0]: line.split() for line in lines[3:]}
+    assert list(rows) == [*bench.STAGE_NAMES, "total"]
+    assert rows["ingest"][-2:] == ["0.500", "2.0x"]  # 1.0 s against a 0.5 s read
+    assert rows["export"][-2:] == ["0.250", "2.0x"]
+    assert rows["fit"][-2:] == ["-", "-"]  # no I/O floor for a stage that reads and writes nothing required
+    assert rows["total"][-1] == f"{result['total']['wall_s'] / 0.75:.1f}x"
+
+
+def test_linear_fit_recovers_a_line(bench):
+    slope, intercept = bench.linear_fit([0.25, 0.5, 1.0], [2.0 + 4.0 * x for x in (0.25, 0.5, 1.0)])
+    assert slope == pytest.approx(4.0)
+    assert intercept == pytest.approx(2.0)
+
+
+@pytest.mark.parametrize(("power", "linear"), [(1.0, True), (2.0, False)])
+def test_growth_with_triangles_is_judged_on_step_slopes(bench, power, linear):
+    sizes = (250_000, 500_000, 1_000_000)
+    runs = [fake_result(bench, t, 41, {"fit": 3.0 + 40.0 * (t / 1e6) ** power}) for t in sizes]
+    lines, verdict = bench.growth_lines(runs, "triangles", "million triangles", 1e6)
+    assert verdict is linear
+    assert any(line.split()[0] == "total" for line in lines)
+
+
+def test_growth_with_two_frame_counts_compares_ratios(bench):
+    proportional = [fake_result(bench, 1000, f, {"export": 0.2 * f}) for f in (11, 41)]
+    faster = [fake_result(bench, 1000, f, {"export": 0.01 * f * f}) for f in (11, 41)]
+    assert bench.growth_lines(proportional, "frames", "frame", 1.0)[1] is True
+    assert bench.growth_lines(faster, "frames", "frame", 1.0)[1] is False
+    assert bench.growth_lines(proportional[:1], "frames", "frame", 1.0) == ([], None)
+
+
+def test_scaling_table_and_targets(bench):
+    runs = [fake_result(bench, t, 41, {}) for t in (1000, 2000)]
+    assert len(bench.scaling_table(runs)) == 1 + len(runs)
+    targets = bench.target_lines(runs[-1], True, None)
+    assert "met" in targets[0] and "met" in targets[1]  # 0.6 s against a 0.75 s floor; 310 MiB
+    assert targets[3].endswith("not measured")
+
+
+def test_synthetic_surface_reaches_the_triangle_count_and_is_closed():
+    vessel = make_synthetic_vessel(SyntheticShape(axial_length_mm=40.0))
+    vertices, faces = synthetic_surface(vessel, 5000)
+    rings, angles = grid_counts(vessel.length, float(vessel.radius.mean()), 5000)
+    assert len(faces) == 2 * rings * angles >= 5000
+    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    _, uses = np.unique(edges, axis=0, return_counts=True)
+    assert np.all(uses == 2)  # every edge shared by exactly two triangles: closed, no seam duplicates
+    assert vertices.shape == (rings * angles + 2, 3)
+
+
+def test_worker_measures_a_tiny_synthetic_build(bench, tmp_path):
+    case = bench.synthetic_case(tmp_path / "inputs", 20_000, 2)  # ~3 wall points per spline coefficient
+    result = bench.run_worker(case.case_file, tmp_path / "run", None)
+    assert set(result["stages"]) == set(bench.STAGE_NAMES)
+    assert result["output"]["meshes"] == 2
+    assert result["input"]["triangles"] >= 20_000
+    assert all(row["peak_mib"] > 0 for row in result["stages"].values())
+    result.update(label="tiny", size={"triangles": 20_000, "frames": 2})
+    assert len(bench.stage_table(result)) == 3 + len(bench.STAGE_NAMES) + 1

@@ -1,0 +1,449 @@
+"""`softdesign report`: the page for the sample case and the real VMTK aorta, its images, table and checks.
+
+Each case is built into a temporary folder first, then reported.  The page
+is read back with an HTML parser written here (not the package's own), the
+images with Pillow, the figures against ``manifest.json`` with a JSON-pointer
+walk written here.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import shutil
+from html.parser import HTMLParser
+from pathlib import Path
+
+import numpy as np
+import pytest
+import typer
+from PIL import Image
+from typer.testing import CliRunner
+
+from softdesign.pipeline.api import build_through
+from softdesign.report.writer import EXPECTED_SIZES, PAGE, REPORT_DIR, ReportOptions, commit_folder, write_report
+
+from tests.helpers.cases import write_case
+from tests.helpers.paths import AORTA_DIR, REPO
+
+DEMO_CASE = REPO / "configs" / "demo.yaml"
+AORTA = AORTA_DIR
+needs_aorta = pytest.mark.skipif(not AORTA.is_dir(), reason=f"real VMTK data not found at {AORTA}")
+#: The page shows figures to 6 significant digits: the text may differ from the exact value by half a unit in the 6th.
+SHOWN_RTOL = 5e-6
+#: Distances recomputed from the kept radius field: the same algorithm as the fit stage, on a rebuilt
+#: (knot-inserted per link) spline, so they agree to rounding of ~5 mm radii.
+DISTANCE_ATOL_MM = 1e-9
+#: kinematics.json and the rebuilt chain evaluate the same spline the same way.
+KINEMATICS_ATOL = 1e-9
+#: The PCC panel needs the PCC design module (another issue); it is drawn when that module is present.
+HAS_PCC = __import__("importlib").util.find_spec("softdesign.kinematics.pcc_fit") is not None
+#: Chamber distance for the demo's PCC panel, mm (its largest curvature is 0.097 /mm: kappa d < 1).
+DEMO_PCC_D = 5.0
+
+
+class PageParser(HTMLParser):
+    """Images, links, key-figure cells and check rows of the report page."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.images: list[dict[str, str]] = []
+        self.links: list[str] = []
+        self.figures: list[dict[str, str]] = []
+        self.rows: list[list[str]] = []
+        self._cell: dict[str, str] | None = None
+        self._row: list[str] | None = None
+
+    def handle_starttag(self, tag, attrs):
+        attributes = dict(attrs)
+        self.links += [v for k, v in attrs if k in ("src", "href") and v is not None]
+        if tag == "img":
+            self.images.append(attributes)
+        elif tag == "tr":
+            self._row = []
+        elif tag == "td":
+            self._cell = {**attributes, "text": ""}
+
+    def handle_data(self, data):
+        if self._cell is not None:
+            self._cell["text"] += data
+
+    def handle_endtag(self, tag):
+        if tag == "td" and self._cell is not None:
+            if "data-pointer" in self._cell:
+                self.figures.append(self._cell)
+            if self._row is not None:
+                self._row.append(self._cell["text"])
+            self._cell = None
+        elif tag == "tr" and self._row is not None:
+            self.rows.append(self._row)
+            self._row = None
+
+
+def parse_page(report_dir: Path) -> PageParser:
+    parser = PageParser()
+    parser.feed((report_dir / PAGE).read_text(encoding="utf-8"))
+    return parser
+
+
+def at_pointer(document, pointer: str):
+    """The value at an RFC 6901 pointer (independent of the package's resolver)."""
+    for token in pointer.lstrip("/").split("/"):
+        token = token.replace("~1", "/").replace("~0", "~")
+        document = document[int(token)] if isinstance(document, list) else document[token]
+    return document
+
+
+def tree_hashes(folder: Path) -> dict[str, str]:
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(folder.iterdir())}
+
+
+@pytest.fixture(scope="module")
+def demo(tmp_path_factory):
+    build_dir = tmp_path_factory.mktemp("demo") / "build"
+    build_through(DEMO_CASE, build_dir)
+    result = write_report(build_dir, ReportOptions(pcc_d=(DEMO_PCC_D,)))
+    return build_dir, result
+
+
+@pytest.fixture(scope="module")
+def aorta(tmp_path_factory):
+    if not AORTA.is_dir():
+        pytest.skip(f"real VMTK data not found at {AORTA}")
+    folder = tmp_path_factory.mktemp("aorta")
+    case = write_case(
+        folder, "aorta",
+        final={"centerline": str(AORTA / "aorta-centerline.vtp"), "surface": str(AORTA / "aorta-surface.stl"),
+               "path": 0},
+        export={"q": [0, 0.25, 0.5, 1]},
+    )
+    build_through(case, folder / "build")
+    return folder / "build", write_report(folder / "build")
+
+
+@pytest.fixture(params=["demo", pytest.param("aorta", marks=needs_aorta)])
+def built(request):
+    return request.getfixturevalue(request.param)
+
+
+def test_every_image_is_a_valid_file_of_the_size_the_page_states(built):
+    build_dir, _ = built
+    report_dir = build_dir / REPORT_DIR
+    page = parse_page(report_dir)
+    assert {"morph.png", "surfaces.png", "fit_residuals.png", "fit_distances.png", "kinematics.png", "morph.gif"} <= {
+        image["src"] for image in page.images
+    }
+    for image in page.images:
+        file = report_dir / image["src"]
+        with Image.open(file) as opened:
+            opened.verify()  # a truncated or corrupt file raises here
+        with Image.open(file) as opened:
+            assert opened.format == ("GIF" if file.suffix == ".gif" else "PNG")
+            assert opened.size == EXPECTED_SIZES[file.name] == (int(image["width"]), int(image["height"]))
+            assert opened.format != "GIF" or opened.n_frames > 2
+
+
+def test_the_page_links_only_to_files_beside_it_and_every_file_is_linked(built):
+    build_dir, result = built
+    report_dir = build_dir / REPORT_DIR
+    page = parse_page(report_dir)
+    files = [link for link in page.links if not link.startswith("#")]
+    assert files, "the page shows no image"
+    for link in files:
+        assert "://" not in link and not link.startswith("/") and ".." not in link, link  # no network, no escape
+        assert (report_dir / link).is_file(), link
+    assert sorted(set(files) | {PAGE}) == sorted(p.name for p in report_dir.iterdir()) == sorted(result.files)
+    anchors = {link[1:] for link in page.links if link.startswith("#")}
+    text = (report_dir / PAGE).read_text(encoding="utf-8")
+    assert all(f'id="{anchor}"' in text for anchor in anchors)
+
+
+def test_every_figure_in_the_table_equals_the_manifest(built):
+    build_dir, _ = built
+    manifest = json.loads((build_dir / "manifest.json").read_text())
+    figures = parse_page(build_dir / REPORT_DIR).figures
+    pointers = {f["data-pointer"] for f in figures}
+    fit = {f"/metrics/fit/{key}" for key in ("rms_mm", "p95_mm", "p99_mm", "max_mm", "holdout_rms_mm", "max_rho_kappa")}
+    meshes = [i for i, o in enumerate(manifest["outputs"]) if o["path"].endswith(".stl")]
+    assert fit <= pointers and meshes
+    assert {f"/outputs/{i}/{key}" for i in meshes for key in ("volume_mm3", "area_mm2", "watertight")} <= pointers
+    for cell in figures:
+        value = at_pointer(manifest, cell["data-pointer"])
+        assert json.loads(cell["data-value"]) == value, cell["data-pointer"]
+        if isinstance(value, bool):
+            assert cell["text"] == ("yes" if value else "no")
+        elif isinstance(value, (int, float)):
+            np.testing.assert_allclose(float(cell["text"]), value, rtol=SHOWN_RTOL, atol=0,
+                                       err_msg=cell["data-pointer"])
+
+
+def test_every_check_passes_and_each_mesh_is_checked(built):
+    build_dir, result = built
+    export = json.loads((build_dir / "export" / "summary.json").read_text())
+    rows = [r for r in parse_page(build_dir / REPORT_DIR).rows if len(r) == 5 and r[-1] in ("pass", "FAIL")]
+    assert len(rows) == result.checks_total == result.checks_passed
+    for mesh in export["meshes"]:
+        names = {r[1] for r in rows if r[0] == mesh}
+        assert {"watertight", "consistent winding", "one body", "volume vs integrated volume"} <= names, mesh
+    manifest = json.loads((build_dir / "manifest.json").read_text())
+    assert {o["path"] for o in manifest["outputs"]} <= {r[0] for r in rows if r[1].startswith("file as recorded")}
+
+
+def test_inputs_and_software_are_listed(built):
+    build_dir, _ = built
+    manifest = json.loads((build_dir / "manifest.json").read_text())
+    rows = parse_page(build_dir / REPORT_DIR).rows
+    for entry in manifest["inputs"]:
+        assert [entry["path"], entry["sha256"], str(entry["bytes"])] in rows
+    packages = {r[0] for r in rows if len(r) == 3}
+    assert {"softdesign", "numpy", "matplotlib", "python"} <= packages
+
+
+@needs_aorta
+def test_aorta_report_notes_the_missing_pcc_panel(aorta):
+    build_dir, _ = aorta
+    text = (build_dir / REPORT_DIR / PAGE).read_text(encoding="utf-8")
+    assert "pcc_chambers.png" not in text and "--pcc-d" in text
+
+
+@pytest.mark.skipif(not HAS_PCC, reason="softdesign.kinematics.pcc_fit (PCC design) is not in this tree")
+def test_demo_report_draws_pcc_chambers(demo):
+    build_dir, result = demo
+    assert "pcc_chambers.png" in result.files
+    with Image.open(build_dir / REPORT_DIR / "pcc_chambers.png") as image:
+        assert image.size == EXPECTED_SIZES["pcc_chambers.png"]
+
+
+def test_histogram_distances_are_the_manifests(demo):
+    from softdesign.fitting.metrics import summarize_distances
+    from softdesign.report.build_folder import load_build
+    from softdesign.report.fit_figures import true_distances
+
+    data = load_build(demo[0])
+    found = summarize_distances(true_distances(data))
+    fit = data.manifest["metrics"]["fit"]
+    assert found.count == fit["points"]["kept"]
+    for key in ("rms_mm", "p95_mm", "p99_mm", "max_mm"):
+        np.testing.assert_allclose(getattr(found, key), fit[key], rtol=0, atol=DISTANCE_ATOL_MM, err_msg=key)
+
+
+def test_kinematics_series_at_the_export_q_equals_kinematics_json(demo):
+    from softdesign.report.build_folder import load_build
+    from softdesign.report.kinematics_figures import kinematics_series
+
+    data = load_build(demo[0])
+    series = kinematics_series(data.kinematics.chain, data.export_q, samples=5)
+    assert series.q[0] == 0.0 and series.q[-1] == 1.0 and np.all(np.diff(series.q) > 0)
+    for pose in data.kinematics.document["poses"]:
+        row = int(np.flatnonzero(series.q == pose["q"][0])[0])
+        for j, link in enumerate(pose["links"]):
+            expected = (link["poe"]["theta1"], link["poe"]["theta2"], link["length"], *link["stretch"])
+            found = (series.theta1[row, j], series.theta2[row, j], series.length[row, j],
+                     series.stretch_min[row, j], series.stretch_max[row, j])
+            np.testing.assert_allclose(found, expected, rtol=0, atol=KINEMATICS_ATOL)
+            assert series.curvature_max[row, j] == pytest.approx(link["curvature_per_mm"][1], abs=KINEMATICS_ATOL)
+
+
+def plot_area_variance(figure, ax) -> float:
+    """Pixel variance inside the axes' frame (spines, ticks and labels excluded) of the figure's PNG."""
+    import io
+
+    from softdesign.report.plotting import png_bytes
+
+    data = png_bytes(figure)
+    figure.canvas.draw()
+    box = ax.get_window_extent()
+    with Image.open(io.BytesIO(data)) as image:
+        pixels = np.asarray(image.convert("L"), float)
+    inset = 3  # pixels: keep the spines out
+    top, bottom = pixels.shape[0] - int(box.y1) + inset, pixels.shape[0] - int(box.y0) - inset
+    return float(pixels[top:bottom, int(box.x0) + inset:int(box.x1) - inset].var())
+
+
+#: Pixel variance (grey levels squared) below which a plot area counts as blank.
+BLANK_VARIANCE = 1.0
+
+
+def test_a_drawn_plot_is_not_blank_and_an_empty_one_is(demo):
+    from softdesign.report.build_folder import load_build
+    from softdesign.report.morph_figures import draw_view, morph_curves
+    from softdesign.report.plotting import link_colours, new_figure
+    from softdesign.report.projection import axis_views
+
+    chain = load_build(demo[0]).kinematics.chain
+    drawn = new_figure((4.0, 3.0))
+    ax = drawn.add_subplot(1, 1, 1)
+    draw_view(ax, morph_curves(chain, [0.0, 1.0]), axis_views()[1], link_colours(chain.count), arm=3.0)
+    assert plot_area_variance(drawn, ax) > BLANK_VARIANCE
+    empty = new_figure((4.0, 3.0))
+    empty_ax = empty.add_subplot(1, 1, 1)
+    empty_ax.set(xlabel="x (mm)", ylabel="z (mm)", title="no data")
+    assert plot_area_variance(empty, empty_ax) < BLANK_VARIANCE  # the check fails a plot without data
+
+
+def test_same_build_gives_the_same_report_bytes(demo, tmp_path):
+    build_dir, _ = demo
+    before = tree_hashes(build_dir / REPORT_DIR)
+    copy = tmp_path / build_dir.name  # the page names the build folder (not its path)
+    shutil.copytree(build_dir, copy)
+    shutil.rmtree(copy / REPORT_DIR)
+    write_report(copy, ReportOptions(pcc_d=(DEMO_PCC_D,)))
+    assert tree_hashes(copy / REPORT_DIR) == before
+
+
+def test_tampered_outputs_fail_their_checks(demo, tmp_path):
+    copy = tmp_path / "tampered"
+    shutil.copytree(demo[0], copy)
+    summary_file = copy / "export" / "summary.json"
+    summary = json.loads(summary_file.read_text())
+    mesh = sorted(summary["meshes"])[0]
+    summary["meshes"][mesh]["watertight"] = False
+    summary["meshes"][mesh]["volume_rel_error"] = 0.02
+    summary_file.write_text(json.dumps(summary))
+    result = write_report(copy, ReportOptions(gif_frames=3))
+    failed = {(r[0], r[1]) for r in parse_page(copy / REPORT_DIR).rows if r[-1:] == ["FAIL"]}
+    assert failed == {(mesh, "watertight"), (mesh, "volume vs integrated volume"),
+                      ("export/summary.json", "file as recorded (sha256)")}
+    assert result.checks_total - result.checks_passed == 3
+
+
+def test_a_stale_stage_is_noted_on_the_page(demo, tmp_path):
+    # what `softdesign fit` records when the export on disk was made from another fit (tests/pipeline/test_build.py)
+    copy = tmp_path / "stale"
+    shutil.copytree(demo[0], copy)
+    manifest_file = copy / "manifest.json"
+    manifest = json.loads(manifest_file.read_text())
+    for stage in manifest["stages"]:
+        if stage["name"] == "export":
+            stage["status"] = "stale"
+    manifest_file.write_text(json.dumps(manifest))
+    write_report(copy, ReportOptions(gif_frames=3))
+    text = (copy / REPORT_DIR / PAGE).read_text(encoding="utf-8")
+    assert "export: out of date" in text
+    assert "out of date" not in (demo[0] / REPORT_DIR / PAGE).read_text(encoding="utf-8")
+
+
+def test_a_failed_write_leaves_the_previous_report(tmp_path):
+    target = tmp_path / REPORT_DIR
+    commit_folder(target, {PAGE: b"old page", "a.png": b"old image"})
+    with pytest.raises(FileNotFoundError):
+        commit_folder(target, {PAGE: b"new page", "no/such/folder.png": b"x"})
+    assert tree_hashes(target) == {PAGE: hashlib.sha256(b"old page").hexdigest(),
+                                   "a.png": hashlib.sha256(b"old image").hexdigest()}
+    assert sorted(p.name for p in tmp_path.iterdir()) == [REPORT_DIR]  # no temporary folder left
+    commit_folder(target, {PAGE: b"new page"})
+    assert tree_hashes(target) == {PAGE: hashlib.sha256(b"new page").hexdigest()}  # replaced as a whole
+
+
+def test_a_build_without_fit_gets_a_report_with_the_centerline_only(tmp_path):
+    build_dir = tmp_path / "build"
+    build_through(DEMO_CASE, build_dir, target="kinematics")
+    result = write_report(build_dir, ReportOptions(gif_frames=4))
+    assert set(result.files) == {PAGE, "morph.png", "kinematics.png", "morph.gif"}
+    text = (build_dir / REPORT_DIR / PAGE).read_text(encoding="utf-8")
+    assert "no fit in this build folder" in text and "no export in this build folder" in text
+    with Image.open(build_dir / REPORT_DIR / "morph.gif") as gif:
+        assert gif.n_frames == 4 and gif.size == EXPECTED_SIZES["morph.gif"]
+
+
+def report_app() -> typer.Typer:
+    """An app with the report command, registered the way softdesign.cli registers commands."""
+    from softdesign.cli.report import report
+
+    app = typer.Typer()
+    app.command()(report)
+    app.command("noop")(lambda: None)  # a second command keeps `report` a named subcommand, as in softdesign
+    return app
+
+
+def test_cli_writes_the_page_and_says_where(demo, tmp_path):
+    copy = tmp_path / "build"
+    shutil.copytree(demo[0], copy)
+    result = CliRunner().invoke(report_app(), ["report", str(copy)])
+    assert result.exit_code == 0, result.output
+    assert str(copy / REPORT_DIR / PAGE) in result.stdout and "checks" in result.stdout
+    assert "pcc_chambers.png" not in tree_hashes(copy / REPORT_DIR)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["report", "{missing}"], "not a build folder (no manifest.json)"),
+        (["report", "{build}", "--pcc-d", "ten"], "--pcc-d value 1: 'ten' is not a number"),
+        (["report", "{build}", "--pcc-d", "-3"], "--pcc-d value 1: -3 mm, expected > 0"),
+        (["report", "{build}", "--pcc-d", "1,2"], "the build has 4 link(s)"),
+    ],
+)
+def test_cli_bad_input_exits_2_with_a_message(demo, tmp_path, args, message):
+    filled = [a.format(missing=tmp_path / "nothing", build=demo[0]) for a in args]
+    before = tree_hashes(demo[0] / REPORT_DIR)
+    result = CliRunner().invoke(report_app(), filled)
+    assert result.exit_code == 2, result.output
+    assert message in result.output and "Traceback" not in result.output
+    assert tree_hashes(demo[0] / REPORT_DIR) == before
+
+
+def test_cli_help_names_the_option():
+    result = CliRunner().invoke(report_app(), ["report", "--help"])
+    assert result.exit_code == 0 and "--pcc-d" in result.output and "BUILD_DIR" in result.output
+
+
+def test_principal_view_looks_at_the_broad_side_of_a_planar_curve():
+    from softdesign.report.projection import principal_view
+
+    t = np.linspace(0.0, 1.0, 50)
+    # in the x-z plane; z = cos is uncorrelated with x, so x is exactly the axis of largest spread
+    points = np.column_stack([80.0 * t, np.zeros_like(t), 10.0 * np.cos(2.0 * np.pi * t)])
+    view = principal_view(points, points[-1] - points[0])
+    np.testing.assert_allclose(view.view2world.T @ view.view2world, np.eye(3), rtol=0, atol=1e-12)
+    assert np.linalg.det(view.view2world) == pytest.approx(1.0, abs=1e-12)
+    np.testing.assert_allclose(abs(view.view2world[:, 2] @ [0.0, 1.0, 0.0]), 1.0, rtol=0, atol=1e-12)
+    screen = view.project(points)
+    np.testing.assert_allclose(screen[0], [0.0, 0.0], rtol=0, atol=1e-12)  # the origin is the first point
+    np.testing.assert_allclose(screen[-1], [80.0, 0.0], rtol=0, atol=1e-9)  # right runs from first to last point
+
+
+def test_shading_order_and_culling_of_two_facing_triangles():
+    from softdesign.report.projection import AMBIENT, LIGHT_VIEW, View, shaded_triangles
+
+    view = View(np.eye(3), ("x", "y"))
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 5], [1, 0, 5], [0, 1, 5]], float)
+    faces = np.array([[3, 4, 5], [0, 2, 1]])  # near face towards the viewer (+z), far face away from it
+    shaded = shaded_triangles(vertices, faces, view)
+    assert shaded.index.tolist() == [1, 0]  # far first
+    facing = AMBIENT + (1.0 - AMBIENT) * LIGHT_VIEW[2] / np.linalg.norm(LIGHT_VIEW)
+    np.testing.assert_allclose(shaded.brightness, [facing, facing], rtol=0, atol=1e-12)  # two-sided
+    assert shaded_triangles(vertices, faces, view, cull=True).index.tolist() == [0]
+
+
+def test_tube_vertices_lie_at_the_fitted_radius_and_face_outwards(demo):
+    from softdesign.report.build_folder import load_build
+    from softdesign.report.surface_figures import tube_mesh
+
+    data = load_build(demo[0])
+    chain, field = data.kinematics.chain, data.fit.field
+    vertices, faces, face_l = tube_mesh(chain, field, 0.0, spacing_mm=2.0, angles=16)
+    curve = chain.shape.curve_at(0.0)
+    rings = vertices.reshape(-1, 16, 3)
+    l = np.linspace(0.0, 1.0, len(rings))
+    radius = np.linalg.norm(rings - curve.points(l)[:, None, :], axis=2)
+    angles = np.linspace(0.0, 2.0 * np.pi, 16, endpoint=False)
+    np.testing.assert_allclose(radius, field.evaluate_grid(0.0, l, angles), rtol=0, atol=1e-9)
+    tri = vertices[faces]
+    normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    outward = tri.mean(axis=1) - curve.points(face_l)
+    assert np.all(np.einsum("ij,ij->i", normals, outward) > 0.0)
+
+
+def test_a_killed_runs_temporary_folder_is_removed_a_running_ones_kept(tmp_path):
+    import subprocess
+    import sys
+
+    finished = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    dead = tmp_path / f".report-{finished.stdout.strip()}-abc"  # that process has exited
+    alive = tmp_path / f".report-{__import__('os').getpid()}-def"  # this test's own process
+    for folder in (dead, alive):
+        folder.mkdir()
+        (folder / PAGE).write_bytes(b"half written")
+    commit_folder(tmp_path / REPORT_DIR, {PAGE: b"page"})
+    assert not dead.exists() and alive.exists()

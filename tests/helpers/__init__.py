@@ -1,0 +1,1 @@
+"""Shared test helpers: paths, small synthetic cases, analytic curves and bodies, seed formulas."""

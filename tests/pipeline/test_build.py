@@ -1,0 +1,267 @@
+"""The build folder: caching by content hash, same bytes for the same inputs, atomic runs."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from softdesign.cli import app
+from tests.helpers.paths import REPO
+
+runner = CliRunner()
+STAGES = ["ingest", "blend", "links", "kinematics", "fit", "export"]
+
+
+def snapshot(folder: Path) -> dict[str, str]:
+    """Every file under ``folder`` with its sha256."""
+    return {
+        str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file()
+    }
+
+
+def statuses(output: str) -> dict[str, str]:
+    """{stage: 'ran' | 'skipped'} from a build's report lines."""
+    return dict(re.findall(r"^\[([a-z]+)\] (ran|skipped|kept|stale)", output, flags=re.MULTILINE))
+
+
+@pytest.fixture
+def demo_case(tmp_path) -> Path:
+    """A copy of configs/demo.yaml pointing at the committed sample data, coarse enough to be quick."""
+    case = yaml.safe_load((REPO / "configs" / "demo.yaml").read_text())
+    for key in ("centerline", "surface"):
+        case["final"][key] = str((REPO / "configs" / case["final"][key]).resolve())
+    case["export"] = {"q": [0, 1], "angular_count": 48, "spacing_mm": 1.0}
+    path = tmp_path / "demo.yaml"
+    path.write_text(yaml.safe_dump(case, sort_keys=False))
+    return path
+
+
+def build(case: Path, out: Path, *extra: str) -> str:
+    result = runner.invoke(app, ["build", str(case), "--out", str(out), *extra])
+    assert result.exit_code == 0, result.output
+    return result.output
+
+
+def edit(case: Path, section: str, **values) -> None:
+    data = yaml.safe_load(case.read_text())
+    data[section] = {**(data.get(section) or {}), **values}
+    case.write_text(yaml.safe_dump(data, sort_keys=False))
+
+
+def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_path):
+    out = tmp_path / "build"
+    assert statuses(build(demo_case, out)) == dict.fromkeys(STAGES, "ran")
+    assert statuses(build(demo_case, out)) == dict.fromkeys(STAGES, "skipped")
+    edit(demo_case, "fit", smoothing=2.0e-5)
+    assert statuses(build(demo_case, out)) == {
+        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "ran", "export": "ran"
+    }
+    edit(demo_case, "export", q=[0, 0.5, 1])
+    assert statuses(build(demo_case, out)) == {
+        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "ran", "fit": "skipped", "export": "ran"
+    }
+    # The mesh formats are read by export alone: kinematics (and the fit) stay cached.
+    edit(demo_case, "export", formats=["stl", "ply"])
+    assert statuses(build(demo_case, out)) == {
+        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "skipped",
+        "export": "ran",
+    }
+    # New link breaks: the links, their kinematics and the per-link fit are redone; ingest and blend are not.
+    edit(demo_case, "links", count=None, breaks=[0, 0.4, 1])
+    assert statuses(build(demo_case, out)) == {
+        "ingest": "skipped", "blend": "skipped", "links": "ran", "kinematics": "ran", "fit": "ran", "export": "ran"
+    }
+    assert statuses(build(demo_case, out, "--force")) == dict.fromkeys(STAGES, "ran")
+
+
+def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tmp_path):
+    out = tmp_path / "build"
+    build(demo_case, out)
+    meshes = {"meshes/q_0.000.stl", "meshes/q_1.000.stl"}
+
+    def run_fit() -> tuple[dict[str, str], dict]:
+        result = runner.invoke(app, ["fit", str(demo_case), "--out", str(out)])
+        assert result.exit_code == 0, result.output
+        return statuses(result.output), json.loads((out / "manifest.json").read_text())
+
+    # Nothing changed: the export on disk is what a build would make now, figures and metrics included.
+    ran, manifest = run_fit()
+    assert ran == {
+        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "skipped",
+        "export": "kept",
+    }
+    outputs = {o["path"]: o for o in manifest["outputs"]}
+    assert all(outputs[m]["watertight"] and outputs[m]["volume_mm3"] > 0 and "stale" not in outputs[m] for m in meshes)
+    assert "export" in manifest["metrics"] and "export" not in manifest["timing_s"]
+    # A new fit: the meshes on disk were made from the old one, and the manifest says so.
+    edit(demo_case, "fit", smoothing=2.0e-5)
+    ran, manifest = run_fit()
+    assert (ran["fit"], ran["export"]) == ("ran", "stale")
+    outputs = {o["path"]: o for o in manifest["outputs"]}
+    assert all(outputs[m]["stale"] is True for m in meshes) and "stale" not in outputs["fit/surface.npz"]
+    assert {"name": "export", "status": "stale"}.items() <= next(
+        s for s in manifest["stages"] if s["name"] == "export").items()
+    assert "export" not in manifest["metrics"]
+    # A build brings them up to date.
+    assert statuses(build(demo_case, out))["export"] == "ran"
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert not any(o.get("stale") for o in manifest["outputs"])
+
+
+def test_a_stale_output_is_not_reused_because_it_exists(demo_case, tmp_path):
+    out = tmp_path / "build"
+    build(demo_case, out)
+    (out / "fit" / "surface.npz").write_bytes(b"tampered")
+    assert statuses(build(demo_case, out))["fit"] == "ran"
+
+
+def test_same_inputs_give_the_same_bytes(demo_case, tmp_path):
+    first, second = tmp_path / "a", tmp_path / "b"
+    build(demo_case, first)
+    build(demo_case, second, "--force")
+    one, two = snapshot(first), snapshot(second)
+    assert one.keys() == two.keys()
+    manifest = json.loads((first / "manifest.json").read_text())
+    listed = {entry["path"]: entry["sha256"] for entry in manifest["outputs"]}
+    assert {"meshes/q_0.000.stl", "meshes/q_1.000.stl", "kinematics.json"} <= listed.keys()
+    for name, digest in listed.items():
+        assert one[name] == two[name] == digest, name
+    # the manifest differs only by its timing block
+    strip = [json.loads((f / "manifest.json").read_text()) for f in (first, second)]
+    for m in strip:
+        m.pop("timing_s")
+    assert strip[0] == strip[1]
+
+
+def test_manifest_records_inputs_case_metrics_and_outputs(demo_case, tmp_path):
+    out = tmp_path / "build"
+    build(demo_case, out)
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert [i["path"].rsplit("/", 1)[-1] for i in manifest["inputs"]] == ["centerline.vtp", "surface.stl"]
+    assert all(len(i["sha256"]) == 64 for i in manifest["inputs"])
+    assert manifest["case"]["fit"]["knot_spacing_mm"] == 1.5  # defaults filled in
+    assert set(manifest["timing_s"]) == set(STAGES)
+    fit = manifest["metrics"]["fit"]
+    assert 0 < fit["p95_mm"] <= fit["p99_mm"] <= fit["max_mm"] and 0 < fit["rms_mm"] <= fit["max_mm"]
+    meshes = [o for o in manifest["outputs"] if o["path"].startswith("meshes/")]
+    assert len(meshes) == 2
+    for mesh in meshes:
+        assert mesh["watertight"] is True and mesh["volume_mm3"] > 0 and mesh["area_mm2"] > 0
+        assert mesh["faces"] > 0 and mesh["vertices"] > 0
+
+
+def test_a_failed_run_leaves_the_previous_build_untouched(demo_case, tmp_path, monkeypatch):
+    out = tmp_path / "build"
+    build(demo_case, out)
+    before = snapshot(out)
+    edit(demo_case, "fit", smoothing=3.0e-5)
+    from softdesign.pipeline.stages import export as export_stage
+
+    calls = []
+
+    def failing(*args, **kwargs):
+        calls.append(1)
+        if len(calls) > 1:
+            raise OSError("disk full (simulated)")
+        return original(*args, **kwargs)
+
+    original = export_stage.mesh_bytes
+    monkeypatch.setattr(export_stage, "mesh_bytes", failing)
+    result = runner.invoke(app, ["build", str(demo_case), "--out", str(out)])
+    assert result.exit_code != 0 and len(calls) == 2
+    assert snapshot(out) == before
+    assert not list(tmp_path.glob(".build.staging-*"))
+
+
+KILL_MID_EXPORT = """
+import os, signal, sys
+import softdesign.pipeline.stages.export as export_stage
+original = export_stage.mesh_bytes
+calls = []
+def killing(*args, **kwargs):
+    calls.append(1)
+    if len(calls) > 1:
+        os.kill(os.getpid(), signal.SIGKILL)
+    return original(*args, **kwargs)
+export_stage.mesh_bytes = killing
+from softdesign.cli import app
+sys.argv = ["softdesign"] + sys.argv[1:]
+app()
+"""
+
+
+def test_a_build_killed_mid_export_leaves_the_previous_build_unchanged(demo_case, tmp_path):
+    out = tmp_path / "build"
+    build(demo_case, out)
+    before = snapshot(out)
+    edit(demo_case, "export", angular_count=56)
+    killed = subprocess.run(
+        [sys.executable, "-c", KILL_MID_EXPORT, "build", str(demo_case), "--out", str(out)],
+        capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(REPO)}, timeout=300,
+    )
+    assert killed.returncode == -9, killed.stderr
+    assert snapshot(out) == before
+    # the next run clears the dead run's staging folder and builds normally
+    assert statuses(build(demo_case, out))["export"] == "ran"
+    assert not list(tmp_path.glob(".build.staging-*"))
+    shutil.rmtree(out)
+
+
+def test_split_regions_writes_one_stl_per_region_that_tiles_each_solid(demo_case, tmp_path):
+    import trimesh
+
+    from softdesign.meshing.compare import surface_area
+
+    edit(demo_case, "export", split_regions=True)
+    out = tmp_path / "out"
+    output = build(demo_case, out)
+    assert "one STL per region: wall" in output
+    manifest = json.loads((out / "manifest.json").read_text())
+    outputs = {o["path"]: o for o in manifest["outputs"]}
+    # the solids keep their names; the pieces sit in a folder per q
+    assert sorted(p.name for p in (out / "meshes").glob("q_*.stl")) == ["q_0.000.stl", "q_1.000.stl"]
+    for q in ("0.000", "1.000"):
+        solid = trimesh.load(out / "meshes" / f"q_{q}.stl", force="mesh")
+        pieces = sorted((out / "meshes" / f"q_{q}").glob("*.stl"))
+        assert [p.stem for p in pieces] == ["base_cap", "tip_cap", "wall"]
+        meshes = [trimesh.load(p, force="mesh", process=False) for p in pieces]
+        assert sum(len(m.faces) for m in meshes) == len(solid.faces)
+        area = sum(surface_area(m.vertices, m.faces) for m in meshes)
+        assert area == pytest.approx(surface_area(solid.vertices, solid.faces), rel=1e-9)
+        for piece in pieces:
+            entry = outputs[f"meshes/q_{q}/{piece.name}"]
+            assert entry["sha256"] == hashlib.sha256(piece.read_bytes()).hexdigest()
+            assert entry["area_mm2"] > 0 and entry["faces"] > 0
+    # a regression check of the build against itself passes, region files included (no volume for open surfaces)
+    result = runner.invoke(app, ["check", str(out), "--reference", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "meshes/q_1.000/wall.stl" in result.output
+
+
+def test_vtp_meshes_carry_the_region_of_every_face(demo_case, tmp_path):
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    from softdesign.io.vtk_polydata import read_polydata
+
+    edit(demo_case, "export", formats=["stl", "vtp"])
+    out = tmp_path / "out"
+    build(demo_case, out)
+    manifest = json.loads((out / "manifest.json").read_text())
+    outputs = {o["path"]: o for o in manifest["outputs"]}
+    for q in ("0.000", "1.000"):
+        poly = read_polydata(out / "meshes" / f"q_{q}.vtp")
+        regions = vtk_to_numpy(poly.GetCellData().GetArray("Region"))
+        assert len(regions) == outputs[f"meshes/q_{q}.stl"]["faces"] == outputs[f"meshes/q_{q}.vtp"]["faces"]
+        assert set(regions.tolist()) == {0, 1, 2}  # wall, base cap, tip cap
