@@ -9,7 +9,7 @@ import pytest
 from tests.helpers.paths import AORTA_DIR
 
 
-@pytest.fixture
+@pytest.fixture(scope="session")
 def aorta_dir() -> Path:
     """../shared/data/vmtk-aorta, or skip (a user's clone has no shared/ beside it)."""
     if not AORTA_DIR.is_dir():

@@ -24,11 +24,9 @@ from softdesign.pipeline.api import build_through
 from softdesign.report.writer import EXPECTED_SIZES, PAGE, REPORT_DIR, ReportOptions, commit_folder, write_report
 
 from tests.helpers.cases import write_case
-from tests.helpers.paths import AORTA_DIR, REPO
+from tests.helpers.paths import REPO
 
 DEMO_CASE = REPO / "configs" / "demo.yaml"
-AORTA = AORTA_DIR
-needs_aorta = pytest.mark.skipif(not AORTA.is_dir(), reason=f"real VMTK data not found at {AORTA}")
 #: The page shows figures to 6 significant digits: the text may differ from the exact value by half a unit in the 6th.
 SHOWN_RTOL = 5e-6
 #: Distances recomputed from the kept radius field: the same algorithm as the fit stage, on a rebuilt
@@ -107,13 +105,11 @@ def demo(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def aorta(tmp_path_factory):
-    if not AORTA.is_dir():
-        pytest.skip(f"real VMTK data not found at {AORTA}")
+def aorta(tmp_path_factory, aorta_dir):
     folder = tmp_path_factory.mktemp("aorta")
     case = write_case(
         folder, "aorta",
-        final={"centerline": str(AORTA / "aorta-centerline.vtp"), "surface": str(AORTA / "aorta-surface.stl"),
+        final={"centerline": str(aorta_dir / "aorta-centerline.vtp"), "surface": str(aorta_dir / "aorta-surface.stl"),
                "path": 0},
         export={"q": [0, 0.25, 0.5, 1]},
     )
@@ -121,7 +117,7 @@ def aorta(tmp_path_factory):
     return folder / "build", write_report(folder / "build")
 
 
-@pytest.fixture(params=["demo", pytest.param("aorta", marks=needs_aorta)])
+@pytest.fixture(params=["demo", "aorta"])
 def built(request):
     return request.getfixturevalue(request.param)
 
@@ -199,7 +195,6 @@ def test_inputs_and_software_are_listed(built):
     assert {"softdesign", "numpy", "matplotlib", "python"} <= packages
 
 
-@needs_aorta
 def test_aorta_report_notes_the_missing_pcc_panel(aorta):
     build_dir, _ = aorta
     text = (build_dir / REPORT_DIR / PAGE).read_text(encoding="utf-8")

@@ -37,10 +37,7 @@ from softdesign.fitting.metrics import closest_surface_points, holdout_rms, summ
 from softdesign.fitting.projection import project_points
 from softdesign.fitting.radius_field import RadiusField, check_self_folding
 from softdesign.fitting.selection import NetworkContext, inscribed_profile, select_wall_points
-from tests.helpers.paths import AORTA_DIR
 
-AORTA = AORTA_DIR
-pytestmark = pytest.mark.skipif(not AORTA.is_dir(), reason=f"real VMTK data not found at {AORTA}")
 
 #: The issue's targets on the kept wall points, mm.
 TARGET_RMS_MM, TARGET_P99_MM, TARGET_HOLDOUT_MM = 0.05, 0.15, 0.06
@@ -50,13 +47,13 @@ BREAKS = (0.0, 0.25, 0.5, 0.75, 1.0)
 
 
 @pytest.fixture(scope="module")
-def path0():
+def path0(aorta_dir):
     from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
     from softdesign.geometry.frames import framed_curve
     from softdesign.geometry.network import all_paths
     from softdesign.io.centerline import read_centerline_network
 
-    paths = all_paths(read_centerline_network(AORTA / "aorta-centerline.vtp"))
+    paths = all_paths(read_centerline_network(aorta_dir / "aorta-centerline.vtp"))
     defaults = Resample()
     options = CurveOptions(spacing_mm=defaults.spacing_mm, smoothing_mm=defaults.smoothing_mm,
                            end_straight_mm=defaults.end_straight_mm)
@@ -65,11 +62,11 @@ def path0():
     return curve, NetworkContext(paths[0].points, (paths[1].points,), l, radius), paths
 
 
-def _fitted(path0, name):
+def _fitted(aorta_dir, path0, name):
     from softdesign.io.surface import read_surface
 
     curve, network, _ = path0
-    vertices, _ = read_surface(AORTA / name)
+    vertices, _ = read_surface(aorta_dir / name)
     polar = project_points(curve, vertices)
     selection = select_wall_points(polar, curve.length, network)
     kept = polar.subset(selection.keep)
@@ -81,13 +78,13 @@ def _fitted(path0, name):
 
 
 @pytest.fixture(scope="module")
-def capped(path0):
-    return _fitted(path0, "aorta-surface.stl")
+def capped(aorta_dir, path0):
+    return _fitted(aorta_dir, path0, "aorta-surface.stl")
 
 
 @pytest.fixture(scope="module")
-def open_ends(path0):
-    return _fitted(path0, "aorta-surface-open-ends.stl")
+def open_ends(aorta_dir, path0):
+    return _fitted(aorta_dir, path0, "aorta-surface-open-ends.stl")
 
 
 @pytest.mark.parametrize("which", ["capped", "open_ends"])
@@ -119,13 +116,13 @@ def test_the_other_iliac_and_its_far_dome_are_dropped(capped, path0):
     assert selection.counts["other_branch"] > 0 and selection.counts["outlier"] == 0
 
 
-def test_caps_are_dropped_and_what_is_kept_of_them_is_wall(capped, path0):
+def test_caps_are_dropped_and_what_is_kept_of_them_is_wall(aorta_dir, capped, path0):
     from scipy.spatial import cKDTree
 
     from softdesign.io.surface import read_surface
 
     curve = path0[0]
-    open_vertices, _ = read_surface(AORTA / "aorta-surface-open-ends.stl")
+    open_vertices, _ = read_surface(aorta_dir / "aorta-surface-open-ends.stl")
     # The capped surface's own cap vertices: those the open-ends file does not have.
     cap = cKDTree(open_vertices).query(capped["vertices"])[0] > 1e-6
     kept_cap = cap & capped["selection"].keep

@@ -26,25 +26,16 @@ from softdesign.geometry.blend import blend_shapes
 from softdesign.geometry.curves import CurveOptions, l_from_points, measure_deviation, smooth_curve_from_polyline
 from softdesign.geometry.frames import adjacent_rotation_angles, framed_curve
 from softdesign.geometry.initial import straight_initial_shape
-from tests.helpers.paths import AORTA_DIR
-
-AORTA = AORTA_DIR
-REFERENCE = AORTA / "vmtk-reference"
 #: The case-file defaults (config.Resample).
 DEFAULTS = CurveOptions(spacing_mm=0.5, smoothing_mm=0.1, end_straight_mm=2.0)
 
-pytestmark = pytest.mark.skipif(
-    not AORTA.is_dir(), reason=f"real VMTK data not found at {AORTA} (CI has ../shared beside the checkout)"
-)
-
-
-def read_reference(name: str) -> tuple[np.ndarray, dict[str, np.ndarray], list[np.ndarray]]:
+def read_reference(aorta_dir: Path, name: str) -> tuple[np.ndarray, dict[str, np.ndarray], list[np.ndarray]]:
     """Points, point arrays and the point ids of each line cell of a VMTK reference file."""
     import vtk
 
     from softdesign.io.vtk_polydata import polydata_arrays, read_polydata
 
-    poly = read_polydata(REFERENCE / name)
+    poly = read_polydata(aorta_dir / "vmtk-reference" / name)
     points, arrays, _ = polydata_arrays(poly)
     cells, ids = [], vtk.vtkIdList()
     lines = poly.GetLines()
@@ -55,11 +46,11 @@ def read_reference(name: str) -> tuple[np.ndarray, dict[str, np.ndarray], list[n
 
 
 @pytest.fixture(scope="module")
-def paths():
+def paths(aorta_dir):
     from softdesign.geometry.network import select_path
     from softdesign.io.centerline import read_centerline_network
 
-    network = read_centerline_network(AORTA / "aorta-centerline.vtp")
+    network = read_centerline_network(aorta_dir / "aorta-centerline.vtp")
     return [select_path(network, i) for i in (0, 1)]
 
 
@@ -68,15 +59,15 @@ def curve0(paths):
     return smooth_curve_from_polyline(paths[0].points, DEFAULTS)
 
 
-def test_reference_files_follow_path_0_point_for_point(paths):
+def test_reference_files_follow_path_0_point_for_point(aorta_dir, paths):
     # the duplicate point at the end of polyline 0 is dropped by ingest; otherwise the same points
     for name in ("centerline-geometry.vtp", "centerline-parallel-transport-normals.vtp"):
-        points, _, cells = read_reference(name)
+        points, _, cells = read_reference(aorta_dir, name)
         np.testing.assert_array_equal(points[cells[0]][:-1], paths[0].points)
 
 
-def test_resampled_path_against_vmtk_resampling(paths, curve0):
-    points, arrays, cells = read_reference("centerline-resampling.vtp")
+def test_resampled_path_against_vmtk_resampling(aorta_dir, paths, curve0):
+    points, arrays, cells = read_reference(aorta_dir, "centerline-resampling.vtp")
     resampled, radius = points[cells[0]], arrays["MaximumInscribedSphereRadius"][cells[0]]
     np.testing.assert_array_equal(resampled[[0, -1]], paths[0].points[[0, -1]])  # same ends, same direction
     deviation = measure_deviation(curve0, resampled)
@@ -93,8 +84,8 @@ def test_resampled_path_against_vmtk_resampling(paths, curve0):
     np.testing.assert_allclose(curve0.length, paths[0].length, rtol=0.01, atol=0)  # 77.38 vs 77.81 raw
 
 
-def test_rmf_normals_against_vmtk_parallel_transport(paths, curve0):
-    _, arrays, cells = read_reference("centerline-parallel-transport-normals.vtp")
+def test_rmf_normals_against_vmtk_parallel_transport(aorta_dir, paths, curve0):
+    _, arrays, cells = read_reference(aorta_dir, "centerline-parallel-transport-normals.vtp")
     vmtk_normals = arrays["ParallelTransportNormals"][cells[0]][:-1]
     l = l_from_points(curve0, paths[0].points)
     frames = framed_curve(curve0).frames(l)
@@ -113,8 +104,8 @@ def test_rmf_normals_against_vmtk_parallel_transport(paths, curve0):
     assert np.max(np.abs(aligned[inner])) < 0.1
 
 
-def test_smoothed_curvature_against_vmtk_raw_curvature(paths, curve0):
-    _, arrays, cells = read_reference("centerline-geometry.vtp")
+def test_smoothed_curvature_against_vmtk_raw_curvature(aorta_dir, paths, curve0):
+    _, arrays, cells = read_reference(aorta_dir, "centerline-geometry.vtp")
     vmtk_curvature = arrays["Curvature"][cells[0]][:-1]
     radius = paths[0].radius
     ours = curve0.curvature(l_from_points(curve0, paths[0].points))
