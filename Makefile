@@ -4,16 +4,38 @@ PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
+# Exact versions of every package the venv holds (and of setuptools for the
+# editable build): the same environment on every machine.  `make lock` remakes it.
+CONSTRAINTS := requirements/constraints.txt
+LOCK_VENV := build/.lock-venv
 
-.PHONY: demo test bench install clean
+.PHONY: demo test lock bench install clean
 
 install: $(STAMP)
 
-$(STAMP): pyproject.toml
-	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[test]'
+# A fresh venv each time (--clear), so a package dropped from the pins leaves it too.
+# The venv's own pip predates --build-constraint: it first installs the pinned pip.
+$(STAMP): pyproject.toml $(CONSTRAINTS)
+	$(PYTHON) -m venv --clear $(VENV)
+	$(BIN)/python -m pip install --quiet -c $(CONSTRAINTS) pip setuptools
+	$(BIN)/python -m pip install --quiet -c $(CONSTRAINTS) --build-constraint $(CONSTRAINTS) -e '.[test,lint]'
 	touch $@
+
+# `make lock`: on purpose only.  Resolves the newest releases pyproject.toml
+# allows in a throwaway venv and pins all of them; then `make install test`.
+lock:
+	rm -rf $(LOCK_VENV)
+	$(PYTHON) -m venv --clear $(LOCK_VENV)
+	$(LOCK_VENV)/bin/python -m pip install --quiet --upgrade pip setuptools
+	$(LOCK_VENV)/bin/python -m pip install --quiet -e '.[test,lint]'
+	mkdir -p $(dir $(CONSTRAINTS))
+	{ echo "# Exact versions of every package 'make install' puts in .venv (direct and transitive)."; \
+	  echo "# Made by 'make lock' (the newest releases pyproject.toml allows) on $$(date -u +%Y-%m-%d)"; \
+	  $(LOCK_VENV)/bin/python -c 'import platform; print("# with", platform.python_implementation(), platform.python_version(), "on", platform.platform())'; \
+	  echo "# Do not edit by hand: change pyproject.toml, run 'make lock', then 'make install test'."; \
+	  $(LOCK_VENV)/bin/python -m pip freeze --all --exclude-editable; } > $(CONSTRAINTS).new
+	mv $(CONSTRAINTS).new $(CONSTRAINTS)
+	rm -rf $(LOCK_VENV)
 
 demo: $(STAMP)
 	$(BIN)/softdesign build configs/demo.yaml --report
