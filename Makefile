@@ -9,7 +9,7 @@ STAMP := $(VENV)/.installed-stamp
 CONSTRAINTS := requirements/constraints.txt
 LOCK_VENV := build/.lock-venv
 
-.PHONY: demo test lock bench install clean
+.PHONY: demo test lint lock bench install clean
 
 install: $(STAMP)
 
@@ -44,6 +44,14 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest
+
+# ruff (style, imports, bugbear, pyupgrade, numpy rules) and mypy, both
+# configured in pyproject.toml; both run, and either failing fails the target.
+lint: $(STAMP)
+	@status=0; \
+	$(BIN)/ruff check . || status=1; \
+	$(BIN)/mypy || status=1; \
+	exit $$status
 
 # `make bench`: per-stage time and peak memory of forced builds (sample case,
 # VMTK aorta when ../shared/data is there, scaled synthetic case) against the
