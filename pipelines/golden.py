@@ -13,8 +13,8 @@ writes OUT/<case>/ as a reference folder for ``softdesign check``:
   (``distance_max_mm``, ``volume_rel_change``, ``area_rel_change``, as
   :func:`softdesign.regression.decimation_entry` gives them; ``check`` widens
   that mesh's tolerances by them), the case file's path and sha256, the input
-  files' sha256, and the versions of softdesign, Python, numpy, scipy,
-  manifold3d, vtk and trimesh that made the build.
+  files' sha256, and the versions of the software that made the build
+  (:func:`softdesign.versions.software_versions`, as the manifest records them).
 
 The new references are written beside OUT and swapped in only when every
 case succeeded, so a failed run leaves the old references as they were.
@@ -25,11 +25,9 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import shutil
 import sys
 import tempfile
-from importlib import metadata
 from pathlib import Path
 
 import numpy as np
@@ -40,12 +38,12 @@ from softdesign.cohort import STATUS_SUFFIX, cohort_cases, read_record
 from softdesign.pipeline.layout import MANIFEST
 from softdesign.pipeline.store import sha256_file
 from softdesign.regression import GOLDEN, KINEMATICS, decimation_entry, mesh_names
+from softdesign.versions import software_versions
 
 #: Strongest target reduction tried, and how many bisection steps find the strongest acceptable one.
 MAX_REDUCTION, BISECTIONS = 0.97, 6
 #: Largest distance a stored mesh may be from the full one, mm (check widens its tolerance by the actual error).
 MAX_ERROR_MM = 0.05
-PACKAGES = ("softdesign", "numpy", "scipy", "manifold3d", "vtk", "trimesh")
 DECIMATION = "vtkQuadricDecimation (volume preservation on), the strongest reduction <= {} keeping the mesh watertight within {} mm"
 
 
@@ -107,17 +105,6 @@ def store_mesh(source: Path, target: Path, max_error_mm: float) -> tuple[MeshDif
     return difference, len(full[1]), len(read_mesh(target)[1])
 
 
-def versions() -> dict[str, str]:
-    """Versions of the software that made the references."""
-    found = {"python": platform.python_version()}
-    for name in PACKAGES:
-        try:
-            found[name] = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            found[name] = "not installed"
-    return found
-
-
 def store_case(case_file: Path, build_dir: Path, out_dir: Path, max_error_mm: float) -> dict:
     """Write one case's reference folder; returns its golden.json payload."""
     record = read_record(build_dir.parent / (case_file.stem + STATUS_SUFFIX))
@@ -138,7 +125,7 @@ def store_case(case_file: Path, build_dir: Path, out_dir: Path, max_error_mm: fl
         "made_by": "make golden (pipelines/golden.py); do not edit by hand",
         "case": {"file": Path(os.path.relpath(case_file)).as_posix(), "sha256": sha256_file(case_file)},
         "inputs": [{"path": i["path"], "sha256": i["sha256"]} for i in manifest.get("inputs", [])],
-        "versions": versions(),
+        "versions": software_versions(),
         "decimation": DECIMATION.format(MAX_REDUCTION, max_error_mm),
         "meshes": meshes,
     }

@@ -1,4 +1,4 @@
-"""The manifest: software, inputs with sha256, the resolved case, stages, timing, metrics, outputs.
+"""The manifest: software versions, inputs with sha256, the resolved case, stages, timing, metrics, outputs.
 
 Outputs are those recorded by this run's stages and by earlier runs' stages
 still in the folder, each with its sha256 and the figures its stage gives
@@ -10,11 +10,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from softdesign import __version__
 from softdesign.config import Case
 from softdesign.pipeline import layout
 from softdesign.pipeline.stage import Results, Stage, StageRun, Status
 from softdesign.pipeline.store import Staging, read_record
+from softdesign.versions import software_versions
 
 
 def build_manifest(
@@ -40,7 +40,7 @@ def build_manifest(
     for entry in outputs:
         del entry["stage"]
     return {
-        "software": {"softdesign": __version__},
+        "software": software_versions(),
         "case": case.resolved(),
         "inputs": [
             {"path": case.resolved_path(p), "sha256": h, "bytes": p.stat().st_size} for p, h in zip(inputs, input_hashes)

@@ -10,21 +10,20 @@ means the folder was altered or a limit changed since).
 
 from __future__ import annotations
 
-import importlib.metadata
-import platform
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from softdesign.meshing.checks import VOLUME_RTOL
 from softdesign.pipeline.store import sha256_file
+from softdesign.versions import software_versions
 
 #: Euler characteristic each kind of solid must have (see :class:`softdesign.meshing.solids.Solid`).
 EULER_BY_KIND = {"solid": 2, "ported": 2, "hollow": 4}
 #: A tube folds through itself where rho * kappa reaches this.
 FOLD_LIMIT = 1.0
-#: Distributions whose versions the page lists (the environment that drew the report).
-PACKAGES = ("numpy", "scipy", "trimesh", "manifold3d", "vtk", "matplotlib", "pillow", "typer", "pydantic", "pyyaml")
+#: Distributions that draw the page, listed after those every build records.
+REPORT_PACKAGES = ("matplotlib", "pillow")
 #: Significant digits of the figures shown (the exact value is kept beside them).
 DIGITS = 6
 
@@ -161,15 +160,15 @@ def input_rows(manifest: dict[str, Any]) -> list[tuple[str, str, str]]:
 
 
 def software_rows(manifest: dict[str, Any]) -> list[tuple[str, str, str]]:
-    """(package, version, where): the build's recorded versions, then this report's environment."""
-    rows = [(name, str(version), "recorded in the manifest") for name, version in manifest.get("software", {}).items()]
-    rows.append(("python", platform.python_version(), "drew this report"))
-    for package in PACKAGES:
-        try:
-            rows.append((package, importlib.metadata.version(package), "drew this report"))
-        except importlib.metadata.PackageNotFoundError:
-            continue
-    return rows
+    """(package, version the build recorded in the manifest, version that drew this report).
+
+    The manifest's packages first, in its order, then those only the report
+    uses; a version one side did not record reads "-".
+    """
+    recorded = {name: str(version) for name, version in manifest.get("software", {}).items()}
+    drawing = software_versions(REPORT_PACKAGES)
+    names = list(recorded) + [name for name in drawing if name not in recorded]
+    return [(name, recorded.get(name, "-"), drawing.get(name, "-")) for name in names]
 
 
 def mesh_checks(export_summary: dict[str, Any] | None) -> list[Check]:

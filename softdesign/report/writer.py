@@ -163,7 +163,7 @@ def _tables_section(data: BuildData) -> tuple[Section, list[Check]]:
         key_figure_table(key_figures(data.manifest)),
         plain_table("Inputs", ("file (as the case names it)", "sha256", "bytes"), input_rows(data.manifest),
                     ("", "hash", "num")),
-        plain_table("Software", ("package", "version", "where"), software_rows(data.manifest)),
+        plain_table("Software", ("package", "build (manifest.json)", "this report"), software_rows(data.manifest)),
         plain_table("Stages of the last run", ("stage", "status", "time (s)"), stages, ("", "", "num")),
         check_table(checks),
     ]

@@ -12,6 +12,7 @@ import hashlib
 import json
 import shutil
 from html.parser import HTMLParser
+from importlib import metadata
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +22,9 @@ from PIL import Image
 from typer.testing import CliRunner
 
 from softdesign.pipeline.api import build_through
+from softdesign.report.tables import software_rows
 from softdesign.report.writer import EXPECTED_SIZES, PAGE, REPORT_DIR, ReportOptions, commit_folder, write_report
+from softdesign.versions import software_versions
 
 from tests.helpers.cases import write_case
 from tests.helpers.paths import REPO
@@ -191,8 +194,17 @@ def test_inputs_and_software_are_listed(built):
     rows = parse_page(build_dir / REPORT_DIR).rows
     for entry in manifest["inputs"]:
         assert [entry["path"], entry["sha256"], str(entry["bytes"])] in rows
-    packages = {r[0] for r in rows if len(r) == 3}
-    assert {"softdesign", "numpy", "matplotlib", "python"} <= packages
+    # the Software table: package, version the manifest recorded, version that drew the page
+    for name, version in manifest["software"].items():
+        assert [name, version, software_versions()[name]] in rows, name
+    assert ["matplotlib", "-", metadata.version("matplotlib")] in rows
+
+
+def test_software_rows_show_what_the_build_recorded_beside_what_draws_the_page():
+    now = software_versions(("matplotlib", "pillow"))
+    rows = software_rows({"software": {"softdesign": "0.0.1", "numpy": "1.26.0"}})
+    assert rows[:2] == [("softdesign", "0.0.1", now["softdesign"]), ("numpy", "1.26.0", now["numpy"])]
+    assert rows[2:] == [(name, "-", version) for name, version in now.items() if name not in ("softdesign", "numpy")]
 
 
 def test_aorta_report_notes_the_missing_pcc_panel(aorta):

@@ -16,6 +16,7 @@ import yaml
 from typer.testing import CliRunner
 
 from softdesign.cli import app
+from softdesign.versions import software_versions
 from tests.helpers.paths import REPO
 
 runner = CliRunner()
@@ -152,6 +153,9 @@ def test_manifest_records_inputs_case_metrics_and_outputs(demo_case, tmp_path):
     assert [i["path"].rsplit("/", 1)[-1] for i in manifest["inputs"]] == ["centerline.vtp", "surface.stl"]
     assert all(len(i["sha256"]) == 64 for i in manifest["inputs"])
     assert manifest["case"]["fit"]["knot_spacing_mm"] == 1.5  # defaults filled in
+    assert manifest["software"] == software_versions()  # the installed versions, keys in order
+    assert list(manifest["software"]) == ["softdesign", "python", "numpy", "scipy", "vtk", "trimesh", "manifold3d",
+                                          "pydantic"]
     assert set(manifest["timing_s"]) == set(STAGES)
     fit = manifest["metrics"]["fit"]
     assert 0 < fit["p95_mm"] <= fit["p99_mm"] <= fit["max_mm"] and 0 < fit["rms_mm"] <= fit["max_mm"]
@@ -197,6 +201,7 @@ def killing(*args, **kwargs):
     return original(*args, **kwargs)
 export_stage.mesh_bytes = killing
 from softdesign.cli import app
+from softdesign.versions import software_versions
 sys.argv = ["softdesign"] + sys.argv[1:]
 app()
 """
