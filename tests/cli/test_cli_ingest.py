@@ -13,6 +13,7 @@ from softdesign.cli import app
 
 from tests.helpers.cases import straight_tube, write_case
 from tests.helpers.paths import REPO
+from tests.helpers.regeneration import REGENERATION_TOL_MM, assert_same_vessel_file, vessel_file_differences
 
 runner = CliRunner()
 
@@ -187,12 +188,58 @@ def test_the_same_vessel_in_mm_and_in_m_ingests_identically(tmp_path):
 
 
 def test_sample_generator_rebuilds_the_committed_demo_data(tmp_path):
-    """data/demo is the generator's output, byte for byte (so it never goes stale)."""
+    """data/demo is the generator's output within REGENERATION_TOL_MM (so it never goes stale)."""
     result = runner.invoke(app, ["sample", str(tmp_path)])
     assert result.exit_code == 0, result.output
     committed = REPO / "data" / "demo"
     for name in ("centerline.vtp", "surface.stl"):
-        assert (tmp_path / name).read_bytes() == (committed / name).read_bytes(), name
+        assert_same_vessel_file(tmp_path / name, committed / name)
+
+
+def test_sample_generator_gives_the_same_bytes_twice(tmp_path):
+    """Within one environment the generator is byte-for-byte repeatable."""
+    for folder in ("a", "b"):
+        assert runner.invoke(app, ["sample", str(tmp_path / folder)]).exit_code == 0
+    assert snapshot(tmp_path / "a") == snapshot(tmp_path / "b")
+
+
+def test_regeneration_check_sees_a_centerline_moved_by_1e_6_mm(tmp_path):
+    """The committed centerline rewritten with one point and one radius moved: 1e-6 mm fails, 1e-12 mm passes."""
+    from softdesign.io.centerline import RADIUS_KEY, read_centerline_network
+    from softdesign.io.polylines_vtp import write_polylines_vtp
+
+    committed = REPO / "data" / "demo" / "centerline.vtp"
+    network = read_centerline_network(committed)
+    for name, move in (("moved.vtp", 1e-6), ("rounded.vtp", 1e-3 * REGENERATION_TOL_MM)):
+        lines = [line.points.copy() for line in network.polylines]
+        radii = [line.radius.copy() for line in network.polylines]
+        middle = len(lines[0]) // 2
+        lines[0][middle, 1] += move
+        radii[0][middle] += move
+        write_polylines_vtp(tmp_path / name, lines, {RADIUS_KEY: radii})
+    differences = vessel_file_differences(tmp_path / "moved.vtp", committed)
+    assert len(differences) == 2, differences
+    assert differences[0].startswith("points: 1 of")
+    assert differences[1].startswith(f"point array {RADIUS_KEY}: 1 of")
+    assert vessel_file_differences(tmp_path / "rounded.vtp", committed) == []
+
+
+def test_regeneration_check_sees_an_stl_vertex_moved_past_its_float32_step(tmp_path):
+    """A binary STL stores float32: one step is rounding, three are a real move."""
+    import trimesh
+
+    from softdesign.io.mesh_files import write_mesh
+
+    committed = REPO / "data" / "demo" / "surface.stl"
+    mesh = trimesh.load(committed, process=False)
+    corner = mesh.vertices[mesh.faces[0, 0]]
+    step = np.spacing(np.abs(corner).astype(np.float32)).astype(np.float64)
+    for name, move in (("rounded.stl", step), ("moved.stl", 3 * step)):
+        vertices = mesh.vertices.copy()
+        vertices[mesh.faces[0, 0]] += move
+        write_mesh(tmp_path / name, vertices, mesh.faces)
+    assert vessel_file_differences(tmp_path / "rounded.stl", committed) == []
+    assert vessel_file_differences(tmp_path / "moved.stl", committed)[0].startswith("vertices: 3 of")
 
 
 def test_sample_is_a_vmtk_style_network_with_a_capped_wall(tmp_path):

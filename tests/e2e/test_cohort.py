@@ -17,6 +17,7 @@ from softdesign.config import load_case
 from softdesign.samples.cohort_vessels import COHORT_VARIANTS, make_variant_vessel, variant_named
 from softdesign import cohort
 from tests.helpers.paths import REPO
+from tests.helpers.regeneration import REGENERATION_TOL_MM, assert_same_vessel_file, vessel_file_differences
 
 MAKE = shutil.which("make")
 needs_make = pytest.mark.skipif(MAKE is None, reason="GNU make not found (the cohort is a make recipe)")
@@ -28,14 +29,40 @@ MAKE_CASES = ("meander", "s_bend")
 
 
 def test_committed_cohort_inputs_are_the_generators_output(tmp_path):
-    """data/cohort is what `make cohort-sample` writes, byte for byte (so it never goes stale)."""
-    from softdesign.samples.files import write_cohort
+    """data/cohort is what `make cohort-sample` writes, within REGENERATION_TOL_MM (so it never goes stale)."""
+    from softdesign.samples.files import COHORT_FILE_UNITS, write_cohort
+    from softdesign.types import UNIT_SCALE_TO_MM
 
     written = write_cohort(tmp_path)
     assert len(written) == 2 * len(COHORT_VARIANTS)
     for path in written:
         relative = path.relative_to(tmp_path)
-        assert path.read_bytes() == (REPO / "data" / "cohort" / relative).read_bytes(), relative
+        scale = UNIT_SCALE_TO_MM[COHORT_FILE_UNITS.get(relative.parts[0], "mm")]
+        assert_same_vessel_file(path, REPO / "data" / "cohort" / relative, scale_to_mm=scale)
+
+
+def test_cohort_generator_gives_the_same_bytes_twice(tmp_path):
+    """Within one environment the cohort generator is byte-for-byte repeatable."""
+    from softdesign.samples.files import write_cohort
+
+    first, second = write_cohort(tmp_path / "a"), write_cohort(tmp_path / "b")
+    assert [p.read_bytes() for p in first] == [p.read_bytes() for p in second]
+
+
+def test_regeneration_check_sees_a_cohort_surface_moved_by_1e_6_mm(tmp_path):
+    """The cohort's PLY walls store float64: a vertex moved by 1e-6 mm fails, by 1e-12 mm passes."""
+    import trimesh
+
+    from softdesign.io.mesh_files import write_mesh
+
+    committed = REPO / "data" / "cohort" / "arch" / "surface.ply"
+    mesh = trimesh.load(committed, process=False)
+    for name, move in (("moved.ply", 1e-6), ("rounded.ply", 1e-3 * REGENERATION_TOL_MM)):
+        vertices = np.array(mesh.vertices)
+        vertices[len(vertices) // 2, 2] += move
+        write_mesh(tmp_path / name, vertices, mesh.faces)
+    assert vessel_file_differences(tmp_path / "moved.ply", committed)[0].startswith("vertices: 1 of")
+    assert vessel_file_differences(tmp_path / "rounded.ply", committed) == []
 
 
 def test_sample_cohort_differs_in_shape_radius_and_links():
