@@ -9,7 +9,7 @@ STAMP := $(VENV)/.installed-stamp
 CONSTRAINTS := requirements/constraints.txt
 LOCK_VENV := build/.lock-venv
 
-.PHONY: demo test lint lock bench install clean
+.PHONY: demo test test-fast lint lock bench install clean
 
 install: $(STAMP)
 
@@ -44,6 +44,10 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest
+
+# Everything but the tests marked slow (whole builds, cohorts, reports): under a minute.
+test-fast: $(STAMP)
+	$(BIN)/python -m pytest -m "not slow"
 
 # ruff (style, imports, bugbear, pyupgrade, numpy rules) and mypy, both
 # configured in pyproject.toml; both run, and either failing fails the target.

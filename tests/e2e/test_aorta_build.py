@@ -10,6 +10,9 @@ from typer.testing import CliRunner
 
 from softdesign.cli import app
 
+#: Whole builds of the real aorta: `make test-fast` leaves them out.
+pytestmark = pytest.mark.slow
+
 runner = CliRunner()
 Q = [0.0, 0.5, 1.0]
 

@@ -97,6 +97,7 @@ def test_synthetic_surface_reaches_the_triangle_count_and_is_closed():
     assert vertices.shape == (rings * angles + 2, 3)
 
 
+@pytest.mark.slow
 def test_worker_measures_a_tiny_synthetic_build(bench, tmp_path):
     case = bench.synthetic_case(tmp_path / "inputs", 20_000, 2)  # ~3 wall points per spline coefficient
     result = bench.run_worker(case.case_file, tmp_path / "run", None)

@@ -185,6 +185,7 @@ def builds_in(dry_run: str, build: Path) -> set[str]:
     return {name for name in MAKE_CASES + ("broken", "missing") if f"--out {build}/{name}" in dry_run}
 
 
+@pytest.mark.slow
 @needs_make
 def test_make_cohort_rebuilds_only_what_changed(tmp_path):
     cases, build = temporary_cohort(tmp_path), tmp_path / "build"
@@ -211,6 +212,7 @@ def test_make_cohort_rebuilds_only_what_changed(tmp_path):
     assert builds_in(make("-n", "cohort", cohort_dir=cases, build=build).stdout, build) == {"s_bend"}
 
 
+@pytest.mark.slow
 @needs_make
 def test_a_broken_case_fails_its_row_and_the_others_still_build(tmp_path):
     cases, build = temporary_cohort(tmp_path), tmp_path / "build"

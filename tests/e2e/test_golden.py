@@ -23,6 +23,9 @@ from softdesign.regression import GOLDEN, CheckOptions, mesh_names
 from .test_cohort import MAKE, make
 from tests.helpers.paths import REPO
 
+#: The sample cohort built afresh: `make test-fast` leaves these out.
+pytestmark = pytest.mark.slow
+
 COHORT = REPO / "configs" / "cohort"
 REFERENCES = REPO / "tests" / "golden"
 CASES = [p.stem for p in cohort_cases(COHORT)]

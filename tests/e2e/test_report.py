@@ -22,12 +22,14 @@ from PIL import Image
 from typer.testing import CliRunner
 
 from softdesign.pipeline.api import build_through
-from softdesign.report.tables import software_rows
 from softdesign.report.writer import EXPECTED_SIZES, PAGE, REPORT_DIR, ReportOptions, commit_folder, write_report
 from softdesign.versions import software_versions
 
 from tests.helpers.cases import write_case
 from tests.helpers.paths import REPO
+
+#: Builds and reports the sample case and the aorta: `make test-fast` leaves these out.
+pytestmark = pytest.mark.slow
 
 DEMO_CASE = REPO / "configs" / "demo.yaml"
 #: The page shows figures to 6 significant digits: the text may differ from the exact value by half a unit in the 6th.
@@ -198,13 +200,6 @@ def test_inputs_and_software_are_listed(built):
     for name, version in manifest["software"].items():
         assert [name, version, software_versions()[name]] in rows, name
     assert ["matplotlib", "-", metadata.version("matplotlib")] in rows
-
-
-def test_software_rows_show_what_the_build_recorded_beside_what_draws_the_page():
-    now = software_versions(("matplotlib", "pillow"))
-    rows = software_rows({"software": {"softdesign": "0.0.1", "numpy": "1.26.0"}})
-    assert rows[:2] == [("softdesign", "0.0.1", now["softdesign"]), ("numpy", "1.26.0", now["numpy"])]
-    assert rows[2:] == [(name, "-", version) for name, version in now.items() if name not in ("softdesign", "numpy")]
 
 
 def test_aorta_report_notes_the_missing_pcc_panel(aorta):

@@ -224,6 +224,7 @@ def _run_pose(demo, q: str, output: Path, *extra: str):
     return runner.invoke(app, ["pose", str(DEMO), "--q", q, "--output", str(output), "--out", str(demo.build_dir), *extra])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("q", [0.0, 0.5, 1.0])
 def test_equal_q_reproduces_the_build_mesh(demo, tmp_path, q):
     output = tmp_path / "pose.stl"
@@ -329,6 +330,7 @@ def hollow_case(tmp_path_factory) -> Path:
     return path
 
 
+@pytest.mark.slow
 def test_hollow_pose_with_equal_q_is_the_builds_hollow_mesh(hollow_case, tmp_path):
     out = tmp_path / "build"
     args = ["pose", str(hollow_case), "--q", "1", "--output", str(tmp_path / "p.stl"), "--out", str(out)]
@@ -342,6 +344,7 @@ def test_hollow_pose_with_equal_q_is_the_builds_hollow_mesh(hollow_case, tmp_pat
     assert mine.volume == pytest.approx(built.volume, rel=1e-12) and len(mine.faces) == len(built.faces)
 
 
+@pytest.mark.slow
 def test_hollow_pose_with_mixed_q_is_one_ported_body_with_its_walls_reported(hollow_case, tmp_path):
     out = tmp_path / "build"
     args = ["pose", str(hollow_case), "--q", "0,1,0,1", "--output", str(tmp_path / "p.ply"), "--out", str(out), "--json"]

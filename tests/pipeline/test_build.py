@@ -61,6 +61,7 @@ def edit(case: Path, section: str, **values) -> None:
     case.write_text(yaml.safe_dump(data, sort_keys=False))
 
 
+@pytest.mark.slow
 def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_path):
     out = tmp_path / "build"
     assert statuses(build(demo_case, out)) == dict.fromkeys(STAGES, "ran")
@@ -87,6 +88,7 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     assert statuses(build(demo_case, out, "--force")) == dict.fromkeys(STAGES, "ran")
 
 
+@pytest.mark.slow
 def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tmp_path):
     out = tmp_path / "build"
     build(demo_case, out)
@@ -121,6 +123,7 @@ def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tm
     assert not any(o.get("stale") for o in manifest["outputs"])
 
 
+@pytest.mark.slow
 def test_a_stale_output_is_not_reused_because_it_exists(demo_case, tmp_path):
     out = tmp_path / "build"
     build(demo_case, out)
@@ -128,6 +131,7 @@ def test_a_stale_output_is_not_reused_because_it_exists(demo_case, tmp_path):
     assert statuses(build(demo_case, out))["fit"] == "ran"
 
 
+@pytest.mark.slow
 def test_same_inputs_give_the_same_bytes(demo_case, tmp_path):
     first, second = tmp_path / "a", tmp_path / "b"
     build(demo_case, first)
@@ -166,6 +170,7 @@ def test_manifest_records_inputs_case_metrics_and_outputs(demo_case, tmp_path):
         assert mesh["faces"] > 0 and mesh["vertices"] > 0
 
 
+@pytest.mark.slow
 def test_a_failed_run_leaves_the_previous_build_untouched(demo_case, tmp_path, monkeypatch):
     out = tmp_path / "build"
     build(demo_case, out)
@@ -207,6 +212,7 @@ app()
 """
 
 
+@pytest.mark.slow
 def test_a_build_killed_mid_export_leaves_the_previous_build_unchanged(demo_case, tmp_path):
     out = tmp_path / "build"
     build(demo_case, out)
@@ -224,6 +230,7 @@ def test_a_build_killed_mid_export_leaves_the_previous_build_unchanged(demo_case
     shutil.rmtree(out)
 
 
+@pytest.mark.slow
 def test_split_regions_writes_one_stl_per_region_that_tiles_each_solid(demo_case, tmp_path):
     import trimesh
 
@@ -255,6 +262,7 @@ def test_split_regions_writes_one_stl_per_region_that_tiles_each_solid(demo_case
     assert "meshes/q_1.000/wall.stl" in result.output
 
 
+@pytest.mark.slow
 def test_vtp_meshes_carry_the_region_of_every_face(demo_case, tmp_path):
     from vtk.util.numpy_support import vtk_to_numpy
 
