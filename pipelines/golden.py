@@ -35,7 +35,8 @@ from pathlib import Path
 import numpy as np
 
 from softdesign.io.mesh_files import write_mesh
-from softdesign.meshing.compare import MeshDifference, compare_meshes, is_watertight
+from softdesign.meshing.compare import MeshDifference, compare_meshes
+from softdesign.meshing.topology import is_winding_consistent
 from softdesign.cohort import STATUS_SUFFIX, cohort_cases, read_record
 from softdesign.pipeline.layout import MANIFEST
 from softdesign.pipeline.store import sha256_file
@@ -91,7 +92,7 @@ def store_mesh(source: Path, target: Path, max_error_mm: float) -> tuple[MeshDif
         write_mesh(target, *decimate(*full, reduction))
         stored = read_mesh(target)
         difference = compare_meshes(*stored, *full)
-        ok = is_watertight(stored[1]) == is_watertight(full[1]) and difference.distance_max_mm <= max_error_mm
+        ok = is_winding_consistent(stored[1]) == is_winding_consistent(full[1]) and difference.distance_max_mm <= max_error_mm
         return difference if ok else None
 
     good, bad = 0.0, MAX_REDUCTION

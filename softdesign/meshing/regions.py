@@ -14,8 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from softdesign.meshing.compare import surface_area
 from softdesign.meshing.tessellate import Region
+from softdesign.meshing.topology import surface_area
 from softdesign.types import FloatArray, IntArray
 
 

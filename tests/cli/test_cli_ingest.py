@@ -197,7 +197,7 @@ def test_sample_generator_rebuilds_the_committed_demo_data(tmp_path):
 
 def test_sample_is_a_vmtk_style_network_with_a_capped_wall(tmp_path):
     from softdesign.geometry.network import select_path
-    from softdesign.geometry.surface_info import describe_surface
+    from softdesign.meshing.topology import describe_surface
     from softdesign.io.centerline import read_centerline_network
     from softdesign.io.surface import read_surface
 

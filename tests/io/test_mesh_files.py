@@ -8,9 +8,9 @@ import trimesh
 
 from softdesign.io.mesh_files import LABELLED_FORMATS, MESH_FORMATS, mesh_bytes, write_mesh
 from softdesign.io.vtk_polydata import read_polydata, triangles_from_polydata
-from softdesign.meshing.compare import enclosed_volume, surface_area
 from softdesign.meshing.solids import build_solid
 from softdesign.meshing.tessellate import Region
+from softdesign.meshing.topology import signed_volume, surface_area
 from softdesign.meshing.volume import BodySpec
 from tests.helpers.bodies import Body, straight_line
 
@@ -36,7 +36,7 @@ def test_every_format_reads_back_as_the_same_solid(ported, tmp_path, fmt):
     path = write_mesh(tmp_path / f"body.{fmt}", ported.vertices, ported.faces, ported.regions)
     vertices, faces = _read_back(path, fmt)
     assert len(faces) == len(ported.faces)
-    for measure in (enclosed_volume, surface_area):
+    for measure in (signed_volume, surface_area):
         expected = measure(ported.vertices, ported.faces)
         assert measure(vertices, faces) == pytest.approx(expected, rel=FLOAT32_RTOL), measure.__name__
     # the same arrays give the same bytes
