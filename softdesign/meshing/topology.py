@@ -207,6 +207,18 @@ def edge_uses(faces: npt.ArrayLike, n_vertices: int) -> tuple[IntArray, IntArray
     return np.column_stack([edge // n_vertices, edge % n_vertices]), uses
 
 
+def drop_unused_vertices(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> tuple[FloatArray, IntArray]:
+    """The vertices that faces use, in their order, and the faces renumbered to them.
+
+    Returns
+    -------
+    vertices : (U, 3) float, mm
+    faces : (F, 3) int64
+    """
+    used, compact = np.unique(np.asarray(faces, np.int64), return_inverse=True)
+    return np.asarray(vertices, float)[used], compact.reshape(-1, 3)
+
+
 def describe_surface(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> SurfaceInfo:
     """Topology summary of a surface that may be open or non-manifold (vertices (V, 3) mm, faces (F, 3))."""
     vertices = np.asarray(vertices, float)

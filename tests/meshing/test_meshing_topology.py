@@ -7,6 +7,7 @@ import pytest
 
 from softdesign.meshing.topology import (
     describe_surface,
+    drop_unused_vertices,
     edge_uses,
     face_areas,
     is_watertight,
@@ -139,3 +140,12 @@ def test_unused_vertices_are_not_counted_and_bad_arrays_are_refused():
         mesh_topology(v[:, :2], f)
     with pytest.raises(ValueError, match="faces refer to vertices that do not exist"):
         mesh_topology(v, f + 1)
+
+
+def test_dropping_unused_vertices_keeps_the_faces_on_the_same_points():
+    v, f = cube()
+    padded = np.vstack([[[9.0, 9.0, 9.0]], v[:4], [[8.0, 8.0, 8.0]], v[4:]])
+    renumbered = np.where(f < 4, f + 1, f + 2)
+    kept, faces = drop_unused_vertices(padded, renumbered)
+    np.testing.assert_array_equal(kept, v)
+    np.testing.assert_array_equal(faces, f)
