@@ -21,7 +21,8 @@ Definitions
 
 trimesh has the same definitions, but its volume integrates about the
 origin and in another order; the figures here are the ones every build has
-written, to the last bit, and need numpy and scipy only.
+written, to the last bit, and need numpy and scipy only (scipy imported
+where used, so that importing the command line stays quick).
 """
 
 from __future__ import annotations
@@ -30,8 +31,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
-from scipy.sparse import coo_matrix, csr_matrix
-from scipy.sparse.csgraph import connected_components
 
 from softdesign.types import FloatArray, IntArray
 
@@ -227,6 +226,9 @@ def describe_surface(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> SurfaceIn
     boundary = edges[uses == 1]
     loops = 0
     if len(boundary):
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
         nodes, local = np.unique(boundary, return_inverse=True)
         local = local.reshape(-1, 2)
         graph = coo_matrix((np.ones(len(local)), (local[:, 0], local[:, 1])), shape=(len(nodes),) * 2)
@@ -291,6 +293,9 @@ def _vertex_manifold(twin: IntArray, used: int) -> bool:
     step walks once round the faces of b that share edges with f: one cycle
     per fan, so a 2-manifold has exactly as many cycles as used vertices.
     """
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import connected_components
+
     step = np.roll(twin.reshape(-1, 3), -1, axis=1).ravel()  # twin of the next half-edge
     n = step.size
     graph = csr_matrix((np.ones(n), step, np.arange(n + 1)), shape=(n, n))  # row j: the one step from j
@@ -300,6 +305,9 @@ def _vertex_manifold(twin: IntArray, used: int) -> bool:
 
 def _shell_volumes(faces: IntArray, corners: FloatArray, n_vertices: int, used: IntArray) -> FloatArray:
     """Each connected shell's signed volume (mm^3), corners (F, 3, 3) mm about the centroid."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import connected_components
+
     n, count_faces = n_vertices, faces.shape[0]
     # one graph of vertices (nodes 0 .. V-1, so components are numbered as over vertices alone)
     # and faces (nodes V ..), each face joined to its three vertices: CSR rows without a sort
