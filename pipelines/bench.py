@@ -255,7 +255,7 @@ def aorta_case(folder: Path) -> BenchCase | None:
 def write_synthetic_inputs(folder: Path, triangles: int) -> None:
     """The synthetic vessel's centerline.vtp and binary surface.stl with at least ``triangles`` faces."""
     from softdesign.samples.synthetic_vessel import make_synthetic_vessel
-    from softdesign.io.mesh_files import write_mesh
+    from softdesign.io.formats import write_mesh
     from softdesign.io.polylines_vtp import write_polylines_vtp
     from softdesign.samples.surfaces import synthetic_surface
 

@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from softdesign.io.mesh_files import write_mesh
+from softdesign.io.formats import read_mesh, write_mesh
 from softdesign.meshing.compare import MeshDifference, compare_meshes
 from softdesign.meshing.topology import is_winding_consistent
 from softdesign.cohort import STATUS_SUFFIX, cohort_cases, read_record
@@ -48,14 +48,6 @@ MAX_REDUCTION, BISECTIONS = 0.97, 6
 MAX_ERROR_MM = 0.05
 PACKAGES = ("softdesign", "numpy", "scipy", "manifold3d", "vtk", "trimesh")
 DECIMATION = "vtkQuadricDecimation (volume preservation on), the strongest reduction <= {} keeping the mesh watertight within {} mm"
-
-
-def read_mesh(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """Vertices and faces of a mesh file with shared vertices merged, as ``softdesign check`` reads it."""
-    import trimesh
-
-    mesh = trimesh.load(str(path), force="mesh", process=True)
-    return np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces, np.int64)
 
 
 def decimate(vertices: np.ndarray, faces: np.ndarray, reduction: float) -> tuple[np.ndarray, np.ndarray]:

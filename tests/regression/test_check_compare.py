@@ -1,4 +1,4 @@
-"""Mesh-to-mesh figures (softdesign.meshing.compare) and pose differences, on known answers first."""
+"""Mesh-to-mesh figures (softdesign.meshing.compare), mesh folders in every format, pose differences."""
 
 from __future__ import annotations
 
@@ -7,8 +7,9 @@ import pytest
 import trimesh
 
 from softdesign.errors import MeshError
+from softdesign.io.formats import MESH_FORMATS, write_mesh
 from softdesign.meshing.compare import compare_meshes, surface_samples
-from softdesign.regression import pose_difference
+from softdesign.regression import CheckOptions, compare_mesh_folders, mesh_names, pose_difference
 
 #: Rounding of double-precision sums over a few thousand terms of size ~1e3, mm, mm^2 or relative.
 EXACT_TOL = 1e-9
@@ -116,6 +117,22 @@ def test_a_mesh_without_faces_is_refused_with_its_shapes():
         compare_meshes(v, f, v, np.zeros((0, 3), np.int64))
     with pytest.raises(MeshError, match=r"face indices must lie in \[0, 7\], got \[0, 8\]"):
         compare_meshes(v, np.vstack([f, [[0, 1, 8]]]), v, f)
+
+
+@pytest.mark.parametrize("fmt", MESH_FORMATS)
+def test_mesh_folders_are_compared_in_every_format(tmp_path, fmt):
+    v, f = box()
+    shift = 0.004  # within check's default 0.01 mm
+    for folder, moved in (("build", shift), ("reference", 0.0)):
+        (tmp_path / folder / "meshes").mkdir(parents=True)
+        write_mesh(tmp_path / folder / "meshes" / f"q_0.000.{fmt}", v + [moved, 0.0, 0.0], f)
+    assert mesh_names(tmp_path / "build") == {f"meshes/q_0.000.{fmt}"}
+    figures = compare_mesh_folders(tmp_path / "build", tmp_path / "reference", CheckOptions(samples=2000), {})
+    by_name = {figure.figure: figure for figure in figures}
+    assert set(by_name) == {"distance_max_mm", "distance_rms_mm", "volume_rel_change", "area_rel_change", "watertight"}
+    assert all(figure.passed for figure in figures) and by_name["watertight"].build is True
+    # float32 files (STL, glTF) round the box's corners by ~1e-6 mm
+    np.testing.assert_allclose(by_name["distance_max_mm"].change, shift, rtol=0, atol=1e-5)
 
 
 def test_pose_difference_known_translation_and_angles():
