@@ -47,7 +47,6 @@ REPO = Path(__file__).resolve().parents[1]
 DEMO_CASE = REPO / "configs" / "demo.yaml"
 AORTA_DIR = REPO.parent / "shared" / "data" / "vmtk-aorta"
 STAGE_NAMES = ("ingest", "blend", "links", "kinematics", "fit", "export")
-MIB = 1024.0 * 1024.0
 
 #: Targets of the scaled case (issue 5, item 9).
 TARGET_FLOOR_RATIO = 3.0

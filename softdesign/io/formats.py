@@ -139,8 +139,6 @@ FORMATS: dict[str, MeshFormat] = {
 }
 #: Formats a mesh can be written in: ``export.formats`` and ``pose --output``.
 MESH_FORMATS = tuple(name for name, f in FORMATS.items() if f.encode is not None)
-#: Formats that carry per-face region labels.
-LABELLED_FORMATS = tuple(name for name in MESH_FORMATS if FORMATS[name].carries_regions)
 
 
 def mesh_bytes(vertices: np.ndarray, faces: np.ndarray, file_type: str, regions: np.ndarray | None = None) -> bytes:
