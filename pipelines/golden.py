@@ -84,7 +84,8 @@ def store_mesh(source: Path, target: Path, max_error_mm: float) -> tuple[MeshDif
         write_mesh(target, *decimate(*full, reduction))
         stored = read_mesh(target)
         difference = compare_meshes(*stored, *full)
-        ok = is_winding_consistent(stored[1]) == is_winding_consistent(full[1]) and difference.distance_max_mm <= max_error_mm
+        closed_alike = is_winding_consistent(stored[1]) == is_winding_consistent(full[1])
+        ok = closed_alike and difference.distance_max_mm <= max_error_mm
         return difference if ok else None
 
     good, bad = 0.0, MAX_REDUCTION

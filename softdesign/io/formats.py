@@ -166,9 +166,8 @@ def read_mesh(path: str | Path) -> Mesh:
     path = Path(path)
     found = FORMATS.get(path.suffix.lower().lstrip("."))
     if found is None:
-        raise InputDataError(
-            f"{path}: unknown mesh format '{path.suffix}'; expected one of {', '.join(f.suffix for f in FORMATS.values())}"
-        )
+        choices = ", ".join(f.suffix for f in FORMATS.values())
+        raise InputDataError(f"{path}: unknown mesh format '{path.suffix}'; expected one of {choices}")
     vertices, faces = found.read(path)
     if len(faces) == 0:
         raise InputDataError(f"{path}: the mesh has no triangles")
