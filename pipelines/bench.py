@@ -47,7 +47,6 @@ REPO = Path(__file__).resolve().parents[1]
 DEMO_CASE = REPO / "configs" / "demo.yaml"
 AORTA_DIR = REPO.parent / "shared" / "data" / "vmtk-aorta"
 STAGE_NAMES = ("ingest", "blend", "links", "kinematics", "fit", "export")
-MIB = 1024.0 * 1024.0
 
 #: Targets of the scaled case (issue 5, item 9).
 TARGET_FLOOR_RATIO = 3.0
@@ -255,7 +254,7 @@ def aorta_case(folder: Path) -> BenchCase | None:
 def write_synthetic_inputs(folder: Path, triangles: int) -> None:
     """The synthetic vessel's centerline.vtp and binary surface.stl with at least ``triangles`` faces."""
     from softdesign.samples.synthetic_vessel import make_synthetic_vessel
-    from softdesign.io.mesh_files import write_mesh
+    from softdesign.io.formats import write_mesh
     from softdesign.io.polylines_vtp import write_polylines_vtp
     from softdesign.samples.surfaces import synthetic_surface
 

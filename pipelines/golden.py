@@ -32,8 +32,9 @@ from pathlib import Path
 
 import numpy as np
 
-from softdesign.io.mesh_files import write_mesh
-from softdesign.meshing.compare import MeshDifference, compare_meshes, is_watertight
+from softdesign.io.formats import read_mesh, write_mesh
+from softdesign.meshing.compare import MeshDifference, compare_meshes
+from softdesign.meshing.topology import is_winding_consistent
 from softdesign.cohort import STATUS_SUFFIX, cohort_cases, read_record
 from softdesign.pipeline.layout import MANIFEST
 from softdesign.pipeline.store import sha256_file
@@ -45,14 +46,6 @@ MAX_REDUCTION, BISECTIONS = 0.97, 6
 #: Largest distance a stored mesh may be from the full one, mm (check widens its tolerance by the actual error).
 MAX_ERROR_MM = 0.05
 DECIMATION = "vtkQuadricDecimation (volume preservation on), the strongest reduction <= {} keeping the mesh watertight within {} mm"
-
-
-def read_mesh(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """Vertices and faces of a mesh file with shared vertices merged, as ``softdesign check`` reads it."""
-    import trimesh
-
-    mesh = trimesh.load(str(path), force="mesh", process=True)
-    return np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces, np.int64)
 
 
 def decimate(vertices: np.ndarray, faces: np.ndarray, reduction: float) -> tuple[np.ndarray, np.ndarray]:
@@ -89,7 +82,8 @@ def store_mesh(source: Path, target: Path, max_error_mm: float) -> tuple[MeshDif
         write_mesh(target, *decimate(*full, reduction))
         stored = read_mesh(target)
         difference = compare_meshes(*stored, *full)
-        ok = is_watertight(stored[1]) == is_watertight(full[1]) and difference.distance_max_mm <= max_error_mm
+        closed_alike = is_winding_consistent(stored[1]) == is_winding_consistent(full[1])
+        ok = closed_alike and difference.distance_max_mm <= max_error_mm
         return difference if ok else None
 
     good, bad = 0.0, MAX_REDUCTION

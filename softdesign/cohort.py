@@ -32,7 +32,6 @@ from softdesign.errors import ConfigError
 from softdesign.pipeline.layout import EXPORT_SUMMARY, FIT_SUMMARY, KINEMATICS, MANIFEST, MESHES_DIR
 
 CASE_SUFFIX = ".yaml"
-LOG_SUFFIX = ".log"
 STATUS_SUFFIX = ".status.json"
 #: Longest error message kept in the summary table (the log keeps all of it).
 MESSAGE_CHARS = 400

@@ -28,6 +28,7 @@ from pydantic import (
 )
 
 from softdesign.errors import ConfigError
+from softdesign.io.formats import MESH_FORMATS
 
 
 class _Section(BaseModel):
@@ -145,7 +146,7 @@ class Export(_Section):
     offset_mm: float = 0.0
     wall_mm: float | None = Field(None, gt=0.0)
     port_mm: float | None = Field(None, gt=0.0)
-    formats: list[Literal["stl", "ply", "obj", "glb", "vtp"]] = ["stl"]
+    formats: list[Literal[MESH_FORMATS]] = ["stl"]
     spacing_mm: float = Field(0.5, gt=0.0)
     angular_count: int = Field(64, ge=8)
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...

@@ -26,18 +26,17 @@ from softdesign.cli.common import (
     run_guarded,
 )
 from softdesign.errors import ConfigError, errors_named_for
+from softdesign.io.formats import MESH_FORMATS
 
 OutputOpt = Annotated[
     Path,
-    typer.Option("--output", help="Mesh file to write; its suffix picks the format (.stl .ply .obj .glb .vtp).",
-                 show_default=False),
+    typer.Option("--output", help="Mesh file to write; its suffix picks the format ("
+                 + " ".join(f".{f}" for f in MESH_FORMATS) + ").", show_default=False),
 ]
 
 
 def mesh_format_of(path: Path) -> str:
     """The mesh format named by ``path``'s suffix; ConfigError for an unknown one or a missing folder."""
-    from softdesign.io.mesh_files import MESH_FORMATS
-
     fmt = path.suffix.lower().lstrip(".")
     if fmt not in MESH_FORMATS:
         raise ConfigError(
@@ -52,8 +51,6 @@ def mesh_format_of(path: Path) -> str:
 
 def _check_build_folder_option(out: Path | None) -> None:
     """``--out/-o`` is the build folder in every command: a mesh file name there is a mistake, say so."""
-    from softdesign.io.mesh_files import MESH_FORMATS
-
     if out is not None and out.suffix.lower().lstrip(".") in MESH_FORMATS:
         raise ConfigError(
             f"--out/-o {out}: is the build folder in every softdesign command, not the mesh file; "
@@ -151,15 +148,15 @@ def pose(
     """
 
     def action() -> None:
-        from softdesign.io.mesh_files import LABELLED_FORMATS, write_mesh
+        from softdesign.io.formats import write_mesh
 
         start = time.perf_counter()
         _check_build_folder_option(out)
         q_values = q_values_from_text(q)
-        fmt = mesh_format_of(output)
+        mesh_format_of(output)  # refuse an unknown suffix or folder before the build, not after
         body = _make_pose(case_file, q_values, out, force)
         try:
-            write_mesh(output, body.vertices, body.faces, body.regions if fmt in LABELLED_FORMATS else None)
+            write_mesh(output, body.vertices, body.faces, body.regions)
         except OSError as err:
             raise ConfigError(f"--output {output}: cannot write the mesh ({err.strerror}); choose a writable path") from err
         payload = pose_payload(body, output)

@@ -38,7 +38,7 @@ from softdesign.geometry.frames import (
     base_normal_from_tangent,
     framed_curve,
 )
-from softdesign.kinematics.poe import inverse_pose, pose_from_twist, rotation_from_rotvec, twist_from_pose
+from softdesign.geometry.se3 import inverse_pose, pose_from_twist, rotation_from_rotvec, twist_from_pose
 from softdesign.types import FloatArray
 
 BlendMode = Literal["linear", "intrinsic"]

@@ -119,13 +119,6 @@ def accumulate_rotations(steps: FloatArray, side: Literal["left", "right"]) -> F
     return out
 
 
-def rmf_frames_from_samples(points: Points, tangents: Points, base_frame: FloatArray) -> Frames:
-    """Rotation-minimizing frames (n, 3, 3) by double reflection from ``base_frame`` at sample 0."""
-    rotations = accumulate_rotations(reflection_rotations(np.diff(points, axis=0), tangents), "left")
-    frames = np.concatenate([base_frame[None], rotations @ base_frame], axis=0)
-    return _orthonormal_with_tangent(frames, tangents)
-
-
 def adjacent_rotation_angles(frames: Frames) -> FloatArray:
     """Rotation angle between consecutive frames, (n-1,) rad in [0, pi]."""
     relative = np.swapaxes(frames[:-1], 1, 2) @ frames[1:]

@@ -28,7 +28,7 @@ import numpy.typing as npt
 from softdesign.errors import ConfigError
 from softdesign.geometry.curves import CurveOptions, SmoothCurve, smooth_curve_from_polyline, smooth_curve_from_samples
 from softdesign.geometry.frames import base_normal_from_tangent, frame_from_tangent
-from softdesign.kinematics.poe import rotation_from_rotvec
+from softdesign.geometry.se3 import rotation_from_rotvec
 from softdesign.types import FloatArray, Points
 
 InitialKind = Literal["straight", "arc", "file"]

@@ -27,7 +27,8 @@ import numpy.typing as npt
 from softdesign.errors import ConfigError
 from softdesign.geometry.blend import BlendedShape, BlendStats
 from softdesign.geometry.frames import FramedSpline, poses_from_frames
-from softdesign.kinematics.poe import PoeSplit, inverse_pose, poe_from_pose
+from softdesign.geometry.se3 import inverse_pose
+from softdesign.kinematics.poe import PoeSplit, poe_from_pose
 from softdesign.types import FloatArray, FramedCurve, Pose
 
 #: Shortest link allowed, as a fraction of the path (below it a link has no room for a surface fit).

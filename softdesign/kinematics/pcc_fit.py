@@ -40,9 +40,9 @@ from scipy.optimize import least_squares
 
 from softdesign.errors import ConfigError, FitError
 from softdesign.geometry.frames import FramedSpline
+from softdesign.geometry.se3 import axis_angle_from_rotation, inverse_pose
 from softdesign.kinematics import pcc
 from softdesign.kinematics.links import LinkChain
-from softdesign.kinematics.poe import axis_angle_from_rotation, inverse_pose
 from softdesign.types import FloatArray, Points, Pose
 
 #: Stated in every ``pcc design`` output.

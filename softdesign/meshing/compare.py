@@ -22,6 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import MeshError
+from softdesign.meshing.topology import face_areas, mesh_topology, surface_area
 from softdesign.types import FloatArray, IntArray
 
 #: Fewest surface samples per mesh; with the vertices added, a 10k-face mesh gets ~25k points.
@@ -93,13 +94,15 @@ def compare_meshes(
     ref = _checked_mesh(ref_vertices, ref_faces, "reference mesh")
     there_max, there_sq = _one_way(mesh, ref, samples)
     back_max, back_sq = _one_way(ref, mesh, samples)
+    ours, theirs = mesh_topology(*mesh), mesh_topology(*ref)
     return MeshDifference(
         distance_max_mm=max(there_max, back_max),
         distance_rms_mm=float(np.sqrt(np.mean(np.concatenate([there_sq, back_sq])))),
-        volume_rel_change=_relative(abs(enclosed_volume(*mesh)), abs(enclosed_volume(*ref))),
-        area_rel_change=_relative(surface_area(*mesh), surface_area(*ref)),
-        watertight=is_watertight(mesh[1]),
-        reference_watertight=is_watertight(ref[1]),
+        volume_rel_change=_relative(abs(ours.volume), abs(theirs.volume)),
+        area_rel_change=_relative(ours.area, theirs.area),
+        # watertight here also asks for consistent winding: only then does the volume mean anything
+        watertight=ours.winding_consistent,
+        reference_watertight=theirs.winding_consistent,
     )
 
 
@@ -126,7 +129,7 @@ def surface_samples(vertices: npt.ArrayLike, faces: npt.ArrayLike, count: int) -
         raise ValueError(f"surface_samples: count must be >= 1, got {count}")
     v, f = _checked_mesh(vertices, faces, "mesh")
     corners = v[f]
-    area = _face_areas(corners)
+    area = face_areas(v, f)
     cumulative = np.cumsum(area)
     k = np.arange(int(count), dtype=np.float64)
     position = (k + 0.5) / count * cumulative[-1]
@@ -137,32 +140,6 @@ def surface_samples(vertices: npt.ArrayLike, faces: npt.ArrayLike, count: int) -
     root = np.sqrt(s)[:, None]
     a, b, c = corners[face, 0], corners[face, 1], corners[face, 2]
     return (1.0 - root) * a + root * (1.0 - t[:, None]) * b + root * t[:, None] * c
-
-
-def enclosed_volume(vertices: FloatArray, faces: IntArray) -> float:
-    """Signed volume (mm^3) enclosed by a closed, outward-oriented triangle mesh (divergence theorem)."""
-    corners = np.asarray(vertices, float)[np.asarray(faces, np.int64)]
-    return float(np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])).sum() / 6.0)
-
-
-def surface_area(vertices: FloatArray, faces: IntArray) -> float:
-    """Total triangle area, mm^2."""
-    return float(_face_areas(np.asarray(vertices, float)[np.asarray(faces, np.int64)]).sum())
-
-
-def is_watertight(faces: IntArray) -> bool:
-    """True when every edge is shared by exactly two faces that run it in opposite directions.
-
-    That is closed, edge-manifold and consistently oriented; vertices must be
-    merged (an STL read without merging is never watertight).
-    """
-    f = np.asarray(faces, np.int64)
-    directed = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
-    unique_directed = np.unique(directed, axis=0)
-    if len(unique_directed) != len(directed):
-        return False
-    # Each directed edge has its reverse, and no other: the set equals its reversal (np.unique sorts rows).
-    return bool(np.array_equal(unique_directed, np.unique(unique_directed[:, ::-1], axis=0)))
 
 
 def _checked_mesh(vertices: npt.ArrayLike, faces: npt.ArrayLike, what: str) -> tuple[FloatArray, IntArray]:
@@ -180,10 +157,6 @@ def _checked_mesh(vertices: npt.ArrayLike, faces: npt.ArrayLike, what: str) -> t
     if surface_area(v, f) <= 0.0:
         raise MeshError(f"{what}: zero total area ({len(f)} degenerate faces)")
     return v, f
-
-
-def _face_areas(corners: FloatArray) -> FloatArray:
-    return 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
 
 
 def _one_way(

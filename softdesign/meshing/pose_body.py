@@ -42,8 +42,8 @@ import numpy.typing as npt
 from softdesign.errors import MeshError
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.geometry.frames import FramedSpline
+from softdesign.geometry.se3 import inverse_pose
 from softdesign.kinematics.links import LinkChain
-from softdesign.kinematics.poe import inverse_pose
 from softdesign.meshing.body import body_breaks, body_stations, export_l_grid, sections_on_grid
 from softdesign.meshing.checks import Expectation, MeshReport, check_solid
 from softdesign.meshing.pose_stitch import JointStep, JointStitch, assemble, placed, resampled_joints

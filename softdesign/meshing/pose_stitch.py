@@ -22,6 +22,7 @@ import numpy.typing as npt
 
 from softdesign.errors import MeshError
 from softdesign.meshing.tessellate import Region, Sweep, TubeMesh, tessellate
+from softdesign.meshing.topology import drop_unused_vertices
 from softdesign.meshing.volume import angle_grid
 from softdesign.types import POINT_TOL_MM, FloatArray, IntArray, Pose
 
@@ -230,6 +231,4 @@ def assemble(sweeps: list[Sweep], stitches: list[JointStitch]) -> tuple[FloatArr
         regions = np.concatenate([regions, split_halves, annulus])
         remap = np.concatenate([remap, crossing_ids])
         remap[ring_a[stitch.merged]] = ring_b[stitch.merged]
-    faces = remap[faces]
-    used, compact = np.unique(faces, return_inverse=True)
-    return np.concatenate(vertices)[used], compact.reshape(-1, 3), regions
+    return *drop_unused_vertices(np.concatenate(vertices), remap[faces]), regions

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from softdesign.meshing.compare import surface_area
 from softdesign.meshing.tessellate import Region
+from softdesign.meshing.topology import drop_unused_vertices, surface_area
 from softdesign.types import FloatArray, IntArray
 
 
@@ -74,6 +74,5 @@ def split_by_region(
         chosen = faces[regions == region.value]
         if len(chosen) == 0:
             continue
-        used, local = np.unique(chosen, return_inverse=True)
-        pieces.append(RegionPiece(region, vertices[used], local.reshape(-1, 3)))
+        pieces.append(RegionPiece(region, *drop_unused_vertices(vertices, chosen)))
     return tuple(pieces)

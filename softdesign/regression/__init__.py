@@ -2,7 +2,7 @@
 
 What is compared, and against which tolerance (:class:`CheckOptions`):
 
-- every mesh file under ``meshes/`` (.stl .ply .obj .glb) present on either
+- every mesh file under ``meshes/`` (any format of :mod:`softdesign.io.formats`) present on either
   side, by name, through :func:`softdesign.meshing.compare.compare_meshes`:
   symmetric surface distance max and RMS (``distance_mm``), relative change of
   volume and area (``rtol``), watertightness (must equal the reference's).

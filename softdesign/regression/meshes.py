@@ -12,14 +12,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Optional
 
-import numpy as np
-
 from softdesign.pipeline.layout import MESHES_DIR
 from softdesign.errors import InputDataError, SoftdesignError
+from softdesign.io.formats import FORMATS, read_mesh
 from softdesign.meshing.compare import MeshDifference, compare_meshes
 from softdesign.regression.figures import CheckOptions, Figure, is_number, missing_figure, read_json
 
-MESH_SUFFIXES = (".stl", ".ply", ".obj", ".glb")
+#: Every registered mesh format is compared by geometry.
+MESH_SUFFIXES = tuple(f.suffix for f in FORMATS.values())
 GOLDEN = "golden.json"
 
 
@@ -87,7 +87,7 @@ def compare_mesh_folders(
         if progress is not None:
             progress(f"check: comparing {name}")
         try:
-            mesh, ref = _read_mesh(build_dir / name), _read_mesh(reference_dir / name)
+            mesh, ref = read_mesh(build_dir / name), read_mesh(reference_dir / name)
             difference = compare_meshes(*mesh, *ref, samples=options.samples)
         except SoftdesignError as err:
             figures.append(Figure(name, "readable", None, None, False, note=str(err)))
@@ -117,16 +117,3 @@ def mesh_figures(name: str, diff: MeshDifference, options: CheckOptions, allowan
     same = diff.watertight == diff.reference_watertight
     figures.append(Figure(name, "watertight", None, None, same, diff.watertight, diff.reference_watertight))
     return figures
-
-
-def _read_mesh(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """Vertices (V, 3) and faces (F, 3) of a mesh file, shared vertices merged (STL stores none)."""
-    import trimesh
-
-    try:
-        mesh = trimesh.load(str(path), force="mesh", process=True)
-    except Exception as err:  # trimesh raises many types for malformed files
-        raise InputDataError(f"{path}: cannot read the mesh ({type(err).__name__}: {err})") from err
-    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        raise InputDataError(f"{path}: the mesh has no triangles")
-    return np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces, np.int64)

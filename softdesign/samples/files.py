@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from softdesign.io.mesh_files import write_mesh
+from softdesign.io.formats import write_mesh
 from softdesign.io.polylines_vtp import write_polylines_vtp
 from softdesign.samples.cohort_vessels import COHORT_VARIANTS, VesselVariant, make_variant_vessel
 from softdesign.samples.sample_vessel import SampleVessel, make_sample_vessel

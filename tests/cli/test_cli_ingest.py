@@ -244,7 +244,7 @@ def test_regeneration_check_sees_an_stl_vertex_moved_past_its_float32_step(tmp_p
 
 def test_sample_is_a_vmtk_style_network_with_a_capped_wall(tmp_path):
     from softdesign.geometry.network import select_path
-    from softdesign.geometry.surface_info import describe_surface
+    from softdesign.meshing.topology import describe_surface
     from softdesign.io.centerline import read_centerline_network
     from softdesign.io.surface import read_surface
 

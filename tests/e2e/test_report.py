@@ -39,8 +39,6 @@ SHOWN_RTOL = 5e-6
 DISTANCE_ATOL_MM = 1e-9
 #: kinematics.json and the rebuilt chain evaluate the same spline the same way.
 KINEMATICS_ATOL = 1e-9
-#: The PCC panel needs the PCC design module (another issue); it is drawn when that module is present.
-HAS_PCC = __import__("importlib").util.find_spec("softdesign.kinematics.pcc_fit") is not None
 #: Chamber distance for the demo's PCC panel, mm (its largest curvature is 0.097 /mm: kappa d < 1).
 DEMO_PCC_D = 5.0
 
@@ -208,7 +206,6 @@ def test_aorta_report_notes_the_missing_pcc_panel(aorta):
     assert "pcc_chambers.png" not in text and "--pcc-d" in text
 
 
-@pytest.mark.skipif(not HAS_PCC, reason="softdesign.kinematics.pcc_fit (PCC design) is not in this tree")
 def test_demo_report_draws_pcc_chambers(demo):
     build_dir, result = demo
     assert "pcc_chambers.png" in result.files

@@ -17,7 +17,7 @@ from softdesign.geometry.initial import (
     initial_shape_from_polyline,
     straight_initial_shape,
 )
-from softdesign.kinematics.poe import rotation_from_rotvec
+from softdesign.geometry.se3 import rotation_from_rotvec
 
 #: Exact compositions (coefficient blends, rigid moves) agree to rounding of ~100 mm coordinates.
 ROUND_MM = 1e-11

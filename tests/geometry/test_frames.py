@@ -15,7 +15,7 @@ from softdesign.geometry.frames import (
     framed_curve,
     frenet_frames,
 )
-from softdesign.kinematics.poe import rotation_from_rotvec
+from softdesign.geometry.se3 import rotation_from_rotvec
 
 #: Frames are orthonormal to rounding.
 ORTHONORMAL_TOL = 1e-12

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from softdesign.geometry.network import Orientation, assemble_path, select_path
-from softdesign.geometry.surface_info import describe_surface
 from softdesign.io.centerline import read_centerline_network
 from softdesign.io.surface import read_surface
+from softdesign.meshing.topology import describe_surface
 
 #: Inserted tract-joint points must lie on the original polyline to float32 precision (VMTK stores float32).
 ON_SEGMENT_TOL_MM = 1e-4

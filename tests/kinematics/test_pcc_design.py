@@ -18,9 +18,9 @@ from typer.testing import CliRunner
 from softdesign.cli import app
 from softdesign.errors import ConfigError
 from softdesign.geometry.frames import base_normal_from_tangent
+from softdesign.geometry.se3 import rotation_from_rotvec
 from softdesign.kinematics import pcc
 from softdesign.kinematics.pcc_fit import ERROR_KEYS, fit_arc, fit_link, trapezoid_weights
-from softdesign.kinematics.poe import rotation_from_rotvec
 from tests.helpers.cases import write_case
 from tests.helpers.paths import REPO
 

@@ -234,7 +234,7 @@ def test_a_build_killed_mid_export_leaves_the_previous_build_unchanged(demo_case
 def test_split_regions_writes_one_stl_per_region_that_tiles_each_solid(demo_case, tmp_path):
     import trimesh
 
-    from softdesign.meshing.compare import surface_area
+    from softdesign.meshing.topology import surface_area
 
     edit(demo_case, "export", split_regions=True)
     out = tmp_path / "out"

@@ -1,4 +1,4 @@
-"""Mesh-to-mesh figures (softdesign.meshing.compare) and pose differences, on known answers first."""
+"""Mesh-to-mesh figures (softdesign.meshing.compare), mesh folders in every format, pose differences."""
 
 from __future__ import annotations
 
@@ -7,14 +7,9 @@ import pytest
 import trimesh
 
 from softdesign.errors import MeshError
-from softdesign.meshing.compare import (
-    compare_meshes,
-    enclosed_volume,
-    is_watertight,
-    surface_area,
-    surface_samples,
-)
-from softdesign.regression import pose_difference
+from softdesign.io.formats import MESH_FORMATS, write_mesh
+from softdesign.meshing.compare import compare_meshes, surface_samples
+from softdesign.regression import CheckOptions, compare_mesh_folders, mesh_names, pose_difference
 
 #: Rounding of double-precision sums over a few thousand terms of size ~1e3, mm, mm^2 or relative.
 EXACT_TOL = 1e-9
@@ -32,12 +27,6 @@ def rotation_about(axis, angle: float) -> np.ndarray:
     axis = np.asarray(axis, float) / np.linalg.norm(axis)
     k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
     return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k
-
-
-def test_box_volume_and_area_are_the_analytic_ones():
-    v, f = box()
-    np.testing.assert_allclose(enclosed_volume(v, f), (2 * HALF) ** 3, rtol=0, atol=EXACT_TOL)
-    np.testing.assert_allclose(surface_area(v, f), 6 * (2 * HALF) ** 2, rtol=0, atol=EXACT_TOL)
 
 
 def test_translated_box_distance_is_the_shift_and_rms_is_shift_over_sqrt3():
@@ -118,8 +107,8 @@ def test_samples_cover_a_triangle_evenly_in_both_directions():
     ],
 )
 def test_watertight_means_closed_manifold_and_consistently_oriented(edit, expected):
-    v, f = edit(*box())
-    assert is_watertight(f) is expected
+    diff = compare_meshes(*edit(*box()), *box())
+    assert diff.watertight is expected and diff.reference_watertight
 
 
 def test_a_mesh_without_faces_is_refused_with_its_shapes():
@@ -128,6 +117,22 @@ def test_a_mesh_without_faces_is_refused_with_its_shapes():
         compare_meshes(v, f, v, np.zeros((0, 3), np.int64))
     with pytest.raises(MeshError, match=r"face indices must lie in \[0, 7\], got \[0, 8\]"):
         compare_meshes(v, np.vstack([f, [[0, 1, 8]]]), v, f)
+
+
+@pytest.mark.parametrize("fmt", MESH_FORMATS)
+def test_mesh_folders_are_compared_in_every_format(tmp_path, fmt):
+    v, f = box()
+    shift = 0.004  # within check's default 0.01 mm
+    for folder, moved in (("build", shift), ("reference", 0.0)):
+        (tmp_path / folder / "meshes").mkdir(parents=True)
+        write_mesh(tmp_path / folder / "meshes" / f"q_0.000.{fmt}", v + [moved, 0.0, 0.0], f)
+    assert mesh_names(tmp_path / "build") == {f"meshes/q_0.000.{fmt}"}
+    figures = compare_mesh_folders(tmp_path / "build", tmp_path / "reference", CheckOptions(samples=2000), {})
+    by_name = {figure.figure: figure for figure in figures}
+    assert set(by_name) == {"distance_max_mm", "distance_rms_mm", "volume_rel_change", "area_rel_change", "watertight"}
+    assert all(figure.passed for figure in figures) and by_name["watertight"].build is True
+    # float32 files (STL, glTF) round the box's corners by ~1e-6 mm
+    np.testing.assert_allclose(by_name["distance_max_mm"].change, shift, rtol=0, atol=1e-5)
 
 
 def test_pose_difference_known_translation_and_angles():

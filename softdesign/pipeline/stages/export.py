@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from softdesign.config import Case
-from softdesign.io.mesh_files import LABELLED_FORMATS, mesh_bytes
+from softdesign.io.formats import mesh_bytes
 from softdesign.io.polylines_vtp import write_polylines_vtp
 from softdesign.meshing.body import body_breaks, body_sections, body_stations
 from softdesign.meshing.checks import check_solid
@@ -146,8 +146,8 @@ def write_export(result: ExportResult, staging: Staging) -> None:
     """Stage every mesh file, the centerline of every q, and the figures."""
     for mesh in result.meshes:
         for fmt in result.summary["formats"]:
-            regions = mesh.solid.regions if fmt in LABELLED_FORMATS else None
-            staging.write_bytes(mesh_name(mesh.q, fmt), mesh_bytes(mesh.solid.vertices, mesh.solid.faces, fmt, regions))
+            solid = mesh.solid
+            staging.write_bytes(mesh_name(mesh.q, fmt), mesh_bytes(solid.vertices, solid.faces, fmt, solid.regions))
         for piece in mesh.pieces:
             staging.write_bytes(region_name(mesh.q, piece), mesh_bytes(piece.vertices, piece.faces, "stl"))
         relative = layout.centerline_path(mesh.q)

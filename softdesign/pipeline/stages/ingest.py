@@ -17,9 +17,9 @@ from softdesign.config import Case
 from softdesign.errors import InputDataError
 from softdesign.geometry.network import CenterlineNetwork, Orientation, SelectedPath, all_paths, select_path
 from softdesign.geometry.plausibility import check_surface_surrounds, radius_note
-from softdesign.geometry.surface_info import SurfaceInfo, describe_surface
 from softdesign.io.centerline import read_centerline_network
 from softdesign.io.surface import read_surface
+from softdesign.meshing.topology import SurfaceInfo, describe_surface
 from softdesign.pipeline import layout
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes

@@ -1,0 +1,174 @@
+"""The one registry of mesh file formats: suffix -> reader, writer, whether it carries region labels.
+
+Every place that names a mesh format takes it from :data:`FORMATS`: the case
+file's ``export.formats``, the export stage, ``pose --output``, the
+regression check's mesh files and the input surface reader.  .stl (binary),
+.ply, .obj and .glb go through trimesh, .vtp and .vtk through vtk; .vtk is read
+only (VMTK's legacy surfaces).
+
+Writing is atomic (a temporary name, then a rename), and the bytes depend only
+on the arrays (neither library writes timestamps), so the same mesh always
+gives the same file.  PLY keeps a per-face ``region`` label and VTP a
+``Region`` cell array (wall, caps, chamber, port, with the names in the field
+array ``RegionNames``) when labels are given; the other formats drop them.
+Reading merges the vertices that faces share (STL stores none), so a closed
+surface reads as a closed mesh.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from softdesign.errors import InputDataError
+from softdesign.io.atomic import write_bytes_atomically
+
+Mesh = tuple[np.ndarray, np.ndarray]
+#: Encodes (vertices (V, 3) mm, faces (F, 3), regions (F,) or None) as the file's bytes.
+Encoder = Callable[[np.ndarray, np.ndarray, "np.ndarray | None"], bytes]
+
+
+@dataclass(frozen=True)
+class MeshFormat:
+    """One mesh file format.
+
+    Attributes
+    ----------
+    name : the suffix without its dot, as the case file names it (``stl``)
+    description : what the file holds, for messages and help
+    read : path -> (vertices (V, 3) float64 mm, faces (F, 3) int64), shared vertices merged;
+        empty arrays when the file holds no triangles
+    encode : the writer's bytes, or None for a format that is only read
+    carries_regions : whether the file keeps a region label per face
+    """
+
+    name: str
+    description: str
+    read: Callable[[Path], Mesh]
+    encode: Encoder | None
+    carries_regions: bool = False
+
+    @property
+    def suffix(self) -> str:
+        """``.stl``"""
+        return f".{self.name}"
+
+
+def _read_trimesh(path: Path) -> Mesh:
+    import trimesh
+
+    try:
+        mesh = trimesh.load(str(path), force="mesh", process=True)
+    except Exception as err:  # trimesh raises many types for malformed files
+        raise InputDataError(f"{path}: cannot read the mesh ({type(err).__name__}: {err}); re-export it") from err
+    if not isinstance(mesh, trimesh.Trimesh):
+        return np.zeros((0, 3)), np.zeros((0, 3), np.int64)
+    return np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces, np.int64)
+
+
+def _read_vtk(path: Path) -> Mesh:
+    from softdesign.io.vtk_polydata import read_polydata, triangles_from_polydata
+
+    return _merge_duplicate_vertices(*triangles_from_polydata(read_polydata(path)))
+
+
+def _merge_duplicate_vertices(vertices: np.ndarray, faces: np.ndarray) -> Mesh:
+    if len(vertices) == 0:
+        return vertices, faces
+    unique, inverse = np.unique(vertices, axis=0, return_inverse=True)
+    used = np.unique(inverse[faces])
+    remap = np.full(len(unique), -1, np.int64)
+    remap[used] = np.arange(len(used))
+    return unique[used], remap[inverse.reshape(-1)[faces]]
+
+
+def _trimesh_encoder(file_type: str) -> Encoder:
+    def encode(vertices: np.ndarray, faces: np.ndarray, regions: np.ndarray | None) -> bytes:
+        import trimesh
+
+        mesh = trimesh.Trimesh(np.asarray(vertices, float), np.asarray(faces, np.int64), process=False)
+        if regions is not None and file_type == "ply":
+            mesh.face_attributes["region"] = np.asarray(regions, np.int8)
+            data = trimesh.exchange.ply.export_ply(mesh, encoding="binary", include_attributes=True)
+        else:
+            data = trimesh.exchange.export.export_mesh(mesh, file_obj=None, file_type=file_type)
+        return data.encode("utf-8") if isinstance(data, str) else bytes(data)
+
+    return encode
+
+
+def _vtp_bytes(vertices: np.ndarray, faces: np.ndarray, regions: np.ndarray | None) -> bytes:
+    """VTK XML PolyData of the triangles, binary (base64) and zlib-compressed, as VMTK writes it."""
+    import vtk
+    from vtk.util.numpy_support import numpy_to_vtk
+
+    from softdesign.io.vtk_polydata import polydata_from_triangles, polydata_writer
+    from softdesign.meshing.tessellate import Region
+
+    poly = polydata_from_triangles(np.asarray(vertices, float), np.asarray(faces, np.int64))
+    if regions is not None:
+        labels = numpy_to_vtk(np.ascontiguousarray(regions, dtype=np.int32), deep=True)
+        labels.SetName("Region")
+        poly.GetCellData().AddArray(labels)
+        names = vtk.vtkStringArray()
+        names.SetName("RegionNames")
+        for region in Region:  # value i is names[i]
+            names.InsertNextValue(region.name.lower())
+        poly.GetFieldData().AddArray(names)
+    writer = polydata_writer(poly)
+    writer.WriteToOutputStringOn()
+    if writer.Write() != 1:
+        raise OSError("vtk could not encode the mesh as .vtp")
+    return writer.GetOutputString().encode("ascii")
+
+
+#: Every mesh format by name, in the order messages list them.
+FORMATS: dict[str, MeshFormat] = {
+    f.name: f
+    for f in (
+        MeshFormat("stl", "binary STL (float32 corners, no shared vertices)", _read_trimesh, _trimesh_encoder("stl")),
+        MeshFormat("ply", "binary PLY with a region label per face", _read_trimesh, _trimesh_encoder("ply"), True),
+        MeshFormat("obj", "Wavefront OBJ (text)", _read_trimesh, _trimesh_encoder("obj")),
+        MeshFormat("glb", "binary glTF 2.0, for viewers", _read_trimesh, _trimesh_encoder("glb")),
+        MeshFormat("vtp", "VTK XML PolyData (binary, zlib) with a Region cell array", _read_vtk, _vtp_bytes, True),
+        MeshFormat("vtk", "legacy VTK PolyData (read only)", _read_vtk, None),
+    )
+}
+#: Formats a mesh can be written in: ``export.formats`` and ``pose --output``.
+MESH_FORMATS = tuple(name for name, f in FORMATS.items() if f.encode is not None)
+
+
+def mesh_bytes(vertices: np.ndarray, faces: np.ndarray, file_type: str, regions: np.ndarray | None = None) -> bytes:
+    """The encoded file for ``file_type`` in MESH_FORMATS; ``regions`` (F,) is kept where the format carries it."""
+    found = FORMATS.get(file_type)
+    if found is None or found.encode is None:
+        raise ValueError(f"mesh format must be one of {', '.join(MESH_FORMATS)}, got {file_type!r}")
+    return found.encode(vertices, faces, regions if found.carries_regions else None)
+
+
+def write_mesh(path: str | Path, vertices: np.ndarray, faces: np.ndarray, regions: np.ndarray | None = None) -> Path:
+    """Write a mesh (format from the suffix) under a temporary name, then rename."""
+    path = Path(path)
+    return write_bytes_atomically(path, mesh_bytes(vertices, faces, path.suffix.lower().lstrip("."), regions))
+
+
+def read_mesh(path: str | Path) -> Mesh:
+    """Vertices (V, 3) float64 mm and faces (F, 3) int64 of a mesh file (format from the suffix).
+
+    Raises
+    ------
+    InputDataError
+        An unknown suffix (the message lists the formats), an unreadable file, or no triangles.
+    """
+    path = Path(path)
+    found = FORMATS.get(path.suffix.lower().lstrip("."))
+    if found is None:
+        choices = ", ".join(f.suffix for f in FORMATS.values())
+        raise InputDataError(f"{path}: unknown mesh format '{path.suffix}'; expected one of {choices}")
+    vertices, faces = found.read(path)
+    if len(faces) == 0:
+        raise InputDataError(f"{path}: the mesh has no triangles")
+    return vertices, faces
