@@ -23,6 +23,7 @@ from pydantic import (
     Field,
     PrivateAttr,
     ValidationError,
+    ValidationInfo,
     field_validator,
     model_validator,
 )
@@ -186,6 +187,40 @@ class Case(_Section):
     export: Export = Export()
 
     _base: Path = PrivateAttr(default_factory=Path.cwd)
+
+    @field_validator("frames")
+    @classmethod
+    def _frenet_needs_curvature(cls, frames: str, info: ValidationInfo) -> str:
+        """Refuse ``frames: frenet`` where a shape is straight by construction: the frame is undefined there.
+
+        A straight q = 0 shape has no curvature anywhere, and ``resample.end_straight_mm > 0``
+        asks for straight ends on every shape; the build would stop at the kinematics stage
+        (curvature below FRENET_KAPPA_TOL, or a frame flip where the curvature passes through
+        zero).  ``initial`` and ``resample`` come before ``frames``, so pydantic has validated
+        them; a section that failed its own checks is absent from ``info.data`` and not judged.
+        """
+        initial, resample = info.data.get("initial"), info.data.get("resample")
+        straight_start = isinstance(initial, InitialShape) and initial.kind == "straight"
+        straight_ends = isinstance(resample, Resample) and resample.end_straight_mm > 0.0
+        if frames != "frenet" or not (straight_start or straight_ends):
+            return frames
+        problems, fixes = [], []
+        if straight_start:
+            default = "" if "kind" in initial.model_fields_set else " (the default)"
+            problems.append(f"initial.kind: straight{default} makes the q = 0 shape a straight line")
+            fixes.append("initial.kind: arc (with initial.bend_radius_mm)")
+        if straight_ends:
+            default = "" if "end_straight_mm" in resample.model_fields_set else " (the default)"
+            problems.append(
+                f"resample.end_straight_mm: {resample.end_straight_mm:g}{default} makes the last "
+                f"{resample.end_straight_mm:g} mm at both ends of every shape straight"
+            )
+            fixes.append("resample.end_straight_mm: 0")
+        raise ValueError(
+            "frenet needs curvature everywhere, but " + " and ".join(problems) + "; the Frenet normal is "
+            "undefined where the curvature is zero. Use frames: rmf (defined on straight parts) or set "
+            + " and ".join(fixes)
+        )
 
     @property
     def base_dir(self) -> Path:
