@@ -29,6 +29,7 @@ from pydantic import (
 )
 
 from softdesign.errors import ConfigError
+from softdesign.meshing.checks import MIN_ANGULAR_COUNT, VOLUME_RTOL
 
 
 class _Section(BaseModel):
@@ -148,7 +149,7 @@ class Export(_Section):
     port_mm: float | None = Field(None, gt=0.0)
     formats: list[Literal["stl", "ply", "obj", "glb", "vtp"]] = ["stl"]
     spacing_mm: float = Field(0.5, gt=0.0)
-    angular_count: int = Field(64, ge=8)
+    angular_count: int = Field(64, ge=MIN_ANGULAR_COUNT)
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...
     split_regions: bool = False
 
@@ -328,6 +329,15 @@ def _format_errors(path: Path, root: yaml.Node | None, err: ValidationError) -> 
     return "\n".join(lines)
 
 
+#: Why a range holds, added to its message (dotted field -> reason).
+_RANGE_REASONS = {
+    "export.angular_count": (
+        f"fewer vertices around cannot pass the mesh volume check (a {MIN_ANGULAR_COUNT - 1}-gon already misses "
+        f"more than {100 * VOLUME_RTOL:g}% of a round section's area)"
+    ),
+}
+
+
 def _describe(loc: tuple[Any, ...], item: dict[str, Any]) -> str:
     field = ".".join(str(p) for p in loc) or "(top level)"
     kind = item["type"]
@@ -344,7 +354,8 @@ def _describe(loc: tuple[Any, ...], item: dict[str, Any]) -> str:
     if kind == "value_error":
         return f"{field}: {text}"
     got = "" if kind == "missing" else f", got {item.get('input')!r}"
-    return f"{field} {text}{got}"
+    reason = f": {_RANGE_REASONS[field]}" if field in _RANGE_REASONS and kind in _TEMPLATES else ""
+    return f"{field} {text}{got}{reason}"
 
 
 def _unknown_key(loc: tuple[Any, ...]) -> str:

@@ -2,13 +2,18 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 from typer.testing import CliRunner
 
 from softdesign.cli import app
+from softdesign.meshing.checks import MIN_ANGULAR_COUNT, VOLUME_RTOL
+from softdesign.meshing.volume import polygon_area_ratio
+from softdesign.pipeline.layout import EXPORT_SUMMARY
 
 from tests.helpers.paths import DEMO, REPO
 
@@ -87,6 +92,35 @@ def test_build_stops_at_validation_before_any_stage_runs(tmp_path):
     assert result.exit_code == 2, result.output
     assert "frames: frenet needs curvature everywhere" in result.output
     assert not out.exists()
+
+
+def test_min_angular_count_is_the_fewest_sides_the_volume_check_can_accept():
+    assert 1.0 - polygon_area_ratio(MIN_ANGULAR_COUNT) <= VOLUME_RTOL < 1.0 - polygon_area_ratio(MIN_ANGULAR_COUNT - 1)
+    assert MIN_ANGULAR_COUNT == 37  # the figure the docstring and README quote
+
+
+def test_angular_count_below_the_minimum_is_refused_by_validate(tmp_path):
+    case = demo_case(tmp_path, export={"angular_count": MIN_ANGULAR_COUNT - 1})
+    output = refused(case)
+    assert f"export.angular_count must be >= {MIN_ANGULAR_COUNT}, got {MIN_ANGULAR_COUNT - 1}" in output
+    assert "cannot pass the mesh volume check" in output
+
+
+def test_angular_count_at_the_minimum_builds_a_round_body_that_passes_the_volume_check(tmp_path):
+    # q = 0 with initial.radius_mm is a straight round tube: the mesh holds exactly the polygon's share
+    case = demo_case(tmp_path, initial={"kind": "straight", "radius_mm": 3.0},
+                     export={"q": [0], "angular_count": MIN_ANGULAR_COUNT, "spacing_mm": 1.0})
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["build", str(case), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["metrics"]["export"]["resolution"]["angular_count"] == MIN_ANGULAR_COUNT
+    (mesh,) = [o for o in manifest["outputs"] if o["path"] == "meshes/q_0.000.stl"]
+    figures = json.loads((out / EXPORT_SUMMARY).read_text())["meshes"]["meshes/q_0.000.stl"]
+    # the integral is exact for a round tube, so the whole difference is the polygon's
+    np.testing.assert_allclose(figures["volume_rel_error"], polygon_area_ratio(MIN_ANGULAR_COUNT) - 1.0,
+                               rtol=0, atol=1e-6)
+    assert abs(figures["volume_rel_error"]) <= VOLUME_RTOL and mesh["watertight"] is True
 
 
 @pytest.mark.parametrize("path", sorted(REPO.glob("configs/**/*.yaml")), ids=lambda p: p.stem)
