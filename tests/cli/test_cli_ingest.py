@@ -237,9 +237,9 @@ def test_the_sample_vessel_declared_in_metres_is_refused_suggesting_mm(tmp_path)
     case = write_case(tmp_path, units="m", final={"centerline": str(demo / "centerline.vtp"),
                                                   "surface": str(demo / "surface.stl")})
     output = _refused_at_ingest(case, tmp_path / "out")
-    assert "final.centerline centerline.vtp: with units: m the vessel is 104 m long with a 3.36 m median radius" in output
+    assert "centerline.vtp: with units: m the vessel is 104 m long with a 3.36 m median radius" in output
     assert "not a human vessel (expected a median radius of 0.3 to 20 mm and a length of 5 to 2000 mm)" in output
-    assert "with units: mm it would be 104 mm long with a 3.36 mm median radius: set units: mm in the case file" in output
+    assert "with units: mm it would be 104 mm long with a 3.36 mm median radius: set units: mm in the case" in output
 
 
 def test_the_sample_vessel_in_metres_declared_in_mm_is_refused_suggesting_m(tmp_path):
@@ -256,8 +256,8 @@ def test_without_radii_the_length_alone_is_judged(tmp_path):
     assert "with units: m it would be 104 mm long: set units: m" in output
     assert "with units: cm" not in output  # 1.04 mm long: no vessel either
     # ... and the same file declared in metres ingests
-    result = runner.invoke(app, ["ingest", str(write_case(tmp_path, "m", units="m", final={"centerline": str(centerline)})),
-                                 "--out", str(tmp_path / "m")])
+    in_metres = write_case(tmp_path, "m", units="m", final={"centerline": str(centerline)})
+    result = runner.invoke(app, ["ingest", str(in_metres), "--out", str(tmp_path / "m")])
     assert result.exit_code == 0, result.output
 
 
