@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from softdesign.config import Case
-from softdesign.geometry.blend import BlendedShape, blend_shapes
+from softdesign.geometry.blend import BlendedShape, Shortening, blend_shapes
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline, smooth_curve_from_samples
 from softdesign.geometry.initial import InitialSpec, build_initial_shape, initial_shape_from_polyline
 from softdesign.pipeline import layout
@@ -120,8 +120,17 @@ def describe_blend(result: BlendResult) -> list[str]:
         f"max curvature {f['max_curvature_per_mm']:.4f} /mm, max |torsion| {f['max_abs_torsion_per_mm']:.4f} /mm",
         f"blend {s['mode']}, frames {s['frames']}; initial length {s['initial_length_mm']:.2f} mm",
     ]
-    sh = s["shortening"]
-    lines.append(f"shortest shape: {sh['min_length_mm']:.2f} mm at q = {sh['q_at_min']:.3f} ({100 * sh['ratio']:.2f}% shorter)")
+    sh = Shortening(**s["shortening"])
+    if sh.intermediate_is_shorter:
+        lines.append(
+            f"shortest shape: {sh.min_length_mm:.2f} mm at q = {sh.q_at_min:.3f}, {100 * sh.ratio:.3g}% shorter "
+            f"than the shorter end shape ({sh.reference_length_mm:.2f} mm)"
+        )
+    else:
+        lines.append(
+            f"no intermediate shape is shorter than both end shapes (q = 0: {s['initial_length_mm']:.2f} mm, "
+            f"q = 1: {f['length_mm']:.2f} mm)"
+        )
     return lines
 
 
