@@ -23,12 +23,14 @@ from pydantic import (
     Field,
     PrivateAttr,
     ValidationError,
+    ValidationInfo,
     field_validator,
     model_validator,
 )
 
 from softdesign.errors import ConfigError
 from softdesign.io.formats import MESH_FORMATS
+from softdesign.meshing.checks import MIN_ANGULAR_COUNT, VOLUME_RTOL
 
 
 class _Section(BaseModel):
@@ -148,7 +150,7 @@ class Export(_Section):
     port_mm: float | None = Field(None, gt=0.0)
     formats: list[Literal[MESH_FORMATS]] = ["stl"]
     spacing_mm: float = Field(0.5, gt=0.0)
-    angular_count: int = Field(64, ge=8)
+    angular_count: int = Field(64, ge=MIN_ANGULAR_COUNT)
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...
     split_regions: bool = False
 
@@ -187,6 +189,40 @@ class Case(_Section):
     export: Export = Export()
 
     _base: Path = PrivateAttr(default_factory=Path.cwd)
+
+    @field_validator("frames")
+    @classmethod
+    def _frenet_needs_curvature(cls, frames: str, info: ValidationInfo) -> str:
+        """Refuse ``frames: frenet`` where a shape is straight by construction: the frame is undefined there.
+
+        A straight q = 0 shape has no curvature anywhere, and ``resample.end_straight_mm > 0``
+        asks for straight ends on every shape; the build would stop at the kinematics stage
+        (curvature below FRENET_KAPPA_TOL, or a frame flip where the curvature passes through
+        zero).  ``initial`` and ``resample`` come before ``frames``, so pydantic has validated
+        them; a section that failed its own checks is absent from ``info.data`` and not judged.
+        """
+        initial, resample = info.data.get("initial"), info.data.get("resample")
+        straight_start = isinstance(initial, InitialShape) and initial.kind == "straight"
+        straight_ends = isinstance(resample, Resample) and resample.end_straight_mm > 0.0
+        if frames != "frenet" or not (straight_start or straight_ends):
+            return frames
+        problems, fixes = [], []
+        if straight_start:
+            default = "" if "kind" in initial.model_fields_set else " (the default)"
+            problems.append(f"initial.kind: straight{default} makes the q = 0 shape a straight line")
+            fixes.append("initial.kind: arc (with initial.bend_radius_mm)")
+        if straight_ends:
+            default = "" if "end_straight_mm" in resample.model_fields_set else " (the default)"
+            problems.append(
+                f"resample.end_straight_mm: {resample.end_straight_mm:g}{default} makes the last "
+                f"{resample.end_straight_mm:g} mm at both ends of every shape straight"
+            )
+            fixes.append("resample.end_straight_mm: 0")
+        raise ValueError(
+            "frenet needs curvature everywhere, but " + " and ".join(problems) + "; the Frenet normal is "
+            "undefined where the curvature is zero. Use frames: rmf (defined on straight parts) or set "
+            + " and ".join(fixes)
+        )
 
     @property
     def base_dir(self) -> Path:
@@ -294,6 +330,15 @@ def _format_errors(path: Path, root: yaml.Node | None, err: ValidationError) -> 
     return "\n".join(lines)
 
 
+#: Why a range holds, added to its message (dotted field -> reason).
+_RANGE_REASONS = {
+    "export.angular_count": (
+        f"fewer vertices around cannot pass the mesh volume check (a {MIN_ANGULAR_COUNT - 1}-gon already misses "
+        f"more than {100 * VOLUME_RTOL:g}% of a round section's area)"
+    ),
+}
+
+
 def _describe(loc: tuple[Any, ...], item: dict[str, Any]) -> str:
     field = ".".join(str(p) for p in loc) or "(top level)"
     kind = item["type"]
@@ -310,7 +355,8 @@ def _describe(loc: tuple[Any, ...], item: dict[str, Any]) -> str:
     if kind == "value_error":
         return f"{field}: {text}"
     got = "" if kind == "missing" else f", got {item.get('input')!r}"
-    return f"{field} {text}{got}"
+    reason = f": {_RANGE_REASONS[field]}" if field in _RANGE_REASONS and kind in _TEMPLATES else ""
+    return f"{field} {text}{got}{reason}"
 
 
 def _unknown_key(loc: tuple[Any, ...]) -> str:

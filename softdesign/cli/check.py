@@ -34,24 +34,33 @@ def check(
         float, typer.Option("--rotation-tol", help="Rotation between link transforms and POE theta2, rad.")
     ] = 1e-4,
     json_out: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
+    failures_only: Annotated[
+        bool,
+        typer.Option("--failures-only", help="List only the figures outside tolerance (the verdict counts all)."),
+    ] = False,
 ) -> None:
     """Compare meshes (by geometry), kinematics and fit metrics with a reference build.
 
     Exit 0 when every figure is within tolerance, 1 when one is not (or a mesh
     is missing on either side), 2 for a missing folder or bad option.  A
     reference's golden.json (decimation error per mesh) widens that mesh's
-    tolerances.
+    tolerances.  A warning (not an error) says when the two are different
+    cases (case names or input files differ).
     """
 
     def action() -> None:
         options = CheckOptions(distance_mm=tolerance_mm, rtol=rtol, rotation_rad=rotation_tol)
         report = check_build(build_dir, reference, options, progress=note)
+        for warning in report.warnings:
+            note(f"warning: {warning}")
         if json_out:
-            emit_json(report.as_dict())
+            emit_json(report.as_dict(failures_only))
             for line in summary_lines(report):
                 note(line)
         else:
-            for line in table_lines(report.figures) + [""] + summary_lines(report):
+            shown = report.failures if failures_only else report.figures
+            table = table_lines(shown) + [""] if shown else []
+            for line in table + summary_lines(report):
                 typer.echo(line)
         if not report.passed:
             raise typer.Exit(code=1)

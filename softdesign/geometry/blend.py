@@ -47,6 +47,9 @@ BLEND_MODES = ("linear", "intrinsic")
 _GAUSS2 = np.array([0.5 - np.sqrt(3.0) / 6.0, 0.5 + np.sqrt(3.0) / 6.0])
 #: q samples for the search of the shortest blended shape (then refined by a bounded search).
 SHORTENING_Q_SAMPLES = 41
+#: A shape shorter than the shorter end shape by less than this fraction is as long as it: the
+#: arc lengths agree to ~1e-13 relative, so an intrinsic blend of two equally long ends stays far below.
+SHORTENING_RTOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -69,6 +72,15 @@ class Shortening:
     min_length_mm: float
     reference_length_mm: float
     ratio: float
+
+    @property
+    def intermediate_is_shorter(self) -> bool:
+        """True when a shape strictly between q = 0 and q = 1 is shorter than both end shapes (beyond round-off).
+
+        Otherwise the shortest shape is an end shape (a longer or shorter q = 0, an
+        intrinsic blend) and there is no shortening to report.
+        """
+        return 0.0 < self.q_at_min < 1.0 and self.ratio > SHORTENING_RTOL
 
 
 @dataclass(frozen=True)

@@ -28,7 +28,7 @@ import numpy.typing as npt
 from scipy.interpolate import BSpline, PPoly, make_interp_spline, splprep
 
 from softdesign.errors import ConfigError, GeometryError
-from softdesign.types import FRENET_KAPPA_TOL, POINT_TOL_MM, FloatArray, Points
+from softdesign.types import POINT_TOL_MM, FloatArray, Points
 
 #: Degree of the spline in l (5: torsion, a third derivative, is still C2).
 DEGREE = 5
@@ -47,6 +47,15 @@ ARC_REL_TOL = 1e-13
 SMOOTHING_SLACK = 1.5
 #: Fewest distinct input points: a cubic (torsion needs a third derivative) needs 4.
 MIN_POLYLINE_POINTS = 4
+#: Curvature below which torsion is not reported, 1/mm: a bend of radius 1 m or more.  Torsion, the
+#: turning rate of the osculating plane, is (c' x c'') . c''' / |c' x c''|^2: it divides by kappa^2,
+#: so near an inflection it is the noise of c''' magnified.  At the vessel scale such a bend is
+#: straight: over 40 mm (a few diameters of the widest vessel) it leaves its chord by at most
+#: L^2 kappa / 8 = 0.2 mm, the order of a VMTK centerline's placement noise and of
+#: resample.smoothing_mm, so its plane is set by that noise, not by the anatomy.  On the VMTK aorta
+#: |tau| reaches 4.7 /mm where kappa ~ 1e-4 /mm; FRENET_KAPPA_TOL (1e-6 /mm), where the frames
+#: themselves give up, is far too low for a rate divided by kappa^2.
+TORSION_KAPPA_FLOOR = 1e-3
 
 
 @dataclass(frozen=True)
@@ -76,8 +85,9 @@ class CurveReport:
     spacing_mm: float
     max_curvature_per_mm: float
     max_curvature_l: float
-    max_abs_torsion_per_mm: float  # where kappa >= FRENET_KAPPA_TOL (0 on a straight curve)
-    max_abs_torsion_l: float
+    max_abs_torsion_per_mm: float | None  # where kappa >= TORSION_KAPPA_FLOOR; None when it never is
+    max_abs_torsion_l: float | None
+    torsion_defined_fraction: float  # of the dense grid: where kappa >= TORSION_KAPPA_FLOOR
 
 
 @dataclass(frozen=True)
@@ -135,10 +145,11 @@ class SmoothCurve:
         return normal_part / speed2[:, None]
 
     def torsion(self, l: npt.ArrayLike) -> FloatArray:
-        """tau = (c' x c'') . c''' / |c' x c''|^2, (n,) 1/mm; NaN where kappa < FRENET_KAPPA_TOL.
+        """tau = (c' x c'') . c''' / |c' x c''|^2, (n,) 1/mm; NaN where kappa < TORSION_KAPPA_FLOOR.
 
         Torsion is the turning rate of the Frenet binormal; where the curve is
-        straight there is no binormal and no torsion, so NaN says so.
+        straight there is no binormal and no torsion, and where it is nearly
+        straight (below the floor) the figure is noise over kappa^2: NaN says so.
         """
         d1, d2, d3 = (self.derivative(l, k) for k in (1, 2, 3))
         cross = np.cross(d1, d2)
@@ -146,7 +157,7 @@ class SmoothCurve:
         kappa = np.sqrt(norm2) / np.linalg.norm(d1, axis=1) ** 3
         with np.errstate(divide="ignore", invalid="ignore"):
             tau = np.einsum("ij,ij->i", cross, d3) / norm2
-        return np.where(kappa >= FRENET_KAPPA_TOL, tau, np.nan)
+        return np.where(kappa >= TORSION_KAPPA_FLOOR, tau, np.nan)
 
     def arc_length(self, l: npt.ArrayLike) -> FloatArray:
         """Arc length from l = 0 to each l (n,), mm (Gauss-Legendre on the sample intervals)."""
@@ -164,20 +175,22 @@ class SmoothCurve:
         return np.linspace(0.0, 1.0, intervals * factor + 1)
 
     def report(self) -> CurveReport:
-        """Length, sample count and spacing, max curvature and max |torsion| (on the dense grid)."""
+        """Length, sample count and spacing, max curvature, and max |torsion| where defined (dense grid)."""
         l = self.dense_l()
         kappa = self.curvature(l)
         tau = np.abs(self.torsion(l))
         ik = int(np.argmax(kappa))
-        it = int(np.nanargmax(tau)) if np.any(np.isfinite(tau)) else 0
+        defined = np.isfinite(tau)
+        it = int(np.nanargmax(tau)) if defined.any() else None
         return CurveReport(
             length_mm=float(self.length),
             sample_count=len(self.l_grid),
             spacing_mm=float(self.length / (len(self.l_grid) - 1)),
             max_curvature_per_mm=float(kappa[ik]),
             max_curvature_l=float(l[ik]),
-            max_abs_torsion_per_mm=float(tau[it]) if np.isfinite(tau[it]) else 0.0,
-            max_abs_torsion_l=float(l[it]),
+            max_abs_torsion_per_mm=None if it is None else float(tau[it]),
+            max_abs_torsion_l=None if it is None else float(l[it]),
+            torsion_defined_fraction=float(defined.mean()),
         )
 
 

@@ -1,8 +1,9 @@
-"""Sanity checks across inputs: does the surface surround the centerline, are radii plausible.
+"""Sanity checks across inputs: does the surface surround the centerline, is the vessel's size human.
 
 The commonest silent failure with vessel data is a unit mismatch (a surface
-in metres beside a centerline in millimetres) or a wrong file; both are
-caught here with a hint naming the factor that would explain them.
+in metres beside a centerline in millimetres, or a case declaring ``units: m``
+for files in mm) or a wrong file; both are caught here, before any costly
+stage, with a hint naming the factor or the units that would explain them.
 """
 
 from __future__ import annotations
@@ -10,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from softdesign.errors import InputDataError
-from softdesign.types import FloatArray, Points
+from softdesign.errors import ConfigError, InputDataError
+from softdesign.types import UNIT_SCALE_TO_MM, FloatArray, Points
 
 #: Fraction of centerline points that must lie inside the surface's bounding box.
 INSIDE_FRACTION = 0.9
@@ -26,8 +27,13 @@ UNIT_FACTORS = (
     (100.0, "surface in m, centerline in cm"),
     (0.01, "surface in cm, centerline in m"),
 )
-#: Vessel radii outside this range (mm) suggest wrong units.
-PLAUSIBLE_RADIUS_MM = (0.1, 60.0)
+#: Median inscribed radius of a human vessel, mm: from a small artery or vein (0.3 mm) to a wide
+#: aorta (20 mm, a 40 mm lumen).  A unit slip scales it by 10, 100 or 1000, far outside this band.
+PLAUSIBLE_RADIUS_MM = (0.3, 20.0)
+#: Centerline length of a human vessel path, mm: the longest arterial path, heart to foot, is
+#: about 1.5 m; a path between an inlet and an outlet shorter than 5 mm (eight diameters of the
+#: narrowest vessel above) is no vessel segment worth an actuator.
+PLAUSIBLE_LENGTH_MM = (5.0, 2000.0)
 
 
 def surrounds(points: Points, radius: FloatArray | None, vertices: Points) -> bool:
@@ -77,15 +83,61 @@ def check_surface_surrounds(
     raise InputDataError(message)
 
 
-def radius_note(radius: FloatArray | None, where: str) -> str | None:
-    """A warning when inscribed radii are implausible for a vessel in mm, else None."""
-    if radius is None or len(radius) == 0:
-        return None
-    median = float(np.median(radius))
+def plausible_vessel(length_mm: float, radius_mm: float | None) -> bool:
+    """True when a path of this length (and median inscribed radius, if known), in mm, can be a human vessel."""
+    length_ok = PLAUSIBLE_LENGTH_MM[0] <= length_mm <= PLAUSIBLE_LENGTH_MM[1]
+    return length_ok and (radius_mm is None or PLAUSIBLE_RADIUS_MM[0] <= radius_mm <= PLAUSIBLE_RADIUS_MM[1])
+
+
+def check_vessel_scale(length_mm: float, radius: FloatArray | None, units: str, where: str) -> None:
+    """Raise ConfigError when the vessel's size in the declared ``units`` is not a human vessel's.
+
+    Parameters
+    ----------
+    length_mm : the selected path's length, converted from ``units`` to mm
+    radius : its inscribed radii (mm), or None when the file has none (then only the length is judged)
+    units : the case's ``units`` ("mm", "cm" or "m")
+    where : names the input in the message (e.g. ``final.centerline aorta.vtp``)
+
+    The message gives the figures and every other unit in which the vessel would be plausible.
+    """
+    known = radius is not None and len(radius) > 0 and bool(np.all(np.isfinite(radius)))
+    median = float(np.median(radius)) if known else None
+    if plausible_vessel(length_mm, median):
+        return
     lo, hi = PLAUSIBLE_RADIUS_MM
-    if lo <= median <= hi:
-        return None
-    return (
-        f"warning: {where}: median MaximumInscribedSphereRadius is {median:.4g} mm, outside the "
-        f"plausible {lo}..{hi} mm for a vessel; check units: in the case file"
+    message = (
+        f"{where}: with units: {units} the vessel is {_size_text(length_mm, median)}, not a human vessel "
+        f"(expected a median radius of {lo:g} to {hi:g} mm and a length of {PLAUSIBLE_LENGTH_MM[0]:g} to "
+        f"{PLAUSIBLE_LENGTH_MM[1]:g} mm)"
     )
+    # the same numbers read in another unit: scaled by that unit's size over the declared one's
+    factors = {other: scale / UNIT_SCALE_TO_MM[units] for other, scale in UNIT_SCALE_TO_MM.items() if other != units}
+    rescaled = {other: (length_mm * f, None if median is None else median * f) for other, f in factors.items()}
+    fits = {other: size for other, size in rescaled.items() if plausible_vessel(*size)}
+    if fits:
+        sizes = ", or ".join(f"with units: {other} it would be {_size_text(*size)}" for other, size in fits.items())
+        which = f"set units: {next(iter(fits))} in the case file" if len(fits) == 1 else (
+            "set the case file's units: to those the files are in"
+        )
+        message += f"; {sizes}: {which}"
+    else:
+        message += (
+            f"; no units ({', '.join(UNIT_SCALE_TO_MM)}) make it plausible: check that the file is a vessel "
+            "centerline and that the case file's units: are its units"
+        )
+    raise ConfigError(message)
+
+
+def _size_text(length_mm: float, radius_mm: float | None) -> str:
+    """``104 m long with a 3.36 m median radius``, ``40 mm long with a 3 mm median radius``."""
+    radius = "" if radius_mm is None else f" with a {_length(radius_mm)} median radius"
+    return f"{_length(length_mm)} long{radius}"
+
+
+def _length(value_mm: float) -> str:
+    """A length for a message, 3 significant digits: in m from 1000 mm up (no exponent), else in mm."""
+    if abs(value_mm) >= 1000.0:
+        metres = value_mm / 1000.0
+        return f"{metres:.0f} m" if abs(metres) >= 1000.0 else f"{metres:.3g} m"
+    return f"{value_mm:.3g} mm"

@@ -16,6 +16,10 @@ What is compared, and against which tolerance (:class:`CheckOptions`):
   link as the kinematics stage writes it;
 - the fit metrics ``manifest.json: metrics.fit.*_mm`` (``distance_mm``).
 
+When the two manifests name different cases, or the same case built from
+input files of other content (sha256), the report carries a warning: the
+figures then measure two vessels, not a change.  It is not a failure.
+
 Any change beyond tolerance fails, an improvement included: a reference is
 updated on purpose, never drifted past.
 
@@ -48,7 +52,7 @@ CheckReport and the helpers every comparison shares),
 manifest.json).  The names below are this package's public API.
 """
 
-from softdesign.regression.check import FIT_KEYS, MANIFEST, check_build, compare_fit
+from softdesign.regression.check import FIT_KEYS, MANIFEST, case_warnings, check_build, compare_fit
 from softdesign.regression.figures import CheckOptions, CheckReport, Figure, Value, scalar_figure
 from softdesign.regression.kinematics import (
     KINEMATICS,
@@ -81,6 +85,7 @@ __all__ = [
     "DecimationError",
     "Figure",
     "Value",
+    "case_warnings",
     "check_build",
     "compare_fit",
     "compare_kinematics",

@@ -1,7 +1,9 @@
 """One whole check of a build folder against a reference: meshes, then kinematics, then fit metrics.
 
 Both folders must be build folders (a ``manifest.json``); the fit metrics are
-compared here because they live in that manifest (``metrics.fit.*_mm``).
+compared here because they live in that manifest (``metrics.fit.*_mm``), and
+so are the case name and the inputs' sha256 that tell whether the two are
+builds of the same case (:func:`case_warnings`).
 """
 
 from __future__ import annotations
@@ -50,7 +52,43 @@ def check_build(
         notes.append("no mesh files under meshes/ on either side")
     figures += compare_kinematics_files(build_dir, reference_dir, options, notes)
     figures += compare_fit(build_manifest, ref_manifest, options.distance_mm, notes)
-    return CheckReport(build_dir, reference_dir, options, tuple(figures), tuple(notes))
+    warnings = tuple(case_warnings(build_manifest, ref_manifest))
+    return CheckReport(build_dir, reference_dir, options, tuple(figures), tuple(notes), warnings)
+
+
+def case_warnings(build_manifest: dict, ref_manifest: dict) -> list[str]:
+    """Why the two builds look like different cases: the case names, else the input files' contents.
+
+    A check of one case against another measures the difference between two
+    vessels, not a regression; it still runs (a user may mean it), with this
+    warning.  Manifests without a case (or without inputs) are not judged.
+    """
+    ours, theirs = build_manifest.get("case"), ref_manifest.get("case")
+    if not (isinstance(ours, dict) and isinstance(theirs, dict)):
+        return []
+    if ours.get("name") != theirs.get("name"):
+        return [
+            f"the build is case {ours.get('name')!r} and the reference case {theirs.get('name')!r}: every figure "
+            "compares two different cases, not a change; give --reference a build of the same case"
+        ]
+    changed = _changed_inputs(build_manifest.get("inputs"), ref_manifest.get("inputs"))
+    if changed:
+        return [
+            f"case {ours.get('name')!r} was built from other input files than the reference (sha256 differs: "
+            f"{', '.join(changed)}): its figures move with the inputs, not only with a change of softdesign; "
+            "rebuild the reference from the same files"
+        ]
+    return []
+
+
+def _changed_inputs(ours: object, theirs: object) -> list[str]:
+    """Input paths whose content (sha256) the other side does not have; the reference's are marked so."""
+    if not (isinstance(ours, list) and isinstance(theirs, list)):
+        return []
+    ours, theirs = ([e for e in side if isinstance(e, dict)] for side in (ours, theirs))
+    ours_hashes, theirs_hashes = ({e.get("sha256") for e in side} for side in (ours, theirs))
+    changed = [str(e.get("path")) for e in ours if e.get("sha256") not in theirs_hashes]
+    return changed + [f"{e.get('path')} (reference)" for e in theirs if e.get("sha256") not in ours_hashes]
 
 
 def compare_fit(build_manifest: dict, ref_manifest: dict, tolerance_mm: float, notes: list[str]) -> list[Figure]:

@@ -77,6 +77,8 @@ class CheckReport:
     options: CheckOptions
     figures: tuple[Figure, ...]
     notes: tuple[str, ...] = field(default=())
+    #: The build and the reference look like different cases (names or input files differ).
+    warnings: tuple[str, ...] = field(default=())
 
     @property
     def passed(self) -> bool:
@@ -88,16 +90,18 @@ class CheckReport:
         """The figures outside tolerance."""
         return tuple(f for f in self.figures if not f.passed)
 
-    def as_dict(self) -> dict[str, Any]:
-        """The JSON object ``softdesign check --json`` prints."""
+    def as_dict(self, failures_only: bool = False) -> dict[str, Any]:
+        """The JSON object ``softdesign check --json`` prints; ``figures`` holds only the failures if asked."""
         return {
             "passed": self.passed,
             "build": self.build_dir.as_posix(),
             "reference": self.reference_dir.as_posix(),
             "tolerances": {key: getattr(self.options, key) for key in ("distance_mm", "rtol", "rotation_rad")},
+            "compared": len(self.figures),
             "failures": len(self.failures),
-            "figures": [f.as_dict() for f in self.figures],
+            "figures": [f.as_dict() for f in (self.failures if failures_only else self.figures)],
             "notes": list(self.notes),
+            "warnings": list(self.warnings),
         }
 
 

@@ -85,3 +85,13 @@ def test_reconstruct_writes_into_shapes_dir_and_has_no_o(tmp_path):
     assert sorted(p.name for p in (tmp_path / "s").iterdir()) == ["backbones.vtp", "rejected.csv", "tips.csv"]
     old = runner.invoke(app, ["pcc", "reconstruct", str(readings), "--d", "5", "-o", str(tmp_path / "t")])
     assert old.exit_code == 2 and "No such option" in old.output and not (tmp_path / "t").exists()
+
+
+def test_readme_documents_what_check_and_validate_refuse_or_warn_about():
+    from softdesign.geometry.plausibility import PLAUSIBLE_RADIUS_MM
+    from softdesign.meshing.checks import MIN_ANGULAR_COUNT
+
+    for text in ("--failures-only", "different cases", "frames: frenet", "resample.end_straight_mm",
+                 f"`export.angular_count` below {MIN_ANGULAR_COUNT}", f"at least {MIN_ANGULAR_COUNT}",
+                 f"median inscribed radius {PLAUSIBLE_RADIUS_MM[0]:g} to {PLAUSIBLE_RADIUS_MM[1]:g} mm"):
+        assert text in README, f"README does not say {text!r}"

@@ -257,3 +257,68 @@ def test_sample_is_a_vmtk_style_network_with_a_capped_wall(tmp_path):
     assert 2.9 < main.radius.min() < main.radius.max() < 4.0  # minor semi-axis of the elliptical lumen
     info = describe_surface(*read_surface(tmp_path / "surface.stl"))
     assert info.capped and info.nonmanifold_edges == 0
+
+
+def _demo_centerline_csv(path: Path, scale: float, radius: bool = True) -> Path:
+    """The sample vessel's main path (data/demo) as a CSV, every coordinate (and radius) times ``scale``."""
+    from softdesign.geometry.network import select_path
+    from softdesign.io.centerline import read_centerline_network
+
+    main = select_path(read_centerline_network(REPO / "data" / "demo" / "centerline.vtp"), 0)
+    columns = [main.points * scale] + ([main.radius[:, None] * scale] if radius else [])
+    header = "x,y,z" + (",radius" if radius else "")
+    np.savetxt(path, np.hstack(columns), delimiter=",", header=header, comments="")
+    return path
+
+
+def _refused_at_ingest(case: Path, out: Path) -> str:
+    result = runner.invoke(app, ["ingest", str(case), "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output
+    assert not out.exists()  # refused before anything was kept
+    return result.output
+
+
+def test_the_sample_vessel_declared_in_metres_is_refused_suggesting_mm(tmp_path):
+    demo = REPO / "data" / "demo"
+    case = write_case(tmp_path, units="m", final={"centerline": str(demo / "centerline.vtp"),
+                                                  "surface": str(demo / "surface.stl")})
+    output = _refused_at_ingest(case, tmp_path / "out")
+    assert "centerline.vtp: with units: m the vessel is 104 m long with a 3.36 m median radius" in output
+    assert "not a human vessel (expected a median radius of 0.3 to 20 mm and a length of 5 to 2000 mm)" in output
+    assert "with units: mm it would be 104 mm long with a 3.36 mm median radius: set units: mm in the case" in output
+
+
+def test_the_sample_vessel_in_metres_declared_in_mm_is_refused_suggesting_m(tmp_path):
+    case = write_case(tmp_path, units="mm", final={"centerline": str(_demo_centerline_csv(tmp_path / "cl.csv", 1e-3))})
+    output = _refused_at_ingest(case, tmp_path / "out")
+    assert "with units: mm the vessel is 0.104 mm long with a 0.00336 mm median radius" in output
+    assert "with units: m it would be 104 mm long with a 3.36 mm median radius: set units: m in the case file" in output
+
+
+def test_without_radii_the_length_alone_is_judged(tmp_path):
+    centerline = _demo_centerline_csv(tmp_path / "cl.csv", 1e-3, radius=False)
+    output = _refused_at_ingest(write_case(tmp_path, final={"centerline": str(centerline)}), tmp_path / "out")
+    assert "the vessel is 0.104 mm long, not a human vessel" in output and "median radius of" in output
+    assert "with units: m it would be 104 mm long: set units: m" in output
+    assert "with units: cm" not in output  # 1.04 mm long: no vessel either
+    # ... and the same file declared in metres ingests
+    in_metres = write_case(tmp_path, "m", units="m", final={"centerline": str(centerline)})
+    result = runner.invoke(app, ["ingest", str(in_metres), "--out", str(tmp_path / "m")])
+    assert result.exit_code == 0, result.output
+
+
+def test_no_units_fit_a_vessel_that_is_not_human_in_any(tmp_path):
+    rows = [[0.0, 0.0, z] for z in np.linspace(0.0, 10.0, 11)]
+    centerline = tmp_path / "cl.csv"
+    centerline.write_text("x,y,z,radius\n" + "".join(f"{x},{y},{z},25\n" for x, y, z in rows))  # wider than long
+    output = _refused_at_ingest(write_case(tmp_path, final={"centerline": str(centerline)}), tmp_path / "out")
+    assert "no units (mm, cm, m) make it plausible" in output
+
+
+def test_the_real_aorta_still_ingests(aorta_dir, tmp_path):
+    case = write_case(tmp_path, final={"centerline": str(aorta_dir / "aorta-centerline.vtp"),
+                                       "surface": str(aorta_dir / "aorta-surface.stl")})
+    result = runner.invoke(app, ["ingest", str(case), "--out", str(tmp_path / "out")])
+    assert result.exit_code == 0, result.output
+    assert "not a human vessel" not in result.output

@@ -93,6 +93,7 @@ def test_summary_of_the_fresh_cohort_has_one_ok_row_per_case(fresh_cohort):
 def test_fresh_build_passes_check_against_its_references(fresh_cohort, name):
     result = CliRunner().invoke(app, ["check", str(fresh_cohort / name), "--reference", str(REFERENCES / name)])
     assert result.exit_code == 0, f"{name} moved from tests/golden ({REGENERATE}):\n{result.output}"
+    assert "warning:" not in result.output, f"{name}: check takes the references for another case:\n{result.output}"
 
 
 @pytest.mark.parametrize("name", CASES)

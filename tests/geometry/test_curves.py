@@ -7,6 +7,7 @@ import pytest
 
 from softdesign.errors import ConfigError, GeometryError
 from softdesign.geometry.curves import (
+    TORSION_KAPPA_FLOOR,
     CurveOptions,
     l_from_points,
     measure_deviation,
@@ -65,7 +66,23 @@ def test_straight_line_has_zero_curvature_and_undefined_torsion():
     l = curve.dense_l()
     np.testing.assert_allclose(curve.curvature(l), 0.0, rtol=0, atol=1e-12)
     assert np.all(np.isnan(curve.torsion(l)))  # no binormal on a straight line, hence no torsion
-    assert curve.report().max_abs_torsion_per_mm == 0.0
+    report = curve.report()
+    assert report.max_abs_torsion_per_mm is None and report.max_abs_torsion_l is None
+    assert report.torsion_defined_fraction == 0.0
+
+
+@pytest.mark.parametrize("radius, defined", [(0.5 / TORSION_KAPPA_FLOOR, True), (2.0 / TORSION_KAPPA_FLOOR, False)])
+def test_torsion_is_reported_only_where_curvature_exceeds_the_floor(radius, defined):
+    # arcs of 500 mm and 2 m radius (kappa twice and half the floor), 100 mm long
+    curve = smooth_curve_from_polyline(circle_points(radius, 100.0, 201), CurveOptions(smoothing_mm=0.0))
+    l = curve.dense_l()
+    tau, report = curve.torsion(l), curve.report()
+    if defined:
+        np.testing.assert_allclose(tau, 0.0, rtol=0, atol=EXACT_REL / radius)  # a plane curve
+        assert report.torsion_defined_fraction == 1.0 and report.max_abs_torsion_per_mm < EXACT_REL / radius
+    else:
+        assert np.all(np.isnan(tau))
+        assert report.max_abs_torsion_per_mm is None and report.torsion_defined_fraction == 0.0
 
 
 def test_resampling_count_spacing_and_uniform_speed():

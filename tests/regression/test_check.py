@@ -318,3 +318,81 @@ def test_library_reports_the_same_figures_as_the_cli(build, reference):
     report = check_build(build, reference)
     code, payload = json_figures(build, reference)
     assert report.as_dict()["figures"] == payload["figures"]
+
+
+def rows(output: str) -> list[str]:
+    """The table's rows under its header (up to the blank line), or [] when no table was printed."""
+    lines = output.splitlines()
+    if not lines or not lines[0].startswith("item"):
+        return []
+    return lines[1:lines.index("")]
+
+
+def test_failures_only_prints_just_the_failing_rows(build, reference):
+    replace_mesh(build, "q_0.500.stl", capsule().apply_translation([2 * TOL_MM, 0.0, 0.0]))
+    everything = rows(run_check(build, reference).stdout)
+    result = run_check(build, reference, "--failures-only")
+    assert result.exit_code == 1, result.output
+    failing = rows(result.stdout)
+    assert failing and all(re.search(r"\sFAIL(\s|$)", row) for row in failing), failing
+    # the same rows as in the whole table (columns are sized to the rows shown)
+    assert [row.split() for row in failing] == [row.split() for row in everything if re.search(r"\sFAIL(\s|$)", row)]
+    assert len(everything) > len(failing)
+    total = len(everything)
+    assert f"check FAILED: {len(failing)} of {total} figure(s)" in result.stdout  # the verdict still counts all
+
+
+def test_failures_only_on_a_passing_check_prints_the_verdict_without_a_table(build, reference):
+    result = run_check(build, reference, "--failures-only")
+    assert result.exit_code == 0, result.output
+    assert rows(result.stdout) == [] and "PASS " not in result.stdout
+    assert result.stdout.startswith("check PASSED")
+
+
+def test_failures_only_with_json_lists_the_failures_and_counts_every_figure(build, reference):
+    replace_mesh(build, "q_0.000.stl", cylinder().apply_translation([0.0, 0.0, 3 * TOL_MM]))
+    code, everything = json_figures(build, reference)
+    code_only, payload = json_figures(build, reference, "--failures-only")
+    assert code == code_only == 1
+    assert payload["figures"] == [f for f in everything["figures"] if not f["passed"]]
+    assert payload["failures"] == len(payload["figures"]) and payload["compared"] == len(everything["figures"])
+
+
+def set_case(folder: Path, name: str, centerline_sha256: str) -> None:
+    """Give a fake build folder's manifest a case and inputs, as a real build writes them."""
+    def edit(manifest):
+        manifest["case"] = {"name": name, "units": "mm"}
+        manifest["inputs"] = [{"path": "../data/centerline.vtp", "sha256": centerline_sha256, "bytes": 100},
+                              {"path": "../data/surface.stl", "sha256": "b" * 64, "bytes": 200}]
+
+    edit_json(folder / "manifest.json", edit)
+
+
+def test_the_same_case_checks_without_a_warning(build, reference):
+    for folder in (build, reference):
+        set_case(folder, "arch", "a" * 64)
+    result = run_check(build, reference)
+    assert result.exit_code == 0 and "warning" not in result.output, result.output
+    assert json_figures(build, reference)[1]["warnings"] == []
+
+
+def test_different_case_names_warn_but_do_not_fail(build, reference):
+    set_case(build, "arch", "a" * 64)
+    set_case(reference, "coil", "a" * 64)
+    result = run_check(build, reference)
+    assert result.exit_code == 0, result.output  # a warning, not an error: every figure is still within tolerance
+    expected = "warning: the build is case 'arch' and the reference case 'coil'"
+    assert expected in result.stderr and expected not in result.stdout
+    assert "give --reference a build of the same case" in result.stderr
+    code, payload = json_figures(build, reference)
+    assert code == 0 and payload["warnings"][0].startswith("the build is case 'arch'")
+
+
+def test_the_same_case_built_from_other_input_files_warns_naming_them(build, reference):
+    set_case(build, "arch", "a" * 64)
+    set_case(reference, "arch", "c" * 64)
+    result = run_check(build, reference, "--failures-only")
+    assert result.exit_code == 0, result.output
+    assert ("warning: case 'arch' was built from other input files than the reference (sha256 differs: "
+            "../data/centerline.vtp, ../data/centerline.vtp (reference))") in result.stderr
+    assert "surface.stl" not in result.stderr

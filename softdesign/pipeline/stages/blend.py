@@ -16,15 +16,22 @@ from typing import Any
 import numpy as np
 
 from softdesign.config import Case
-from softdesign.geometry.blend import BlendedShape, blend_shapes
-from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline, smooth_curve_from_samples
+from softdesign.geometry.blend import BlendedShape, Shortening, blend_shapes
+from softdesign.geometry.curves import (
+    TORSION_KAPPA_FLOOR,
+    CurveOptions,
+    smooth_curve_from_polyline,
+    smooth_curve_from_samples,
+)
 from softdesign.geometry.initial import InitialSpec, build_initial_shape, initial_shape_from_polyline
 from softdesign.pipeline import layout
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.ingest import IngestResult
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 
-VERSION = 1
+#: 2: the final path's torsion only where curvature >= TORSION_KAPPA_FLOOR (null when nowhere), with the
+#: fraction of the path where it is defined and the floor.
+VERSION = 2
 
 
 @dataclass(frozen=True)
@@ -82,6 +89,8 @@ def _summary(case: Case, shape: BlendedShape) -> dict[str, Any]:
             "max_curvature_l": final.max_curvature_l,
             "max_abs_torsion_per_mm": final.max_abs_torsion_per_mm,
             "max_abs_torsion_l": final.max_abs_torsion_l,
+            "torsion_defined_fraction": final.torsion_defined_fraction,
+            "torsion_kappa_floor_per_mm": TORSION_KAPPA_FLOOR,
         },
         "initial_length_mm": shape.keys[0].length,
         "shortening": {
@@ -111,17 +120,35 @@ def load_blend(build_dir: Path) -> BlendResult:
     return BlendResult(shape, summary)
 
 
+def torsion_text(path: dict[str, Any]) -> str:
+    """Max |torsion| and where it is defined (curvature above the floor), or that it is undefined everywhere."""
+    floor, fraction = path["torsion_kappa_floor_per_mm"], path["torsion_defined_fraction"]
+    if path["max_abs_torsion_per_mm"] is None:
+        return f"torsion undefined (curvature below {floor:g} /mm everywhere)"
+    where = "" if fraction == 1.0 else f" on {100 * fraction:.1f}% of the path; undefined elsewhere"
+    return f"max |torsion| {path['max_abs_torsion_per_mm']:.4f} /mm (where curvature >= {floor:g} /mm{where})"
+
+
 def describe_blend(result: BlendResult) -> list[str]:
     """Human summary lines."""
     s = result.summary
     f = s["final_path"]
     lines = [
         f"final path: {f['length_mm']:.2f} mm, {f['samples']} samples every {f['spacing_mm']:.3f} mm, "
-        f"max curvature {f['max_curvature_per_mm']:.4f} /mm, max |torsion| {f['max_abs_torsion_per_mm']:.4f} /mm",
+        f"max curvature {f['max_curvature_per_mm']:.4f} /mm, {torsion_text(f)}",
         f"blend {s['mode']}, frames {s['frames']}; initial length {s['initial_length_mm']:.2f} mm",
     ]
-    sh = s["shortening"]
-    lines.append(f"shortest shape: {sh['min_length_mm']:.2f} mm at q = {sh['q_at_min']:.3f} ({100 * sh['ratio']:.2f}% shorter)")
+    sh = Shortening(**s["shortening"])
+    if sh.intermediate_is_shorter:
+        lines.append(
+            f"shortest shape: {sh.min_length_mm:.2f} mm at q = {sh.q_at_min:.3f}, {100 * sh.ratio:.3g}% shorter "
+            f"than the shorter end shape ({sh.reference_length_mm:.2f} mm)"
+        )
+    else:
+        lines.append(
+            f"no intermediate shape is shorter than both end shapes (q = 0: {s['initial_length_mm']:.2f} mm, "
+            f"q = 1: {f['length_mm']:.2f} mm)"
+        )
     return lines
 
 

@@ -16,7 +16,7 @@ import numpy as np
 from softdesign.config import Case
 from softdesign.errors import InputDataError
 from softdesign.geometry.network import CenterlineNetwork, Orientation, SelectedPath, all_paths, select_path
-from softdesign.geometry.plausibility import check_surface_surrounds, radius_note
+from softdesign.geometry.plausibility import check_surface_surrounds, check_vessel_scale
 from softdesign.io.centerline import read_centerline_network
 from softdesign.io.surface import read_surface
 from softdesign.meshing.topology import SurfaceInfo, describe_surface
@@ -25,7 +25,8 @@ from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 from softdesign.types import UNIT_SCALE_TO_MM, FloatArray
 
-VERSION = 1
+#: 2: a vessel whose size is not human in the declared units is refused (it was a warning on radii only).
+VERSION = 2
 
 
 @dataclass(frozen=True)
@@ -90,17 +91,18 @@ def run_ingest(case: Case) -> IngestResult:
     ------
     InputDataError
         A file is missing, unreadable or geometrically unusable.
+    ConfigError
+        The vessel's size is not a human vessel's in the declared ``units`` (checked before the surface is read).
     """
     scale = UNIT_SCALE_TO_MM[case.units]
     network = read_centerline_network(case.final.centerline, scale)
     inlet = None if case.final.inlet is None else np.asarray(case.final.inlet, float) * scale
     orientation = Orientation(inlet=inlet, reverse=case.final.reverse)
     path = select_path(network, case.final.path, orientation)
+    check_vessel_scale(path.length, path.radius, case.units, f"final.centerline {case.final.centerline.name}")
     others = tuple(p for p in all_paths(network, Orientation(inlet=path.points[0])) if p.index != path.index)
     notes = list(path.notes)
     vertices, faces, info = _final_surface(case, path, scale)
-    note = radius_note(path.radius, str(case.final.centerline))
-    notes += [note] if note else []
     initial_path = None
     if case.initial.kind == "file" and case.initial.centerline is not None:
         initial_path = _one_path(case.initial.centerline, case.initial.path, scale, Orientation())
