@@ -21,6 +21,7 @@ from softdesign.config import Case
 from softdesign.pipeline import layout
 from softdesign.pipeline.lock import BuildLock
 from softdesign.pipeline.manifest import build_manifest
+from softdesign.pipeline.out_folder import check_out_folder, folder_errors
 from softdesign.pipeline.stage import Results, Stage, StageRun, Status, stage_key
 from softdesign.pipeline.store import Staging, read_record, sha256_file
 from softdesign.pipeline.swap import repair
@@ -66,12 +67,16 @@ def run_stages(
     Holding the folder's lock, the whole next folder is staged beside it
     (new files written, kept stages' files linked) and swapped in only when
     every stage succeeded; a failure leaves the previous build folder as it
-    was.  ConfigError when another run holds the folder's lock.
+    was.  ConfigError when ``build_dir`` may not be replaced
+    (:func:`~softdesign.pipeline.out_folder.check_out_folder`), is locked by
+    another run, or cannot be written.
     """
     build_dir = Path(build_dir)
     input_hashes = [sha256_file(p) for p in inputs]
     target = Path(os.path.realpath(build_dir))
-    with BuildLock(target):
+    with folder_errors(build_dir):
+        check_out_folder(build_dir, inputs)  # before the lock: a refused --out gets no lock file beside it
+    with folder_errors(build_dir), BuildLock(target):
         for line in repair(target):
             options.progress(line)
         with Staging(build_dir) as staging:

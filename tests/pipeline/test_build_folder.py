@@ -6,8 +6,11 @@ the folder there byte for byte as it was (every file hashed before and after).
 
 from __future__ import annotations
 
+import ctypes
+import errno
 import json
 import os
+import pathlib
 import select
 import shutil
 import signal
@@ -202,6 +205,77 @@ def test_the_folder_holds_what_its_manifest_lists_and_kept_files_are_linked(tmp_
     assert leftovers(tmp_path, "build") == []
 
 
+# --- 2. a commit that fails part-way: the old folder as it was, exit 2 with the path --------------------------
+
+
+def refuse_exchange(monkeypatch: pytest.MonkeyPatch) -> None:
+    """renameat2 answers EACCES, as it does when the parent folder became read-only."""
+
+    def refusing(*args) -> int:
+        ctypes.set_errno(errno.EACCES)
+        return -1
+
+    monkeypatch.setattr(swap, "_renameat2", refusing)
+
+
+def refuse_second_rename(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Two-rename swap: the old folder moves aside, then moving the new one in is refused (EACCES)."""
+    monkeypatch.setattr(swap, "_renameat2", None)
+    calls = []
+    rename = os.rename
+
+    def second_refused(source, target) -> None:
+        calls.append(target)
+        if len(calls) == 2:
+            raise PermissionError(errno.EACCES, "Permission denied", str(source), None, str(target))
+        rename(source, target)
+
+    monkeypatch.setattr(os, "rename", second_refused)
+
+
+def fill_the_disk(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Writing a mesh fails as on a full disk: write() raises ENOSPC without a file name."""
+    write_bytes = pathlib.Path.write_bytes
+
+    def full(self: Path, data: bytes) -> int:
+        if self.suffix == ".stl":
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return write_bytes(self, data)
+
+    monkeypatch.setattr(pathlib.Path, "write_bytes", full)
+
+
+@pytest.mark.parametrize(
+    "fault, needles",
+    [
+        (refuse_exchange, ["Permission denied", "make it writable"]),
+        (refuse_second_rename, ["Permission denied", "make it writable"]),
+        (fill_the_disk, ["No space left on device", "meshes/q_0.000.stl", "free space"]),
+    ],
+    ids=["read-only-parent", "read-only-parent-two-renames", "disk-full"],
+)
+def test_a_commit_that_fails_part_way_leaves_the_old_folder_as_it_was(fault, needles, tmp_path, monkeypatch):
+    out = tmp_path / "build"
+    built(write_demo(tmp_path), out)
+    before = snapshot(out)
+    case = write_demo(tmp_path, angular_count=56)
+    fault(monkeypatch)
+    result = run("build", case, "--out", out)
+    assert_refused(result, f"build folder {out}", str(tmp_path), *needles)
+    assert snapshot(out) == before
+    assert leftovers(tmp_path, "build") == []
+
+
+def test_an_out_that_is_a_file_or_below_a_file_is_refused(tmp_path):
+    case = write_demo(tmp_path)
+    notes = tmp_path / "notes.txt"
+    notes.write_text("mine")
+    assert_refused(run("build", case, "--out", notes), f"build folder {notes}: is a file", "--out")
+    assert_refused(run("build", case, "--out", notes / "build"), str(notes), "a file is in the way")
+    assert notes.read_text() == "mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["demo.yaml", "notes.txt"]
+
+
 # --- 3. one run at a time ---------------------------------------------------------------------------------------
 
 HOLD_IN_EXPORT = """
@@ -241,6 +315,48 @@ def test_a_second_build_into_a_folder_being_built_is_refused_naming_the_first(tm
     built(case, out)
     assert_exactly_as_listed(out)
     assert leftovers(tmp_path, "build") == []
+
+
+# --- 4. what --out may be -----------------------------------------------------------------------------------------
+
+
+def test_out_must_be_a_softdesign_build_an_empty_folder_or_new(tmp_path):
+    case = write_demo(tmp_path)
+    papers = tmp_path / "papers"
+    papers.mkdir()
+    (papers / "thesis.tex").write_text("chapter 1")
+    assert_refused(run("build", case, "--out", papers), str(papers), "thesis.tex", "no softdesign manifest.json",
+                   "--out")
+    assert snapshot(papers) == {"thesis.tex": snapshot(papers)["thesis.tex"]}
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    built(case, empty)
+    assert_exactly_as_listed(empty)
+
+
+def test_a_build_folder_holding_files_of_its_user_is_not_replaced(tmp_path):
+    case = write_demo(tmp_path)
+    out = tmp_path / "build"
+    built(case, out)
+    (out / "notes.txt").write_text("what I saw in the q = 1 mesh")
+    before = snapshot(out)
+    assert_refused(run("build", case, "--out", out), str(out), "notes.txt", "move them out")
+    assert snapshot(out) == before
+
+
+def test_out_may_not_hold_the_input_files(tmp_path):
+    data = tmp_path / "data" / "demo"
+    shutil.copytree(REPO / "data" / "demo", data)
+    case = tmp_path / "case.yaml"
+    case.write_text(
+        "name: demo\nfinal: {centerline: data/demo/centerline.vtp, surface: data/demo/surface.stl}\n"
+        "export: {q: [0, 1], angular_count: 48, spacing_mm: 1.0}\n"
+    )
+    before = snapshot(tmp_path / "data")
+    for out in (data, tmp_path / "data", tmp_path):
+        assert_refused(run("build", case, "--out", out), f"build folder {out}", "holds the input file", "--out")
+    assert snapshot(tmp_path / "data") == before
+    built(case, data / "build")  # beside the inputs is fine: the build replaces only its own folder
 
 
 # --- 8. names beside the build folder are matched exactly, never as patterns ---------------------------------------
