@@ -23,7 +23,6 @@ import yaml
 from typer.testing import CliRunner, Result
 
 from softdesign.cli import app
-from softdesign.pipeline import swap
 from tests.helpers.folders import assert_exactly_as_listed, leftovers, snapshot
 from tests.helpers.paths import REPO
 
@@ -127,6 +126,8 @@ KILL_POINTS = {
 
 def exchange_works(folder: Path) -> bool:
     """Whether renameat2(RENAME_EXCHANGE) swaps two folders in ``folder`` on this system."""
+    from softdesign.pipeline import swap
+
     first, second = folder / "probe-a", folder / "probe-b"
     first.mkdir()
     second.mkdir()
@@ -171,7 +172,9 @@ def test_a_build_killed_during_its_commit_leaves_the_old_folder_or_the_new_one(p
         assert_exactly_as_listed(out)
     else:  # between the two renames: the name is free and the old folder waits under its trash name
         assert not out.exists() and any(".build.trash-" in name for name in leftovers(tmp_path, "build"))
-        swap.repair(out)
+        from softdesign.pipeline.swap import repair
+
+        repair(out)
         assert snapshot(out) == snapshot(old)
     # the next run clears what the killed one left and ends with the new folder
     built(case, out)
@@ -210,6 +213,7 @@ def test_the_folder_holds_what_its_manifest_lists_and_kept_files_are_linked(tmp_
 
 def refuse_exchange(monkeypatch: pytest.MonkeyPatch) -> None:
     """renameat2 answers EACCES, as it does when the parent folder became read-only."""
+    from softdesign.pipeline import swap
 
     def refusing(*args) -> int:
         ctypes.set_errno(errno.EACCES)
@@ -220,6 +224,8 @@ def refuse_exchange(monkeypatch: pytest.MonkeyPatch) -> None:
 
 def refuse_second_rename(monkeypatch: pytest.MonkeyPatch) -> None:
     """Two-rename swap: the old folder moves aside, then moving the new one in is refused (EACCES)."""
+    from softdesign.pipeline import swap
+
     monkeypatch.setattr(swap, "_renameat2", None)
     calls = []
     rename = os.rename
