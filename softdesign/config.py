@@ -11,6 +11,7 @@ softdesign is millimetres, the conversion happens at ingest.
 from __future__ import annotations
 
 import difflib
+import re
 from pathlib import Path
 from typing import Any, Literal
 
@@ -31,6 +32,7 @@ from pydantic import (
 from softdesign.errors import ConfigError
 from softdesign.io.formats import MESH_FORMATS
 from softdesign.meshing.checks import MIN_ANGULAR_COUNT, VOLUME_RTOL
+from softdesign.pipeline.layout import q_label
 
 
 class _Section(BaseModel):
@@ -154,6 +156,21 @@ class Export(_Section):
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...
     split_regions: bool = False
 
+    @field_validator("q")
+    @classmethod
+    def _q_names_differ(cls, values: list[float] | None) -> list[float] | None:
+        # a mesh is named by its q with three decimals (meshes/q_0.500.stl, DESIGN.md): two q values that
+        # print alike would write one file, and one of the two meshes would be lost without a word
+        seen: dict[str, float] = {}
+        for q in values or []:
+            name = q_label(q)
+            if name in seen:
+                what = f"{q!r} is listed twice" if seen[name] == q else (
+                    f"{seen[name]!r} and {q!r} both name their mesh {name}.stl (q has three decimals in file names)")
+                raise ValueError(f"{what}; give each q once, the values at least 0.001 apart (e.g. 0.5 and 0.501)")
+            seen[name] = q
+        return values
+
     @model_validator(mode="after")
     def _q_values(self) -> "Export":
         if self.q is not None and self.frames is not None:
@@ -223,6 +240,18 @@ class Case(_Section):
             "undefined where the curvature is zero. Use frames: rmf (defined on straight parts) or set "
             + " and ".join(fixes)
         )
+
+    @field_validator("name")
+    @classmethod
+    def _name_is_a_slug(cls, value: str) -> str:
+        # the name becomes a folder (build/<name>) and the stem of names beside it: a name, never a path
+        if re.fullmatch(r"[A-Za-z0-9_-][A-Za-z0-9._-]{0,99}", value) is None:
+            example = re.sub(r"[^A-Za-z0-9._-]+", "-", value).lstrip(".-")[:100] or "demo"
+            raise ValueError(
+                f"must be a name, not a path: 1 to 100 letters, digits, '-', '_' or '.', not starting with '.', "
+                f"got {value!r}; write e.g. name: {example} (the default is the case file's name without .yaml)"
+            )
+        return value
 
     @property
     def base_dir(self) -> Path:

@@ -1,4 +1,4 @@
-"""Every path inside a build folder, named once.
+"""Every path inside a build folder, and every name beside it, named once.
 
 Stages, the runner, the report, the regression check and the cohort summary
 all find files through these names; nothing else spells a build-folder path.
@@ -13,8 +13,6 @@ REPORT_DIR = "report"
 MESHES_DIR = "meshes"
 #: The record of one stage's run (its cache key and outputs with sha256) inside the stage's folder.
 STAGE_RECORD = "stage.json"
-#: Staging folders sit beside the build folder: ``.<build folder name>.staging-<pid>-XXXX``.
-STAGING_PREFIX = ".staging-"
 
 INGEST_PATH = "ingest/path.npz"
 INGEST_NETWORK = "ingest/network.npz"
@@ -29,6 +27,39 @@ FIT_SURFACE = "fit/surface.npz"
 FIT_POINTS = "fit/points.npz"
 FIT_SUMMARY = "fit/summary.json"
 EXPORT_SUMMARY = "export/summary.json"
+
+
+# Beside the build folder ``<name>``, in the same parent (so a rename never crosses file systems), named
+# ``.<name>.<role>``: a run's new folder (``staging-<pid>-<hex>``), an old folder set aside while the new one
+# takes its name (``trash-<pid>-<hex>``, only where the two cannot be exchanged in one step) and the lock.
+
+
+def staging_name(build_name: str, pid: int, token: str) -> str:
+    """``.<name>.staging-<pid>-<token>`` (token: lowercase hex): a run's next folder, before it becomes ``<name>``."""
+    return f".{build_name}.staging-{pid}-{token}"
+
+
+def trash_name(build_name: str, pid: int, token: str) -> str:
+    """``.<name>.trash-<pid>-<token>``: the previous folder while a two-rename swap is under way."""
+    return f".{build_name}.trash-{pid}-{token}"
+
+
+def sibling_role(build_name: str, entry_name: str) -> str | None:
+    """``"staging"`` or ``"trash"`` when ``entry_name`` is one of those folders of build ``build_name``, else None.
+
+    Exact names, not glob patterns: a build folder named ``*`` or ``a.staging-1`` claims only its own.
+    """
+    for role in ("staging", "trash"):
+        rest = entry_name.removeprefix(f".{build_name}.{role}-")
+        pid, _, token = rest.partition("-")
+        if rest != entry_name and pid.isdigit() and token and set(token) <= set("0123456789abcdef"):
+            return role
+    return None
+
+
+def lock_name(build_name: str) -> str:
+    """``.<name>.lock``: the file a run locks while it writes build folder ``<name>``."""
+    return f".{build_name}.lock"
 
 
 def stage_record(stage: str) -> str:

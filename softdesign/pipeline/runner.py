@@ -2,12 +2,15 @@
 
 A stage whose key (:func:`~softdesign.pipeline.stage.stage_key`) matches the
 one recorded in ``DIR/<stage>/stage.json`` *and* whose recorded outputs are
-all present with their recorded hashes is skipped; nothing is reused merely
-because a file exists.
+all present with their recorded hashes is skipped (its files are carried
+into the new folder); nothing is reused merely because a file exists.  The
+new folder holds exactly what its manifest lists: outputs of an earlier
+configuration (a mesh for a q no longer asked for) go with the old folder.
 """
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -16,17 +19,33 @@ from typing import Any
 
 from softdesign.config import Case
 from softdesign.pipeline import layout
+from softdesign.pipeline.lock import BuildLock
 from softdesign.pipeline.manifest import build_manifest
+from softdesign.pipeline.out_folder import check_out_folder, folder_errors
 from softdesign.pipeline.stage import Results, Stage, StageRun, Status, stage_key
 from softdesign.pipeline.store import Staging, read_record, sha256_file
+from softdesign.pipeline.swap import repair
 
 
-def _up_to_date(build_dir: Path, stage: Stage, key: str) -> bool:
-    record = read_record(build_dir / layout.stage_record(stage.name))
-    if record is None or record.get("key") != key:
-        return False
+def _intact(build_dir: Path, record: dict[str, Any]) -> bool:
+    """Whether every output ``record`` lists is in ``build_dir`` with its recorded hash."""
     outputs = record.get("outputs", {})
     return all((build_dir / rel).is_file() and sha256_file(build_dir / rel) == sha for rel, sha in outputs.items())
+
+
+def _up_to_date(build_dir: Path, stage: Stage, key: str) -> dict[str, Any] | None:
+    """The stage's record in ``build_dir`` when its key is ``key`` and its outputs are intact, else None."""
+    record = read_record(build_dir / layout.stage_record(stage.name))
+    if record is None or record.get("key") != key or not _intact(build_dir, record):
+        return None
+    return record
+
+
+def _keep(staging: Staging, stage: Stage, record: dict[str, Any]) -> None:
+    """Carry a stage's record and outputs, checked intact, from the current folder into the new one."""
+    staging.keep(layout.stage_record(stage.name), sha256_file(staging.target / layout.stage_record(stage.name)))
+    for rel, sha in record.get("outputs", {}).items():
+        staging.keep(rel, sha)
 
 
 @dataclass(frozen=True)
@@ -45,30 +64,56 @@ def run_stages(
 ) -> tuple[Results, list[StageRun]]:
     """Run ``stages`` (in order, upstream first) into ``build_dir``.
 
-    All new files are staged and committed only when every stage succeeded;
-    a failure leaves the previous build folder as it was.
+    Holding the folder's lock, the whole next folder is staged beside it
+    (new files written, kept stages' files linked) and swapped in only when
+    every stage succeeded; a failure leaves the previous build folder as it
+    was.  ConfigError when ``build_dir`` may not be replaced
+    (:func:`~softdesign.pipeline.out_folder.check_out_folder`), is locked by
+    another run, or cannot be written.
     """
     build_dir = Path(build_dir)
     input_hashes = [sha256_file(p) for p in inputs]
+    target = Path(os.path.realpath(build_dir))
+    with folder_errors(build_dir):
+        check_out_folder(build_dir, inputs)  # before the lock: a refused --out gets no lock file beside it
+    with folder_errors(build_dir), BuildLock(target):
+        for line in repair(target):
+            options.progress(line)
+        with Staging(build_dir) as staging:
+            results, runs = _run_all(case, staging, stages, input_hashes, options)
+            stages_run = [*stages, *options.later]
+            manifest = build_manifest(case, staging.folder, stages_run, runs, results, inputs, input_hashes)
+            staging.write_json(layout.MANIFEST, manifest)
+            _check_listed(manifest, staging.written)
+            staging.commit()
+    return results, runs
+
+
+def _run_all(
+    case: Case, staging: Staging, stages: list[Stage], input_hashes: list[str], options: RunOptions
+) -> tuple[Results, list[StageRun]]:
+    """Run or keep ``stages``, then keep what ``options.later`` has in the current folder; fills ``staging``."""
     results: Results = {}
     keys: dict[str, str] = {}
     runs: list[StageRun] = []
-    with Staging(build_dir) as staging:
-        for index, stage in enumerate(stages):
-            upstream = [keys[u] for u in stage.upstream]
-            keys[stage.name] = stage_key(stage, case, upstream, input_hashes if not stage.upstream else [])
-            step = RunOptions(options.force, _counted(options.progress, index, len(stages)))
-            runs.append(_run_one(stage, case, build_dir, keys[stage.name], results, staging, step))
-        for stage in options.later:
-            if (build_dir / layout.stage_record(stage.name)).is_file() and all(u in keys for u in stage.upstream):
-                keys[stage.name] = stage_key(stage, case, [keys[u] for u in stage.upstream], [])
-                runs.append(_kept_run(stage, build_dir, keys[stage.name], results))
-        manifest = build_manifest(
-            case, build_dir, [*stages, *options.later], runs, results, inputs, input_hashes, staging
-        )
-        staging.write_json(layout.MANIFEST, manifest)
-        staging.commit()
+    for index, stage in enumerate(stages):
+        upstream = [keys[u] for u in stage.upstream]
+        keys[stage.name] = stage_key(stage, case, upstream, input_hashes if not stage.upstream else [])
+        step = RunOptions(options.force, _counted(options.progress, index, len(stages)))
+        runs.append(_run_one(stage, case, keys[stage.name], results, staging, step))
+    for stage in options.later:
+        record = read_record(staging.target / layout.stage_record(stage.name))
+        if record is not None and all(u in keys for u in stage.upstream):
+            keys[stage.name] = stage_key(stage, case, [keys[u] for u in stage.upstream], [])
+            runs.append(_kept_run(stage, record, keys[stage.name], results, staging))
     return results, runs
+
+
+def _check_listed(manifest: dict[str, Any], files: dict[str, str]) -> None:
+    """The manifest lists every file of the new folder but itself, with its hash, and nothing else (else a bug)."""
+    listed = {entry["path"]: entry["sha256"] for entry in manifest["outputs"] + manifest["records"]}
+    if listed != {rel: sha for rel, sha in files.items() if rel != layout.MANIFEST}:
+        raise RuntimeError("the manifest does not list exactly the files of the new build folder")
 
 
 def _counted(progress: Callable[[str], None], index: int, total: int) -> Callable[[str], None]:
@@ -82,32 +127,42 @@ def _counted(progress: Callable[[str], None], index: int, total: int) -> Callabl
 
 
 def _run_one(
-    stage: Stage, case: Case, build_dir: Path, key: str, results: Results, staging: Staging, options: RunOptions
+    stage: Stage, case: Case, key: str, results: Results, staging: Staging, options: RunOptions
 ) -> StageRun:
     start = time.perf_counter()
-    if not options.force and _up_to_date(build_dir, stage, key):
-        results[stage.name] = stage.load(build_dir, results)
+    record = None if options.force else _up_to_date(staging.target, stage, key)
+    if record is not None:
+        results[stage.name] = stage.load(staging.target, results)
+        _keep(staging, stage, record)
         options.progress(f"{stage.name}: unchanged, skipped")
-        return StageRun(stage.name, key, Status.SKIPPED, time.perf_counter() - start, stage.describe(results[stage.name]))
+        seconds = time.perf_counter() - start
+        return StageRun(stage.name, key, Status.SKIPPED, seconds, stage.describe(results[stage.name]))
     options.progress(f"{stage.name}: running")
     results[stage.name] = stage.compute(case, results)
     before = set(staging.written)
     stage.write(results[stage.name], staging)
     outputs = {rel: staging.written[rel] for rel in sorted(set(staging.written) - before)}
-    staging.write_json(layout.stage_record(stage.name), {"stage": stage.name, "version": stage.version, "key": key, "outputs": outputs})
+    done = {"stage": stage.name, "version": stage.version, "key": key, "outputs": outputs}
+    staging.write_json(layout.stage_record(stage.name), done)
     seconds = time.perf_counter() - start
     options.progress(f"{stage.name}: done in {seconds:.2f} s")
     return StageRun(stage.name, key, Status.RAN, seconds, stage.describe(results[stage.name]))
 
 
-def _kept_run(stage: Stage, build_dir: Path, key: str, results: Results) -> StageRun:
-    """A later stage's outputs from an earlier run: ``kept`` (loaded) if made from what is there now, else ``stale``."""
+def _kept_run(stage: Stage, record: dict[str, Any], key: str, results: Results, staging: Staging) -> StageRun:
+    """A later stage's outputs from an earlier run: ``kept`` (loaded) if made from what is there now, else ``stale``.
+
+    Either way they go into the new folder, unless some are missing or changed on disk: then none do.
+    """
     start = time.perf_counter()
-    if _up_to_date(build_dir, stage, key):
-        results[stage.name] = stage.load(build_dir, results)
+    if not _intact(staging.target, record):
+        line = (f"{stage.name}/: outputs of an earlier run are missing or changed on disk, so none are kept; "
+                "run `softdesign build` to redo them")
+        return StageRun(stage.name, key, Status.STALE, time.perf_counter() - start, [line])
+    _keep(staging, stage, record)
+    if record.get("key") == key:
+        results[stage.name] = stage.load(staging.target, results)
         return StageRun(stage.name, key, Status.KEPT, time.perf_counter() - start, stage.describe(results[stage.name]))
     line = (f"{stage.name}/ and its outputs were built from other inputs or settings than this run's; "
             "they are out of date: run `softdesign build` to redo them")
     return StageRun(stage.name, key, Status.STALE, time.perf_counter() - start, [line])
-
-

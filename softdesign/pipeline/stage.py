@@ -32,8 +32,6 @@ class Status:
     KEPT = "kept"
     #: a stage after the target, not run; its outputs were built from other inputs or settings
     STALE = "stale"
-    #: in the build folder from an earlier run, but no longer a stage of the pipeline
-    UNKNOWN = "unknown"
 
 
 @dataclass(frozen=True)

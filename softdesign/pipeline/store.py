@@ -1,11 +1,14 @@
-"""The build folder: staged atomic writes, canonical JSON, hashes.
+"""The build folder as one transaction: a complete new folder swapped in whole; canonical JSON, hashes.
 
-A run writes every new file into a staging folder beside the build folder
-(``.<name>.staging-XXXX`` in the same parent, so renames stay on one file
-system) and moves the files into place only when the whole run has
-succeeded (``manifest.json`` last).  A run that fails, or is killed, leaves
-the previous good build folder untouched; its staging folder is removed on
-failure, or cleared by the next run after a kill.
+A run fills a staging folder beside the build folder
+(``.<name>.staging-<pid>-<hex>`` in the same parent, so renames stay on one
+file system) with the whole next build: the files it writes, and the files
+of the stages it keeps, hard-linked from the current folder.  Only when every
+stage has succeeded and the manifest lists every file is that folder swapped
+in for the old one, in one step (:mod:`softdesign.pipeline.swap`); the old
+folder, with anything the new manifest does not list, is then removed.  A
+run that fails, or is killed, leaves the previous build folder as it was; its
+staging folder is removed on failure, or by the next run after a kill.
 """
 
 from __future__ import annotations
@@ -14,15 +17,15 @@ import hashlib
 import io
 import json
 import os
+import secrets
 import shutil
-import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from softdesign.pipeline.layout import MANIFEST, STAGING_PREFIX
-
+from softdesign.pipeline.layout import staging_name, trash_name
+from softdesign.pipeline.swap import remove_folder, swap_in
 
 
 def canonical_json(payload: Any) -> str:
@@ -78,7 +81,7 @@ def read_record(file: Path) -> dict[str, Any] | None:
 
 
 def process_alive(pid: str) -> bool:
-    """Whether process ``pid`` (digits) runs on this machine (the owner of a staging folder)."""
+    """Whether process ``pid`` (digits) runs on this machine (the owner of a temporary folder)."""
     if not pid.isdigit():
         return False
     try:
@@ -91,39 +94,53 @@ def process_alive(pid: str) -> bool:
 
 
 class Staging:
-    """Files of one run, written under a staging folder and committed together.
+    """The next build folder, filled complete beside the current one and swapped in whole.
 
-    Use as a context manager: on an exception the staging folder is removed
-    and the build folder is left as it was.
+    Use as a context manager while holding the folder's lock
+    (:class:`~softdesign.pipeline.lock.BuildLock`): on an exception the
+    staging folder is removed and the build folder is left as it was.
     """
 
     def __init__(self, build_dir: Path) -> None:
         self.build_dir = Path(build_dir)
+        #: where the folder really is: a symlinked build folder is replaced where it points, the link kept
+        self.target = Path(os.path.realpath(self.build_dir))
         self.root: Path | None = None
+        #: every file of the new folder (written by this run or kept from the current one) with its sha256
         self.written: dict[str, str] = {}
 
-    def __enter__(self) -> "Staging":
-        parent = self.build_dir.resolve().parent
-        parent.mkdir(parents=True, exist_ok=True)
-        prefix = f".{self.build_dir.name}{STAGING_PREFIX}"
-        for stale in parent.glob(prefix + "*"):
-            if not process_alive(stale.name.removeprefix(prefix).split("-", 1)[0]):
-                shutil.rmtree(stale, ignore_errors=True)
-        self.root = Path(tempfile.mkdtemp(prefix=f"{prefix}{os.getpid()}-", dir=parent))
+    def __enter__(self) -> Staging:
+        self.target.parent.mkdir(parents=True, exist_ok=True)
+        root = self.target.parent / staging_name(self.target.name, os.getpid(), secrets.token_hex(6))
+        root.mkdir()  # unlike mkdtemp, honours the umask: the build is as readable as before
+        self.root = root
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
         if self.root is not None:
-            shutil.rmtree(self.root, ignore_errors=True)
+            remove_folder(self.root)
             self.root = None
+
+    def _root(self) -> Path:
+        if self.root is None:
+            raise RuntimeError("Staging used outside its with-block")
+        return self.root
+
+    @property
+    def folder(self) -> Path:
+        """The new folder being filled (its files are :attr:`written`)."""
+        return self._root()
 
     def write_bytes(self, relative: str, data: bytes) -> str:
         """Stage ``data`` for ``build_dir/relative``; returns its sha256."""
-        if self.root is None:
-            raise RuntimeError("Staging used outside its with-block")
-        target = self.root / relative
-        target.parent.mkdir(parents=True, exist_ok=True)
-        target.write_bytes(data)
+        target = self.staged_path(relative)
+        try:
+            target.write_bytes(data)
+        except OSError as err:
+            if err.filename is not None:
+                raise
+            # a failed write() (a full disk) names no file: name it, so the message can
+            raise OSError(err.errno, err.strerror, str(target)) from err
         self.written[relative] = sha256_bytes(data)
         return self.written[relative]
 
@@ -133,9 +150,7 @@ class Staging:
 
     def staged_path(self, relative: str) -> Path:
         """Where a file is staged (for writers that need a path, e.g. vtk)."""
-        if self.root is None:
-            raise RuntimeError("Staging used outside its with-block")
-        target = self.root / relative
+        target = self._root() / relative
         target.parent.mkdir(parents=True, exist_ok=True)
         return target
 
@@ -144,13 +159,23 @@ class Staging:
         self.written[relative] = sha256_file(self.staged_path(relative))
         return self.written[relative]
 
+    def keep(self, relative: str, sha256: str) -> None:
+        """Carry ``build_dir/relative`` (checked: its hash is ``sha256``) into the new folder: hard link, else copy."""
+        source, target = self.target / relative, self.staged_path(relative)
+        try:
+            os.link(source, target)
+        except OSError:  # a file system without hard links (or at its link limit)
+            shutil.copyfile(source, target)
+        self.written[relative] = sha256
+
     def commit(self) -> None:
-        """Move every staged file into the build folder, the manifest last."""
-        if self.root is None:
-            raise RuntimeError("Staging used outside its with-block")
-        ordered = sorted(self.written, key=lambda rel: (rel == MANIFEST, rel))
-        self.build_dir.mkdir(parents=True, exist_ok=True)
-        for relative in ordered:
-            target = self.build_dir / relative
-            target.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(self.root / relative, target)
+        """Swap the new folder in for the build folder in one step (:func:`~softdesign.pipeline.swap.swap_in`)."""
+        root = self._root()
+        on_disk = {p.relative_to(root).as_posix() for p in root.rglob("*") if not p.is_dir()}
+        if on_disk != set(self.written):  # a stage wrote a file it did not record: a bug
+            raise RuntimeError(f"staged files not recorded: {sorted(on_disk ^ set(self.written))}")
+        trash = self.target.parent / trash_name(self.target.name, os.getpid(), secrets.token_hex(6))
+        previous = swap_in(root, self.target, trash)
+        self.root = None
+        if previous is not None:
+            remove_folder(previous)
