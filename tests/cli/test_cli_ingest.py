@@ -228,7 +228,7 @@ def test_regeneration_check_sees_an_stl_vertex_moved_past_its_float32_step(tmp_p
     """A binary STL stores float32: one step is rounding, three are a real move."""
     import trimesh
 
-    from softdesign.io.mesh_files import write_mesh
+    from softdesign.io.formats import write_mesh
 
     committed = REPO / "data" / "demo" / "surface.stl"
     mesh = trimesh.load(committed, process=False)

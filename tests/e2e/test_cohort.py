@@ -53,7 +53,7 @@ def test_regeneration_check_sees_a_cohort_surface_moved_by_1e_6_mm(tmp_path):
     """The cohort's PLY walls store float64: a vertex moved by 1e-6 mm fails, by 1e-12 mm passes."""
     import trimesh
 
-    from softdesign.io.mesh_files import write_mesh
+    from softdesign.io.formats import write_mesh
 
     committed = REPO / "data" / "cohort" / "arch" / "surface.ply"
     mesh = trimesh.load(committed, process=False)
