@@ -39,9 +39,10 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 REPO = Path(__file__).resolve().parents[1]
 DEMO_CASE = REPO / "configs" / "demo.yaml"
@@ -253,10 +254,10 @@ def aorta_case(folder: Path) -> BenchCase | None:
 
 def write_synthetic_inputs(folder: Path, triangles: int) -> None:
     """The synthetic vessel's centerline.vtp and binary surface.stl with at least ``triangles`` faces."""
-    from softdesign.samples.synthetic_vessel import make_synthetic_vessel
     from softdesign.io.formats import write_mesh
     from softdesign.io.polylines_vtp import write_polylines_vtp
     from softdesign.samples.surfaces import synthetic_surface
+    from softdesign.samples.synthetic_vessel import make_synthetic_vessel
 
     folder.mkdir(parents=True, exist_ok=True)
     vessel = make_synthetic_vessel()

@@ -32,10 +32,10 @@ from pathlib import Path
 
 import numpy as np
 
+from softdesign.cohort import STATUS_SUFFIX, cohort_cases, read_record
 from softdesign.io.formats import read_mesh, write_mesh
 from softdesign.meshing.compare import MeshDifference, compare_meshes
 from softdesign.meshing.topology import is_winding_consistent
-from softdesign.cohort import STATUS_SUFFIX, cohort_cases, read_record
 from softdesign.pipeline.layout import MANIFEST
 from softdesign.pipeline.store import sha256_file
 from softdesign.regression import GOLDEN, KINEMATICS, decimation_entry, mesh_names

@@ -11,13 +11,12 @@ softdesign is millimetres, the conversion happens at ingest.
 from __future__ import annotations
 
 import difflib
+import os
 import re
 from pathlib import Path
 from typing import Any, Literal
 
 import yaml
-import os
-
 from pydantic import (
     BaseModel,
     ConfigDict,
@@ -73,7 +72,7 @@ class InitialShape(_Section):
     align_base: bool = True
 
     @model_validator(mode="after")
-    def _kind_needs(self) -> "InitialShape":
+    def _kind_needs(self) -> InitialShape:
         if self.kind == "arc" and self.bend_radius_mm is None:
             raise ValueError("kind: arc needs bend_radius_mm (the arc's radius of curvature, mm)")
         if self.kind == "file" and self.centerline is None:
@@ -100,7 +99,7 @@ class Links(_Section):
     length_mm: float | None = Field(None, gt=0.0)
 
     @model_validator(mode="after")
-    def _one_rule(self) -> "Links":
+    def _one_rule(self) -> Links:
         given = [k for k in ("count", "breaks", "length_mm") if getattr(self, k) is not None]
         if len(given) > 1:
             raise ValueError(f"give one of count, breaks, length_mm; got {', '.join(given)}")
@@ -172,7 +171,7 @@ class Export(_Section):
         return values
 
     @model_validator(mode="after")
-    def _q_values(self) -> "Export":
+    def _q_values(self) -> Export:
         if self.q is not None and self.frames is not None:
             raise ValueError("give q (a list) or frames (a count), not both")
         if self.port_mm is not None and self.wall_mm is None:

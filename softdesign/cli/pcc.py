@@ -18,10 +18,10 @@ import numpy as np
 import typer
 
 from softdesign.cli.common import JsonOpt, emit_json, note, run_guarded
-from softdesign.errors import ConfigError, InputDataError
-from softdesign.io.atomic import write_bytes_atomically
 from softdesign.cli.pcc_design import design
 from softdesign.cli.pcc_options import DOpt, LengthsOpt, lengths_from_text, spacing_from_text
+from softdesign.errors import ConfigError, InputDataError
+from softdesign.io.atomic import write_bytes_atomically
 
 CONVENTION = (
     "Encoders at 90, 210, 330 degrees from the section's base x axis, d mm from the backbone; "

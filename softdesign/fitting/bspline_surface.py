@@ -132,7 +132,7 @@ class RadiusSpline:
         return {"knots": self.knots.copy(), "coefficients": self.coefficients.copy()}
 
     @classmethod
-    def from_arrays(cls, knots: npt.ArrayLike, coefficients: npt.ArrayLike) -> "RadiusSpline":
+    def from_arrays(cls, knots: npt.ArrayLike, coefficients: npt.ArrayLike) -> RadiusSpline:
         """The inverse of :meth:`to_arrays`."""
         return cls(np.array(knots, float), np.array(coefficients, float))
 

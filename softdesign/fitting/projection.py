@@ -55,7 +55,7 @@ class PolarPoints:
     def __len__(self) -> int:
         return len(self.l)
 
-    def subset(self, mask: npt.ArrayLike) -> "PolarPoints":
+    def subset(self, mask: npt.ArrayLike) -> PolarPoints:
         """The points selected by a boolean mask or an index array (copies)."""
         mask = np.asarray(mask)
         return PolarPoints(

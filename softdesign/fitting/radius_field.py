@@ -187,7 +187,7 @@ class RadiusField:
         return out
 
     @classmethod
-    def from_arrays(cls, arrays) -> "RadiusField":
+    def from_arrays(cls, arrays) -> RadiusField:
         """The inverse of :meth:`to_arrays` (accepts the mapping ``np.load`` returns)."""
         breaks = np.array(arrays["breaks"], float)
         count = len(breaks) - 1

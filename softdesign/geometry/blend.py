@@ -32,8 +32,8 @@ from scipy.optimize import minimize_scalar
 from softdesign.errors import ConfigError, GeometryError
 from softdesign.geometry.curves import SmoothCurve, smooth_curve_from_samples
 from softdesign.geometry.frames import (
-    FrameMode,
     FramedSpline,
+    FrameMode,
     accumulate_rotations,
     base_normal_from_tangent,
     framed_curve,

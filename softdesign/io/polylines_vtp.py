@@ -9,8 +9,8 @@ renamed, so a reader never sees half a file.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 import numpy.typing as npt

@@ -60,7 +60,7 @@ class JointStitch:
         e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
         return 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
 
-    def figures(self, index: int, l: float) -> "JointStep":
+    def figures(self, index: int, l: float) -> JointStep:
         """The joint's figures for reports."""
         step = np.abs(self.end_radius - self.start_radius)
         area = float(np.sum(np.abs(self.signed_areas())))

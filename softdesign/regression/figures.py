@@ -11,12 +11,12 @@ import json
 import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any
 
 from softdesign.errors import ConfigError, InputDataError
 from softdesign.meshing.compare import DEFAULT_SAMPLES
 
-Value = Optional[float | bool | str]
+Value = float | bool | str | None
 
 
 @dataclass(frozen=True)
@@ -57,7 +57,7 @@ class Figure:
     item: str
     figure: str
     change: Value
-    tolerance: Optional[float]
+    tolerance: float | None
     passed: bool
     build: Value = None
     reference: Value = None

@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from softdesign.pipeline.layout import KINEMATICS
 from softdesign.errors import InputDataError
+from softdesign.pipeline.layout import KINEMATICS
 from softdesign.regression.figures import CheckOptions, Figure, is_number, missing_figure, read_json, scalar_figure
 
 #: Decimals of q that identify a pose (q values are written as the case file gives them).

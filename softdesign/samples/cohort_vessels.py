@@ -18,8 +18,8 @@ Paths (``s`` runs over ``[0, length_mm]`` before arc-length resampling)
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 

@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from softdesign import cohort
 from softdesign.config import load_case
 from softdesign.samples.cohort_vessels import COHORT_VARIANTS, make_variant_vessel, variant_named
-from softdesign import cohort
 from tests.helpers.paths import REPO
 from tests.helpers.regeneration import REGENERATION_TOL_MM, assert_same_vessel_file, vessel_file_differences
 

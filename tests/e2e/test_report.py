@@ -24,7 +24,6 @@ from typer.testing import CliRunner
 from softdesign.pipeline.api import build_through
 from softdesign.report.writer import EXPECTED_SIZES, PAGE, REPORT_DIR, ReportOptions, commit_folder, write_report
 from softdesign.versions import software_versions
-
 from tests.helpers.cases import write_case
 from tests.helpers.paths import REPO
 

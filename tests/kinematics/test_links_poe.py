@@ -13,7 +13,6 @@ from softdesign.geometry.initial import arc_initial_shape, straight_initial_shap
 from softdesign.geometry.se3 import inverse_pose, pose_from_twist, rotation_from_rotvec, rotvec_from_rotation
 from softdesign.kinematics.links import LinkChain, link_breaks, link_transforms
 from softdesign.kinematics.poe import PoeSplit, poe_from_pose, pose_from_poe
-
 from tests.helpers.seed_transforms import seed_chain
 
 #: The issue's bound on reproducing S_T_E from its POE split (we reach rounding).

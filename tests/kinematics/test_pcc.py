@@ -7,7 +7,6 @@ import pytest
 
 from softdesign.errors import ConfigError, InputDataError
 from softdesign.kinematics import pcc
-
 from tests.helpers.seed_transforms import rot_y, rot_z, seed_chain
 
 #: Agreement of two exact computations of the same length, mm (double rounding on ~500 mm).

@@ -18,6 +18,7 @@ import yaml
 from typer.testing import CliRunner
 
 from softdesign.cli import build
+from softdesign.cli.pose import pose
 from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import RadiusSpline
 from softdesign.fitting.radius_field import RadiusField
@@ -30,7 +31,6 @@ from softdesign.meshing.compare import compare_meshes
 from softdesign.meshing.pose_body import PoseSpec, pose_body
 from softdesign.meshing.pose_stitch import radii_on_rays, stitch_joint
 from softdesign.meshing.tessellate import Region
-from softdesign.cli.pose import pose
 from tests.helpers.paths import REPO
 
 app = typer.Typer(add_completion=False)
