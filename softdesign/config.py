@@ -113,7 +113,7 @@ class Links(_Section):
 def _check_breaks(breaks: list[float]) -> None:
     if len(breaks) < 2 or breaks[0] != 0.0 or breaks[-1] != 1.0:
         raise ValueError(f"breaks must start at 0 and end at 1 (normalized l), got {breaks}")
-    if any(nxt <= prev for prev, nxt in zip(breaks, breaks[1:])):
+    if any(nxt <= prev for prev, nxt in zip(breaks[:-1], breaks[1:], strict=True)):
         raise ValueError(f"breaks must be strictly increasing, got {breaks}")
 
 

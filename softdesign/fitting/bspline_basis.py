@@ -41,7 +41,7 @@ def open_knots(breaks: npt.ArrayLike, intervals: npt.ArrayLike) -> FloatArray:
     """
     breaks = np.asarray(breaks, float)
     counts = np.asarray(intervals, int)
-    pieces = [np.linspace(b0, b1, c + 1)[:-1] for b0, b1, c in zip(breaks[:-1], breaks[1:], counts)]
+    pieces = [np.linspace(b0, b1, c + 1)[:-1] for b0, b1, c in zip(breaks[:-1], breaks[1:], counts, strict=True)]
     inner = np.concatenate(pieces)[1:]
     return np.concatenate([np.zeros(DEGREE + 1), inner, np.ones(DEGREE + 1)])
 

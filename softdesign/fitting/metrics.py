@@ -236,7 +236,7 @@ def _damped_update(curve, spline, twist, p, current, step):
         surface, du, dv = _surface_and_tangents(curve, spline, twist, l, a)
         d = np.linalg.norm(p[pending] - surface, axis=1)
         better = d <= dist0[pending]
-        for target, value in zip(out, (l, a, surface, du, dv, d)):
+        for target, value in zip(out, (l, a, surface, du, dv, d), strict=True):
             target[pending[better]] = value[better]
         pending = pending[~better]
         if pending.size == 0:

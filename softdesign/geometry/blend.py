@@ -205,7 +205,7 @@ def blend_shapes(
 
 def _check_common_grid(keys: tuple[SmoothCurve, ...], key_q: FloatArray) -> None:
     ref = keys[-1].spline
-    for q, key in zip(key_q, keys):
+    for q, key in zip(key_q, keys, strict=True):
         if key.spline.k != ref.k or not np.array_equal(key.spline.t, ref.t):
             raise GeometryError(
                 f"blend: the shape at q = {q:g} has {len(key.l_grid)} samples, the final shape "

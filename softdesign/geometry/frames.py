@@ -273,7 +273,7 @@ def poses_from_frames(frames: Frames, points: Points) -> Pose:
 
 def _ranges_text(l: FloatArray, mask: npt.NDArray[np.bool_], shown: int = 3) -> str:
     edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(np.int8), [0]])))
-    runs = [(float(l[a]), float(l[b - 1])) for a, b in zip(edges[::2], edges[1::2])]
+    runs = [(float(l[a]), float(l[b - 1])) for a, b in zip(edges[::2], edges[1::2], strict=True)]
     text = ", ".join(f"[{a:.4f}, {b:.4f}]" for a, b in runs[:shown])
     return text + (f" and {len(runs) - shown} more range(s)" if len(runs) > shown else "")
 

@@ -78,7 +78,7 @@ def _line_cells(poly) -> list[np.ndarray]:
     conn = poly.GetLines()
     offsets = vtk_to_numpy(conn.GetOffsetsArray()).astype(np.int64)
     ids = vtk_to_numpy(conn.GetConnectivityArray()).astype(np.int64)
-    return [ids[a:b] for a, b in zip(offsets[:-1], offsets[1:]) if b - a >= 1]
+    return [ids[a:b] for a, b in zip(offsets[:-1], offsets[1:], strict=True) if b - a >= 1]
 
 
 def _read_csv(path: Path) -> list[Polyline]:

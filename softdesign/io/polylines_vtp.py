@@ -79,7 +79,7 @@ def _stack_point_array(name: str, arrays: Sequence[npt.ArrayLike], sizes: list[i
             f"point array '{name}': expected one array per polyline ({len(sizes)}), got {len(arrays)}"
         )
     checked = []
-    for index, (values, size) in enumerate(zip(arrays, sizes)):
+    for index, (values, size) in enumerate(zip(arrays, sizes, strict=True)):
         values = np.asarray(values, dtype=np.float64)
         if values.ndim not in (1, 2) or len(values) != size:
             raise InputDataError(

@@ -210,7 +210,7 @@ def assemble(sweeps: list[Sweep], stitches: list[JointStitch]) -> tuple[FloatArr
     meshes = [_link_mesh(sweep, j == 0, j == len(sweeps) - 1) for j, sweep in enumerate(sweeps)]
     offsets = np.cumsum([0] + [m.vertices.shape[0] for m in meshes])
     vertices = [m.vertices for m in meshes]
-    faces = np.concatenate([m.faces + off for m, off in zip(meshes, offsets)])
+    faces = np.concatenate([m.faces + off for m, off in zip(meshes, offsets[:-1], strict=True)])
     regions = np.concatenate([m.regions for m in meshes])
     remap = np.arange(offsets[-1])
     added = offsets[-1]
@@ -221,7 +221,7 @@ def assemble(sweeps: list[Sweep], stitches: list[JointStitch]) -> tuple[FloatArr
         frame, center = sweeps[j + 1].frames[0], sweeps[j + 1].centers[0]
         vertices.append(center + stitch.crossings @ frame[:, :2].T)
         added += len(stitch.crossings)
-        for x, k in zip(crossing_ids, stitch.crossing_interval):
+        for x, k in zip(crossing_ids, stitch.crossing_interval, strict=True):
             k1 = (k + 1) % na
             faces = _split_edge(faces, ring_a[k1], ring_a[k], x)
             faces = _split_edge(faces, ring_b[k], ring_b[k1], x)

@@ -88,7 +88,7 @@ def check_table(checks: list[Check]) -> Table:
 def plain_table(caption: str, header: tuple[str, ...], rows: list[tuple[str, ...]], css: tuple[str, ...] = ()) -> Table:
     """A table of plain texts; ``css`` gives a class per column."""
     classes = css or ("",) * len(header)
-    return Table(caption, header, [tuple(Cell(text, c) for text, c in zip(row, classes)) for row in rows])
+    return Table(caption, header, [tuple(Cell(text, c) for text, c in zip(row, classes, strict=True)) for row in rows])
 
 
 def _attributes(pairs: tuple[tuple[str, str], ...]) -> str:

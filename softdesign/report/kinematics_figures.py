@@ -130,7 +130,7 @@ def pcc_picture(chain: LinkChain, series: KinematicsSeries, d: float | list[floa
         figure = new_figure(PCC_SIZE_IN)
         axes = list(panels(figure, chain.count + 1, max_columns=5))
         for j, ax in enumerate(axes[:-1]):
-            for k, (style, angle) in enumerate(zip(CHAMBER_STYLES, CHAMBER_ANGLES_DEG)):
+            for k, (style, angle) in enumerate(zip(CHAMBER_STYLES, CHAMBER_ANGLES_DEG, strict=True)):
                 ax.plot(series.q, lengths[:, j, k], color=colours[j], ls=style, lw=1.3, label=f"{angle} deg")
             _mark_export_q(ax, series)
             ax.set(title=f"link {j} chambers", xlabel="q", ylabel="chamber length (mm)", xlim=(0.0, 1.0))

@@ -95,7 +95,7 @@ def draw_3d(ax, curves: list[MorphCurve], colours: list, arm: float) -> None:
     points = np.concatenate([p for c in curves for p in c.links])
     lo, hi = points.min(axis=0), points.max(axis=0)
     centre, half = (lo + hi) / 2.0, float(np.max(hi - lo)) / 2.0
-    for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
+    for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, strict=True):
         setter(c - half, c + half)
     ax.set_box_aspect((1.0, 1.0, 1.0))
     ax.set_xlabel("x (mm)")

@@ -139,7 +139,7 @@ def test_reconstruct_writes_tips_matching_the_library(reconstructed):
     with open(out / "tips.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
     assert len(rows) == len(GOOD_ROWS)
-    for row, (time, lengths) in zip(rows, GOOD_ROWS.values()):
+    for row, (time, lengths) in zip(rows, GOOD_ROWS.values(), strict=True):
         arcs, _, tip2base = library_forward(lengths, np.array([15.0, 12.0]))
         assert float(row["time"]) == time
         np.testing.assert_allclose([float(row[k]) for k in ("tip_x", "tip_y", "tip_z")], tip2base[:3, 3], rtol=0, atol=CSV_TOL)

@@ -31,7 +31,7 @@ STEP_MM = 0.005
 def curvature_jumps() -> list[float]:
     """|change of the curvature vector| at each joint, 1/mm (in the common RMF: constant per arc)."""
     vectors = [k * np.array([np.cos(p), np.sin(p)]) for k, p, _ in ARCS]
-    return [float(np.linalg.norm(b - a)) for a, b in zip(vectors, vectors[1:])]
+    return [float(np.linalg.norm(b - a)) for a, b in zip(vectors[:-1], vectors[1:], strict=True)]
 
 
 @pytest.fixture(scope="module")
