@@ -392,7 +392,8 @@ def growth_lines(results: Sequence[dict[str, Any]], key: str, unit: str, scale: 
     y = {c: [sum(seconds(r, s, c) for s in SCALES_WITH[key]) for r in runs] for c in ("wall_s", "cpu_s")}
     exponent = {c: growth_exponent(x, v) for c, v in y.items()}
     lines.append(
-        f"    {name}: time ratio {y['wall_s'][-1] / y['wall_s'][0]:.2f} wall, {y['cpu_s'][-1] / y['cpu_s'][0]:.2f} cpu, "
+        f"    {name}: time ratio {y['wall_s'][-1] / y['wall_s'][0]:.2f} wall, "
+        f"{y['cpu_s'][-1] / y['cpu_s'][0]:.2f} cpu, "
         f"for a size ratio {x[-1] / x[0]:.2f}; time ~ size^{exponent['wall_s']:.2f} wall, "
         f"^{exponent['cpu_s']:.2f} cpu (1 = linear)"
     )
@@ -415,8 +416,10 @@ def target_lines(scaled: dict[str, Any] | None, linear_triangles: bool | None, l
     ratio = scaled["total"]["wall_s"] / floor
     peak = scaled["total"]["peak_mib"]
     return [
-        f"  build / I/O floor     {ratio:7.1f}x   target <= {TARGET_FLOOR_RATIO:g}x      {verdict(ratio <= TARGET_FLOOR_RATIO)}",
-        f"  peak memory           {peak:7.0f} MiB target < {TARGET_PEAK_MIB:.0f} MiB  {verdict(peak < TARGET_PEAK_MIB)}",
+        f"  build / I/O floor     {ratio:7.1f}x   target <= {TARGET_FLOOR_RATIO:g}x      "
+        f"{verdict(ratio <= TARGET_FLOOR_RATIO)}",
+        f"  peak memory           {peak:7.0f} MiB target < {TARGET_PEAK_MIB:.0f} MiB  "
+        f"{verdict(peak < TARGET_PEAK_MIB)}",
         f"  linear in triangles   cpu time ~ size^e, e <= {LINEAR_EXPONENT_MAX:g}    {verdict(linear_triangles)}",
         f"  linear in frames      cpu time ~ size^e, e <= {LINEAR_EXPONENT_MAX:g}    {verdict(linear_frames)}",
     ]
@@ -514,11 +517,15 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
     targets = target_lines(scaled, linear_t, linear_f)
     emit([f"targets, scaled case ({scaled['label']}):"] + targets)
     if any(line.endswith("MISSED") for line in targets) and not args.profile:
-        emit(["  hot spots per stage: python pipelines/bench.py --profile (adds one profiled build of the scaled case)"])
+        emit(["  hot spots per stage: python pipelines/bench.py --profile "
+              "(adds one profiled build of the scaled case)"])
     if args.profile:
         profile_dir = scratch / "profile"
         measure(next(c for c in plan if (c.triangles, c.frames) == (top_t, top_f)), scratch, profile_dir)
-        emit(["", "hot spots of the scaled case (cProfile per stage; times inflated by the profiler):"] + profile_lines(profile_dir))
+        emit(
+            ["", "hot spots of the scaled case (cProfile per stage; times inflated by the profiler):"]
+            + profile_lines(profile_dir)
+        )
     emit(["", f"benchmark took {time.perf_counter() - started:.0f} s"])
 
 

@@ -45,7 +45,10 @@ from softdesign.versions import software_versions
 MAX_REDUCTION, BISECTIONS = 0.97, 6
 #: Largest distance a stored mesh may be from the full one, mm (check widens its tolerance by the actual error).
 MAX_ERROR_MM = 0.05
-DECIMATION = "vtkQuadricDecimation (volume preservation on), the strongest reduction <= {} keeping the mesh watertight within {} mm"
+DECIMATION = (
+    "vtkQuadricDecimation (volume preservation on), the strongest reduction <= {} "
+    "keeping the mesh watertight within {} mm"
+)
 
 
 def decimate(vertices: np.ndarray, faces: np.ndarray, reduction: float) -> tuple[np.ndarray, np.ndarray]:

@@ -316,7 +316,9 @@ def _resolve_paths(case: Case, base: Path) -> Case:
     def full(p: Path | None) -> Path | None:
         return None if p is None else (p if p.is_absolute() else base / p)
 
-    final = case.final.model_copy(update={"centerline": full(case.final.centerline), "surface": full(case.final.surface)})
+    final = case.final.model_copy(
+        update={"centerline": full(case.final.centerline), "surface": full(case.final.surface)}
+    )
     initial = case.initial.model_copy(
         update={"centerline": full(case.initial.centerline), "surface": full(case.initial.surface)}
     )

@@ -115,7 +115,9 @@ def _read_npy(path: Path) -> list[Polyline]:
     except (OSError, ValueError) as err:
         raise InputDataError(f"{path}: cannot read the .npy centerline ({err})") from err
     if values.ndim != 2 or values.shape[1] not in (3, 4):
-        raise InputDataError(f"{path}: expected an (n, 3) or (n, 4) array (x, y, z[, radius]), got shape {values.shape}")
+        raise InputDataError(
+            f"{path}: expected an (n, 3) or (n, 4) array (x, y, z[, radius]), got shape {values.shape}"
+        )
     values = values.astype(float)
     return [Polyline(values[:, :3], values[:, 3] if values.shape[1] == 4 else None)] if len(values) else []
 

@@ -99,7 +99,8 @@ def _check_cell_array(name: str, values: npt.ArrayLike, count: int) -> np.ndarra
     values = values.astype(np.int32 if np.issubdtype(values.dtype, np.integer) else np.float64)
     if values.ndim not in (1, 2) or len(values) != count:
         raise InputDataError(
-            f"cell array '{name}': expected ({count},) or ({count}, c), one value per polyline, got shape {values.shape}"
+            f"cell array '{name}': expected ({count},) or ({count}, c), one value per polyline, "
+            f"got shape {values.shape}"
         )
     return values
 

@@ -49,8 +49,10 @@ from softdesign.types import FloatArray, Points, Pose
 DESIGN_CONVENTION = (
     "Per q and link, one constant-curvature arc starting at the link's start frame {S} = F(q, l_start) = [N B T c], "
     "tangent to T; phi (rad) is measured from N towards B, the arc bends towards phi; chambers at 90, 210, 330 degrees "
-    "from N, d mm from the backbone (seed 003); chamber_strain = l_j(q) / l_j(0) - 1 against the same link's arc at q = 0. "
-    "The arc is the least-squares fit of the backbone samples matched at equal arc-length fractions (trapezoid weights); "
+    "from N, d mm from the backbone (seed 003); chamber_strain = l_j(q) / l_j(0) - 1 "
+    "against the same link's arc at q = 0. "
+    "The arc is the least-squares fit of the backbone samples matched at equal arc-length fractions "
+    "(trapezoid weights); "
     "backbone_max_mm and backbone_rms_mm are distances between matched points; tip_error_mm is the distance between "
     "the arc's tip and c(q, l_end); tangent_error_rad is the angle between the arc's end tangent and T(q, l_end); "
     "rotation_error_rad is the rotation angle between the arc's end frame (no twist) and F(q, l_end), both in {S}; "
@@ -102,7 +104,10 @@ def _checked_backbone(points: npt.ArrayLike, fractions: npt.ArrayLike) -> tuple[
             f"pcc fit: expected points (n, 3) and fractions (n,) with n >= {MIN_SAMPLES}; "
             f"got shapes {points.shape} and {fractions.shape}"
         )
-    if not (np.all(np.isfinite(points)) and fractions[0] == 0.0 and fractions[-1] == 1.0 and np.all(np.diff(fractions) > 0)):
+    if not (
+        np.all(np.isfinite(points))
+        and fractions[0] == 0.0 and fractions[-1] == 1.0 and np.all(np.diff(fractions) > 0)
+    ):
         raise ConfigError("pcc fit: fractions must rise strictly from 0 to 1 and points must be finite")
     return points, fractions
 
@@ -178,7 +183,9 @@ def fit_link(poses: npt.ArrayLike, arc_length: npt.ArrayLike) -> ArcFit:
     """
     poses, arc_length = np.asarray(poses, float), np.asarray(arc_length, float)
     if poses.ndim != 3 or poses.shape[1:] != (4, 4) or arc_length.shape != (len(poses),):
-        raise ConfigError(f"pcc fit: expected poses (n, 4, 4) and arc lengths (n,); got {poses.shape}, {arc_length.shape}")
+        raise ConfigError(
+            f"pcc fit: expected poses (n, 4, 4) and arc lengths (n,); got {poses.shape}, {arc_length.shape}"
+        )
     in_start = inverse_pose(poses[0]) @ poses
     points, end2start = in_start[:, :3, 3], in_start[-1]
     total = float(arc_length[-1] - arc_length[0])

@@ -20,7 +20,9 @@ Q = [0.0, 0.5, 1.0]
 def aorta_case(folder, aorta_dir, surface: str, **export) -> tuple:
     case = {
         "name": "aorta",
-        "final": {"centerline": str(aorta_dir / "aorta-centerline.vtp"), "surface": str(aorta_dir / surface), "path": 0},
+        "final": {
+            "centerline": str(aorta_dir / "aorta-centerline.vtp"), "surface": str(aorta_dir / surface), "path": 0
+        },
         "export": {"q": Q, **export},
     }
     path = folder / f"{surface}.{len(export)}.yaml"

@@ -231,7 +231,10 @@ def test_one_d_per_link_is_used_per_link(arcs_design):
     for j, d in enumerate([1.0, 2.0, 3.0]):
         link = per_link["poses"][1]["links"][j]
         np.testing.assert_allclose(
-            link["chamber_lengths"], pcc.lengths_from_arcs(link["kappa"], link["phi"], link["length"], d), rtol=0, atol=JSON_TOL
+            link["chamber_lengths"],
+            pcc.lengths_from_arcs(link["kappa"], link["phi"], link["length"], d),
+            rtol=0,
+            atol=JSON_TOL,
         )
 
 
@@ -257,7 +260,10 @@ def test_demo_case_reports_finite_figures(tmp_path):
     payload = json.loads(result.stdout)
     assert list(payload) == ["d", "poses", "convention"]
     assert [pose["q"] for pose in payload["poses"]] == [0.0, 0.5, 1.0]
-    keys = ["index", "l_start", "l_end", "kappa", "phi", "length", "theta", "chamber_lengths", "chamber_strain", *ERROR_KEYS]
+    keys = [
+        "index", "l_start", "l_end", "kappa", "phi", "length", "theta", "chamber_lengths", "chamber_strain",
+        *ERROR_KEYS,
+    ]
     for pose in payload["poses"]:
         assert list(pose) == ["q", "links", "worst"] and len(pose["links"]) == 4
         for link in pose["links"]:

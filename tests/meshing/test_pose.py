@@ -221,7 +221,8 @@ def demo(tmp_path_factory):
 
 
 def _run_pose(demo, q: str, output: Path, *extra: str):
-    return runner.invoke(app, ["pose", str(DEMO), "--q", q, "--output", str(output), "--out", str(demo.build_dir), *extra])
+    args = ["pose", str(DEMO), "--q", q, "--output", str(output), "--out", str(demo.build_dir), *extra]
+    return runner.invoke(app, args)
 
 
 @pytest.mark.slow
@@ -347,7 +348,9 @@ def test_hollow_pose_with_equal_q_is_the_builds_hollow_mesh(hollow_case, tmp_pat
 @pytest.mark.slow
 def test_hollow_pose_with_mixed_q_is_one_ported_body_with_its_walls_reported(hollow_case, tmp_path):
     out = tmp_path / "build"
-    args = ["pose", str(hollow_case), "--q", "0,1,0,1", "--output", str(tmp_path / "p.ply"), "--out", str(out), "--json"]
+    args = [
+        "pose", str(hollow_case), "--q", "0,1,0,1", "--output", str(tmp_path / "p.ply"), "--out", str(out), "--json"
+    ]
     result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
     import json

@@ -56,7 +56,9 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     network = NetworkContext(path.points, tuple(p.points for p in ingest.others), *inscribed)
     fit = case.fit
     auto = fit.knot_spacing_mm == "auto"
-    settings = FitSettings(1.0 if auto else fit.knot_spacing_mm, fit.angular_intervals, fit.smoothing, tuple(chain.breaks))
+    settings = FitSettings(
+        1.0 if auto else fit.knot_spacing_mm, fit.angular_intervals, fit.smoothing, tuple(chain.breaks)
+    )
     options = WallFitOptions(
         fit=settings,
         auto_spacing=auto,
