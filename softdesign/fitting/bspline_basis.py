@@ -49,7 +49,7 @@ def open_knots(breaks: npt.ArrayLike, intervals: npt.ArrayLike) -> FloatArray:
 def periodic_knots(intervals: int) -> FloatArray:
     """Uniform knots ``(j - DEGREE) 2 pi / M``, j = 0 .. M + 2 DEGREE, for a periodic basis (rad)."""
     step = 2.0 * np.pi / intervals
-    return (np.arange(intervals + 2 * DEGREE + 1) - DEGREE) * step
+    return (np.arange(intervals + 2 * DEGREE + 1, dtype=np.float64) - DEGREE) * step  # small integers: exact
 
 
 def open_spans(knots: FloatArray, x: FloatArray) -> IntArray:

@@ -155,7 +155,7 @@ def grid_from_local(
     """
     rows_l, values_l = along
     order = np.argsort(around[0], axis=1, kind="stable")
-    rows_a, values_a = (np.take_along_axis(v, order, axis=1) for v in around)
+    rows_a, values_a = np.take_along_axis(around[0], order, axis=1), np.take_along_axis(around[1], order, axis=1)
     lead = coefficients.shape[:-2]
     inner = np.zeros(lead + (coefficients.shape[-2], rows_a.shape[0]))  # (..., n, m): sum over the periodic basis
     for s in range(rows_a.shape[1]):

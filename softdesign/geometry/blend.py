@@ -121,7 +121,7 @@ class BlendedShape:
         q = float(q)
         if q not in self._smooth:
             a, w = self._segment(q)
-            if self.mode == "linear":
+            if self._intrinsic is None:  # mode "linear": blend_shapes prepares the data of "intrinsic" only
                 self._smooth[q] = _linear(self.keys[a], self.keys[a + 1], w)
             else:
                 self._smooth[q] = _integrate_intrinsic(self.keys[0], self._intrinsic, a, w)

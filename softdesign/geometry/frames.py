@@ -61,7 +61,7 @@ def frame_from_tangent(tangent: npt.ArrayLike, reference_normal: npt.ArrayLike) 
     t = _unit(np.asarray(tangent, float).reshape(3))
     n_ref = np.asarray(reference_normal, float).reshape(3)
     n = n_ref - (n_ref @ t) * t
-    if np.linalg.norm(n) < PARALLEL_TOL * max(np.linalg.norm(n_ref), 1e-300):
+    if np.linalg.norm(n) < PARALLEL_TOL * max(float(np.linalg.norm(n_ref)), 1e-300):
         raise GeometryError(
             f"base frame: the reference normal {n_ref.round(6).tolist()} is parallel to the base tangent "
             f"{t.round(6).tolist()}; give a reference normal at an angle to the tangent"

@@ -136,7 +136,8 @@ def stitch_joint(
     merged = np.abs(step) <= tol
     sign = np.where(merged, 0.0, np.sign(step))
     outer = np.where(merged, na + np.arange(na), np.arange(na))  # link j's ring, merged ids folded onto j+1's
-    crossings, intervals, triangles = [], [], []
+    crossings: list[FloatArray] = []
+    intervals, triangles = [], []
     for k in range(na):
         k1 = (k + 1) % na
         a0, a1, b0, b1 = outer[k], outer[k1], na + k, na + k1
