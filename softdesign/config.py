@@ -13,6 +13,7 @@ from __future__ import annotations
 import difflib
 import os
 import re
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Literal
 
@@ -149,7 +150,8 @@ class Export(_Section):
     offset_mm: float = 0.0
     wall_mm: float | None = Field(None, gt=0.0)
     port_mm: float | None = Field(None, gt=0.0)
-    formats: list[Literal[MESH_FORMATS]] = ["stl"]
+    # the names come from io.formats' registry (one list); mypy cannot read a Literal built from a tuple at run time
+    formats: list[Literal[MESH_FORMATS]] = ["stl"]  # type: ignore[valid-type]
     spacing_mm: float = Field(0.5, gt=0.0)
     angular_count: int = Field(64, ge=MIN_ANGULAR_COUNT)
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...
@@ -218,16 +220,18 @@ class Case(_Section):
         them; a section that failed its own checks is absent from ``info.data`` and not judged.
         """
         initial, resample = info.data.get("initial"), info.data.get("resample")
-        straight_start = isinstance(initial, InitialShape) and initial.kind == "straight"
-        straight_ends = isinstance(resample, Resample) and resample.end_straight_mm > 0.0
-        if frames != "frenet" or not (straight_start or straight_ends):
+        if not (isinstance(initial, InitialShape) and initial.kind == "straight"):
+            initial = None  # judged only when it is a straight initial shape
+        if not (isinstance(resample, Resample) and resample.end_straight_mm > 0.0):
+            resample = None  # judged only when it asks for straight ends
+        if frames != "frenet" or (initial is None and resample is None):
             return frames
         problems, fixes = [], []
-        if straight_start:
+        if initial is not None:
             default = "" if "kind" in initial.model_fields_set else " (the default)"
             problems.append(f"initial.kind: straight{default} makes the q = 0 shape a straight line")
             fixes.append("initial.kind: arc (with initial.bend_radius_mm)")
-        if straight_ends:
+        if resample is not None:
             default = "" if "end_straight_mm" in resample.model_fields_set else " (the default)"
             problems.append(
                 f"resample.end_straight_mm: {resample.end_straight_mm:g}{default} makes the last "
@@ -369,7 +373,7 @@ _RANGE_REASONS = {
 }
 
 
-def _describe(loc: tuple[Any, ...], item: dict[str, Any]) -> str:
+def _describe(loc: tuple[Any, ...], item: Mapping[str, Any]) -> str:
     field = ".".join(str(p) for p in loc) or "(top level)"
     kind = item["type"]
     if kind == "extra_forbidden":

@@ -9,7 +9,7 @@ renamed, so a reader never sees half a file.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -23,8 +23,8 @@ from softdesign.io.vtk_polydata import polydata_writer
 def write_polylines_vtp(
     path: str | Path,
     polylines: Sequence[npt.ArrayLike],
-    point_arrays: dict[str, Sequence[npt.ArrayLike]] | None = None,
-    cell_arrays: dict[str, npt.ArrayLike] | None = None,
+    point_arrays: Mapping[str, Sequence[npt.ArrayLike]] | None = None,
+    cell_arrays: Mapping[str, npt.ArrayLike] | None = None,
 ) -> Path:
     """Write polylines and their data to a .vtp file, atomically.
 

@@ -31,6 +31,7 @@ Chambers
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -66,6 +67,15 @@ STRAIGHT_THETA_RAD = 1e-9
 SOLVER_TOL = 1e-12
 #: Fewest backbone samples per link: three parameters need at least two points besides the base.
 MIN_SAMPLES = 3
+
+
+class BestArc(NamedTuple):
+    """One section's arc as scalars (:class:`pcc.ArcParameters` holds arrays of them)."""
+
+    kappa: float  #: curvature, 1/mm, >= 0
+    phi: float  #: bending-plane angle, rad, in (-pi, pi]; 0 when straight
+    length: float  #: arc length L, mm
+    theta: float  #: bending angle kappa L, rad
 
 
 class ArcFit(NamedTuple):
@@ -112,7 +122,7 @@ def _checked_backbone(points: npt.ArrayLike, fractions: npt.ArrayLike) -> tuple[
     return points, fractions
 
 
-def fit_arc(points: npt.ArrayLike, fractions: npt.ArrayLike, length_scale: float) -> pcc.ArcParameters:
+def fit_arc(points: npt.ArrayLike, fractions: npt.ArrayLike, length_scale: float) -> BestArc:
     """Least-squares arc from the origin, tangent to z, through backbone points matched by fraction.
 
     Parameters
@@ -126,7 +136,7 @@ def fit_arc(points: npt.ArrayLike, fractions: npt.ArrayLike, length_scale: float
 
     Returns
     -------
-    pcc.ArcParameters
+    BestArc
         Scalars ``kappa`` (1/mm, >= 0), ``phi`` (rad), ``length`` (mm), ``theta`` (rad).
 
     Raises
@@ -158,9 +168,9 @@ def fit_arc(points: npt.ArrayLike, fractions: npt.ArrayLike, length_scale: float
         )
     theta_s, length = float(np.hypot(found.x[0], found.x[1])), float(found.x[2] * scale)
     if theta_s * found.x[2] < STRAIGHT_THETA_RAD:
-        return pcc.ArcParameters(0.0, 0.0, length, 0.0)
+        return BestArc(0.0, 0.0, length, 0.0)
     kappa = theta_s / scale
-    return pcc.ArcParameters(kappa, float(np.arctan2(found.x[1], found.x[0])), length, kappa * length)
+    return BestArc(kappa, float(np.arctan2(found.x[1], found.x[0])), length, kappa * length)
 
 
 def _angle_between(a: FloatArray, b: FloatArray) -> float:
@@ -264,7 +274,9 @@ class PccDesign:
     notes: tuple[str, ...]  #: chambers that would need a length <= 0 (kappa d >= 1), at q = 0 or a requested q
 
 
-def design_sections(chain: LinkChain, q_values: npt.ArrayLike, d: npt.ArrayLike, samples: int = 201) -> PccDesign:
+def design_sections(
+    chain: LinkChain, q_values: Sequence[float] | FloatArray, d: npt.ArrayLike, samples: int = 201
+) -> PccDesign:
     """One PCC section per link at every q: best arcs, chamber lengths and strain against q = 0.
 
     Parameters
