@@ -11,8 +11,9 @@ from __future__ import annotations
 import csv
 import io
 import math
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Annotated, NamedTuple
+from typing import Annotated, Any, NamedTuple
 
 import numpy as np
 import typer
@@ -181,17 +182,20 @@ def read_readings(path: Path, max_rate: float | None = None) -> Readings:
     if not rows:
         raise InputDataError(f"{path}: the file is empty; expected a header row and one row per reading")
     sections = _header_sections(path, rows[0][1])
-    times, accepted, lines, rejected = [], [], [], []
+    times: list[float] = []
+    accepted: list[np.ndarray] = []
+    lines: list[int] = []
+    rejected: list[tuple[int, str, str]] = []
     for line, values in rows[1:]:
         if len(values) != 3 * sections + 1:
             raise InputDataError(
                 f"{path} line {line}: {len(values)} column(s), expected {3 * sections + 1} as in the header "
                 f"(time + 3 lengths for each of {sections} section(s)); fix or remove the row"
             )
-        time, lengths, reasons = _parse_row(values, sections)
-        if not reasons and accepted:
+        time, lengths, reasons = _parse_row(values, sections)  # time and lengths are None only with reasons
+        if time is not None and lengths is not None and accepted:
             reasons = _rate_reasons(time, lengths, (lines[-1], times[-1], accepted[-1]), max_rate)
-        if reasons:
+        if reasons or time is None or lengths is None:
             rejected.append((line, values[0].strip(), "; ".join(reasons)))
             continue
         times.append(time)
@@ -210,7 +214,7 @@ def _write_text_atomically(path: Path, text: str) -> Path:
     return write_bytes_atomically(path, text.encode("utf-8"))
 
 
-def _csv_text(header: list[str], rows: list[list]) -> str:
+def _csv_text(header: list[str], rows: Sequence[Sequence[Any]]) -> str:
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(header)

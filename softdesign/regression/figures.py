@@ -11,7 +11,7 @@ import json
 import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeGuard
 
 from softdesign.errors import ConfigError, InputDataError
 from softdesign.meshing.compare import DEFAULT_SAMPLES
@@ -134,7 +134,7 @@ def read_json(path: Path) -> dict:
     return payload
 
 
-def is_number(value: Any) -> bool:
+def is_number(value: Any) -> TypeGuard[int | float]:
     """An int or float, not a bool."""
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 

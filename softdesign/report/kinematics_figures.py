@@ -50,7 +50,8 @@ def q_grid(export_q: list[float], samples: int = Q_SAMPLES) -> FloatArray:
 def kinematics_series(chain: LinkChain, export_q: list[float], samples: int = Q_SAMPLES) -> KinematicsSeries:
     """Evaluate every link's report at each q of :func:`q_grid`."""
     q = q_grid(export_q, samples)
-    rows = {k: [] for k in ("theta1", "theta2", "length", "stretch_min", "stretch_max", "curvature_max")}
+    names = ("theta1", "theta2", "length", "stretch_min", "stretch_max", "curvature_max")
+    rows: dict[str, list[list[float]]] = {k: [] for k in names}
     tip = []
     for value in q:
         reports = chain.reports(float(value))

@@ -73,7 +73,9 @@ def draw_view(ax, curves: list[MorphCurve], view: View, colours: list, arm: floa
             ax.plot(xy[:, 0], xy[:, 1], color=colours[j], alpha=alpha, lw=1.6)
         for k, segments in enumerate(_triad_segments(curve.joints, arm)):
             flat = view.project(segments.reshape(-1, 3)).reshape(-1, 2, 2)
-            ax.add_collection(LineCollection(flat, colors=TRIAD_COLOURS[k], linewidths=0.9, alpha=alpha))
+            # an (n, 2, 2) array is a documented segments argument; the stubs accept only a Sequence
+            segments_2d = LineCollection(flat, colors=TRIAD_COLOURS[k], linewidths=0.9, alpha=alpha)  # type: ignore[arg-type]
+            ax.add_collection(segments_2d)
         end = view.project(curve.links[-1][-1:])[0]
         ax.annotate(f"q={curve.q:g}", end, xytext=(3, 3), textcoords="offset points", fontsize=7, alpha=alpha)
     ax.set_xlabel(view.labels[0])
