@@ -42,7 +42,10 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import cProfile
 
 REPO = Path(__file__).resolve().parents[1]
 DEMO_CASE = REPO / "configs" / "demo.yaml"
@@ -84,13 +87,20 @@ class PeakMemory:
 
     @staticmethod
     def peak_mib() -> float:
-        status = Path("/proc/self/status").read_text()
-        return int(re.search(r"VmHWM:\s+(\d+)\s+kB", status).group(1)) / 1024.0
+        return _status_mib("VmHWM")
 
     @staticmethod
     def current_mib() -> float:
-        status = Path("/proc/self/status").read_text()
-        return int(re.search(r"VmRSS:\s+(\d+)\s+kB", status).group(1)) / 1024.0
+        return _status_mib("VmRSS")
+
+
+def _status_mib(key: str) -> float:
+    """A memory figure of /proc/self/status (Linux), MiB."""
+    status = Path("/proc/self/status").read_text()
+    found = re.search(key + r":\s+(\d+)\s+kB", status)
+    if found is None:
+        raise RuntimeError(f"/proc/self/status has no {key} line; the benchmark needs Linux")
+    return int(found.group(1)) / 1024.0
 
 
 class StageClock:
@@ -106,7 +116,7 @@ class StageClock:
         self.rows: dict[str, dict[str, float]] = {}
         self.overall_peak = 0.0
         self._start: tuple[float, float] = (0.0, 0.0)
-        self._profiler = None
+        self._profiler: cProfile.Profile | None = None
 
     def begin(self, name: str) -> None:
         self.overall_peak = max(self.overall_peak, self.memory.peak_mib())
@@ -120,7 +130,7 @@ class StageClock:
 
     def end(self, name: str) -> None:
         wall, cpu = time.perf_counter() - self._start[0], time.process_time() - self._start[1]
-        if self._profiler is not None:
+        if self._profiler is not None and self.profile_dir is not None:  # a profiler runs only with a folder
             self._profiler.disable()
             self._profiler.dump_stats(str(self.profile_dir / f"{name}.prof"))
             self._profiler = None
@@ -180,6 +190,8 @@ def io_floor(surface: Path, meshes: list[Path], scratch: Path) -> dict[str, floa
     writes = [0.0] * FLOOR_REPEATS
     for k, path in enumerate(meshes):
         loaded = trimesh.load(str(path), force="mesh", process=False)  # untimed: only its size matters
+        if not isinstance(loaded, trimesh.Trimesh):
+            raise RuntimeError(f"{path}: expected one triangle mesh, got {type(loaded).__name__}")
         vertices, faces = np.array(loaded.vertices), np.array(loaded.faces)
         for attempt in range(FLOOR_REPEATS):
             start = time.perf_counter()
@@ -209,6 +221,8 @@ def run_worker(case_file: Path, out_dir: Path, profile_dir: Path | None) -> dict
     total["peak_mib"] = max(clock.overall_peak, memory.peak_mib())
     manifest = json.loads((out_dir / "build" / "manifest.json").read_text())
     meshes = [o for o in manifest["outputs"] if o["path"].startswith("meshes/") and o["path"].endswith(".stl")]
+    if case.final.surface is None:
+        raise RuntimeError(f"{case_file}: the benchmark needs a case with final.surface")
     floor = io_floor(case.final.surface, [out_dir / "build" / o["path"] for o in meshes], out_dir / "floor")
     surface = manifest["metrics"]["ingest"]["surface"]
     return {
@@ -429,7 +443,8 @@ def profile_lines(profile_dir: Path, rows: int = PROFILE_ROWS) -> list[str]:
     """Per stage worth it: the functions with the largest cumulative and own time, as % of the whole build."""
     import pstats
 
-    stats = {n: pstats.Stats(str(profile_dir / f"{n}.prof")).stats for n in STAGE_NAMES}
+    # Stats.stats is the raw table pstats itself reads (typeshed leaves it out)
+    stats = {n: pstats.Stats(str(profile_dir / f"{n}.prof")).stats for n in STAGE_NAMES}  # type: ignore[attr-defined]
     # pstats entries: (file, line, name) -> (primitive calls, calls, own s, cumulative s, callers)
     spent = {n: max(v[3] for v in entries.values()) for n, entries in stats.items()}
     build = sum(spent.values())
