@@ -39,9 +39,13 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Sequence
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import cProfile
 
 REPO = Path(__file__).resolve().parents[1]
 DEMO_CASE = REPO / "configs" / "demo.yaml"
@@ -83,13 +87,20 @@ class PeakMemory:
 
     @staticmethod
     def peak_mib() -> float:
-        status = Path("/proc/self/status").read_text()
-        return int(re.search(r"VmHWM:\s+(\d+)\s+kB", status).group(1)) / 1024.0
+        return _status_mib("VmHWM")
 
     @staticmethod
     def current_mib() -> float:
-        status = Path("/proc/self/status").read_text()
-        return int(re.search(r"VmRSS:\s+(\d+)\s+kB", status).group(1)) / 1024.0
+        return _status_mib("VmRSS")
+
+
+def _status_mib(key: str) -> float:
+    """A memory figure of /proc/self/status (Linux), MiB."""
+    status = Path("/proc/self/status").read_text()
+    found = re.search(key + r":\s+(\d+)\s+kB", status)
+    if found is None:
+        raise RuntimeError(f"/proc/self/status has no {key} line; the benchmark needs Linux")
+    return int(found.group(1)) / 1024.0
 
 
 class StageClock:
@@ -105,7 +116,7 @@ class StageClock:
         self.rows: dict[str, dict[str, float]] = {}
         self.overall_peak = 0.0
         self._start: tuple[float, float] = (0.0, 0.0)
-        self._profiler = None
+        self._profiler: cProfile.Profile | None = None
 
     def begin(self, name: str) -> None:
         self.overall_peak = max(self.overall_peak, self.memory.peak_mib())
@@ -119,7 +130,7 @@ class StageClock:
 
     def end(self, name: str) -> None:
         wall, cpu = time.perf_counter() - self._start[0], time.process_time() - self._start[1]
-        if self._profiler is not None:
+        if self._profiler is not None and self.profile_dir is not None:  # a profiler runs only with a folder
             self._profiler.disable()
             self._profiler.dump_stats(str(self.profile_dir / f"{name}.prof"))
             self._profiler = None
@@ -179,6 +190,8 @@ def io_floor(surface: Path, meshes: list[Path], scratch: Path) -> dict[str, floa
     writes = [0.0] * FLOOR_REPEATS
     for k, path in enumerate(meshes):
         loaded = trimesh.load(str(path), force="mesh", process=False)  # untimed: only its size matters
+        if not isinstance(loaded, trimesh.Trimesh):
+            raise RuntimeError(f"{path}: expected one triangle mesh, got {type(loaded).__name__}")
         vertices, faces = np.array(loaded.vertices), np.array(loaded.faces)
         for attempt in range(FLOOR_REPEATS):
             start = time.perf_counter()
@@ -208,6 +221,8 @@ def run_worker(case_file: Path, out_dir: Path, profile_dir: Path | None) -> dict
     total["peak_mib"] = max(clock.overall_peak, memory.peak_mib())
     manifest = json.loads((out_dir / "build" / "manifest.json").read_text())
     meshes = [o for o in manifest["outputs"] if o["path"].startswith("meshes/") and o["path"].endswith(".stl")]
+    if case.final.surface is None:
+        raise RuntimeError(f"{case_file}: the benchmark needs a case with final.surface")
     floor = io_floor(case.final.surface, [out_dir / "build" / o["path"] for o in meshes], out_dir / "floor")
     surface = manifest["metrics"]["ingest"]["surface"]
     return {
@@ -253,10 +268,10 @@ def aorta_case(folder: Path) -> BenchCase | None:
 
 def write_synthetic_inputs(folder: Path, triangles: int) -> None:
     """The synthetic vessel's centerline.vtp and binary surface.stl with at least ``triangles`` faces."""
-    from softdesign.samples.synthetic_vessel import make_synthetic_vessel
     from softdesign.io.formats import write_mesh
     from softdesign.io.polylines_vtp import write_polylines_vtp
     from softdesign.samples.surfaces import synthetic_surface
+    from softdesign.samples.synthetic_vessel import make_synthetic_vessel
 
     folder.mkdir(parents=True, exist_ok=True)
     vessel = make_synthetic_vessel()
@@ -347,7 +362,7 @@ def linear_fit(x: Sequence[float], y: Sequence[float]) -> tuple[float, float]:
     n = len(x)
     mx, my = sum(x) / n, sum(y) / n
     sxx = sum((xi - mx) ** 2 for xi in x)
-    slope = sum((xi - mx) * (yi - my) for xi, yi in zip(x, y)) / sxx if sxx > 0 else float("nan")
+    slope = sum((xi - mx) * (yi - my) for xi, yi in zip(x, y, strict=True)) / sxx if sxx > 0 else float("nan")
     return slope, my - slope * mx
 
 
@@ -391,7 +406,8 @@ def growth_lines(results: Sequence[dict[str, Any]], key: str, unit: str, scale: 
     y = {c: [sum(seconds(r, s, c) for s in SCALES_WITH[key]) for r in runs] for c in ("wall_s", "cpu_s")}
     exponent = {c: growth_exponent(x, v) for c, v in y.items()}
     lines.append(
-        f"    {name}: time ratio {y['wall_s'][-1] / y['wall_s'][0]:.2f} wall, {y['cpu_s'][-1] / y['cpu_s'][0]:.2f} cpu, "
+        f"    {name}: time ratio {y['wall_s'][-1] / y['wall_s'][0]:.2f} wall, "
+        f"{y['cpu_s'][-1] / y['cpu_s'][0]:.2f} cpu, "
         f"for a size ratio {x[-1] / x[0]:.2f}; time ~ size^{exponent['wall_s']:.2f} wall, "
         f"^{exponent['cpu_s']:.2f} cpu (1 = linear)"
     )
@@ -414,8 +430,10 @@ def target_lines(scaled: dict[str, Any] | None, linear_triangles: bool | None, l
     ratio = scaled["total"]["wall_s"] / floor
     peak = scaled["total"]["peak_mib"]
     return [
-        f"  build / I/O floor     {ratio:7.1f}x   target <= {TARGET_FLOOR_RATIO:g}x      {verdict(ratio <= TARGET_FLOOR_RATIO)}",
-        f"  peak memory           {peak:7.0f} MiB target < {TARGET_PEAK_MIB:.0f} MiB  {verdict(peak < TARGET_PEAK_MIB)}",
+        f"  build / I/O floor     {ratio:7.1f}x   target <= {TARGET_FLOOR_RATIO:g}x      "
+        f"{verdict(ratio <= TARGET_FLOOR_RATIO)}",
+        f"  peak memory           {peak:7.0f} MiB target < {TARGET_PEAK_MIB:.0f} MiB  "
+        f"{verdict(peak < TARGET_PEAK_MIB)}",
         f"  linear in triangles   cpu time ~ size^e, e <= {LINEAR_EXPONENT_MAX:g}    {verdict(linear_triangles)}",
         f"  linear in frames      cpu time ~ size^e, e <= {LINEAR_EXPONENT_MAX:g}    {verdict(linear_frames)}",
     ]
@@ -425,7 +443,8 @@ def profile_lines(profile_dir: Path, rows: int = PROFILE_ROWS) -> list[str]:
     """Per stage worth it: the functions with the largest cumulative and own time, as % of the whole build."""
     import pstats
 
-    stats = {n: pstats.Stats(str(profile_dir / f"{n}.prof")).stats for n in STAGE_NAMES}
+    # Stats.stats is the raw table pstats itself reads (typeshed leaves it out)
+    stats = {n: pstats.Stats(str(profile_dir / f"{n}.prof")).stats for n in STAGE_NAMES}  # type: ignore[attr-defined]
     # pstats entries: (file, line, name) -> (primitive calls, calls, own s, cumulative s, callers)
     spent = {n: max(v[3] for v in entries.values()) for n, entries in stats.items()}
     build = sum(spent.values())
@@ -513,11 +532,15 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
     targets = target_lines(scaled, linear_t, linear_f)
     emit([f"targets, scaled case ({scaled['label']}):"] + targets)
     if any(line.endswith("MISSED") for line in targets) and not args.profile:
-        emit(["  hot spots per stage: python pipelines/bench.py --profile (adds one profiled build of the scaled case)"])
+        emit(["  hot spots per stage: python pipelines/bench.py --profile "
+              "(adds one profiled build of the scaled case)"])
     if args.profile:
         profile_dir = scratch / "profile"
         measure(next(c for c in plan if (c.triangles, c.frames) == (top_t, top_f)), scratch, profile_dir)
-        emit(["", "hot spots of the scaled case (cProfile per stage; times inflated by the profiler):"] + profile_lines(profile_dir))
+        emit(
+            ["", "hot spots of the scaled case (cProfile per stage; times inflated by the profiler):"]
+            + profile_lines(profile_dir)
+        )
     emit(["", f"benchmark took {time.perf_counter() - started:.0f} s"])
 
 

@@ -16,8 +16,9 @@ import os
 import sys
 from pathlib import Path
 
-from softdesign.errors import SoftdesignError
 from softdesign import cohort
+from softdesign.errors import SoftdesignError
+
 
 def deps(args: argparse.Namespace) -> int:
     text = cohort.deps_text(Path(args.case), args.target, Path.cwd())

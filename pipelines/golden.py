@@ -32,10 +32,10 @@ from pathlib import Path
 
 import numpy as np
 
+from softdesign.cohort import STATUS_SUFFIX, cohort_cases, read_record
 from softdesign.io.formats import read_mesh, write_mesh
 from softdesign.meshing.compare import MeshDifference, compare_meshes
 from softdesign.meshing.topology import is_winding_consistent
-from softdesign.cohort import STATUS_SUFFIX, cohort_cases, read_record
 from softdesign.pipeline.layout import MANIFEST
 from softdesign.pipeline.store import sha256_file
 from softdesign.regression import GOLDEN, KINEMATICS, decimation_entry, mesh_names
@@ -45,7 +45,10 @@ from softdesign.versions import software_versions
 MAX_REDUCTION, BISECTIONS = 0.97, 6
 #: Largest distance a stored mesh may be from the full one, mm (check widens its tolerance by the actual error).
 MAX_ERROR_MM = 0.05
-DECIMATION = "vtkQuadricDecimation (volume preservation on), the strongest reduction <= {} keeping the mesh watertight within {} mm"
+DECIMATION = (
+    "vtkQuadricDecimation (volume preservation on), the strongest reduction <= {} "
+    "keeping the mesh watertight within {} mm"
+)
 
 
 def decimate(vertices: np.ndarray, faces: np.ndarray, reduction: float) -> tuple[np.ndarray, np.ndarray]:

@@ -24,9 +24,10 @@ import json
 import os
 import subprocess
 import time
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any, Optional, Sequence
+from typing import Any
 
 from softdesign.errors import ConfigError
 from softdesign.pipeline.layout import EXPORT_SUMMARY, FIT_SUMMARY, KINEMATICS, MANIFEST, MESHES_DIR
@@ -75,7 +76,7 @@ class RunRecord:
 
     case: str
     status: str
-    exit_code: Optional[int]
+    exit_code: int | None
     seconds: float
     message: str
     log: str
@@ -183,7 +184,7 @@ def write_record(record: RunRecord, path: Path) -> None:
     _write_atomically(Path(path), json.dumps(record.as_dict(), indent=2) + "\n")
 
 
-def read_record(path: Path) -> Optional[RunRecord]:
+def read_record(path: Path) -> RunRecord | None:
     """The run record at ``path``; None when there is none or it is unreadable."""
     try:
         return RunRecord(**json.loads(Path(path).read_text(encoding="utf-8")))
@@ -201,7 +202,7 @@ def summary_rows(cohort_dir: Path, build_root: Path) -> list[dict[str, Any]]:
     return rows
 
 
-def case_row(name: str, build_dir: Path, record: Optional[RunRecord]) -> dict[str, Any]:
+def case_row(name: str, build_dir: Path, record: RunRecord | None) -> dict[str, Any]:
     """The summary row of one case: its run record, and the manifest's figures when it built."""
     row: dict[str, Any] = {column: "" for column in SUMMARY_COLUMNS}
     row["case"] = name

@@ -11,13 +11,13 @@ softdesign is millimetres, the conversion happens at ingest.
 from __future__ import annotations
 
 import difflib
+import os
 import re
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Literal
 
 import yaml
-import os
-
 from pydantic import (
     BaseModel,
     ConfigDict,
@@ -73,7 +73,7 @@ class InitialShape(_Section):
     align_base: bool = True
 
     @model_validator(mode="after")
-    def _kind_needs(self) -> "InitialShape":
+    def _kind_needs(self) -> InitialShape:
         if self.kind == "arc" and self.bend_radius_mm is None:
             raise ValueError("kind: arc needs bend_radius_mm (the arc's radius of curvature, mm)")
         if self.kind == "file" and self.centerline is None:
@@ -100,7 +100,7 @@ class Links(_Section):
     length_mm: float | None = Field(None, gt=0.0)
 
     @model_validator(mode="after")
-    def _one_rule(self) -> "Links":
+    def _one_rule(self) -> Links:
         given = [k for k in ("count", "breaks", "length_mm") if getattr(self, k) is not None]
         if len(given) > 1:
             raise ValueError(f"give one of count, breaks, length_mm; got {', '.join(given)}")
@@ -114,7 +114,7 @@ class Links(_Section):
 def _check_breaks(breaks: list[float]) -> None:
     if len(breaks) < 2 or breaks[0] != 0.0 or breaks[-1] != 1.0:
         raise ValueError(f"breaks must start at 0 and end at 1 (normalized l), got {breaks}")
-    if any(nxt <= prev for prev, nxt in zip(breaks, breaks[1:])):
+    if any(nxt <= prev for prev, nxt in zip(breaks[:-1], breaks[1:], strict=True)):
         raise ValueError(f"breaks must be strictly increasing, got {breaks}")
 
 
@@ -150,7 +150,8 @@ class Export(_Section):
     offset_mm: float = 0.0
     wall_mm: float | None = Field(None, gt=0.0)
     port_mm: float | None = Field(None, gt=0.0)
-    formats: list[Literal[MESH_FORMATS]] = ["stl"]
+    # the names come from io.formats' registry (one list); mypy cannot read a Literal built from a tuple at run time
+    formats: list[Literal[MESH_FORMATS]] = ["stl"]  # type: ignore[valid-type]
     spacing_mm: float = Field(0.5, gt=0.0)
     angular_count: int = Field(64, ge=MIN_ANGULAR_COUNT)
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...
@@ -172,7 +173,7 @@ class Export(_Section):
         return values
 
     @model_validator(mode="after")
-    def _q_values(self) -> "Export":
+    def _q_values(self) -> Export:
         if self.q is not None and self.frames is not None:
             raise ValueError("give q (a list) or frames (a count), not both")
         if self.port_mm is not None and self.wall_mm is None:
@@ -219,16 +220,18 @@ class Case(_Section):
         them; a section that failed its own checks is absent from ``info.data`` and not judged.
         """
         initial, resample = info.data.get("initial"), info.data.get("resample")
-        straight_start = isinstance(initial, InitialShape) and initial.kind == "straight"
-        straight_ends = isinstance(resample, Resample) and resample.end_straight_mm > 0.0
-        if frames != "frenet" or not (straight_start or straight_ends):
+        if not (isinstance(initial, InitialShape) and initial.kind == "straight"):
+            initial = None  # judged only when it is a straight initial shape
+        if not (isinstance(resample, Resample) and resample.end_straight_mm > 0.0):
+            resample = None  # judged only when it asks for straight ends
+        if frames != "frenet" or (initial is None and resample is None):
             return frames
         problems, fixes = [], []
-        if straight_start:
+        if initial is not None:
             default = "" if "kind" in initial.model_fields_set else " (the default)"
             problems.append(f"initial.kind: straight{default} makes the q = 0 shape a straight line")
             fixes.append("initial.kind: arc (with initial.bend_radius_mm)")
-        if straight_ends:
+        if resample is not None:
             default = "" if "end_straight_mm" in resample.model_fields_set else " (the default)"
             problems.append(
                 f"resample.end_straight_mm: {resample.end_straight_mm:g}{default} makes the last "
@@ -317,7 +320,9 @@ def _resolve_paths(case: Case, base: Path) -> Case:
     def full(p: Path | None) -> Path | None:
         return None if p is None else (p if p.is_absolute() else base / p)
 
-    final = case.final.model_copy(update={"centerline": full(case.final.centerline), "surface": full(case.final.surface)})
+    final = case.final.model_copy(
+        update={"centerline": full(case.final.centerline), "surface": full(case.final.surface)}
+    )
     initial = case.initial.model_copy(
         update={"centerline": full(case.initial.centerline), "surface": full(case.initial.surface)}
     )
@@ -368,7 +373,7 @@ _RANGE_REASONS = {
 }
 
 
-def _describe(loc: tuple[Any, ...], item: dict[str, Any]) -> str:
+def _describe(loc: tuple[Any, ...], item: Mapping[str, Any]) -> str:
     field = ".".join(str(p) for p in loc) or "(top level)"
     kind = item["type"]
     if kind == "extra_forbidden":

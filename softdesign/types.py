@@ -51,7 +51,10 @@ class FramedCurve(Protocol):
         Arc length of the curve, mm.
     """
 
-    length: float
+    @property
+    def length(self) -> float:
+        """Arc length of the curve, mm (read-only)."""
+        ...
 
     def points(self, l: npt.ArrayLike) -> Points:
         """Positions ``c(l)``, (n, 3) mm, for ``l`` (n,) in [0, 1]."""

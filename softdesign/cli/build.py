@@ -10,7 +10,16 @@ from typing import Annotated, Any
 
 import typer
 
-from softdesign.cli.common import CaseArg, ForceOpt, JsonOpt, OutOpt, StageProgress, emit_json, q_values_from_text, run_guarded
+from softdesign.cli.common import (
+    CaseArg,
+    ForceOpt,
+    JsonOpt,
+    OutOpt,
+    StageProgress,
+    emit_json,
+    q_values_from_text,
+    run_guarded,
+)
 
 ReportOpt = Annotated[bool, typer.Option("--report", help="Then write BUILD/report/index.html (softdesign report).")]
 KinematicsQOpt = Annotated[

@@ -75,7 +75,8 @@ def table_lines(figures: tuple[Figure, ...]) -> list[str]:
         for f in figures
     ]
     widths = [max(len(row[i]) for row in rows) for i in range(len(HEADER) - 1)]
-    return [("  ".join(cell.ljust(w) for cell, w in zip(row, widths)) + "  " + row[-1]).rstrip() for row in rows]
+    padded = ["  ".join(cell.ljust(w) for cell, w in zip(row[:-1], widths, strict=True)) for row in rows]
+    return [(cells + "  " + row[-1]).rstrip() for cells, row in zip(padded, rows, strict=True)]
 
 
 def summary_lines(report: CheckReport) -> list[str]:

@@ -11,17 +11,18 @@ from __future__ import annotations
 import csv
 import io
 import math
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Annotated, NamedTuple
+from typing import Annotated, Any, NamedTuple
 
 import numpy as np
 import typer
 
 from softdesign.cli.common import JsonOpt, emit_json, note, run_guarded
-from softdesign.errors import ConfigError, InputDataError
-from softdesign.io.atomic import write_bytes_atomically
 from softdesign.cli.pcc_design import design
 from softdesign.cli.pcc_options import DOpt, LengthsOpt, lengths_from_text, spacing_from_text
+from softdesign.errors import ConfigError, InputDataError
+from softdesign.io.atomic import write_bytes_atomically
 
 CONVENTION = (
     "Encoders at 90, 210, 330 degrees from the section's base x axis, d mm from the backbone; "
@@ -57,7 +58,10 @@ def forward_payload(lengths: np.ndarray, d: np.ndarray) -> dict:
 
 
 def _print_forward(payload: dict) -> None:
-    typer.echo(f"{'section':>7}  {'kappa [1/mm]':>13}  {'phi [rad]':>10}  {'phi [deg]':>9}  {'L [mm]':>10}  {'theta [rad]':>11}")
+    typer.echo(
+        f"{'section':>7}  {'kappa [1/mm]':>13}  {'phi [rad]':>10}  {'phi [deg]':>9}  {'L [mm]':>10}  "
+        f"{'theta [rad]':>11}"
+    )
     for i, s in enumerate(payload["sections"], start=1):
         typer.echo(
             f"{i:>7}  {s['kappa']:>13.6e}  {s['phi']:>10.6f}  {math.degrees(s['phi']):>9.3f}  "
@@ -140,7 +144,9 @@ def _parse_row(values: list[str], sections: int) -> tuple[float | None, np.ndarr
     return time, (None if reasons else lengths), reasons
 
 
-def _rate_reasons(time: float, lengths: np.ndarray, previous: tuple[int, float, np.ndarray], max_rate: float | None) -> list[str]:
+def _rate_reasons(
+    time: float, lengths: np.ndarray, previous: tuple[int, float, np.ndarray], max_rate: float | None
+) -> list[str]:
     """Why a row cannot follow the previous accepted row in time (empty when it can)."""
     line, last_time, last_lengths = previous
     dt = time - last_time
@@ -176,17 +182,20 @@ def read_readings(path: Path, max_rate: float | None = None) -> Readings:
     if not rows:
         raise InputDataError(f"{path}: the file is empty; expected a header row and one row per reading")
     sections = _header_sections(path, rows[0][1])
-    times, accepted, lines, rejected = [], [], [], []
+    times: list[float] = []
+    accepted: list[np.ndarray] = []
+    lines: list[int] = []
+    rejected: list[tuple[int, str, str]] = []
     for line, values in rows[1:]:
         if len(values) != 3 * sections + 1:
             raise InputDataError(
                 f"{path} line {line}: {len(values)} column(s), expected {3 * sections + 1} as in the header "
                 f"(time + 3 lengths for each of {sections} section(s)); fix or remove the row"
             )
-        time, lengths, reasons = _parse_row(values, sections)
-        if not reasons and accepted:
+        time, lengths, reasons = _parse_row(values, sections)  # time and lengths are None only with reasons
+        if time is not None and lengths is not None and accepted:
             reasons = _rate_reasons(time, lengths, (lines[-1], times[-1], accepted[-1]), max_rate)
-        if reasons:
+        if reasons or time is None or lengths is None:
             rejected.append((line, values[0].strip(), "; ".join(reasons)))
             continue
         times.append(time)
@@ -205,7 +214,7 @@ def _write_text_atomically(path: Path, text: str) -> Path:
     return write_bytes_atomically(path, text.encode("utf-8"))
 
 
-def _csv_text(header: list[str], rows: list[list]) -> str:
+def _csv_text(header: list[str], rows: Sequence[Sequence[Any]]) -> str:
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(header)
@@ -217,7 +226,9 @@ def _tips_csv(readings: Readings, arcs, tip2base: np.ndarray) -> str:
     sections = readings.lengths.shape[1]
     header = ["time", "tip_x", "tip_y", "tip_z"] + [f"r{i}{j}" for i in range(1, 4) for j in range(1, 4)]
     header += [f"{name}_{s}" for s in range(1, sections + 1) for name in ("kappa", "phi", "length", "theta")]
-    per_section = np.stack([arcs.kappa, arcs.phi, arcs.length, arcs.theta], axis=-1).reshape(len(readings.times), 4 * sections)
+    per_section = np.stack([arcs.kappa, arcs.phi, arcs.length, arcs.theta], axis=-1).reshape(
+        len(readings.times), 4 * sections
+    )
     table = np.column_stack([readings.times, tip2base[:, :3, 3], tip2base[:, :3, :3].reshape(-1, 9), per_section])
     return _csv_text(header, table.tolist())
 
@@ -253,7 +264,9 @@ def reconstruct(
     max_rate: Annotated[
         float | None, typer.Option("--max-rate", help="Reject a row whose length changes faster than this, mm/s.")
     ] = None,
-    points_per_section: Annotated[int, typer.Option("--points-per-section", min=2, help="Backbone samples per arc.")] = 21,
+    points_per_section: Annotated[
+        int, typer.Option("--points-per-section", min=2, help="Backbone samples per arc.")
+    ] = 21,
 ) -> None:
     """Backbone and tip pose for every row of an encoder-readings CSV.
 
@@ -273,7 +286,9 @@ def reconstruct(
         from softdesign.kinematics import pcc
 
         if max_rate is not None and not (math.isfinite(max_rate) and max_rate > 0):
-            raise ConfigError(f"--max-rate must be a finite number > 0 mm/s, got {max_rate:g}; omit it to skip the check")
+            raise ConfigError(
+                f"--max-rate must be a finite number > 0 mm/s, got {max_rate:g}; omit it to skip the check"
+            )
         readings = read_readings(readings_csv, max_rate)
         spacing = spacing_from_text(d, readings.lengths.shape[1], where=str(readings_csv))
         for line, time, reason in readings.rejected:

@@ -13,8 +13,8 @@ from typing import Annotated
 import typer
 
 from softdesign.cli.common import CaseArg, JsonOpt, OutOpt, emit_json, note, run_guarded
-from softdesign.errors import errors_named_for
 from softdesign.cli.pcc_options import spacing_from_text
+from softdesign.errors import errors_named_for
 
 
 def _print_design(document: dict, case_file: Path) -> None:

@@ -52,7 +52,9 @@ def lengths_from_text(text: str) -> np.ndarray:
     for i, part in enumerate(sections, start=1):
         values = part.split(",")
         if len(values) != 3:
-            raise ConfigError(f"--lengths: section {i} has {len(values)} length(s) ('{part.strip()}'), expected 3; {fix}")
+            raise ConfigError(
+                f"--lengths: section {i} has {len(values)} length(s) ('{part.strip()}'), expected 3; {fix}"
+            )
         row = [_number(v, f"--lengths: section {i} cable {j}", fix) for j, v in enumerate(values, start=1)]
         for j, value in enumerate(row, start=1):
             if value <= 0:

@@ -158,7 +158,9 @@ def pose(
         try:
             write_mesh(output, body.vertices, body.faces, body.regions)
         except OSError as err:
-            raise ConfigError(f"--output {output}: cannot write the mesh ({err.strerror}); choose a writable path") from err
+            raise ConfigError(
+                f"--output {output}: cannot write the mesh ({err.strerror}); choose a writable path"
+            ) from err
         payload = pose_payload(body, output)
         if as_json:
             emit_json(payload)

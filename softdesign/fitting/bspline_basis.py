@@ -41,7 +41,7 @@ def open_knots(breaks: npt.ArrayLike, intervals: npt.ArrayLike) -> FloatArray:
     """
     breaks = np.asarray(breaks, float)
     counts = np.asarray(intervals, int)
-    pieces = [np.linspace(b0, b1, c + 1)[:-1] for b0, b1, c in zip(breaks[:-1], breaks[1:], counts)]
+    pieces = [np.linspace(b0, b1, c + 1)[:-1] for b0, b1, c in zip(breaks[:-1], breaks[1:], counts, strict=True)]
     inner = np.concatenate(pieces)[1:]
     return np.concatenate([np.zeros(DEGREE + 1), inner, np.ones(DEGREE + 1)])
 
@@ -49,7 +49,7 @@ def open_knots(breaks: npt.ArrayLike, intervals: npt.ArrayLike) -> FloatArray:
 def periodic_knots(intervals: int) -> FloatArray:
     """Uniform knots ``(j - DEGREE) 2 pi / M``, j = 0 .. M + 2 DEGREE, for a periodic basis (rad)."""
     step = 2.0 * np.pi / intervals
-    return (np.arange(intervals + 2 * DEGREE + 1) - DEGREE) * step
+    return (np.arange(intervals + 2 * DEGREE + 1, dtype=np.float64) - DEGREE) * step  # small integers: exact
 
 
 def open_spans(knots: FloatArray, x: FloatArray) -> IntArray:

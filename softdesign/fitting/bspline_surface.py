@@ -132,7 +132,7 @@ class RadiusSpline:
         return {"knots": self.knots.copy(), "coefficients": self.coefficients.copy()}
 
     @classmethod
-    def from_arrays(cls, knots: npt.ArrayLike, coefficients: npt.ArrayLike) -> "RadiusSpline":
+    def from_arrays(cls, knots: npt.ArrayLike, coefficients: npt.ArrayLike) -> RadiusSpline:
         """The inverse of :meth:`to_arrays`."""
         return cls(np.array(knots, float), np.array(coefficients, float))
 
@@ -155,7 +155,7 @@ def grid_from_local(
     """
     rows_l, values_l = along
     order = np.argsort(around[0], axis=1, kind="stable")
-    rows_a, values_a = (np.take_along_axis(v, order, axis=1) for v in around)
+    rows_a, values_a = np.take_along_axis(around[0], order, axis=1), np.take_along_axis(around[1], order, axis=1)
     lead = coefficients.shape[:-2]
     inner = np.zeros(lead + (coefficients.shape[-2], rows_a.shape[0]))  # (..., n, m): sum over the periodic basis
     for s in range(rows_a.shape[1]):
@@ -238,7 +238,7 @@ def fold_fits(polar: PolarPoints, length_mm: float, settings: FitSettings, label
     parts = [(design[r].T @ design[r], design[r].T @ polar.rho[r]) for r in rows]
     gram, moment = sum(p[0] for p in parts), sum(p[1] for p in parts)
     splines = []
-    for held, (fold_gram, fold_moment) in zip(rows, parts):
+    for held, (fold_gram, fold_moment) in zip(rows, parts, strict=True):
         train = np.ones(len(polar), bool)
         train[held] = False
         scale = float(np.median(polar.rho[train]))
@@ -312,7 +312,7 @@ def split_at_breaks(whole: RadiusSpline, breaks: tuple[float, ...]) -> tuple[Rad
         for _ in range(bb.DEGREE + 1 - int(np.count_nonzero(knots == b))):
             knots, coef = bb.insert_knot(knots, coef, b)
     links = []
-    for b0, b1 in zip(breaks[:-1], breaks[1:]):
+    for b0, b1 in zip(breaks[:-1], breaks[1:], strict=True):
         first = int(np.flatnonzero(knots == b0)[0])
         last = int(np.flatnonzero(knots == b1)[0])
         links.append(RadiusSpline(knots[first : last + bb.DEGREE + 1].copy(), coef[first:last].copy()))
@@ -326,7 +326,7 @@ def joint_jumps(links: tuple[RadiusSpline, ...], length_mm: float) -> tuple[Floa
     count = JUMP_SAMPLES_PER_INTERVAL * links[0].angular_intervals
     angle = np.linspace(0.0, 2.0 * np.pi, count, endpoint=False)
     values, slopes = [], []
-    for left, right in zip(links[:-1], links[1:]):
+    for left, right in zip(links[:-1], links[1:], strict=True):
         joint = np.full(count, left.domain[1])
         values.append(np.max(np.abs(left.evaluate(joint, angle) - right.evaluate(joint, angle))))
         d = left.evaluate(joint, angle, dl=1) - right.evaluate(joint, angle, dl=1)

@@ -22,8 +22,10 @@ fold is measured against the fit on the other k - 1 folds.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Protocol
 
 import numpy as np
+import numpy.typing as npt
 
 from softdesign.errors import ConfigError
 from softdesign.fitting.bspline_surface import FitSettings, RadiusSpline, fold_fits
@@ -129,8 +131,16 @@ def surface_points(curve: FramedCurve, spline: RadiusSpline, l: FloatArray, angl
     return curve.points(l) + rho[:, None] * direction
 
 
+class RadiusSurface(Protocol):
+    """rho(l, a) of a fitted surface: a :class:`RadiusSpline`, or a radius field at one q (the report's)."""
+
+    def evaluate(self, l: npt.ArrayLike, a: npt.ArrayLike, dl: int = 0, da: int = 0) -> FloatArray:
+        """rho (or its derivatives) at the points (l, a), mm."""
+        ...
+
+
 def closest_surface_points(
-    curve: FramedCurve, spline: RadiusSpline, polar: PolarPoints, start: tuple[FloatArray, FloatArray] | None = None
+    curve: FramedCurve, spline: RadiusSurface, polar: PolarPoints, start: tuple[FloatArray, FloatArray] | None = None
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Closest point on the fitted surface to each point, from its projection (or from ``start``).
 
@@ -181,7 +191,7 @@ def frame_twist_table(curve: FramedCurve) -> tuple[FloatArray, FloatArray]:
     return l, np.einsum("ni,ni->n", normal_change, curve.frames(l)[:, :, 1])
 
 
-def _surface_and_tangents(curve: FramedCurve, spline: RadiusSpline, twist, l: FloatArray, a: FloatArray):
+def _surface_and_tangents(curve: FramedCurve, spline: RadiusSurface, twist, l: FloatArray, a: FloatArray):
     """S, dS/dl and dS/da at (l, a), with the frames' l derivative from c', c'' and the twist table."""
     frames = curve.frames(l)
     normal, binormal, tangent = frames[:, :, 0], frames[:, :, 1], frames[:, :, 2]
@@ -236,7 +246,7 @@ def _damped_update(curve, spline, twist, p, current, step):
         surface, du, dv = _surface_and_tangents(curve, spline, twist, l, a)
         d = np.linalg.norm(p[pending] - surface, axis=1)
         better = d <= dist0[pending]
-        for target, value in zip(out, (l, a, surface, du, dv, d)):
+        for target, value in zip(out, (l, a, surface, du, dv, d), strict=True):
             target[pending[better]] = value[better]
         pending = pending[~better]
         if pending.size == 0:

@@ -55,7 +55,7 @@ class PolarPoints:
     def __len__(self) -> int:
         return len(self.l)
 
-    def subset(self, mask: npt.ArrayLike) -> "PolarPoints":
+    def subset(self, mask: npt.ArrayLike) -> PolarPoints:
         """The points selected by a boolean mask or an index array (copies)."""
         mask = np.asarray(mask)
         return PolarPoints(
@@ -109,7 +109,7 @@ def foot_parameters(curve: FramedCurve, points: Points) -> FloatArray:
     """
     count = max(int(np.ceil(curve.length / SEED_SPACING_MM)), 8) + 1
     grid = np.linspace(0.0, 1.0, count)
-    nearest = cKDTree(curve.points(grid)).query(points)[1]
+    nearest = np.asarray(cKDTree(curve.points(grid)).query(points)[1])
     # solved in order along the curve (each evaluation then reads its polynomial pieces in turn)
     order = np.argsort(nearest, kind="stable")
     l = np.empty(len(points))

@@ -83,7 +83,7 @@ class RadiusField:
                 f"radius field: expected {len(self.breaks) - 1} links for breaks {list(self.breaks)}, "
                 f"got {len(self.final)} final and {len(self.initial)} initial splines"
             )
-        for j, (f, i) in enumerate(zip(self.final, self.initial)):
+        for j, (f, i) in enumerate(zip(self.final, self.initial, strict=True)):
             if f.knots.shape != i.knots.shape or not np.array_equal(f.knots, i.knots) or (
                 f.coefficients.shape != i.coefficients.shape
             ):
@@ -112,7 +112,10 @@ class RadiusField:
 
         The same numbers as ``link_spline(j, q).evaluate_grid`` on each link.
         """
-        blended = [((1.0 - q) * i.coefficients + q * f.coefficients)[None] for f, i in zip(self.final, self.initial)]
+        blended = [
+            ((1.0 - q) * i.coefficients + q * f.coefficients)[None]
+            for f, i in zip(self.final, self.initial, strict=True)
+        ]
         return self._link_grids(blended, l, a, dl, da)[0]  # blended as link_spline blends them
 
     def end_grids(self, l: npt.ArrayLike, a: npt.ArrayLike, dl: int = 0, da: int = 0) -> tuple[FloatArray, FloatArray]:
@@ -132,7 +135,7 @@ class RadiusField:
             object.__setattr__(self, "_grid_cache", cache)  # frozen: the cache is not part of the value
         grids = cache.pop(key, None)  # put back last: the dict runs from least to most recently used
         if grids is None:
-            ends = [np.stack([i.coefficients, f.coefficients]) for f, i in zip(self.final, self.initial)]
+            ends = [np.stack([i.coefficients, f.coefficients]) for f, i in zip(self.final, self.initial, strict=True)]
             grids = self._link_grids(ends, l, a, dl, da)
             grids.setflags(write=False)
         cache[key] = grids
@@ -180,14 +183,14 @@ class RadiusField:
     def to_arrays(self) -> dict[str, FloatArray]:
         """Plain arrays for ``np.savez``: ``breaks`` and ``link{j}_knots|final|initial``."""
         out = {"breaks": np.array(self.breaks, float)}
-        for j, (f, i) in enumerate(zip(self.final, self.initial)):
+        for j, (f, i) in enumerate(zip(self.final, self.initial, strict=True)):
             out[f"link{j}_knots"] = f.knots.copy()
             out[f"link{j}_final"] = f.coefficients.copy()
             out[f"link{j}_initial"] = i.coefficients.copy()
         return out
 
     @classmethod
-    def from_arrays(cls, arrays) -> "RadiusField":
+    def from_arrays(cls, arrays) -> RadiusField:
         """The inverse of :meth:`to_arrays` (accepts the mapping ``np.load`` returns)."""
         breaks = np.array(arrays["breaks"], float)
         count = len(breaks) - 1

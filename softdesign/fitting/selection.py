@@ -224,7 +224,7 @@ def _nearest_segment_distances(
     for lo in range(0, len(points), chunk):
         p = points[lo : lo + chunk]
         mid_distance, index = tree.query(p, k=k, workers=-1)
-        mid_distance, index = mid_distance.reshape(len(p), k), index.reshape(len(p), k)
+        mid_distance, index = np.asarray(mid_distance).reshape(len(p), k), np.asarray(index).reshape(len(p), k)
         near_start, near_edge = start[index], edge[index]
         t = np.clip(np.einsum("nkj,nkj->nk", p[:, None, :] - near_start, near_edge) / edge2[index], 0.0, 1.0)
         nearest = near_start + t[:, :, None] * near_edge

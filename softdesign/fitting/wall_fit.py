@@ -112,7 +112,7 @@ def fit_wall(
     # in order along the path: every later evaluation then reads the splines' pieces in turn
     kept_index = np.flatnonzero(selection.keep)
     kept = polar.subset(kept_index[np.argsort(polar.l[kept_index], kind="stable")])
-    settings, scores = options.fit, {}
+    settings, scores = options.fit, dict[float, float]()
     if options.auto_spacing:
         spacing, scores = choose_knot_spacing(curve, kept, settings, rng, options.holdout)
         settings = replace(settings, knot_spacing_mm=spacing)

@@ -32,8 +32,8 @@ from scipy.optimize import minimize_scalar
 from softdesign.errors import ConfigError, GeometryError
 from softdesign.geometry.curves import SmoothCurve, smooth_curve_from_samples
 from softdesign.geometry.frames import (
-    FrameMode,
     FramedSpline,
+    FrameMode,
     accumulate_rotations,
     base_normal_from_tangent,
     framed_curve,
@@ -121,7 +121,7 @@ class BlendedShape:
         q = float(q)
         if q not in self._smooth:
             a, w = self._segment(q)
-            if self.mode == "linear":
+            if self._intrinsic is None:  # mode "linear": blend_shapes prepares the data of "intrinsic" only
                 self._smooth[q] = _linear(self.keys[a], self.keys[a + 1], w)
             else:
                 self._smooth[q] = _integrate_intrinsic(self.keys[0], self._intrinsic, a, w)
@@ -205,7 +205,7 @@ def blend_shapes(
 
 def _check_common_grid(keys: tuple[SmoothCurve, ...], key_q: FloatArray) -> None:
     ref = keys[-1].spline
-    for q, key in zip(key_q, keys):
+    for q, key in zip(key_q, keys, strict=True):
         if key.spline.k != ref.k or not np.array_equal(key.spline.t, ref.t):
             raise GeometryError(
                 f"blend: the shape at q = {q:g} has {len(key.l_grid)} samples, the final shape "

@@ -201,7 +201,7 @@ def piecewise_polynomial(spline: BSpline) -> PPoly:
     Boor's recursion per point and per derivative order.
     """
     coefficients = np.asarray(spline.c, float)
-    per_axis = [PPoly.from_spline(BSpline(spline.t, column, spline.k)) for column in coefficients.T]
+    per_axis = [PPoly.from_spline(BSpline(spline.t, column, spline.k).tck) for column in coefficients.T]
     return PPoly(np.stack([p.c for p in per_axis], axis=-1), per_axis[0].x)
 
 
@@ -336,7 +336,8 @@ def _chord_spline(points: Points, smoothing_mm: float) -> tuple[BSpline, FloatAr
     if smoothing_mm == 0.0:
         return make_interp_spline(u, points, k=k), u
     s = len(points) * smoothing_mm**2
-    ((t, c, k), _), fp, ier, msg = splprep(points.T, u=u, k=k, s=s, full_output=True, quiet=True)
+    # splprep returns [t, c, k] with the k it was given
+    ((t, c, _), _), fp, ier, msg = splprep(points.T, u=u, k=k, s=s, full_output=True, quiet=True)
     # FITPACK: ier <= 0 success, 1..3 warnings (then check the residual it reached), >= 10 bad input.
     if ier >= 10 or (ier > 0 and fp > SMOOTHING_SLACK * s):
         raise GeometryError(

@@ -61,7 +61,7 @@ def frame_from_tangent(tangent: npt.ArrayLike, reference_normal: npt.ArrayLike) 
     t = _unit(np.asarray(tangent, float).reshape(3))
     n_ref = np.asarray(reference_normal, float).reshape(3)
     n = n_ref - (n_ref @ t) * t
-    if np.linalg.norm(n) < PARALLEL_TOL * max(np.linalg.norm(n_ref), 1e-300):
+    if np.linalg.norm(n) < PARALLEL_TOL * max(float(np.linalg.norm(n_ref)), 1e-300):
         raise GeometryError(
             f"base frame: the reference normal {n_ref.round(6).tolist()} is parallel to the base tangent "
             f"{t.round(6).tolist()}; give a reference normal at an angle to the tangent"
@@ -273,7 +273,7 @@ def poses_from_frames(frames: Frames, points: Points) -> Pose:
 
 def _ranges_text(l: FloatArray, mask: npt.NDArray[np.bool_], shown: int = 3) -> str:
     edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.astype(np.int8), [0]])))
-    runs = [(float(l[a]), float(l[b - 1])) for a, b in zip(edges[::2], edges[1::2])]
+    runs = [(float(l[a]), float(l[b - 1])) for a, b in zip(edges[::2], edges[1::2], strict=True)]
     text = ", ".join(f"[{a:.4f}, {b:.4f}]" for a, b in runs[:shown])
     return text + (f" and {len(runs) - shown} more range(s)" if len(runs) > shown else "")
 

@@ -52,7 +52,7 @@ def surrounds(points: Points, radius: FloatArray | None, vertices: Points) -> bo
     distance = np.median(cKDTree(vertices).query(points)[0])
     if radius is not None and np.all(np.isfinite(radius)) and np.median(radius) > 0:
         ratio = distance / float(np.median(radius))
-        return WALL_RATIO_BAND[0] <= ratio <= WALL_RATIO_BAND[1]
+        return bool(WALL_RATIO_BAND[0] <= ratio <= WALL_RATIO_BAND[1])
     return bool(distance < 0.25 * float(np.min(hi - lo)))
 
 
@@ -102,7 +102,7 @@ def check_vessel_scale(length_mm: float, radius: FloatArray | None, units: str, 
     The message gives the figures and every other unit in which the vessel would be plausible.
     """
     known = radius is not None and len(radius) > 0 and bool(np.all(np.isfinite(radius)))
-    median = float(np.median(radius)) if known else None
+    median = float(np.median(radius)) if radius is not None and known else None
     if plausible_vessel(length_mm, median):
         return
     lo, hi = PLAUSIBLE_RADIUS_MM

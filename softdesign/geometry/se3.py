@@ -38,7 +38,7 @@ def vector_from_skew(m: npt.ArrayLike) -> FloatArray:
     )
 
 
-def _rodrigues_coefficients(theta: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+def _rodrigues_coefficients(theta: FloatArray | np.floating) -> tuple[FloatArray, FloatArray, FloatArray]:
     """sin(t)/t, (1 - cos t)/t^2, (t - sin t)/t^3, with series where t is small."""
     small = theta < 1e-4
     t = np.where(small, 1.0, theta)

@@ -10,8 +10,8 @@ one polyline.
 from __future__ import annotations
 
 import csv
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -78,7 +78,7 @@ def _line_cells(poly) -> list[np.ndarray]:
     conn = poly.GetLines()
     offsets = vtk_to_numpy(conn.GetOffsetsArray()).astype(np.int64)
     ids = vtk_to_numpy(conn.GetConnectivityArray()).astype(np.int64)
-    return [ids[a:b] for a, b in zip(offsets[:-1], offsets[1:]) if b - a >= 1]
+    return [ids[a:b] for a, b in zip(offsets[:-1], offsets[1:], strict=True) if b - a >= 1]
 
 
 def _read_csv(path: Path) -> list[Polyline]:
@@ -115,7 +115,9 @@ def _read_npy(path: Path) -> list[Polyline]:
     except (OSError, ValueError) as err:
         raise InputDataError(f"{path}: cannot read the .npy centerline ({err})") from err
     if values.ndim != 2 or values.shape[1] not in (3, 4):
-        raise InputDataError(f"{path}: expected an (n, 3) or (n, 4) array (x, y, z[, radius]), got shape {values.shape}")
+        raise InputDataError(
+            f"{path}: expected an (n, 3) or (n, 4) array (x, y, z[, radius]), got shape {values.shape}"
+        )
     values = values.astype(float)
     return [Polyline(values[:, :3], values[:, 3] if values.shape[1] == 4 else None)] if len(values) else []
 

@@ -9,8 +9,8 @@ renamed, so a reader never sees half a file.
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -23,8 +23,8 @@ from softdesign.io.vtk_polydata import polydata_writer
 def write_polylines_vtp(
     path: str | Path,
     polylines: Sequence[npt.ArrayLike],
-    point_arrays: dict[str, Sequence[npt.ArrayLike]] | None = None,
-    cell_arrays: dict[str, npt.ArrayLike] | None = None,
+    point_arrays: Mapping[str, Sequence[npt.ArrayLike]] | None = None,
+    cell_arrays: Mapping[str, npt.ArrayLike] | None = None,
 ) -> Path:
     """Write polylines and their data to a .vtp file, atomically.
 
@@ -79,7 +79,7 @@ def _stack_point_array(name: str, arrays: Sequence[npt.ArrayLike], sizes: list[i
             f"point array '{name}': expected one array per polyline ({len(sizes)}), got {len(arrays)}"
         )
     checked = []
-    for index, (values, size) in enumerate(zip(arrays, sizes)):
+    for index, (values, size) in enumerate(zip(arrays, sizes, strict=True)):
         values = np.asarray(values, dtype=np.float64)
         if values.ndim not in (1, 2) or len(values) != size:
             raise InputDataError(
@@ -99,7 +99,8 @@ def _check_cell_array(name: str, values: npt.ArrayLike, count: int) -> np.ndarra
     values = values.astype(np.int32 if np.issubdtype(values.dtype, np.integer) else np.float64)
     if values.ndim not in (1, 2) or len(values) != count:
         raise InputDataError(
-            f"cell array '{name}': expected ({count},) or ({count}, c), one value per polyline, got shape {values.shape}"
+            f"cell array '{name}': expected ({count},) or ({count}, c), one value per polyline, "
+            f"got shape {values.shape}"
         )
     return values
 

@@ -60,7 +60,9 @@ class _ErrorCatcher:
         text = re.sub(r" \(0x[0-9a-fA-F]+\)", "", text.splitlines()[-1] if text else str(event))
         self.messages.append(text)
 
-    catch.CallDataType = "string0"  # vtk passes the error text to the observer
+    # vtk passes the error text to an observer whose function has CallDataType "string0" (what
+    # vtkmodules.util.misc.calldata_type sets); mypy does not model attributes set on functions
+    catch.CallDataType = "string0"  # type: ignore[attr-defined]
 
 
 def polydata_arrays(poly) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:

@@ -68,7 +68,7 @@ def link_breaks(
         out = np.linspace(0.0, 1.0, int(count) + 1)
     elif breaks is not None:
         out = _checked_breaks(breaks)
-    else:
+    elif length_mm is not None:  # exactly one of the three is given (checked above)
         out = _breaks_from_length(float(total_length_mm), float(length_mm))
     if np.min(np.diff(out)) < MIN_LINK_FRACTION:
         raise ConfigError(

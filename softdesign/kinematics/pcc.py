@@ -348,7 +348,9 @@ def sample_backbone(
     return sample_backbone_poses(kappa, phi, length, points_per_section)[..., :3, 3]
 
 
-def backbone_arc_lengths(length: npt.ArrayLike, points_per_section: int = 21) -> tuple[FloatArray, npt.NDArray[np.int64]]:
+def backbone_arc_lengths(
+    length: npt.ArrayLike, points_per_section: int = 21
+) -> tuple[FloatArray, npt.NDArray[np.int64]]:
     """Arc length from the base and section index of every sample of :func:`sample_backbone_poses`.
 
     Parameters

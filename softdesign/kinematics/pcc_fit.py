@@ -31,6 +31,7 @@ Chambers
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -49,8 +50,10 @@ from softdesign.types import FloatArray, Points, Pose
 DESIGN_CONVENTION = (
     "Per q and link, one constant-curvature arc starting at the link's start frame {S} = F(q, l_start) = [N B T c], "
     "tangent to T; phi (rad) is measured from N towards B, the arc bends towards phi; chambers at 90, 210, 330 degrees "
-    "from N, d mm from the backbone (seed 003); chamber_strain = l_j(q) / l_j(0) - 1 against the same link's arc at q = 0. "
-    "The arc is the least-squares fit of the backbone samples matched at equal arc-length fractions (trapezoid weights); "
+    "from N, d mm from the backbone (seed 003); chamber_strain = l_j(q) / l_j(0) - 1 "
+    "against the same link's arc at q = 0. "
+    "The arc is the least-squares fit of the backbone samples matched at equal arc-length fractions "
+    "(trapezoid weights); "
     "backbone_max_mm and backbone_rms_mm are distances between matched points; tip_error_mm is the distance between "
     "the arc's tip and c(q, l_end); tangent_error_rad is the angle between the arc's end tangent and T(q, l_end); "
     "rotation_error_rad is the rotation angle between the arc's end frame (no twist) and F(q, l_end), both in {S}; "
@@ -64,6 +67,15 @@ STRAIGHT_THETA_RAD = 1e-9
 SOLVER_TOL = 1e-12
 #: Fewest backbone samples per link: three parameters need at least two points besides the base.
 MIN_SAMPLES = 3
+
+
+class BestArc(NamedTuple):
+    """One section's arc as scalars (:class:`pcc.ArcParameters` holds arrays of them)."""
+
+    kappa: float  #: curvature, 1/mm, >= 0
+    phi: float  #: bending-plane angle, rad, in (-pi, pi]; 0 when straight
+    length: float  #: arc length L, mm
+    theta: float  #: bending angle kappa L, rad
 
 
 class ArcFit(NamedTuple):
@@ -102,12 +114,15 @@ def _checked_backbone(points: npt.ArrayLike, fractions: npt.ArrayLike) -> tuple[
             f"pcc fit: expected points (n, 3) and fractions (n,) with n >= {MIN_SAMPLES}; "
             f"got shapes {points.shape} and {fractions.shape}"
         )
-    if not (np.all(np.isfinite(points)) and fractions[0] == 0.0 and fractions[-1] == 1.0 and np.all(np.diff(fractions) > 0)):
+    if not (
+        np.all(np.isfinite(points))
+        and fractions[0] == 0.0 and fractions[-1] == 1.0 and np.all(np.diff(fractions) > 0)
+    ):
         raise ConfigError("pcc fit: fractions must rise strictly from 0 to 1 and points must be finite")
     return points, fractions
 
 
-def fit_arc(points: npt.ArrayLike, fractions: npt.ArrayLike, length_scale: float) -> pcc.ArcParameters:
+def fit_arc(points: npt.ArrayLike, fractions: npt.ArrayLike, length_scale: float) -> BestArc:
     """Least-squares arc from the origin, tangent to z, through backbone points matched by fraction.
 
     Parameters
@@ -121,7 +136,7 @@ def fit_arc(points: npt.ArrayLike, fractions: npt.ArrayLike, length_scale: float
 
     Returns
     -------
-    pcc.ArcParameters
+    BestArc
         Scalars ``kappa`` (1/mm, >= 0), ``phi`` (rad), ``length`` (mm), ``theta`` (rad).
 
     Raises
@@ -153,9 +168,9 @@ def fit_arc(points: npt.ArrayLike, fractions: npt.ArrayLike, length_scale: float
         )
     theta_s, length = float(np.hypot(found.x[0], found.x[1])), float(found.x[2] * scale)
     if theta_s * found.x[2] < STRAIGHT_THETA_RAD:
-        return pcc.ArcParameters(0.0, 0.0, length, 0.0)
+        return BestArc(0.0, 0.0, length, 0.0)
     kappa = theta_s / scale
-    return pcc.ArcParameters(kappa, float(np.arctan2(found.x[1], found.x[0])), length, kappa * length)
+    return BestArc(kappa, float(np.arctan2(found.x[1], found.x[0])), length, kappa * length)
 
 
 def _angle_between(a: FloatArray, b: FloatArray) -> float:
@@ -178,7 +193,9 @@ def fit_link(poses: npt.ArrayLike, arc_length: npt.ArrayLike) -> ArcFit:
     """
     poses, arc_length = np.asarray(poses, float), np.asarray(arc_length, float)
     if poses.ndim != 3 or poses.shape[1:] != (4, 4) or arc_length.shape != (len(poses),):
-        raise ConfigError(f"pcc fit: expected poses (n, 4, 4) and arc lengths (n,); got {poses.shape}, {arc_length.shape}")
+        raise ConfigError(
+            f"pcc fit: expected poses (n, 4, 4) and arc lengths (n,); got {poses.shape}, {arc_length.shape}"
+        )
     in_start = inverse_pose(poses[0]) @ poses
     points, end2start = in_start[:, :3, 3], in_start[-1]
     total = float(arc_length[-1] - arc_length[0])
@@ -257,7 +274,9 @@ class PccDesign:
     notes: tuple[str, ...]  #: chambers that would need a length <= 0 (kappa d >= 1), at q = 0 or a requested q
 
 
-def design_sections(chain: LinkChain, q_values: npt.ArrayLike, d: npt.ArrayLike, samples: int = 201) -> PccDesign:
+def design_sections(
+    chain: LinkChain, q_values: Sequence[float] | FloatArray, d: npt.ArrayLike, samples: int = 201
+) -> PccDesign:
     """One PCC section per link at every q: best arcs, chamber lengths and strain against q = 0.
 
     Parameters

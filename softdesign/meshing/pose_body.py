@@ -187,7 +187,7 @@ def pose_body(chain: LinkChain, field: RadiusField, q: float | npt.ArrayLike, sp
     volumes = [_link_volume(curves[qj], field, j, qj, spec) for j, qj in enumerate(q.tolist())]
     start2world = chain.base2world(q)
     links, moves = [], []
-    for j, (qj, transform) in enumerate(zip(q.tolist(), chain.transforms(q))):
+    for j, (qj, transform) in enumerate(zip(q.tolist(), chain.transforms(q), strict=True)):
         moves.append(start2world @ inverse_pose(curves[qj].poses([field.breaks[j]])[0]))
         sweep = placed(sweeps[j], moves[-1])
         length = float(sweep.s[-1] - sweep.s[0])
@@ -202,8 +202,8 @@ def pose_body(chain: LinkChain, field: RadiusField, q: float | npt.ArrayLike, sp
     if spec.wall_mm > 0:
         chamber, chamber_stitches = _chamber(sections, spec, label)
         joints = [replace(step, min_wall_mm=_joint_wall(outer, inner, step, spec))
-                  for outer, inner, step in zip(stitches, chamber_stitches, joints)]
-        chamber = [placed(sweep, move) for sweep, move in zip(chamber, moves)]
+                  for outer, inner, step in zip(stitches, chamber_stitches, joints, strict=True)]
+        chamber = [placed(sweep, move) for sweep, move in zip(chamber, moves, strict=True)]
         cavity = TubeMesh(*assemble(chamber, chamber_stitches))
         body = TubeMesh(vertices, faces, regions)
         solid = carve_chamber(body, cavity, links[0].sweep, chamber[0], spec.body(), label)

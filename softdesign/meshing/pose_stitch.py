@@ -60,7 +60,7 @@ class JointStitch:
         e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
         return 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
 
-    def figures(self, index: int, l: float) -> "JointStep":
+    def figures(self, index: int, l: float) -> JointStep:
         """The joint's figures for reports."""
         step = np.abs(self.end_radius - self.start_radius)
         area = float(np.sum(np.abs(self.signed_areas())))
@@ -136,7 +136,8 @@ def stitch_joint(
     merged = np.abs(step) <= tol
     sign = np.where(merged, 0.0, np.sign(step))
     outer = np.where(merged, na + np.arange(na), np.arange(na))  # link j's ring, merged ids folded onto j+1's
-    crossings, intervals, triangles = [], [], []
+    crossings: list[FloatArray] = []
+    intervals, triangles = [], []
     for k in range(na):
         k1 = (k + 1) % na
         a0, a1, b0, b1 = outer[k], outer[k1], na + k, na + k1
@@ -210,7 +211,7 @@ def assemble(sweeps: list[Sweep], stitches: list[JointStitch]) -> tuple[FloatArr
     meshes = [_link_mesh(sweep, j == 0, j == len(sweeps) - 1) for j, sweep in enumerate(sweeps)]
     offsets = np.cumsum([0] + [m.vertices.shape[0] for m in meshes])
     vertices = [m.vertices for m in meshes]
-    faces = np.concatenate([m.faces + off for m, off in zip(meshes, offsets)])
+    faces = np.concatenate([m.faces + off for m, off in zip(meshes, offsets[:-1], strict=True)])
     regions = np.concatenate([m.regions for m in meshes])
     remap = np.arange(offsets[-1])
     added = offsets[-1]
@@ -221,7 +222,7 @@ def assemble(sweeps: list[Sweep], stitches: list[JointStitch]) -> tuple[FloatArr
         frame, center = sweeps[j + 1].frames[0], sweeps[j + 1].centers[0]
         vertices.append(center + stitch.crossings @ frame[:, :2].T)
         added += len(stitch.crossings)
-        for x, k in zip(crossing_ids, stitch.crossing_interval):
+        for x, k in zip(crossing_ids, stitch.crossing_interval, strict=True):
             k1 = (k + 1) % na
             faces = _split_edge(faces, ring_a[k1], ring_a[k], x)
             faces = _split_edge(faces, ring_b[k], ring_b[k1], x)

@@ -141,7 +141,7 @@ def mesh_topology(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> MeshTopology
     n = vertices.shape[0]
     used = np.flatnonzero(np.bincount(faces.ravel(), minlength=n))
     twin, watertight, consistent, n_edges = _half_edges(faces, n)
-    manifold = consistent and _vertex_manifold(twin, used.size)
+    manifold = consistent and twin is not None and _vertex_manifold(twin, used.size)  # twin: None unless consistent
     corners = np.take(vertices, faces, axis=0)  # (F, 3, 3); take gathers rows faster than vertices[faces]
     centroid = (vertices if used.size == n else vertices[used]).mean(axis=0)
     return MeshTopology(
@@ -320,7 +320,8 @@ def _shell_volumes(faces: IntArray, corners: FloatArray, n_vertices: int, used: 
     shell_of_vertex[used] = relabel
     tet = np.einsum("ij,ij->i", corners[:, 0], _cross(corners[:, 1], corners[:, 2])) / 6.0
     count = int(relabel.max()) + 1 if used.size else 0
-    return np.bincount(shell_of_vertex[faces[:, 0]], weights=tet, minlength=count)
+    # weighted counts are float64 (the stubs type every bincount as int)
+    return np.asarray(np.bincount(shell_of_vertex[faces[:, 0]], weights=tet, minlength=count), np.float64)
 
 
 def _cross(u: FloatArray, v: FloatArray) -> FloatArray:

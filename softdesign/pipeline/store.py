@@ -60,7 +60,8 @@ def sha256_file(path: Path) -> str:
 def npz_bytes(**arrays: np.ndarray) -> bytes:
     """An uncompressed .npz archive as bytes (numpy writes fixed zip timestamps)."""
     buffer = io.BytesIO()
-    np.savez(buffer, **{k: np.asarray(v) for k, v in sorted(arrays.items())})
+    # mypy: a spread dict might name savez's allow_pickle; the names here are the stages' array names
+    np.savez(buffer, **{k: np.asarray(v) for k, v in sorted(arrays.items())})  # type: ignore[arg-type]
     return buffer.getvalue()
 
 

@@ -8,13 +8,13 @@ builds of the same case (:func:`case_warnings`).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable, Optional
 
 from softdesign.errors import ConfigError, InputDataError
+from softdesign.pipeline.layout import MANIFEST
 from softdesign.regression.figures import CheckOptions, CheckReport, Figure, missing_figure, read_json, scalar_figure
 from softdesign.regression.kinematics import compare_kinematics_files
-from softdesign.pipeline.layout import MANIFEST
 from softdesign.regression.meshes import compare_mesh_folders, read_golden
 
 #: Fit metrics compared first, in this order; other ``*_mm`` keys of metrics.fit follow, sorted.
@@ -25,7 +25,7 @@ def check_build(
     build_dir: Path,
     reference_dir: Path,
     options: CheckOptions = CheckOptions(),
-    progress: Optional[Callable[[str], None]] = None,
+    progress: Callable[[str], None] | None = None,
 ) -> CheckReport:
     """Compare a build folder with a reference build folder.
 
@@ -105,7 +105,7 @@ def compare_fit(build_manifest: dict, ref_manifest: dict, tolerance_mm: float, n
     return [scalar_figure("fit", key, ours.get(key), theirs.get(key), tolerance_mm) for key in keys]
 
 
-def _fit_metrics(manifest: dict, where: str) -> Optional[dict]:
+def _fit_metrics(manifest: dict, where: str) -> dict | None:
     metrics = manifest.get("metrics") or {}
     if not isinstance(metrics, dict):
         raise InputDataError(f"{where}: 'metrics' must be an object, got {type(metrics).__name__}")

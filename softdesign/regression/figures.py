@@ -11,12 +11,12 @@ import json
 import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, TypeGuard
 
 from softdesign.errors import ConfigError, InputDataError
 from softdesign.meshing.compare import DEFAULT_SAMPLES
 
-Value = Optional[float | bool | str]
+Value = float | bool | str | None
 
 
 @dataclass(frozen=True)
@@ -57,7 +57,7 @@ class Figure:
     item: str
     figure: str
     change: Value
-    tolerance: Optional[float]
+    tolerance: float | None
     passed: bool
     build: Value = None
     reference: Value = None
@@ -134,7 +134,7 @@ def read_json(path: Path) -> dict:
     return payload
 
 
-def is_number(value: Any) -> bool:
+def is_number(value: Any) -> TypeGuard[int | float]:
     """An int or float, not a bool."""
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 

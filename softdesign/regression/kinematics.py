@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from softdesign.pipeline.layout import KINEMATICS
 from softdesign.errors import InputDataError
+from softdesign.pipeline.layout import KINEMATICS
 from softdesign.regression.figures import CheckOptions, Figure, is_number, missing_figure, read_json, scalar_figure
 
 #: Decimals of q that identify a pose (q values are written as the case file gives them).
@@ -109,7 +109,7 @@ def _keyed(parent: dict, field_name: str, key: str, where: str) -> dict[str, dic
     out: dict[str, dict] = {}
     for i, entry in enumerate(entries):
         value = entry.get(key) if isinstance(entry, dict) else None
-        values = value if isinstance(value, list) and value else [value]
+        values: list[Any] = value if isinstance(value, list) and value else [value]
         if not all(is_number(v) for v in values):
             raise InputDataError(f"{where}: {field_name}[{i}].{key} must be a number or numbers, got {value!r}")
         # One q per link, all equal, is the same pose as that single q: name it once.

@@ -8,14 +8,14 @@ tolerances by it (see :mod:`softdesign.regression`).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Optional
 
-from softdesign.pipeline.layout import MESHES_DIR
 from softdesign.errors import InputDataError, SoftdesignError
 from softdesign.io.formats import FORMATS, read_mesh
 from softdesign.meshing.compare import MeshDifference, compare_meshes
+from softdesign.pipeline.layout import MESHES_DIR
 from softdesign.regression.figures import CheckOptions, Figure, is_number, missing_figure, read_json
 
 #: Every registered mesh format is compared by geometry.
@@ -75,7 +75,7 @@ def compare_mesh_folders(
     reference_dir: Path,
     options: CheckOptions,
     golden: dict[str, DecimationError],
-    progress: Optional[Callable[[str], None]] = None,
+    progress: Callable[[str], None] | None = None,
 ) -> list[Figure]:
     """Figures of every mesh present on either side, sorted by name."""
     ours, theirs = mesh_names(build_dir), mesh_names(reference_dir)

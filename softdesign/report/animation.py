@@ -45,7 +45,7 @@ def _frame_geometry(chain: LinkChain, field: RadiusField | None, q: float, view:
         return view.project(chain.shape.curve_at(q).points(np.linspace(0.0, 1.0, CURVE_SAMPLES))), None
     vertices, faces, face_l = tube_mesh(chain, field, q, TUBE_SPACING_MM, TUBE_ANGLES)
     shaded = shaded_triangles(vertices, faces, view, cull=True)
-    colours = np.array(link_colours(chain.count))[:, :3][field.link_of(face_l[shaded.index])]
+    colours = np.array(link_colours(chain.count))[:, :3][field.link_of(face_l[shaded.face_index])]
     return shaded.triangles, np.clip(shaded.brightness[:, None] * colours, 0.0, 1.0)
 
 

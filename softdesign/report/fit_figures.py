@@ -14,10 +14,12 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from softdesign.errors import InputDataError
 from softdesign.fitting.metrics import closest_surface_points
 from softdesign.fitting.projection import PolarPoints
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.selection import REASONS
+from softdesign.pipeline.stages.fit import FitResult
 from softdesign.report.build_folder import BuildData
 from softdesign.report.plotting import Picture, new_figure, panels, picture, styled
 from softdesign.report.projection import principal_view
@@ -54,16 +56,24 @@ class _FieldAtQ:
         return out
 
 
+def _fit_of(data: BuildData) -> FitResult:
+    """The build's fit: the fit figures are drawn only for a build that has one (the writer checks)."""
+    if data.fit is None:
+        raise InputDataError(f"{data.build_dir}: the build has no fit to draw; run the fit stage first")
+    return data.fit
+
+
 def true_distances(data: BuildData) -> FloatArray:
     """True distances (n_kept,) mm from each kept wall point to the fitted surface at q = 1."""
-    points = data.fit.points
+    fit = _fit_of(data)
+    points = fit.points
     keep = points["reason"] == 0
     polar = PolarPoints(
         data.ingest.vertices[keep], points["l"][keep], points["angle"][keep], points["rho"][keep],
         np.zeros(int(keep.sum()), np.int8),
     )
     curve = data.kinematics.chain.shape.curve_at(1.0)
-    return closest_surface_points(curve, _FieldAtQ(data.fit.field, 1.0), polar)[0]
+    return closest_surface_points(curve, _FieldAtQ(fit.field, 1.0), polar)[0]
 
 
 def residual_bins(l_mm: FloatArray, angle: FloatArray, residual: FloatArray, edges: tuple[FloatArray, FloatArray]):
@@ -76,9 +86,10 @@ def residual_bins(l_mm: FloatArray, angle: FloatArray, residual: FloatArray, edg
 
 def _link_maps(data: BuildData) -> list[tuple[FloatArray, FloatArray, FloatArray]]:
     """Per link: l edges (mm), angle edges (deg), mean residual per bin."""
-    p, breaks = data.fit.points, data.fit.field.breaks
+    fit = _fit_of(data)
+    p, breaks = fit.points, fit.field.breaks
     length = data.kinematics.chain.shape.keys[-1].length
-    settings = data.fit.summary["settings"]
+    settings = fit.summary["settings"]
     keep = p["reason"] == 0
     l_mm, angle, residual = p["l"][keep] * length, p["angle"][keep], p["residual"][keep]
     angle_edges = np.linspace(-180.0, 180.0, int(settings["angular_intervals"]) + 1)
@@ -133,7 +144,7 @@ def distance_histogram(ax, distances: FloatArray, metrics: dict) -> None:
 
 def exclusion_views(ax_map, ax_bar, data: BuildData) -> None:
     """The surface's points coloured by why they were kept or left out, and their counts."""
-    reason = data.fit.points["reason"]
+    reason = _fit_of(data).points["reason"]
     curve = data.kinematics.chain.shape.curve_at(1.0)
     samples = curve.points(np.linspace(0.0, 1.0, 101))
     view = principal_view(samples, samples[-1] - samples[0])

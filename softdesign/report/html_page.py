@@ -11,6 +11,7 @@ same bytes.
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from html import escape
 from typing import Any
@@ -48,7 +49,7 @@ class Table:
 
     caption: str
     header: tuple[str, ...]
-    rows: list[tuple[Cell, ...]]
+    rows: Sequence[tuple[Cell, ...]]
 
 
 @dataclass(frozen=True)
@@ -85,10 +86,12 @@ def check_table(checks: list[Check]) -> Table:
     return Table(f"Checks: {passed} of {len(checks)} passed", ("subject", "check", "found", "required", "status"), rows)
 
 
-def plain_table(caption: str, header: tuple[str, ...], rows: list[tuple[str, ...]], css: tuple[str, ...] = ()) -> Table:
+def plain_table(
+    caption: str, header: tuple[str, ...], rows: Sequence[tuple[str, ...]], css: tuple[str, ...] = ()
+) -> Table:
     """A table of plain texts; ``css`` gives a class per column."""
     classes = css or ("",) * len(header)
-    return Table(caption, header, [tuple(Cell(text, c) for text, c in zip(row, classes)) for row in rows])
+    return Table(caption, header, [tuple(Cell(text, c) for text, c in zip(row, classes, strict=True)) for row in rows])
 
 
 def _attributes(pairs: tuple[tuple[str, str], ...]) -> str:

@@ -50,7 +50,8 @@ def q_grid(export_q: list[float], samples: int = Q_SAMPLES) -> FloatArray:
 def kinematics_series(chain: LinkChain, export_q: list[float], samples: int = Q_SAMPLES) -> KinematicsSeries:
     """Evaluate every link's report at each q of :func:`q_grid`."""
     q = q_grid(export_q, samples)
-    rows = {k: [] for k in ("theta1", "theta2", "length", "stretch_min", "stretch_max", "curvature_max")}
+    names = ("theta1", "theta2", "length", "stretch_min", "stretch_max", "curvature_max")
+    rows: dict[str, list[list[float]]] = {k: [] for k in names}
     tip = []
     for value in q:
         reports = chain.reports(float(value))
@@ -130,7 +131,7 @@ def pcc_picture(chain: LinkChain, series: KinematicsSeries, d: float | list[floa
         figure = new_figure(PCC_SIZE_IN)
         axes = list(panels(figure, chain.count + 1, max_columns=5))
         for j, ax in enumerate(axes[:-1]):
-            for k, (style, angle) in enumerate(zip(CHAMBER_STYLES, CHAMBER_ANGLES_DEG)):
+            for k, (style, angle) in enumerate(zip(CHAMBER_STYLES, CHAMBER_ANGLES_DEG, strict=True)):
                 ax.plot(series.q, lengths[:, j, k], color=colours[j], ls=style, lw=1.3, label=f"{angle} deg")
             _mark_export_q(ax, series)
             ax.set(title=f"link {j} chambers", xlabel="q", ylabel="chamber length (mm)", xlim=(0.0, 1.0))

@@ -73,7 +73,9 @@ def draw_view(ax, curves: list[MorphCurve], view: View, colours: list, arm: floa
             ax.plot(xy[:, 0], xy[:, 1], color=colours[j], alpha=alpha, lw=1.6)
         for k, segments in enumerate(_triad_segments(curve.joints, arm)):
             flat = view.project(segments.reshape(-1, 3)).reshape(-1, 2, 2)
-            ax.add_collection(LineCollection(flat, colors=TRIAD_COLOURS[k], linewidths=0.9, alpha=alpha))
+            # an (n, 2, 2) array is a documented segments argument; the stubs accept only a Sequence
+            segments_2d = LineCollection(flat, colors=TRIAD_COLOURS[k], linewidths=0.9, alpha=alpha)  # type: ignore[arg-type]
+            ax.add_collection(segments_2d)
         end = view.project(curve.links[-1][-1:])[0]
         ax.annotate(f"q={curve.q:g}", end, xytext=(3, 3), textcoords="offset points", fontsize=7, alpha=alpha)
     ax.set_xlabel(view.labels[0])
@@ -95,7 +97,7 @@ def draw_3d(ax, curves: list[MorphCurve], colours: list, arm: float) -> None:
     points = np.concatenate([p for c in curves for p in c.links])
     lo, hi = points.min(axis=0), points.max(axis=0)
     centre, half = (lo + hi) / 2.0, float(np.max(hi - lo)) / 2.0
-    for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
+    for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, strict=True):
         setter(c - half, c + half)
     ax.set_box_aspect((1.0, 1.0, 1.0))
     ax.set_xlabel("x (mm)")

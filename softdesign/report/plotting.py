@@ -11,15 +11,19 @@ bytes.
 from __future__ import annotations
 
 import io
+from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import Iterator
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:  # matplotlib is imported when a figure is drawn
+    from matplotlib.typing import RcKeyType
 
 #: Resolution of every PNG, dots per inch.
 DPI = 100
 #: rcParams for every figure: fixed font and sizes, a fixed SVG hash salt (reproducible if ever saved as SVG).
-STYLE = {
+STYLE: dict[RcKeyType, Any] = {
     "font.family": "DejaVu Sans",
     "font.size": 8.5,
     "axes.titlesize": 9.5,

@@ -75,7 +75,7 @@ class ShadedFaces(NamedTuple):
 
     triangles: FloatArray  #: (k, 3, 2) screen coordinates, mm
     brightness: FloatArray  #: (k,) in [AMBIENT, 1], two-sided Lambert shading
-    index: np.ndarray  #: (k,) the face each triangle came from (degenerate faces are dropped)
+    face_index: np.ndarray  #: (k,) the face each triangle came from (degenerate faces are dropped)
 
 
 def shaded_triangles(vertices: npt.ArrayLike, faces: npt.ArrayLike, view: View, cull: bool = False) -> ShadedFaces:

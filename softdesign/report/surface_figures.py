@@ -92,7 +92,9 @@ def draw_shaded(ax, body: Body, view: View) -> None:
     triangles, brightness, _ = shaded_triangles(body.vertices, body.faces, view, cull=body.closed)
     colours = np.clip(brightness[:, None] * np.asarray(body.rgb)[None, :], 0.0, 1.0)
     # edges in the face colour close the hairline gaps antialiasing leaves between neighbours
-    ax.add_collection(PolyCollection(triangles, facecolors=colours, edgecolors=colours, linewidths=0.15))
+    # an (n, 3, 2) array is a documented verts argument (and matplotlib's fast path); the stubs accept only a Sequence
+    shaded = PolyCollection(triangles, facecolors=colours, edgecolors=colours, linewidths=0.15)  # type: ignore[arg-type]
+    ax.add_collection(shaded)
     ax.set_aspect("equal", adjustable="datalim")
     ax.autoscale_view()
     ax.set_title(body.title)

@@ -115,7 +115,9 @@ def report_sections(data: BuildData, options: ReportOptions) -> tuple[list[Secti
         surfaces.notes.append(NO_FIT)
         fit.notes.append(NO_FIT)
     else:
-        surfaces.pictures.append(surface_figures.surface_picture(data))
+        surface = surface_figures.surface_picture(data)  # None only without a fit
+        if surface is not None:
+            surfaces.pictures.append(surface)
         distances = fit_figures.true_distances(data)
         fit.pictures.extend([fit_figures.residual_picture(data), fit_figures.distance_picture(data, distances)])
     kinematics = _kinematics_section(data, options, notes)

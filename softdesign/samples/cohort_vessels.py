@@ -18,8 +18,8 @@ Paths (``s`` runs over ``[0, length_mm]`` before arc-length resampling)
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
@@ -145,9 +145,13 @@ def _branch(main: Points, main_radius: FloatArray, variant: VesselVariant) -> tu
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(main, axis=0), axis=1))])
     at = int(np.searchsorted(arc, variant.branch_at_mm))
     if not 0 < at < len(main) - 1:
-        raise ValueError(f"{variant.name}: branch_at_mm {variant.branch_at_mm} must lie inside the trunk (0, {arc[-1]:.1f})")
+        raise ValueError(
+            f"{variant.name}: branch_at_mm {variant.branch_at_mm} must lie inside the trunk (0, {arc[-1]:.1f})"
+        )
     if variant.branch_radius_mm >= (1.0 - variant.ellipticity) * main_radius[at]:
-        raise ValueError(f"{variant.name}: the branch (radius {variant.branch_radius_mm} mm) must be thinner than the trunk")
+        raise ValueError(
+            f"{variant.name}: the branch (radius {variant.branch_radius_mm} mm) must be thinner than the trunk"
+        )
     tangent = main[at + 1] - main[at - 1]
     tangent /= np.linalg.norm(tangent)
     side = np.asarray(variant.branch_side, float)

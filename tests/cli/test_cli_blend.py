@@ -15,7 +15,6 @@ from softdesign.cli import app
 from softdesign.geometry.curves import TORSION_KAPPA_FLOOR
 from softdesign.pipeline.layout import BLEND_SUMMARY
 from softdesign.pipeline.stages.blend import load_blend
-
 from tests.helpers.cases import straight_tube, write_case
 from tests.helpers.paths import DEMO
 

@@ -10,7 +10,6 @@ import pytest
 from typer.testing import CliRunner
 
 from softdesign.cli import app
-
 from tests.helpers.cases import straight_tube, write_case
 from tests.helpers.paths import REPO
 from tests.helpers.regeneration import REGENERATION_TOL_MM, assert_same_vessel_file, vessel_file_differences
@@ -244,9 +243,9 @@ def test_regeneration_check_sees_an_stl_vertex_moved_past_its_float32_step(tmp_p
 
 def test_sample_is_a_vmtk_style_network_with_a_capped_wall(tmp_path):
     from softdesign.geometry.network import select_path
-    from softdesign.meshing.topology import describe_surface
     from softdesign.io.centerline import read_centerline_network
     from softdesign.io.surface import read_surface
+    from softdesign.meshing.topology import describe_surface
 
     runner.invoke(app, ["sample", str(tmp_path)])
     network = read_centerline_network(tmp_path / "centerline.vtp")

@@ -76,7 +76,11 @@ def test_kinematics_json_is_kept_for_every_export_q(built):
 
 @pytest.mark.parametrize(
     ("q", "message"),
-    [("0.5,2", "value 2 of '0.5,2' is 2, expected a number in [0, 1]"), ("a", "'a' of 'a' is not a number"), ("0.1,0.2", "expected one value or 4 values")],
+    [
+        ("0.5,2", "value 2 of '0.5,2' is 2, expected a number in [0, 1]"),
+        ("a", "'a' of 'a' is not a number"),
+        ("0.1,0.2", "expected one value or 4 values"),
+    ],
 )
 def test_bad_q_exits_2(built, q, message):
     result = runner.invoke(app, ["kinematics", str(DEMO), "--out", str(built), "--q", q])

@@ -14,7 +14,6 @@ from softdesign.cli import app
 from softdesign.meshing.checks import MIN_ANGULAR_COUNT, VOLUME_RTOL
 from softdesign.meshing.volume import polygon_area_ratio
 from softdesign.pipeline.layout import EXPORT_SUMMARY
-
 from tests.helpers.paths import DEMO, REPO
 
 runner = CliRunner()

@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
 from softdesign.config import load_case
 from softdesign.errors import ConfigError
-
 from tests.helpers.cases import write_case
 from tests.helpers.paths import REPO
 

@@ -45,7 +45,8 @@ def test_forward_json_equals_the_library(d_text, d):
     payload = forward_json("--lengths", BENDING, "--d", d_text)
     assert list(payload) == ["sections", "tip", "transform"]
     assert [list(s) for s in payload["sections"]] == [["kappa", "phi", "length", "theta", "transform"]] * 3
-    arcs, section2prev, tip2base = library_forward(np.array([[121, 123, 125], [236, 187, 269], [236, 186, 268]], float), d)
+    lengths = np.array([[121, 123, 125], [236, 187, 269], [236, 186, 268]], float)
+    arcs, section2prev, tip2base = library_forward(lengths, d)
     for name in ("kappa", "phi", "length", "theta"):
         np.testing.assert_allclose([s[name] for s in payload["sections"]], getattr(arcs, name), rtol=0, atol=EXACT_TOL)
     np.testing.assert_allclose([s["transform"] for s in payload["sections"]], section2prev, rtol=0, atol=EXACT_TOL)
@@ -127,7 +128,9 @@ def reconstructed(tmp_path):
     readings.write_text(CSV_TEXT)
     out = tmp_path / "out"
     result = runner.invoke(
-        app, ["pcc", "reconstruct", str(readings), "--d", "15,12", "--shapes-dir", str(out), "--max-rate", "100", "--points-per-section", "7"]
+        app,
+        ["pcc", "reconstruct", str(readings), "--d", "15,12", "--shapes-dir", str(out),
+         "--max-rate", "100", "--points-per-section", "7"],
     )
     return result, out
 
@@ -139,10 +142,11 @@ def test_reconstruct_writes_tips_matching_the_library(reconstructed):
     with open(out / "tips.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
     assert len(rows) == len(GOOD_ROWS)
-    for row, (time, lengths) in zip(rows, GOOD_ROWS.values()):
+    for row, (time, lengths) in zip(rows, GOOD_ROWS.values(), strict=True):
         arcs, _, tip2base = library_forward(lengths, np.array([15.0, 12.0]))
         assert float(row["time"]) == time
-        np.testing.assert_allclose([float(row[k]) for k in ("tip_x", "tip_y", "tip_z")], tip2base[:3, 3], rtol=0, atol=CSV_TOL)
+        tip = [float(row[k]) for k in ("tip_x", "tip_y", "tip_z")]
+        np.testing.assert_allclose(tip, tip2base[:3, 3], rtol=0, atol=CSV_TOL)
         rotation = [float(row[f"r{i}{j}"]) for i in range(1, 4) for j in range(1, 4)]
         np.testing.assert_allclose(rotation, tip2base[:3, :3].ravel(), rtol=0, atol=CSV_TOL)
         for s in range(2):
@@ -185,7 +189,8 @@ def test_reconstruct_backbones_vtp_holds_one_polyline_per_accepted_row(reconstru
 def test_reconstruct_without_max_rate_accepts_the_jump(tmp_path):
     readings = tmp_path / "readings.csv"
     readings.write_text(CSV_TEXT)
-    result = runner.invoke(app, ["pcc", "reconstruct", str(readings), "--d", "15", "--shapes-dir", str(tmp_path / "out")])
+    args = ["pcc", "reconstruct", str(readings), "--d", "15", "--shapes-dir", str(tmp_path / "out")]
+    result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
     assert "4 row(s) accepted, 2 rejected" in result.stdout
 
@@ -211,11 +216,15 @@ def test_reconstruct_bad_file_exits_2_naming_the_file(tmp_path, text, d, message
 
 
 def test_reconstruct_missing_file_and_bad_rate_exit_2(tmp_path):
-    missing = runner.invoke(app, ["pcc", "reconstruct", str(tmp_path / "nope.csv"), "--d", "15", "--shapes-dir", str(tmp_path)])
+    missing = runner.invoke(
+        app, ["pcc", "reconstruct", str(tmp_path / "nope.csv"), "--d", "15", "--shapes-dir", str(tmp_path)]
+    )
     assert missing.exit_code == 2 and "nope.csv: readings file not found" in missing.stderr
     readings = tmp_path / "readings.csv"
     readings.write_text(CSV_TEXT)
-    rate = runner.invoke(app, ["pcc", "reconstruct", str(readings), "--d", "15", "--shapes-dir", str(tmp_path), "--max-rate", "0"])
+    rate = runner.invoke(
+        app, ["pcc", "reconstruct", str(readings), "--d", "15", "--shapes-dir", str(tmp_path), "--max-rate", "0"]
+    )
     assert rate.exit_code == 2 and "--max-rate must be a finite number > 0" in rate.stderr
 
 
@@ -253,7 +262,8 @@ def test_polyline_writer_rejects_mismatched_arrays(tmp_path):
 def test_reconstruct_rejects_a_row_that_goes_back_in_time(tmp_path):
     readings = tmp_path / "readings.csv"
     readings.write_text("time,a,b,c\n0,100,100,100\n0.1,100,101,102\n0.05,100,101,102\n")
-    result = runner.invoke(app, ["pcc", "reconstruct", str(readings), "--d", "10", "--shapes-dir", str(tmp_path / "out")])
+    args = ["pcc", "reconstruct", str(readings), "--d", "10", "--shapes-dir", str(tmp_path / "out")]
+    result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
     with open(tmp_path / "out" / "rejected.csv", newline="") as handle:
         rejected = list(csv.reader(handle))

@@ -20,7 +20,9 @@ Q = [0.0, 0.5, 1.0]
 def aorta_case(folder, aorta_dir, surface: str, **export) -> tuple:
     case = {
         "name": "aorta",
-        "final": {"centerline": str(aorta_dir / "aorta-centerline.vtp"), "surface": str(aorta_dir / surface), "path": 0},
+        "final": {
+            "centerline": str(aorta_dir / "aorta-centerline.vtp"), "surface": str(aorta_dir / surface), "path": 0
+        },
         "export": {"q": Q, **export},
     }
     path = folder / f"{surface}.{len(export)}.yaml"
@@ -59,12 +61,12 @@ def test_aorta_builds_end_to_end_within_the_fit_targets(tmp_path, aorta_dir, sur
 def test_aorta_offset_and_hollow_variants_are_valid_solids(tmp_path, aorta_dir):
     shrunk, _ = aorta_case(tmp_path, aorta_dir, "aorta-surface.stl", offset_mm=-0.5)
     solid, _ = aorta_case(tmp_path, aorta_dir, "aorta-surface.stl")
-    for small, full in zip(meshes(shrunk), meshes(solid)):
+    for small, full in zip(meshes(shrunk), meshes(solid), strict=True):
         assert small["watertight"] and small["volume_mm3"] < full["volume_mm3"]
     hollow, _ = aorta_case(tmp_path, aorta_dir, "aorta-surface.stl", wall_mm=0.8, port_mm=2.0)
     export = hollow["metrics"]["export"]
     assert export["spec"] == {"offset_mm": 0.0, "wall_mm": 0.8, "port_mm": 2.0}
-    for ported, full in zip(meshes(hollow), meshes(solid)):
+    for ported, full in zip(meshes(hollow), meshes(solid), strict=True):
         assert ported["watertight"]
         # the chamber takes most of the volume: a 0.8 mm wall around a 4-7 mm radius
         assert 0.15 * full["volume_mm3"] < ported["volume_mm3"] < 0.5 * full["volume_mm3"]

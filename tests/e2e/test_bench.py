@@ -7,13 +7,12 @@ from __future__ import annotations
 
 import importlib.util
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from softdesign.samples.synthetic_vessel import SyntheticShape, make_synthetic_vessel
 from softdesign.samples.surfaces import grid_counts, synthetic_surface
+from softdesign.samples.synthetic_vessel import SyntheticShape, make_synthetic_vessel
 from tests.helpers.paths import REPO
 
 BENCH_FILE = REPO / "pipelines" / "bench.py"

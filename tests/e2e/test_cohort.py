@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from softdesign import cohort
 from softdesign.config import load_case
 from softdesign.samples.cohort_vessels import COHORT_VARIANTS, make_variant_vessel, variant_named
-from softdesign import cohort
 from tests.helpers.paths import REPO
 from tests.helpers.regeneration import REGENERATION_TOL_MM, assert_same_vessel_file, vessel_file_differences
 
@@ -216,13 +216,15 @@ def test_make_cohort_rebuilds_only_what_changed(tmp_path):
 @needs_make
 def test_a_broken_case_fails_its_row_and_the_others_still_build(tmp_path):
     cases, build = temporary_cohort(tmp_path), tmp_path / "build"
-    (cases / "broken.yaml").write_text((cases / "meander.yaml").read_text().replace("knot_spacing_mm", "knot_spacng_mm"))
+    broken = (cases / "meander.yaml").read_text().replace("knot_spacing_mm", "knot_spacng_mm")
+    (cases / "broken.yaml").write_text(broken)
     (cases / "missing.yaml").write_text("final: {centerline: ../nowhere/centerline.vtp}\n")
     result = make("-j2", "cohort", cohort_dir=cases, build=build)
     assert result.returncode != 0
     assert "2 of 4 case(s) failed (broken, missing)" in result.stderr
     rows = summary(build)
-    assert [rows[name]["status"] for name in ("broken", "meander", "missing", "s_bend")] == ["failed", "ok", "failed", "ok"]
+    statuses = [rows[name]["status"] for name in ("broken", "meander", "missing", "s_bend")]
+    assert statuses == ["failed", "ok", "failed", "ok"]
     assert "unknown key 'knot_spacng_mm'" in rows["broken"]["message"]
     assert "final.centerline: file not found" in rows["missing"]["message"]
     for name in ("broken", "missing"):

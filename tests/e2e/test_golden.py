@@ -19,9 +19,9 @@ from softdesign.cli import app
 from softdesign.cohort import cohort_cases
 from softdesign.pipeline.store import sha256_file
 from softdesign.regression import GOLDEN, CheckOptions, mesh_names
+from tests.helpers.paths import REPO
 
 from .test_cohort import MAKE, make
-from tests.helpers.paths import REPO
 
 #: The sample cohort built afresh: `make test-fast` leaves these out.
 pytestmark = pytest.mark.slow

@@ -24,7 +24,6 @@ from typer.testing import CliRunner
 from softdesign.pipeline.api import build_through
 from softdesign.report.writer import EXPECTED_SIZES, PAGE, REPORT_DIR, ReportOptions, commit_folder, write_report
 from softdesign.versions import software_versions
-
 from tests.helpers.cases import write_case
 from tests.helpers.paths import REPO
 
@@ -409,10 +408,10 @@ def test_shading_order_and_culling_of_two_facing_triangles():
     vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 5], [1, 0, 5], [0, 1, 5]], float)
     faces = np.array([[3, 4, 5], [0, 2, 1]])  # near face towards the viewer (+z), far face away from it
     shaded = shaded_triangles(vertices, faces, view)
-    assert shaded.index.tolist() == [1, 0]  # far first
+    assert shaded.face_index.tolist() == [1, 0]  # far first
     facing = AMBIENT + (1.0 - AMBIENT) * LIGHT_VIEW[2] / np.linalg.norm(LIGHT_VIEW)
     np.testing.assert_allclose(shaded.brightness, [facing, facing], rtol=0, atol=1e-12)  # two-sided
-    assert shaded_triangles(vertices, faces, view, cull=True).index.tolist() == [0]
+    assert shaded_triangles(vertices, faces, view, cull=True).face_index.tolist() == [0]
 
 
 def test_tube_vertices_lie_at_the_fitted_radius_and_face_outwards(demo):

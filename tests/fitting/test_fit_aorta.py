@@ -25,8 +25,6 @@ at 1e-6; larger values cost accuracy (RMS 0.028 at 1e-5, 0.045 at 1e-4, 0.078 at
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -37,7 +35,6 @@ from softdesign.fitting.metrics import closest_surface_points, holdout_rms, summ
 from softdesign.fitting.projection import project_points
 from softdesign.fitting.radius_field import RadiusField, check_self_folding
 from softdesign.fitting.selection import NetworkContext, inscribed_profile, select_wall_points
-
 
 #: The issue's targets on the kept wall points, mm.
 TARGET_RMS_MM, TARGET_P99_MM, TARGET_HOLDOUT_MM = 0.05, 0.15, 0.06

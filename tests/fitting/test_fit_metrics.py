@@ -9,17 +9,17 @@ from softdesign.errors import ConfigError
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface, fold_fits
 from softdesign.fitting.metrics import (
     CLOSEST_TOL_MM,
-    frame_twist_table,
-    surface_points,
     HoldoutSettings,
     choose_knot_spacing,
     closest_surface_points,
     fold_labels,
+    frame_twist_table,
     holdout_rms,
     holdout_sample,
     measure_distances,
     measure_fit,
     summarize_distances,
+    surface_points,
 )
 from softdesign.fitting.projection import project_points
 from tests.helpers.analytic import Arc, FrenetHelix, Helix, Line, grid_parameters, tube_points

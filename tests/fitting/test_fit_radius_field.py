@@ -28,7 +28,7 @@ VALUE_TOL_MM = 1e-12
 def _random_links(breaks=(0.0, 0.4, 1.0), intervals=12, seed=0):
     rng = np.random.default_rng(seed)
     links = []
-    for lo, hi in zip(breaks[:-1], breaks[1:]):
+    for lo, hi in zip(breaks[:-1], breaks[1:], strict=True):
         knots = bb.open_knots([lo, hi], [5])
         links.append(RadiusSpline(knots, 3.0 + 0.4 * rng.uniform(-1, 1, (len(knots) - 4, intervals))))
     return tuple(links)

@@ -91,7 +91,7 @@ def test_links_split_from_one_fit_match_it_and_join_in_value_and_slope():
     assert fit.joint_value_jump_mm.max() <= JOINT_TOL
     assert fit.joint_slope_jump.max() <= JOINT_TOL
     a = np.linspace(-np.pi, np.pi, 50)
-    for link, (lo, hi) in zip(fit.links, zip(breaks[:-1], breaks[1:])):
+    for link, (lo, hi) in zip(fit.links, zip(breaks[:-1], breaks[1:], strict=True), strict=True):
         assert link.domain == (lo, hi)
         l = np.linspace(lo, hi, 30)
         np.testing.assert_allclose(link.evaluate_grid(l, a), fit.whole.evaluate_grid(l, a), rtol=0, atol=SPLIT_TOL_MM)
@@ -106,7 +106,8 @@ def test_values_and_slopes_in_one_pass_are_the_separate_evaluations():
     l, a = rng.random(300), rng.uniform(-10.0, 10.0, 300)
     together = spline.evaluate_with_slopes(l, a)
     alone = (spline.evaluate(l, a), spline.evaluate(l, a, dl=1), spline.evaluate(l, a, da=1))
-    for t, s in zip(together, alone):  # the same products summed in another order: rounding of ~100 (mm per unit l)
+    # the same products summed in another order: rounding of ~100 (mm per unit l)
+    for t, s in zip(together, alone, strict=True):
         np.testing.assert_allclose(t, s, rtol=0, atol=SPLIT_TOL_MM)
 
 

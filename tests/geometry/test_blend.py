@@ -43,7 +43,8 @@ def frame0() -> np.ndarray:
 def final(frame0):
     """An arc of radius 30 mm, 60 mm long, from BASE along TANGENT, bending towards B0 (phi = pi/2)."""
     s = np.linspace(0, LENGTH, 3001)
-    return smooth_curve_from_polyline(analytic_arc(s, RADIUS, frame0[:, 1]), CurveOptions(spacing_mm=0.5, smoothing_mm=0.0))
+    options = CurveOptions(spacing_mm=0.5, smoothing_mm=0.0)
+    return smooth_curve_from_polyline(analytic_arc(s, RADIUS, frame0[:, 1]), options)
 
 
 def test_straight_initial_shape_is_registered_and_as_long_as_final(final):

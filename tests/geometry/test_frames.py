@@ -44,7 +44,8 @@ def angle_between(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 @pytest.fixture(scope="module")
 def helix_curve():
     length = 150.0
-    return smooth_curve_from_polyline(helix(np.linspace(0, length, 6001)), CurveOptions(spacing_mm=0.1, smoothing_mm=0.0))
+    options = CurveOptions(spacing_mm=0.1, smoothing_mm=0.0)
+    return smooth_curve_from_polyline(helix(np.linspace(0, length, 6001)), options)
 
 
 def test_rmf_on_a_helix_matches_the_analytic_rotation_minimizing_frame(helix_curve):
@@ -99,7 +100,8 @@ def test_base_normal_rule_is_deterministic_and_can_be_overridden():
     tilted = framed_curve(line, base_normal=[1, 1, 5])
     np.testing.assert_allclose(tilted.dense_frames[0, :, 0], [1 / np.sqrt(2), 1 / np.sqrt(2), 0], rtol=0, atol=1e-15)
     # a straight line's RMF never turns
-    np.testing.assert_allclose(tilted.frames(np.linspace(0, 1, 11)), np.broadcast_to(tilted.dense_frames[0], (11, 3, 3)),
+    np.testing.assert_allclose(tilted.frames(np.linspace(0, 1, 11)),
+                               np.broadcast_to(tilted.dense_frames[0], (11, 3, 3)),
                                rtol=0, atol=ORTHONORMAL_TOL)
     with pytest.raises(GeometryError, match="parallel to the base tangent"):
         framed_curve(line, base_normal=[0, 0, 2])

@@ -17,7 +17,6 @@ from softdesign.geometry.se3 import (
     twist_from_pose,
     vector_from_skew,
 )
-
 from tests.helpers.seed_transforms import rot_z
 
 #: Rounding-level agreement of exact compositions.

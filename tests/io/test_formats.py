@@ -74,7 +74,7 @@ def _oriented_triangles(faces: np.ndarray) -> set[tuple[int, int, int]]:
     """Each face as a tuple starting at its smallest index, orientation kept."""
     faces = np.asarray(faces)
     first = np.argmin(faces, axis=1)
-    rolled = np.stack([np.roll(f, -k) for f, k in zip(faces, first)])
+    rolled = np.stack([np.roll(f, -k) for f, k in zip(faces, first, strict=True)])
     return set(map(tuple, rolled.tolist()))
 
 

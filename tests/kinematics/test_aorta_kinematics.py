@@ -26,6 +26,7 @@ from softdesign.geometry.blend import blend_shapes
 from softdesign.geometry.curves import CurveOptions, l_from_points, measure_deviation, smooth_curve_from_polyline
 from softdesign.geometry.frames import adjacent_rotation_angles, framed_curve
 from softdesign.geometry.initial import straight_initial_shape
+
 #: The case-file defaults (config.Resample).
 DEFAULTS = CurveOptions(spacing_mm=0.5, smoothing_mm=0.1, end_straight_mm=2.0)
 

@@ -13,7 +13,6 @@ from softdesign.geometry.initial import arc_initial_shape, straight_initial_shap
 from softdesign.geometry.se3 import inverse_pose, pose_from_twist, rotation_from_rotvec, rotvec_from_rotation
 from softdesign.kinematics.links import LinkChain, link_breaks, link_transforms
 from softdesign.kinematics.poe import PoeSplit, poe_from_pose, pose_from_poe
-
 from tests.helpers.seed_transforms import seed_chain
 
 #: The issue's bound on reproducing S_T_E from its POE split (we reach rounding).
@@ -32,7 +31,7 @@ STEP_MM = 0.005
 def curvature_jumps() -> list[float]:
     """|change of the curvature vector| at each joint, 1/mm (in the common RMF: constant per arc)."""
     vectors = [k * np.array([np.cos(p), np.sin(p)]) for k, p, _ in ARCS]
-    return [float(np.linalg.norm(b - a)) for a, b in zip(vectors, vectors[1:])]
+    return [float(np.linalg.norm(b - a)) for a, b in zip(vectors[:-1], vectors[1:], strict=True)]
 
 
 @pytest.fixture(scope="module")
@@ -60,7 +59,9 @@ def test_rmf_link_transforms_equal_seed_003_arcs(arcs_case):
     framed = framed_curve(curve, "rmf", base_normal=base[:3, 0])
     # joint positions (world) to 1e-6 of the link length
     for j, (_, _, length) in enumerate(ARCS):
-        np.testing.assert_allclose(curve.points(breaks[j : j + 2]), joints[j : j + 2, :3, 3], rtol=0, atol=1e-6 * length)
+        np.testing.assert_allclose(
+            curve.points(breaks[j : j + 2]), joints[j : j + 2, :3, 3], rtol=0, atol=1e-6 * length
+        )
     jumps = [0.0, *curvature_jumps(), 0.0]
     transforms = link_transforms(framed, breaks)
     for j, (kappa, phi, length) in enumerate(ARCS):
@@ -81,7 +82,9 @@ def test_rmf_link_transforms_equal_seed_003_arcs(arcs_case):
         # the POE split of the arc: theta2 = kappa L about the binormal axis (-sin phi, cos phi, 0)
         split = poe_from_pose(transforms[j])
         np.testing.assert_allclose(split.theta2, kappa * length, rtol=0, atol=2 * angle_tol)
-        np.testing.assert_allclose(split.omega, [-np.sin(phi), np.cos(phi), 0], rtol=0, atol=2 * angle_tol / (kappa * length))
+        np.testing.assert_allclose(
+            split.omega, [-np.sin(phi), np.cos(phi), 0], rtol=0, atol=2 * angle_tol / (kappa * length)
+        )
         np.testing.assert_allclose(pose_from_poe(split), transforms[j], rtol=0, atol=POE_TOL)
 
 

@@ -7,7 +7,6 @@ import pytest
 
 from softdesign.errors import ConfigError, InputDataError
 from softdesign.kinematics import pcc
-
 from tests.helpers.seed_transforms import rot_y, rot_z, seed_chain
 
 #: Agreement of two exact computations of the same length, mm (double rounding on ~500 mm).
@@ -232,7 +231,9 @@ def test_the_tip_is_smooth_through_zero_curvature():
     assert np.all(np.isfinite(tip))
     theta = kappa * length
     # series of eq. 6: ((theta/2) L cos phi, (theta/2) L sin phi, L (1 - theta^2/6)) + O(L theta^3)
-    series = np.column_stack([theta / 2 * length * np.cos(phi), theta / 2 * length * np.sin(phi), length * (1 - theta**2 / 6)])
+    series = np.column_stack(
+        [theta / 2 * length * np.cos(phi), theta / 2 * length * np.sin(phi), length * (1 - theta**2 / 6)]
+    )
     np.testing.assert_array_less(np.abs(tip - series).max(axis=1), length * np.abs(theta) ** 3 + 1e-13)
     # slope at kappa = 0 from a central difference: L^2 / 2 (cos phi, sin phi, 0)
     step = 1e-7
@@ -286,7 +287,9 @@ def test_backbone_samples_lie_on_each_arc_and_end_at_the_tip():
     np.testing.assert_array_equal(poses[0], np.eye(4))
     section2base = pcc.chain_transforms(pcc.transform_from_arc(arcs.kappa, arcs.phi, arcs.length))
     np.testing.assert_allclose(poses[-1], section2base[-1], rtol=0, atol=LENGTH_TOL_MM)
-    np.testing.assert_allclose(arc_length[[0, m - 1, -1]], [0, arcs.length[0], arcs.length.sum()], rtol=0, atol=LENGTH_TOL_MM)
+    np.testing.assert_allclose(
+        arc_length[[0, m - 1, -1]], [0, arcs.length[0], arcs.length.sum()], rtol=0, atol=LENGTH_TOL_MM
+    )
     check_rotation(poses)
     bases = [np.eye(4), section2base[0], section2base[1]]
     for i in range(3):
@@ -294,9 +297,11 @@ def test_backbone_samples_lie_on_each_arc_and_end_at_the_tip():
         samples = np.concatenate([[samples[0] - 1], samples]) if i else samples  # the junction starts the arc
         # centre of curvature: 1/kappa from the arc's base along its bending direction phi
         centre = bases[i] @ np.array([np.cos(arcs.phi[i]) / arcs.kappa[i], np.sin(arcs.phi[i]) / arcs.kappa[i], 0, 1])
-        np.testing.assert_allclose(np.linalg.norm(points[samples] - centre[:3], axis=1), 1 / arcs.kappa[i], rtol=0, atol=LENGTH_TOL_MM)
+        radii = np.linalg.norm(points[samples] - centre[:3], axis=1)
+        np.testing.assert_allclose(radii, 1 / arcs.kappa[i], rtol=0, atol=LENGTH_TOL_MM)
         chord = 2 / arcs.kappa[i] * np.sin(arcs.theta[i] / (m - 1) / 2)
-        np.testing.assert_allclose(np.linalg.norm(np.diff(points[samples], axis=0), axis=1), chord, rtol=0, atol=LENGTH_TOL_MM)
+        chords = np.linalg.norm(np.diff(points[samples], axis=0), axis=1)
+        np.testing.assert_allclose(chords, chord, rtol=0, atol=LENGTH_TOL_MM)
 
 
 def test_straight_backbone_is_on_the_z_axis():

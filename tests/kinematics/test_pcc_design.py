@@ -46,7 +46,7 @@ D_MM = 2.0
 def curvature_jumps() -> list[float]:
     """|change of the curvature vector| at the base, each joint and the tip, 1/mm (0 at base and tip)."""
     vectors = [k * np.array([np.cos(p), np.sin(p)]) for k, p, _ in ARCS]
-    return [0.0] + [float(np.linalg.norm(b - a)) for a, b in zip(vectors, vectors[1:])] + [0.0]
+    return [0.0] + [float(np.linalg.norm(b - a)) for a, b in zip(vectors[:-1], vectors[1:], strict=True)] + [0.0]
 
 
 def joint_angle_rad(link: int) -> float:
@@ -164,7 +164,7 @@ def arcs_design(tmp_path_factory) -> tuple[Path, Path, dict]:
 def test_final_shape_made_of_arcs_gives_back_their_kappa_phi_and_length(arcs_design):
     *_, payload = arcs_design
     assert [pose["q"] for pose in payload["poses"]] == [0.0, 1.0]
-    for j, (link, (kappa, phi, length)) in enumerate(zip(payload["poses"][1]["links"], ARCS)):
+    for j, (link, (kappa, phi, length)) in enumerate(zip(payload["poses"][1]["links"], ARCS, strict=True)):
         # the spline's frame error at a joint tilts the link in {S} by up to eps; the best arc absorbs a tilt
         # as a change of its bending vector theta (cos phi, sin phi) of about eps (measured <= 0.65 of 2 eps)
         eps = joint_angle_rad(j)
@@ -180,7 +180,7 @@ def test_final_shape_made_of_arcs_gives_back_their_kappa_phi_and_length(arcs_des
 
 def test_straight_insertion_shape_is_straight_with_equal_chambers(arcs_design):
     *_, payload = arcs_design
-    for link, (_, _, length) in zip(payload["poses"][0]["links"], ARCS):
+    for link, (_, _, length) in zip(payload["poses"][0]["links"], ARCS, strict=True):
         assert (link["kappa"], link["phi"], link["theta"]) == (0.0, 0.0, 0.0)
         # the straight initial shape has the final shape's length: each link keeps its length
         np.testing.assert_allclose(link["length"], length, rtol=0, atol=1e-6 * length)
@@ -191,7 +191,7 @@ def test_straight_insertion_shape_is_straight_with_equal_chambers(arcs_design):
 
 def test_chamber_strain_shortens_the_chambers_on_the_bending_side(arcs_design):
     *_, payload = arcs_design
-    for j, (link, (kappa, phi, length)) in enumerate(zip(payload["poses"][1]["links"], ARCS)):
+    for j, (link, (kappa, phi, length)) in enumerate(zip(payload["poses"][1]["links"], ARCS, strict=True)):
         cosines = np.cos(pcc.ENCODER_ANGLES_RAD - phi)
         # same link length at q = 0 and 1: strain_j = -kappa d cos(a_j - phi) (seed eq. 2 over L)
         expected = -kappa * D_MM * cosines
@@ -231,7 +231,10 @@ def test_one_d_per_link_is_used_per_link(arcs_design):
     for j, d in enumerate([1.0, 2.0, 3.0]):
         link = per_link["poses"][1]["links"][j]
         np.testing.assert_allclose(
-            link["chamber_lengths"], pcc.lengths_from_arcs(link["kappa"], link["phi"], link["length"], d), rtol=0, atol=JSON_TOL
+            link["chamber_lengths"],
+            pcc.lengths_from_arcs(link["kappa"], link["phi"], link["length"], d),
+            rtol=0,
+            atol=JSON_TOL,
         )
 
 
@@ -257,7 +260,10 @@ def test_demo_case_reports_finite_figures(tmp_path):
     payload = json.loads(result.stdout)
     assert list(payload) == ["d", "poses", "convention"]
     assert [pose["q"] for pose in payload["poses"]] == [0.0, 0.5, 1.0]
-    keys = ["index", "l_start", "l_end", "kappa", "phi", "length", "theta", "chamber_lengths", "chamber_strain", *ERROR_KEYS]
+    keys = [
+        "index", "l_start", "l_end", "kappa", "phi", "length", "theta", "chamber_lengths", "chamber_strain",
+        *ERROR_KEYS,
+    ]
     for pose in payload["poses"]:
         assert list(pose) == ["q", "links", "worst"] and len(pose["links"]) == 4
         for link in pose["links"]:

@@ -93,7 +93,8 @@ def test_hollow_tube_is_prism_minus_chamber_with_euler_four():
     area += polygon_perimeter(r - w, na) * inner + 2 * polygon_area(r - w, na)
     assert_figures(report, volume, area)
     assert (solid.kind, report.euler, report.shells, report.bodies, report.voids) == ("hollow", 4, 2, 1, 1)
-    assert set(np.unique(solid.regions)) == set(Region) - {Region.PORT, Region.JOINT_STEP}  # JOINT_STEP only in pose bodies
+    # JOINT_STEP only in pose bodies
+    assert set(np.unique(solid.regions)) == set(Region) - {Region.PORT, Region.JOINT_STEP}
 
 
 def _axis_crossings(solid, x: float, y: float, z_range: tuple[float, float]) -> int:

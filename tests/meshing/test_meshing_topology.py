@@ -39,7 +39,8 @@ def cube(size: float = 1.0, origin=(0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndar
 def joined(*meshes: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     """One mesh of several, vertices renumbered."""
     offsets = np.cumsum([0] + [len(v) for v, _ in meshes])
-    return np.concatenate([v for v, _ in meshes]), np.concatenate([f + o for (_, f), o in zip(meshes, offsets)])
+    faces = [f + o for (_, f), o in zip(meshes, offsets[:-1], strict=True)]
+    return np.concatenate([v for v, _ in meshes]), np.concatenate(faces)
 
 
 def test_cube_volume_area_edges_and_flags():

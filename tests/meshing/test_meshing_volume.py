@@ -7,8 +7,8 @@ import pytest
 
 from softdesign.meshing.volume import (
     BodySpec,
-    angular_derivative,
     angle_grid,
+    angular_derivative,
     gauss_legendre_nodes,
     integrate_body,
     l_at_arclength,

@@ -18,6 +18,7 @@ import yaml
 from typer.testing import CliRunner
 
 from softdesign.cli import build
+from softdesign.cli.pose import pose
 from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import RadiusSpline
 from softdesign.fitting.radius_field import RadiusField
@@ -30,7 +31,6 @@ from softdesign.meshing.compare import compare_meshes
 from softdesign.meshing.pose_body import PoseSpec, pose_body
 from softdesign.meshing.pose_stitch import radii_on_rays, stitch_joint
 from softdesign.meshing.tessellate import Region
-from softdesign.cli.pose import pose
 from tests.helpers.paths import REPO
 
 app = typer.Typer(add_completion=False)
@@ -91,7 +91,7 @@ def test_crossing_rings_get_the_crossing_as_a_vertex():
     end, start = 3.0 + 0.5 * np.cos(2 * np.pi * np.arange(na) / na), np.full(na, 3.0)
     stitch = stitch_joint(end, start)
     assert stitch.crossing_interval.tolist() == [2, 7] and stitch.triangles.shape == (2 * na, 3)
-    for x, k in zip(stitch.crossings, stitch.crossing_interval):
+    for x, k in zip(stitch.crossings, stitch.crossing_interval, strict=True):
         for ring in (end, start):  # on the chord k -> k+1 of both rings
             p0, p1 = ring[k] * rays(na)[k], ring[(k + 1) % na] * rays(na)[(k + 1) % na]
             np.testing.assert_allclose(cross2(p1 - p0, x - p0), 0.0, rtol=0, atol=ROUND_TOL)
@@ -221,7 +221,8 @@ def demo(tmp_path_factory):
 
 
 def _run_pose(demo, q: str, output: Path, *extra: str):
-    return runner.invoke(app, ["pose", str(DEMO), "--q", q, "--output", str(output), "--out", str(demo.build_dir), *extra])
+    args = ["pose", str(DEMO), "--q", q, "--output", str(output), "--out", str(demo.build_dir), *extra]
+    return runner.invoke(app, args)
 
 
 @pytest.mark.slow
@@ -244,7 +245,7 @@ def test_mixed_q_links_start_on_the_previous_links_end_frame(demo):
     for q in ((0.0, 1.0, 0.0, 1.0), (0.2, 0.8, 1.0, 0.5)):
         body = pose_body(chain, field, q, PoseSpec(export.spacing_mm, export.angular_count))
         expected = chain.base2world(q)
-        for link, transform in zip(body.links, chain.transforms(q)):
+        for link, transform in zip(body.links, chain.transforms(q), strict=True):
             sweep = link.sweep
             np.testing.assert_allclose(link.start2world, expected, rtol=0, atol=PLACEMENT_TOL_MM)
             np.testing.assert_allclose(sweep.centers[0], expected[:3, 3], rtol=0, atol=PLACEMENT_TOL_MM)
@@ -273,7 +274,7 @@ def test_mixed_q_steps_are_closed_by_a_reported_annulus(demo, tmp_path):
     annulus = body.vertices[body.faces[body.regions == Region.JOINT_STEP]]
     joints = [link.start2world for link in body.links[1:]]
     nearest = np.argmin([np.linalg.norm(annulus.mean(axis=1) - pose[:3, 3], axis=1) for pose in joints], axis=0)
-    for j, (joint, joint_pose) in enumerate(zip(payload["joints"], joints)):
+    for j, (joint, joint_pose) in enumerate(zip(payload["joints"], joints, strict=True)):
         l = field.breaks[j + 1]
         end = field.link_spline(j, q[j]).evaluate_grid([l], a)[0]
         start = field.link_spline(j + 1, q[j + 1]).evaluate_grid([l], a)[0]
@@ -347,7 +348,9 @@ def test_hollow_pose_with_equal_q_is_the_builds_hollow_mesh(hollow_case, tmp_pat
 @pytest.mark.slow
 def test_hollow_pose_with_mixed_q_is_one_ported_body_with_its_walls_reported(hollow_case, tmp_path):
     out = tmp_path / "build"
-    args = ["pose", str(hollow_case), "--q", "0,1,0,1", "--output", str(tmp_path / "p.ply"), "--out", str(out), "--json"]
+    args = [
+        "pose", str(hollow_case), "--q", "0,1,0,1", "--output", str(tmp_path / "p.ply"), "--out", str(out), "--json"
+    ]
     result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
     import json

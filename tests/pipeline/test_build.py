@@ -68,11 +68,13 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     assert statuses(build(demo_case, out)) == dict.fromkeys(STAGES, "skipped")
     edit(demo_case, "fit", smoothing=2.0e-5)
     assert statuses(build(demo_case, out)) == {
-        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "ran", "export": "ran"
+        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
+        "fit": "ran", "export": "ran",
     }
     edit(demo_case, "export", q=[0, 0.5, 1])
     assert statuses(build(demo_case, out)) == {
-        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "ran", "fit": "skipped", "export": "ran"
+        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "ran",
+        "fit": "skipped", "export": "ran",
     }
     # The mesh formats are read by export alone: kinematics (and the fit) stay cached.
     edit(demo_case, "export", formats=["stl", "ply"])

@@ -115,7 +115,7 @@ def load_blend(build_dir: Path) -> BlendResult:
     data = load_npz(Path(build_dir) / layout.BLEND_CURVES)
     summary = json.loads((Path(build_dir) / layout.BLEND_SUMMARY).read_text(encoding="utf-8"))
     keys = [smooth_curve_from_samples(data[f"key_{k}"]) for k in range(len(data["key_q"]))]
-    keyframes = tuple(zip(data["key_q"][1:-1].tolist(), keys[1:-1]))
+    keyframes = tuple(zip(data["key_q"][1:-1].tolist(), keys[1:-1], strict=True))
     shape = blend_shapes(keys[0], keys[-1], keyframes, summary["mode"], summary["frames"])
     return BlendResult(shape, summary)
 

@@ -56,7 +56,13 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     network = NetworkContext(path.points, tuple(p.points for p in ingest.others), *inscribed)
     fit = case.fit
     auto = fit.knot_spacing_mm == "auto"
-    settings = FitSettings(1.0 if auto else fit.knot_spacing_mm, fit.angular_intervals, fit.smoothing, tuple(chain.breaks))
+    settings = FitSettings(
+        # the only text knot_spacing_mm takes is 'auto' (then the spacing is chosen below)
+        1.0 if isinstance(fit.knot_spacing_mm, str) else fit.knot_spacing_mm,
+        fit.angular_intervals,
+        fit.smoothing,
+        tuple(chain.breaks),
+    )
     options = WallFitOptions(
         fit=settings,
         auto_spacing=auto,

@@ -152,7 +152,9 @@ def _summary(case: Case, network: CenterlineNetwork, path: SelectedPath, info: S
             "outlet_mm": path.points[-1].tolist(),
             "bounds_mm": [path.points.min(axis=0).tolist(), path.points.max(axis=0).tolist()],
         },
-        "surface": None if info is None else {"file": case.final.surface.name, **info.as_dict()},
+        "surface": None if info is None or case.final.surface is None else {
+            "file": case.final.surface.name, **info.as_dict()
+        },
     }
 
 

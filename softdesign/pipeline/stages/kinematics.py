@@ -103,7 +103,8 @@ def run_kinematics(case: Case, links: LinksResult) -> KinematicsResult:
         "convention": CONVENTION,
         "units": {"length": "mm", "angle": "rad"},
         "links": [
-            {"index": j, "l_start": float(chain.breaks[j]), "l_end": float(chain.breaks[j + 1])} for j in range(chain.count)
+            {"index": j, "l_start": float(chain.breaks[j]), "l_end": float(chain.breaks[j + 1])}
+            for j in range(chain.count)
         ],
         "per_q": [shape_figures(chain, q) for q in case.export.q_values()],
         "poses": [pose_document(chain, q) for q in case.export.q_values()],
