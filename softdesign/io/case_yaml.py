@@ -46,22 +46,10 @@ def read_case_text(path: Path) -> str:
         raise ConfigError(f"{path}: case file not found; check the path") from None
     except OSError as err:
         raise ConfigError(f"{path}: cannot open the case file ({err.strerror}); check its permissions") from None
-    with os.fdopen(fd, "rb") as handle:
-        info = os.fstat(handle.fileno())
-        if not stat.S_ISREG(info.st_mode):
-            raise ConfigError(
-                f"{path}: is {file_kind(info.st_mode)}, not a regular file; expected a YAML case file "
-                "(e.g. configs/demo.yaml)"
-            )
-        if info.st_size > MAX_CASE_BYTES:
-            raise ConfigError(
-                f"{path}: the case file is {info.st_size} bytes, more than the limit of {MAX_CASE_BYTES} bytes "
-                "(1 MB); a case file holds keys and paths, the data stay in the files it names"
-            )
-        try:
-            data = handle.read(MAX_CASE_BYTES + 1)
-        except OSError as err:
-            raise ConfigError(f"{path}: cannot read the case file ({err.strerror})") from None
+    try:
+        data = _read_regular(path, fd)
+    finally:
+        os.close(fd)
     if len(data) > MAX_CASE_BYTES:  # the file grew after fstat
         raise ConfigError(f"{path}: the case file is more than the limit of {MAX_CASE_BYTES} bytes (1 MB)")
     try:
@@ -71,6 +59,25 @@ def read_case_text(path: Path) -> str:
             f"{path}: the case file is not UTF-8 text (byte {err.start}: {data[err.start:err.start + 1]!r}); "
             "save it as UTF-8 YAML"
         ) from None
+
+
+def _read_regular(path: Path, fd: int) -> bytes:
+    """At most MAX_CASE_BYTES + 1 bytes of the open ``fd``, after checking it is a regular file of at most that size."""
+    info = os.fstat(fd)
+    if not stat.S_ISREG(info.st_mode):
+        raise ConfigError(
+            f"{path}: is {file_kind(info.st_mode)}, not a regular file; expected a YAML case file "
+            "(e.g. configs/demo.yaml)"
+        )
+    if info.st_size > MAX_CASE_BYTES:
+        raise ConfigError(
+            f"{path}: the case file is {info.st_size} bytes, more than the limit of {MAX_CASE_BYTES} bytes "
+            "(1 MB); a case file holds keys and paths, the data stay in the files it names"
+        )
+    try:
+        return os.read(fd, MAX_CASE_BYTES + 1)
+    except OSError as err:
+        raise ConfigError(f"{path}: cannot read the case file ({err.strerror})") from None
 
 
 def file_kind(mode: int) -> str:
@@ -114,9 +121,9 @@ def _check_nesting(path: Path, text: str) -> None:
         if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
             depth += 1
             if depth > MAX_NESTING:
-                line = event.start_mark.line + 1
+                where = f"{path}:{event.start_mark.line + 1}" if event.start_mark is not None else str(path)
                 raise ConfigError(
-                    f"{path}:{line}: mappings and lists nested more than {MAX_NESTING} deep (the limit); "
+                    f"{where}: mappings and lists nested more than {MAX_NESTING} deep (the limit); "
                     "a case file is 3 levels deep, see configs/demo.yaml"
                 )
         elif isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
