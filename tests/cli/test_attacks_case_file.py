@@ -149,3 +149,13 @@ def test_five_thousand_q_values_are_refused_with_a_short_message(tmp_path):
     result = run_limited("validate", str(case))
     text = assert_refused(result, "export.q has more than", f"{MAX_EXPORT_Q} entries (the limit)")
     assert len(text) < 2000
+
+
+def test_the_most_frames_allowed_still_give_every_mesh_its_own_name(tmp_path):
+    """export.frames is bounded by MAX_EXPORT_Q = 1001, where q steps by 0.001: three decimals still tell them apart."""
+    from softdesign.config import load_case
+    from softdesign.pipeline.stages.export import mesh_name
+
+    case = load_case(demo_case(tmp_path, export={"q": None, "frames": MAX_EXPORT_Q}))
+    names = {mesh_name(q, "stl") for q in case.export.q_values()}
+    assert len(names) == MAX_EXPORT_Q

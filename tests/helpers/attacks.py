@@ -55,7 +55,8 @@ def demo_case(folder: Path, name: str = "demo", **sections: Any) -> Path:
         if value is None:
             case.pop(key, None)
         elif isinstance(value, dict) and isinstance(case.get(key), dict):
-            case[key] = {**case[key], **value}
+            merged = {**case[key], **value}
+            case[key] = {k: v for k, v in merged.items() if v is not None}
         else:
             case[key] = value
     path = folder / f"{name}.yaml"
