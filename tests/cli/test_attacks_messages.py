@@ -67,3 +67,19 @@ def test_a_flip_of_rotation_minimizing_frames_does_not_advise_frames_rmf():
     assert f"(limit {FLIP_LIMIT_RAD:g})" in message and "frames: rmf, q = 1" in message
     assert "use frames: rmf" not in message
     assert "resample.smoothing_mm" in message and "kink" in message
+
+
+def test_a_fit_that_fails_because_the_centerline_strays_names_the_resample_keys(prior_build, tmp_path):
+    """resample.smoothing_mm 2 pulls the demo's centerline 2.7 mm off its axis (radius 2.9 mm): rho goes negative."""
+    out = tmp_path / "build"
+    shutil.copytree(prior_build, out)
+    before = snapshot(out)
+    case = demo_case(tmp_path, resample={"smoothing_mm": 2.0})
+    result = runner.invoke(app, ["build", str(case), "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output
+    assert "the cause is the centerline, not the fit" in result.output
+    assert "smoothed by 2 mm (resample.smoothing_mm)" in result.output
+    assert "lower resample.smoothing_mm" in result.output
+    assert "raise fit.smoothing" not in result.output
+    assert snapshot(out) == before
