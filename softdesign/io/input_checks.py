@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import os
 import stat
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -50,6 +52,24 @@ def check_input_file(path: Path, key: str) -> None:
         )
     if not os.access(path, os.R_OK):
         raise InputDataError(f"{key}: {path} cannot be read (permission denied); make it readable for this user")
+
+
+@contextmanager
+def input_os_errors(inputs: list[Path]) -> Iterator[None]:
+    """Turn an OSError on one of ``inputs`` (e.g. EIO, or permission lost mid-run) into an InputDataError naming it."""
+    try:
+        yield
+    except OSError as err:
+        names = {os.path.realpath(p) for p in inputs}
+        path = next(
+            (os.fsdecode(n) for n in (err.filename, err.filename2) if n is not None and os.path.realpath(n) in names),
+            None,
+        )
+        if path is None:
+            raise
+        raise InputDataError(
+            f"{path}: cannot read this input file ({err.strerror or err}); check that it is readable and complete"
+        ) from err
 
 
 def check_npy_header(path: Path) -> None:

@@ -104,3 +104,28 @@ def test_a_csv_centerline_with_a_nan_radius_names_the_point(tmp_path, out):
     centerline.write_text("x,y,z,radius\n" + "\n".join(rows) + "\n")
     refused_build(tmp_path, out, str(centerline), "NaN or infinite values at point 5", "fix or remove",
                   final={"centerline": str(centerline)})
+
+
+def test_an_input_that_fails_to_read_mid_build_is_exit_2_naming_it(tmp_path, out, monkeypatch):
+    """An I/O error (EIO: a failing disk, a dropped network mount) while the build hashes an input."""
+    import errno
+
+    from typer.testing import CliRunner
+
+    from softdesign.cli import app
+    from softdesign.pipeline import runner as pipeline_runner
+
+    surface = _demo_surface()
+    real_hash = pipeline_runner.sha256_file
+
+    def failing(path: Path) -> str:
+        if Path(path).resolve() == surface.resolve():
+            raise OSError(errno.EIO, os.strerror(errno.EIO), str(path))
+        return real_hash(path)
+
+    monkeypatch.setattr(pipeline_runner, "sha256_file", failing)
+    before = snapshot(out)
+    case = demo_case(tmp_path)
+    result = CliRunner().invoke(app, ["build", str(case), "--out", str(out)])
+    assert_refused(result, str(case), f"{surface}: cannot read this input file (Input/output error)")
+    assert snapshot(out) == before
