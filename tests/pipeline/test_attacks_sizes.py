@@ -20,6 +20,8 @@ from tests.helpers.folders import snapshot
 
 #: A full demo build (python start-up, imports, six stages at the coarse export) takes about 12 s.
 BUILD_TIMEOUT_S = 300
+#: How far the vertex estimate of softdesign.pipeline.bounds may fall short of a mesh's vertices (caps, joint rings).
+ESTIMATE_RTOL = 0.01
 
 
 @pytest.fixture(scope="module")
@@ -91,3 +93,23 @@ def test_a_npy_header_claiming_a_huge_array_is_refused_before_allocation(tmp_pat
     result = run_limited("build", str(case), "--out", str(out))
     assert_refused(result, str(centerline), "(100000000000, 3)", "the file has", "truncated or corrupt")
     assert snapshot(out) == before
+
+
+@pytest.mark.slow
+def test_a_mesh_at_the_vertex_limit_builds_within_the_memory_budget(prior_build, tmp_path):
+    """The bound is not only a refusal: the largest mesh it allows builds under RLIMIT_AS = the budget (about 20 s)."""
+    import json
+
+    from softdesign.limits import MAX_ANGULAR_COUNT
+
+    length = demo_length_mm(prior_build)
+    # the finest export.spacing_mm check_sizes allows at the most vertices around, rounded up to 0.1 um
+    spacing = float(np.ceil(length / (MAX_MESH_VERTICES / MAX_ANGULAR_COUNT - 2) * 1e4) / 1e4)
+    out = tmp_path / "build"
+    shutil.copytree(prior_build, out)
+    case = demo_case(tmp_path, export={"q": [1], "spacing_mm": spacing, "angular_count": MAX_ANGULAR_COUNT})
+    result = run_limited("build", str(case), "--out", str(out), timeout=BUILD_TIMEOUT_S)
+    assert result.returncode == 0, result.stderr
+    vertices = json.loads((out / "export" / "summary.json").read_text())["meshes"]["meshes/q_1.000.stl"]["vertices"]
+    # the bound counts rings x angular_count; the caps and the rings at link joints add under ESTIMATE_RTOL
+    assert 0.9 * MAX_MESH_VERTICES < vertices <= (1 + ESTIMATE_RTOL) * MAX_MESH_VERTICES
