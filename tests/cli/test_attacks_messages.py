@@ -83,3 +83,19 @@ def test_a_fit_that_fails_because_the_centerline_strays_names_the_resample_keys(
     assert "lower resample.smoothing_mm" in result.output
     assert "raise fit.smoothing" not in result.output
     assert snapshot(out) == before
+
+
+def test_a_surface_that_does_not_surround_the_path_is_bad_input_exit_2():
+    """It was a FitError (exit 1, "processing failure") though its fix is the case's final.surface or final.path."""
+    from softdesign.errors import FitError, InputDataError
+    from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
+    from softdesign.fitting.projection import project_points
+    from tests.helpers.analytic import Line
+
+    curve = Line(40.0)
+    l, a = np.meshgrid(np.linspace(0.0, 1.0, 40), np.linspace(0.0, 2 * np.pi, 30, endpoint=False))
+    beside = curve.points(l.ravel()) + 3.0 * np.column_stack([np.cos(a.ravel()), np.sin(a.ravel()), 0 * l.ravel()])
+    with pytest.raises(FitError) as err:
+        fit_radius_surface(project_points(curve, beside + np.array([10.0, 0.0, 0.0])), curve.length, FitSettings())
+    assert isinstance(err.value, InputDataError) and err.value.exit_code == 2
+    assert "check final.surface, final.path and units" in str(err.value)
