@@ -11,6 +11,7 @@ softdesign is millimetres, the conversion happens at ingest.
 from __future__ import annotations
 
 import difflib
+import math
 import os
 import re
 from collections.abc import Mapping
@@ -29,8 +30,19 @@ from pydantic import (
     model_validator,
 )
 
+from softdesign.config_types import FiniteFloat, Integer
 from softdesign.errors import ConfigError
+from softdesign.io.case_yaml import parse_case_yaml, read_case_text
 from softdesign.io.formats import MESH_FORMATS
+from softdesign.limits import (
+    MAX_ANGULAR_COUNT,
+    MAX_ANGULAR_INTERVALS,
+    MAX_CURVE_SAMPLES,
+    MAX_EXPORT_Q,
+    MAX_HOLDOUT_FOLDS,
+    MAX_LINKS,
+    MEMORY_BUDGET_TEXT,
+)
 from softdesign.meshing.checks import MIN_ANGULAR_COUNT, VOLUME_RTOL
 from softdesign.pipeline.layout import q_label
 
@@ -44,8 +56,8 @@ class FinalShape(_Section):
 
     centerline: Path
     surface: Path | None = None
-    path: int = Field(0, ge=0)
-    inlet: tuple[float, float, float] | None = None
+    path: Integer = Field(0, ge=0)
+    inlet: tuple[FiniteFloat, FiniteFloat, FiniteFloat] | None = None
     reverse: bool = False
     surface_units: Literal["mm", "cm", "m"] | None = None
 
@@ -53,9 +65,9 @@ class FinalShape(_Section):
 class IntermediateShape(_Section):
     """A keyframe centerline reached at ``q`` (piecewise-linear in q between keyframes)."""
 
-    q: float = Field(gt=0.0, lt=1.0)
+    q: FiniteFloat = Field(gt=0.0, lt=1.0)
     centerline: Path
-    path: int = Field(0, ge=0)
+    path: Integer = Field(0, ge=0)
     reverse: bool = False
 
 
@@ -63,13 +75,13 @@ class InitialShape(_Section):
     """The insertion shape, q = 0, and the body radius there."""
 
     kind: Literal["straight", "arc", "file"] = "straight"
-    length_mm: float | None = Field(None, gt=0.0)
-    radius_mm: float | None = Field(None, gt=0.0)
+    length_mm: FiniteFloat | None = Field(None, gt=0.0)
+    radius_mm: FiniteFloat | None = Field(None, gt=0.0)
     surface: Path | None = None
-    bend_radius_mm: float | None = Field(None, gt=0.0)
-    bend_plane_deg: float = 0.0
+    bend_radius_mm: FiniteFloat | None = Field(None, gt=0.0)
+    bend_plane_deg: FiniteFloat = 0.0
     centerline: Path | None = None
-    path: int = Field(0, ge=0)
+    path: Integer = Field(0, ge=0)
     align_base: bool = True
 
     @model_validator(mode="after")
@@ -86,18 +98,18 @@ class InitialShape(_Section):
 class Resample(_Section):
     """Arc-length resampling and smoothing of every centerline."""
 
-    spacing_mm: float = Field(0.5, gt=0.0)
-    count: int | None = Field(None, ge=4)
-    smoothing_mm: float = Field(0.1, ge=0.0)
-    end_straight_mm: float = Field(2.0, ge=0.0)
+    spacing_mm: FiniteFloat = Field(0.5, gt=0.0)
+    count: Integer | None = Field(None, ge=4, le=MAX_CURVE_SAMPLES)
+    smoothing_mm: FiniteFloat = Field(0.1, ge=0.0)
+    end_straight_mm: FiniteFloat = Field(2.0, ge=0.0)
 
 
 class Links(_Section):
     """How the actuator is split into links: exactly one of the three keys."""
 
-    count: int | None = Field(None, ge=1)
-    breaks: list[float] | None = None
-    length_mm: float | None = Field(None, gt=0.0)
+    count: Integer | None = Field(None, ge=1, le=MAX_LINKS)
+    breaks: list[FiniteFloat] | None = Field(None, max_length=MAX_LINKS + 1)
+    length_mm: FiniteFloat | None = Field(None, gt=0.0)
 
     @model_validator(mode="after")
     def _one_rule(self) -> Links:
@@ -125,10 +137,10 @@ class Fit(_Section):
     # coefficient; 1e-5 is the least penalty that bridges the other iliac's opening; the aorta's
     # elliptical inlet wall reaches 1.79x the inscribed radius, so outliers start at 2x
     knot_spacing_mm: float | Literal["auto"] = 1.5
-    angular_intervals: int = Field(24, ge=4)
-    smoothing: float = Field(1.0e-5, ge=0.0)
-    holdout_folds: int = Field(5, ge=2)
-    outlier_factor: float = Field(2.0, gt=1.0)
+    angular_intervals: Integer = Field(24, ge=4, le=MAX_ANGULAR_INTERVALS)
+    smoothing: FiniteFloat = Field(1.0e-5, ge=0.0)
+    holdout_folds: Integer = Field(5, ge=2, le=MAX_HOLDOUT_FOLDS)
+    outlier_factor: FiniteFloat = Field(2.0, gt=1.0)
 
     @field_validator("knot_spacing_mm", mode="before")
     @classmethod
@@ -137,6 +149,8 @@ class Fit(_Section):
             return value
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ValueError(f"must be a number of mm or 'auto', got {value!r}")
+        if not math.isfinite(value):
+            raise ValueError(f"must be a finite number of mm or 'auto', got {value}")
         if value <= 0:
             raise ValueError(f"must be > 0 mm, got {value}")
         return float(value)
@@ -145,15 +159,15 @@ class Fit(_Section):
 class Export(_Section):
     """Meshes at the requested q values."""
 
-    q: list[float] | None = None
-    frames: int | None = Field(None, ge=2)
-    offset_mm: float = 0.0
-    wall_mm: float | None = Field(None, gt=0.0)
-    port_mm: float | None = Field(None, gt=0.0)
+    q: list[FiniteFloat] | None = Field(None, max_length=MAX_EXPORT_Q)
+    frames: Integer | None = Field(None, ge=2, le=MAX_EXPORT_Q)
+    offset_mm: FiniteFloat = 0.0
+    wall_mm: FiniteFloat | None = Field(None, gt=0.0)
+    port_mm: FiniteFloat | None = Field(None, gt=0.0)
     # the names come from io.formats' registry (one list); mypy cannot read a Literal built from a tuple at run time
     formats: list[Literal[MESH_FORMATS]] = ["stl"]  # type: ignore[valid-type]
-    spacing_mm: float = Field(0.5, gt=0.0)
-    angular_count: int = Field(64, ge=MIN_ANGULAR_COUNT)
+    spacing_mm: FiniteFloat = Field(0.5, gt=0.0)
+    angular_count: Integer = Field(64, ge=MIN_ANGULAR_COUNT, le=MAX_ANGULAR_COUNT)
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...
     split_regions: bool = False
 
@@ -284,13 +298,7 @@ def load_case(path: str | Path) -> Case:
         match the schema; the message names the file, line and field.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ConfigError(f"{path}: case file not found; check the path") from None
-    except (OSError, UnicodeDecodeError) as err:
-        raise ConfigError(f"{path}: cannot read the case file ({err})") from err
-    raw, root = _parse_yaml(path, text)
+    raw, root = _parse_yaml(path, read_case_text(path))
     raw.setdefault("name", path.stem)
     try:
         case = Case.model_validate(raw)
@@ -300,14 +308,7 @@ def load_case(path: str | Path) -> Case:
 
 
 def _parse_yaml(path: Path, text: str) -> tuple[dict[str, Any], yaml.Node | None]:
-    try:
-        raw = yaml.safe_load(text)
-        root = yaml.compose(text)
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f"{path}:{mark.line + 1}" if mark is not None else str(path)
-        problem = getattr(err, "problem", None) or str(err)
-        raise ConfigError(f"{where}: not valid YAML ({problem}); fix the syntax at that line") from None
+    raw, root = parse_case_yaml(path, text)
     if not isinstance(raw, dict):
         raise ConfigError(
             f"{path}: expected a mapping of keys (name, units, final, ...), "
@@ -350,7 +351,17 @@ _TEMPLATES = {
     "less_than": "must be < {lt}",
     "less_than_equal": "must be <= {le}",
     "missing": "is required",
+    "finite_number": "must be a finite number (not NaN, inf, or too large for a float)",
+    "int_type": "must be a whole number written as one (e.g. 4; not true/false, 4.0, 1e6 or a string)",
+    "too_long": "has more than {max_length} entries (the limit)",
 }
+#: Keys whose upper bound is a limit of softdesign.limits (what it protects, for the message).
+_LIMITED = {
+    "resample.count", "links.count", "links.breaks", "fit.angular_intervals", "fit.holdout_folds",
+    "export.q", "export.frames", "export.angular_count",
+}
+#: Longest shown input value in a message, characters (a value of megabytes would make a message of megabytes).
+_SHOWN_CHARS = 200
 
 
 def _format_errors(path: Path, root: yaml.Node | None, err: ValidationError) -> str:
@@ -388,9 +399,16 @@ def _describe(loc: tuple[Any, ...], item: Mapping[str, Any]) -> str:
     # a model-level rule names its keys and quotes the values in its own message
     if kind == "value_error":
         return f"{field}: {text}"
-    got = "" if kind == "missing" else f", got {item.get('input')!r}"
+    got = "" if kind == "missing" else f", got {_shown(item.get('input'))}"
     reason = f": {_RANGE_REASONS[field]}" if field in _RANGE_REASONS and kind in _TEMPLATES else ""
+    if field in _LIMITED and kind in ("less_than_equal", "too_long"):
+        reason = f": a limit of softdesign/limits.py that keeps a build within {MEMORY_BUDGET_TEXT} of memory"
     return f"{field} {text}{got}{reason}"
+
+
+def _shown(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= _SHOWN_CHARS else f"{text[:_SHOWN_CHARS]}... ({len(text)} characters)"
 
 
 def _unknown_key(loc: tuple[Any, ...]) -> str:

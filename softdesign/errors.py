@@ -42,6 +42,12 @@ class FitError(SoftdesignError):
     """The surface fit failed or violates a stated bound."""
 
 
+class InputFitError(FitError, InputDataError):
+    """The fit failed because of the inputs (a surface that does not surround the centerline): bad input, exit 2."""
+
+    exit_code = 2
+
+
 class MeshError(SoftdesignError):
     """A mesh could not be made into a valid solid."""
 

@@ -32,7 +32,7 @@ import numpy.typing as npt
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from softdesign.errors import ConfigError, FitError
+from softdesign.errors import ConfigError, FitError, InputFitError
 from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.projection import PolarPoints
 from softdesign.types import FloatArray, IntArray
@@ -354,7 +354,7 @@ def check_surrounds(polar: PolarPoints, length_mm: float, settings: FitSettings)
     surrounded = gaps <= SURROUND_GAP_RAD
     if surrounded.mean() < MIN_SURROUNDED_FRACTION:
         first = int(np.flatnonzero(~surrounded)[0])
-        raise FitError(
+        raise InputFitError(
             f"surface fit: the wall points surround only {surrounded.mean():.0%} of the path "
             f"(expected >= {MIN_SURROUNDED_FRACTION:.0%}); first gap at l = {first / intervals:.3f} "
             f"({first * length_mm / intervals:.1f} mm), widest empty sector {np.degrees(gaps[first]):.0f} deg; "

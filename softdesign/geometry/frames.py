@@ -129,20 +129,28 @@ def adjacent_rotation_angles(frames: Frames) -> FloatArray:
     return np.arctan2(sin_t, cos_t)
 
 
+#: The fix for a flip of Frenet frames, and for one of rotation-minimizing frames (already rmf: only the curve helps).
+FLIP_FIXES = {
+    "frenet": "use frames: rmf, or smooth the centerline more (resample.smoothing_mm)",
+    "rmf": "the centerline turns this sharply between two samples: smooth it more (resample.smoothing_mm) "
+    "or check the input centerline for a kink there",
+}
+
+
 def check_no_flips(
-    frames: Frames, l: FloatArray, label: str, limit_rad: float = FLIP_LIMIT_RAD, why: str = ""
+    frames: Frames, l: FloatArray, label: str, limit_rad: float = FLIP_LIMIT_RAD, why: str = "",
+    fix: str = FLIP_FIXES["frenet"],
 ) -> float:
     """Largest adjacent rotation, rad; GeometryError naming the l interval if it exceeds ``limit_rad``.
 
-    ``why`` is appended to the message (the likely cause for the frame mode).
+    ``why`` is appended to the message (the likely cause for the frame mode), then ``fix``.
     """
     angles = adjacent_rotation_angles(frames)
     worst = int(np.argmax(angles))
     if angles[worst] > limit_rad:
         raise GeometryError(
             f"frames: {label}: adjacent frames at l = {l[worst]:.6f} and {l[worst + 1]:.6f} differ by "
-            f"{angles[worst]:.3g} rad (limit {limit_rad:g}): the frame flips there{why}; use frames: rmf, "
-            "or smooth the centerline more (resample.smoothing_mm)"
+            f"{angles[worst]:.3g} rad (limit {limit_rad:g}): the frame flips there{why}; {fix}"
         )
     return float(angles[worst])
 
@@ -224,7 +232,7 @@ def framed_curve(
     else:
         frames = _rmf_along(curve, l, base_normal)
     why = " (the Frenet normal reverses where the curvature passes through zero)" if mode == "frenet" else ""
-    worst = check_no_flips(frames, l, f"{mode}, {label}", why=why)
+    worst = check_no_flips(frames, l, f"{mode}, {label}", why=why, fix=FLIP_FIXES[mode])
     at = float(l[int(np.argmax(adjacent_rotation_angles(frames)))])
     return FramedSpline(curve, mode, label, l, frames, worst, at)
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from softdesign.errors import InputDataError
 from softdesign.geometry.network import TRACT_KEYS, CenterlineNetwork, Polyline
+from softdesign.io.input_checks import check_input_file, check_npy_header
 from softdesign.io.vtk_polydata import polydata_arrays, read_polydata
 
 RADIUS_KEY = "MaximumInscribedSphereRadius"
@@ -42,14 +43,22 @@ def read_centerline_network(path: str | Path, scale_to_mm: float = 1.0) -> Cente
             f"{path}: unknown centerline format '{path.suffix}'; expected one of "
             f"{', '.join(sorted(_READERS))} (convert it, e.g. with vmtkcenterlines -ofile x.vtp)"
         )
-    if not path.is_file():
-        raise InputDataError(f"{path}: centerline file not found; check final.centerline in the case file")
+    check_input_file(path, "centerline")
     lines = reader(path)
     if not lines:
         raise InputDataError(
             f"{path}: the file has no polylines (no lines); expected VMTK centerlines "
             "(vmtkcenterlines output), not a surface or a point cloud"
         )
+    for number, line in enumerate(lines):
+        bad = ~np.isfinite(line.points).all(axis=1)
+        if line.radius is not None:
+            bad |= ~np.isfinite(line.radius)
+        if bad.any():
+            raise InputDataError(
+                f"{path}: polyline {number} has NaN or infinite values at point {int(np.flatnonzero(bad)[0])} "
+                f"({int(bad.sum())} point(s)); expected finite coordinates and radii: fix or remove those points"
+            )
     scaled = tuple(
         Polyline(line.points * scale_to_mm, None if line.radius is None else line.radius * scale_to_mm, line.cell_data)
         for line in lines
@@ -110,6 +119,7 @@ def _csv_row(path: Path, line: int, row: list[str], cols: list[int]) -> list[flo
 
 
 def _read_npy(path: Path) -> list[Polyline]:
+    check_npy_header(path)
     try:
         values = np.load(path, allow_pickle=False)
     except (OSError, ValueError) as err:

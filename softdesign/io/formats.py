@@ -60,6 +60,11 @@ class MeshFormat:
 def _read_trimesh(path: Path) -> Mesh:
     import trimesh
 
+    from softdesign.io.input_checks import stl_problem
+
+    problem = stl_problem(path) if path.suffix.lower() == ".stl" else None
+    if problem is not None:
+        raise InputDataError(f"{path}: not an STL file: {problem}; re-export the mesh as STL")
     try:
         mesh = trimesh.load(str(path), force="mesh", process=True)
     except Exception as err:  # trimesh raises many types for malformed files

@@ -15,6 +15,7 @@ import numpy as np
 
 from softdesign.errors import InputDataError
 from softdesign.io.formats import FORMATS, Mesh
+from softdesign.io.input_checks import check_input_file
 
 #: The formats vessel walls come in from VMTK, 3D Slicer or ParaView (.glb is an output for viewers).
 SURFACE_FORMATS = ("stl", "ply", "obj", "vtp", "vtk")
@@ -35,8 +36,7 @@ def read_surface(path: str | Path, scale_to_mm: float = 1.0) -> Mesh:
             f"{path}: unknown surface format '{path.suffix}'; expected one of "
             + ", ".join(sorted(f".{f}" for f in SURFACE_FORMATS))
         )
-    if not path.is_file():
-        raise InputDataError(f"{path}: surface file not found; check final.surface in the case file")
+    check_input_file(path, "surface")
     vertices, faces = FORMATS[name].read(path)
     if len(faces) == 0 or len(vertices) == 0:
         raise InputDataError(

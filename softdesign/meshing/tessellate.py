@@ -236,7 +236,7 @@ def _refuse_bad_sections(q: float, l: FloatArray, xy: FloatArray, rho: FloatArra
         raise MeshError(
             f"{field}: at {_where(q, l[i], angles[k])} the inward offset leaves a radius of {radius[i, k]:.3f} mm, "
             f"expected >= {limit:g} mm; the local radius is {rho[i].min():.3f} mm, so the inward offset in total "
-            f"(wall_mm - offset_mm) must stay below about {rho[i].min() - limit:.3f} mm here: make {field} smaller"
+            f"(wall_mm - offset_mm) must stay below about {rho[i].min() - limit:.3f} mm here: {_inward_fix(field)}"
         )
     bad = np.argwhere(~(np.isfinite(turn) & (turn > 0)))
     if bad.size:
@@ -246,6 +246,13 @@ def _refuse_bad_sections(q: float, l: FloatArray, xy: FloatArray, rho: FloatArra
             f"winds once around the centerline; local radius {rho[i].min():.3f} mm, the section's own "
             f"curvature is too tight for this offset): make |{field}| smaller"
         )
+
+
+def _inward_fix(field: str) -> str:
+    """How to shrink an inward offset that is too deep: a thinner wall, or an offset closer to 0 (not 'smaller')."""
+    if field == "wall_mm":
+        return "make wall_mm thinner (or offset_mm larger)"
+    return f"make {field} closer to 0 (less negative)"
 
 
 def _refuse_ring_crossing(sweep: Sweep, field: str) -> None:

@@ -9,6 +9,7 @@ from typing import Any
 
 from softdesign.config import Case, load_case
 from softdesign.errors import errors_named_for
+from softdesign.io.input_checks import input_os_errors
 from softdesign.pipeline.runner import RunOptions, run_stages
 from softdesign.pipeline.stage import StageRun
 from softdesign.pipeline.stages import STAGES, input_files, stages_through
@@ -43,5 +44,7 @@ def build_through(
     later = tuple(s for s in STAGES if s not in stages)
     options = RunOptions(force=force, progress=progress, later=later)
     with errors_named_for(case_file):
-        results, runs = run_stages(case, build_dir, stages, input_files(case), options)
+        inputs = input_files(case)
+        with input_os_errors(inputs):
+            results, runs = run_stages(case, build_dir, stages, inputs, options)
     return BuildOutcome(case, build_dir, results, runs)

@@ -19,6 +19,7 @@ from typing import Any
 
 from softdesign.config import Case
 from softdesign.pipeline import layout
+from softdesign.pipeline.bounds import check_sizes
 from softdesign.pipeline.lock import BuildLock
 from softdesign.pipeline.manifest import build_manifest
 from softdesign.pipeline.out_folder import check_out_folder, folder_errors
@@ -101,6 +102,8 @@ def _run_all(
         keys[stage.name] = stage_key(stage, case, upstream, input_hashes if not stage.upstream else [])
         step = RunOptions(options.force, _counted(options.progress, index, len(stages)))
         runs.append(_run_one(stage, case, keys[stage.name], results, staging, step))
+        if stage.name == "ingest":  # the vessel is measured: refuse spacings it cannot afford before they run
+            check_sizes(case, results["ingest"])
     for stage in options.later:
         record = read_record(staging.target / layout.stage_record(stage.name))
         if record is not None and all(u in keys for u in stage.upstream):

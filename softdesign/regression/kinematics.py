@@ -45,40 +45,52 @@ def compare_kinematics_files(
         return []
     if not ours.is_file() or not theirs.is_file():
         return [missing_figure("kinematics", KINEMATICS, in_build=ours.is_file())]
-    return compare_kinematics(read_json(ours), read_json(theirs), options, ours.as_posix())
+    return compare_kinematics(read_json(ours), read_json(theirs), options, ours.as_posix(), theirs.as_posix())
 
 
-def compare_kinematics(build: dict, ref: dict, options: CheckOptions, where: str = KINEMATICS) -> list[Figure]:
+def compare_kinematics(
+    build: dict, ref: dict, options: CheckOptions, where: str = KINEMATICS, ref_where: str | None = None
+) -> list[Figure]:
     """Figures of two ``kinematics.json`` objects: frames, then per q each link and the chain transforms."""
     frames_ok = build.get("frames") == ref.get("frames")
     figures = [Figure("kinematics", "frames", None, None, frames_ok, build.get("frames"), ref.get("frames"))]
-    ours, theirs = _keyed(build, "poses", "q", where), _keyed(ref, "poses", "q", "reference " + where)
+    ref_where = ref_where or "reference " + where
+    ours, theirs = _keyed(build, "poses", "q", where), _keyed(ref, "poses", "q", ref_where)
     for q in sorted(set(ours) | set(theirs), key=_numeric_order):
         item = f"kinematics q={q}"
         if q not in ours or q not in theirs:
             figures.append(missing_figure(item, "pose", in_build=q in ours))
             continue
-        figures += _pose_figures(item, ours[q], theirs[q], options, f"{where}: pose q={q}")
+        pose_wheres = (f"{where}: pose q={q}", f"{ref_where}: pose q={q}")
+        figures += _pose_figures(item, ours[q], theirs[q], options, pose_wheres)
     return figures
 
 
-def _pose_figures(item: str, pose: dict, ref_pose: dict, options: CheckOptions, where: str) -> list[Figure]:
-    ours, theirs = _keyed(pose, "links", "index", where), _keyed(ref_pose, "links", "index", "reference " + where)
+def _pose_figures(
+    item: str, pose: dict, ref_pose: dict, options: CheckOptions, wheres: tuple[str, str]
+) -> list[Figure]:
+    """``wheres``: where the build's and the reference's pose are, for messages."""
+    where, ref_where = wheres
+    ours, theirs = _keyed(pose, "links", "index", where), _keyed(ref_pose, "links", "index", ref_where)
     figures: list[Figure] = []
     for index in sorted(set(ours) | set(theirs), key=_numeric_order):
         link_item = f"{item} link {index}"
         if index not in ours or index not in theirs:
             figures.append(missing_figure(link_item, "link", in_build=index in ours))
             continue
-        figures += _link_figures(link_item, ours[index], theirs[index], options, f"{where} link {index}")
+        link_wheres = (f"{where} link {index}", f"{ref_where} link {index}")
+        figures += _link_figures(link_item, ours[index], theirs[index], options, link_wheres)
     for key in POSE_TRANSFORMS:
         if pose.get(key) is not None or ref_pose.get(key) is not None:
-            figures += _transform_figures(f"{item} {key}", pose.get(key), ref_pose.get(key), options, f"{where} {key}")
+            key_wheres = (f"{where} {key}", f"{ref_where} {key}")
+            figures += _transform_figures(f"{item} {key}", pose.get(key), ref_pose.get(key), options, key_wheres)
     return figures
 
 
-def _link_figures(item: str, link: dict, ref_link: dict, options: CheckOptions, where: str) -> list[Figure]:
-    figures = _transform_figures(item, link.get("transform"), ref_link.get("transform"), options, where)
+def _link_figures(
+    item: str, link: dict, ref_link: dict, options: CheckOptions, wheres: tuple[str, str]
+) -> list[Figure]:
+    figures = _transform_figures(item, link.get("transform"), ref_link.get("transform"), options, wheres)
     poe, ref_poe = link.get("poe") or {}, ref_link.get("poe") or {}
     for figure, value, reference, tolerance in (
         ("length_mm", link.get("length"), ref_link.get("length"), options.distance_mm),
@@ -90,11 +102,11 @@ def _link_figures(item: str, link: dict, ref_link: dict, options: CheckOptions, 
 
 
 def _transform_figures(
-    item: str, transform: Any, ref_transform: Any, options: CheckOptions, where: str
+    item: str, transform: Any, ref_transform: Any, options: CheckOptions, wheres: tuple[str, str]
 ) -> list[Figure]:
     if transform is None or ref_transform is None:
         return [missing_figure(item, "transform", in_build=transform is not None)]
-    translation, angle = pose_difference(_pose(transform, where), _pose(ref_transform, "reference " + where))
+    translation, angle = pose_difference(_pose(transform, wheres[0]), _pose(ref_transform, wheres[1]))
     return [
         Figure(item, "translation_mm", translation, options.distance_mm, translation <= options.distance_mm),
         Figure(item, "rotation_rad", angle, options.rotation_rad, angle <= options.rotation_rad),

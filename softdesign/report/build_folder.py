@@ -9,6 +9,7 @@ built only through ``softdesign kinematics`` gets a report without them).
 from __future__ import annotations
 
 import json
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -98,7 +99,7 @@ def load_build(build_dir: str | Path) -> BuildData:
         kinematics = load_kinematics(root, load_links(root, blend))
         fit = load_fit(root) if _has(root, layout.FIT_SURFACE, layout.FIT_POINTS, layout.FIT_SUMMARY) else None
         export = load_export(root).summary if _has(root, layout.EXPORT_SUMMARY) else None
-    except (OSError, KeyError, ValueError, json.JSONDecodeError) as err:
+    except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile) as err:  # a truncated .npz is a BadZipFile
         raise InputDataError(
             f"{root}: a stage's kept files are unreadable ({type(err).__name__}: {err}); {fix} --force"
         ) from err

@@ -17,6 +17,8 @@ from pathlib import Path
 
 from softdesign.errors import ConfigError
 from softdesign.pipeline.layout import REPORT_DIR
+from softdesign.pipeline.lock import BuildLock
+from softdesign.pipeline.out_folder import folder_errors
 from softdesign.pipeline.store import process_alive
 from softdesign.report import animation, fit_figures, kinematics_figures, morph_figures, surface_figures
 from softdesign.report.build_folder import BuildData, load_build
@@ -101,7 +103,9 @@ def write_report(build_dir: str | Path, options: ReportOptions = ReportOptions()
     if missing:
         raise RuntimeError(f"report page links to files it does not write: {missing}")  # a bug, not a user error
     target = Path(build_dir) / REPORT_DIR
-    commit_folder(target, files)
+    # under the build's lock, so a build cannot swap the folder away mid-commit; OSErrors name the folder, exit 2
+    with folder_errors(Path(build_dir)), BuildLock(Path(os.path.realpath(build_dir))):
+        commit_folder(target, files)
     return ReportResult(target / PAGE, {k: len(v) for k, v in sorted(files.items())}, passed, len(checks), notes)
 
 

@@ -14,10 +14,10 @@ from typing import Any
 import numpy as np
 
 from softdesign.config import Case
-from softdesign.errors import InputDataError
 from softdesign.geometry.network import CenterlineNetwork, Orientation, SelectedPath, all_paths, select_path
 from softdesign.geometry.plausibility import check_surface_surrounds, check_vessel_scale
 from softdesign.io.centerline import read_centerline_network
+from softdesign.io.input_checks import check_input_file
 from softdesign.io.surface import read_surface
 from softdesign.meshing.topology import SurfaceInfo, describe_surface
 from softdesign.pipeline import layout
@@ -77,10 +77,7 @@ def input_files(case: Case) -> list[Path]:
         A named file does not exist.
     """
     for name, path in input_fields(case):
-        if not path.is_file():
-            raise InputDataError(
-                f"{name}: file not found: {path}; check the path (relative paths start at the case file's folder)"
-            )
+        check_input_file(path, name)
     return [path for _, path in input_fields(case)]
 
 

@@ -1,0 +1,28 @@
+"""The number types of the case file's schema: finite floats and true integers.
+
+Every numeric key of the case file is one of these two, so ``softdesign
+validate`` refuses what would otherwise reach the numeric core: NaN, inf and
+``"1e400"`` (which reads as inf) for a float; a bool (``count: true`` is not
+one link), a float (``count: 1e30``, ``count: 2.0``) or a string for an
+integer.  A float key takes an integer (``spacing_mm: 1``) and a number
+written without a dot (YAML 1.1 reads ``1e-5`` as the string "1e-5"), but
+never a bool.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any
+
+from pydantic import AllowInfNan, BeforeValidator, Strict
+
+
+def _not_a_bool(value: Any) -> Any:
+    if isinstance(value, bool):
+        raise ValueError(f"must be a number, got {value!r} (true/false is not a number)")
+    return value
+
+
+#: A float that is finite (NaN, inf and overflowing strings like "1e400" are refused) and not a bool.
+FiniteFloat = Annotated[float, BeforeValidator(_not_a_bool), AllowInfNan(False)]
+#: An integer written as one: bools, floats and strings are refused.
+Integer = Annotated[int, Strict()]
