@@ -18,7 +18,14 @@ from scipy.spatial import cKDTree
 
 from softdesign.centerline.closing import ClosedSurface, Opening, close_surface
 from softdesign.centerline.endpoints import caps_from_regions, choose_inlet, graph_extremities, planar_caps
-from softdesign.centerline.paths import check_path_length, least_cost_paths, seed_vertex, smooth_path
+from softdesign.centerline.paths import (
+    bridge_components,
+    check_path_length,
+    least_cost_paths,
+    seed_vertex,
+    smooth_path,
+    trim_rounded_ends,
+)
 from softdesign.centerline.voronoi import VoronoiGraph, internal_voronoi, mean_edge_length
 from softdesign.errors import ConfigError, InputDataError
 from softdesign.types import FloatArray, Points
@@ -107,7 +114,10 @@ def extract_centerlines(
     smoothing = SMOOTHING_REL * mean_edge_length(closed.vertices, closed.faces)
     tree = cKDTree(closed.vertices)
     paths, radii = [], []
+    graph = bridge_components(graph, seeds)
     for k, ids in enumerate(least_cost_paths(graph, seeds[0], seeds[1:])):
+        if kind == "graph extremities":
+            ids = trim_rounded_ends(ids, graph)
         check_path_length(graph.points[ids], k)
         points, radius = smooth_path(graph.points[ids], tree, spacing, smoothing)
         paths.append(points)

@@ -34,6 +34,9 @@ from softdesign.errors import GeometryError
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
 from softdesign.types import FloatArray, IntArray, Points
 
+#: A path between graph extremities keeps the vertices at least this many of their radii from each tip.
+TIP_RADII = 2.0
+
 
 def edge_costs(graph: VoronoiGraph) -> FloatArray:
     """Cost of each Voronoi edge (k,): its length times the mean of 1/R at its ends (dimensionless)."""
@@ -60,6 +63,35 @@ def seed_vertex(graph: VoronoiGraph, surface_vertices: FloatArray, point: FloatA
     nearest = int(cKDTree(surface_vertices).query(point)[1])
     pole = pole_of(graph, nearest)
     return pole if pole >= 0 else int(cKDTree(graph.points).query(point)[1])
+
+
+def bridge_components(graph: VoronoiGraph, seeds: list[int]) -> VoronoiGraph:
+    """The graph with edges added so that every seed's piece joins the first seed's, where balls overlap.
+
+    The internal-tetrahedron test drops some circumcentres at sharp creases (the crotch of a branch
+    grafted onto a tube), which can cut the Voronoi graph there although the lumen is open.  VMTK's fast
+    marching crosses such gaps through the Voronoi faces; here a vertex of a seed's piece is joined to
+    its nearest vertex of another piece when one of the two centres lies inside the other's empty sphere
+    (the segment between them then lies inside the lumen).  Only pieces holding a seed are bridged.
+    """
+    from scipy.sparse.csgraph import connected_components
+
+    _, label = connected_components(graph.adjacency(np.ones(len(graph.edges))), directed=False)
+    added: list[IntArray] = []
+    for seed in seeds[1:]:
+        piece = np.flatnonzero(label == label[seed])
+        if label[seed] == label[seeds[0]]:
+            continue
+        rest = np.flatnonzero(label != label[seed])
+        distance, nearest = cKDTree(graph.points[rest]).query(graph.points[piece])
+        other = rest[nearest]
+        overlap = distance < np.maximum(graph.radius[piece], graph.radius[other])
+        added.append(np.stack([piece[overlap], other[overlap]], axis=1))
+        label[label == label[seed]] = label[seeds[0]] if overlap.any() else label[seed]
+    if not added:
+        return graph
+    edges = np.concatenate([graph.edges, *added])
+    return VoronoiGraph(graph.points, graph.radius, graph.tets, edges)
 
 
 def least_cost_paths(graph: VoronoiGraph, source: int, targets: list[int]) -> list[IntArray]:
@@ -118,6 +150,22 @@ def smooth_path(
     samples = curve.points(curve.l_grid)
     radius = np.asarray(surface_tree.query(samples)[0], float)
     return samples, radius
+
+
+def trim_rounded_ends(ids: IntArray, graph: VoronoiGraph) -> IntArray:
+    """Drop the Voronoi vertices whose empty sphere reaches past either end of the path (ids, proximal first).
+
+    A path between graph extremities runs into the tips of rounded ends, where the medial axis frays and
+    the radius falls to nothing, and where the tip lies off the axis (most segmented domes), the path
+    curls towards it.  Keeping only the vertices at least TIP_RADII of their own radii (along the path)
+    from each end drops the curl: one radius is where the last sphere touches the tip (where a pole stops
+    a path at an opening); the second is the dome itself, over which the sphere's centre leaves the axis
+    (on the VMTK aorta's capped top, up to 6 mm at one radius from the tip, 0.1 mm at two).
+    """
+    points = graph.points[ids]
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    keep = (s >= TIP_RADII * graph.radius[ids]) & (s[-1] - s >= TIP_RADII * graph.radius[ids])
+    return ids[keep] if keep.sum() >= 4 else ids
 
 
 def check_path_length(points: Points, index: int) -> None:
