@@ -160,9 +160,9 @@ def _candidates(closed: ClosedSurface, options: CenterlineOptions) -> tuple[str,
     """The openings, else the labelled caps, else the flat caps (empty when there are fewer than two)."""
     if closed.openings:
         return "openings", closed.openings
-    if options.regions is not None and len(np.unique(options.regions)) > 1:
-        faces = closed.faces[: len(options.regions)]
-        return "face regions", caps_from_regions(closed.vertices, faces, options.regions)
+    regions = options.regions
+    if regions is not None and len(regions) == len(closed.faces) and len(np.unique(regions)) > 1:
+        return "face regions", caps_from_regions(closed.vertices, closed.faces, regions)
     caps = planar_caps(closed.vertices, closed.faces)
     return ("planar caps", caps) if len(caps) >= 2 else ("graph extremities", ())
 

@@ -112,3 +112,40 @@ def test_bad_options_exit_2(tmp_path):
 def test_help():
     result = runner.invoke(app, ["centerline", "--help"])
     assert result.exit_code == 0 and "--outlet" in result.output
+
+
+def test_labelled_caps_are_the_endpoints(tmp_path):
+    import vtk
+    from vtk.util.numpy_support import numpy_to_vtk
+
+    from softdesign.io.vtk_polydata import polydata_from_triangles, polydata_writer
+    from tests.helpers.vessels import y_bifurcation
+
+    vertices, faces, axes = y_bifurcation(4.0, 3.0, 30.0, np.radians(30.0), 0.8)
+    centroids = vertices[faces].mean(axis=1)
+    labels = np.ones(len(faces), np.int32)  # the wall
+    for label, axis in enumerate(axes, start=2):  # each flat end: faces whose centroid lies at its far end
+        end = np.abs(centroids @ axis - 30.0) < 1e-6
+        labels[end] = label
+    poly = polydata_from_triangles(vertices, faces)
+    array = numpy_to_vtk(labels, deep=True)
+    array.SetName("CellEntityIds")
+    poly.GetCellData().AddArray(array)
+    writer = polydata_writer(poly)
+    writer.SetFileName(str(tmp_path / "y.vtp"))
+    assert writer.Write() == 1 and vtk is not None
+    result = runner.invoke(app, ["centerline", str(tmp_path / "y.vtp"), "--output", str(tmp_path / "cl.vtp"), "--json"])
+    assert result.exit_code == 0, result.output
+    assert '"endpoints": "face regions"' in result.output
+    network = read_centerline_network(tmp_path / "cl.vtp")
+    assert len(network.polylines) == 2
+    assert all(p.points[0, 2] < -20.0 for p in network.polylines)  # from the trunk's (largest) cap
+
+
+def test_outlet_option_gives_one_path_per_outlet(aorta_dir, tmp_path):
+    out = tmp_path / "cl.vtp"
+    surface = str(aorta_dir / "aorta-surface-open-ends.stl")
+    result = runner.invoke(app, ["centerline", surface, "--outlet", "210.1,102.9,30.7", "--output", str(out)])
+    assert result.exit_code == 0, result.output
+    (line,) = read_centerline_network(out).polylines
+    assert line.points[0, 1] > 165.0 and np.linalg.norm(line.points[-1] - [210.1, 102.9, 30.7]) < 8.0
