@@ -7,24 +7,33 @@ of a sphere that holds no surface point (the *maximum inscribed sphere
 radius*), and two tetrahedra sharing a face give a Voronoi edge.  Of these
 vertices the ones inside the surface approximate its medial axis.
 
+Which circumcentres are inside is decided as VMTK's
+``vtkvmtkInternalTetrahedraExtractor`` decides it: every corner's outward
+vertex normal sees the circumcentre on its inner side (a numpy test, so a
+100,000-triangle surface costs a fraction of a second; ray casting,
+vtkSelectEnclosedPoints, took 1 s on the 13,000-triangle VMTK aorta).  Of
+the 21,386 vertices it keeps there, ray casting puts 41 outside, all within
+0.91 mm of the wall: slivers whose small radius the 1/R cost keeps paths away
+from.  Centres outside the surface's
+bounding box are dropped first: nearly flat tetrahedra on a planar cap have
+far-away centres that no normal test can judge.
+
 Where this differs from VMTK, and why:
 
-* VMTK keeps the *internal tetrahedra* (each vertex normal sees the
-  circumcentre on its inner side) and then walks the Voronoi *faces* with a
-  fast-marching solver; here the circumcentres themselves are tested against
-  the surface (signed distance from vtk's ``vtkImplicitPolyDataDistance``),
-  and the path search runs on the Voronoi *edges* (:mod:`.paths`), which is
-  a sparse graph scipy's Dijkstra solves exactly.  The edge graph is finer
-  than VMTK's backtracing needs to be: its zig-zag is of the order of the
-  spread of the Voronoi vertices about the medial axis, which the smoothing
-  spline removes.
+* VMTK walks the Voronoi *faces* with a fast-marching solver and backtraces
+  by steepest descent; here the path search runs on the Voronoi *edges*
+  (:mod:`.paths`), a sparse graph scipy's Dijkstra solves exactly.  The
+  edge path zig-zags by the spread of the Voronoi vertices about the medial
+  axis, which the smoothing spline removes.
 * Qhull is asked for a Delaunay tetrahedralisation of the points after a
-  seeded jitter of ``JITTER_REL`` times the mean edge: surfaces built from
-  rings of points (every analytic tube, many CAD exports) have four or more
-  co-spherical points everywhere, whose flat tetrahedra have no circumcentre.
-  VMTK relies on vtkDelaunay3D's own tie-breaking for the same cases.
+  seeded jitter of ``JITTER_REL`` times the mean edge, and the circumspheres
+  are those of the jittered points: surfaces built from rings of points
+  (every analytic tube, many CAD exports) have four or more co-spherical
+  points everywhere, whose flat tetrahedra have no circumcentre (any point
+  on a line), and only the jittered spheres are empty.  VMTK relies on
+  vtkDelaunay3D's own tie-breaking for the same cases.
 
-No files, no printing: numpy, scipy, and vtk for the signed distance.
+No files, no printing: numpy and scipy only.
 """
 
 from __future__ import annotations
