@@ -519,6 +519,7 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
         emit([f"VMTK aorta: skipped, {AORTA_DIR} not found", ""])
     else:
         emit(stage_table(measure(aorta, scratch)) + [""])
+    emit(centerline_lines() + [""])
     plan = synthetic_plan(scratch, args.triangles, args.frames)
     results = run_synthetic(plan, scratch)
     top_t, top_f = max(args.triangles), max(args.frames)
@@ -542,6 +543,15 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
             + profile_lines(profile_dir)
         )
     emit(["", f"benchmark took {time.perf_counter() - started:.0f} s"])
+
+
+def centerline_lines() -> list[str]:
+    """`softdesign centerline` on a 100k-triangle surface and the aorta (pipelines/bench_centerline.py)."""
+    done = subprocess.run([sys.executable, str(REPO / "pipelines" / "bench_centerline.py")],
+                          capture_output=True, text=True, cwd=REPO)
+    if done.returncode != 0:
+        raise RuntimeError(f"bench_centerline.py failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
+    return done.stdout.splitlines()
 
 
 def parse_counts(text: str) -> list[int]:

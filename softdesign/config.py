@@ -52,14 +52,24 @@ class _Section(BaseModel):
 
 
 class FinalShape(_Section):
-    """The patient's shape, q = 1."""
+    """The patient's shape, q = 1.
 
-    centerline: Path
+    ``centerline: auto`` extracts it from ``surface`` at ingest (softdesign.centerline, as
+    ``softdesign centerline`` does); the file it makes is kept in the build folder.
+    """
+
+    centerline: Literal["auto"] | Path
     surface: Path | None = None
     path: Integer = Field(0, ge=0)
     inlet: tuple[FiniteFloat, FiniteFloat, FiniteFloat] | None = None
     reverse: bool = False
     surface_units: Literal["mm", "cm", "m"] | None = None
+
+    @model_validator(mode="after")
+    def _auto_needs_surface(self) -> FinalShape:
+        if self.centerline == "auto" and self.surface is None:
+            raise ValueError("centerline: auto extracts the centerline from the surface: give surface too")
+        return self
 
 
 class IntermediateShape(_Section):
@@ -321,8 +331,13 @@ def _resolve_paths(case: Case, base: Path) -> Case:
     def full(p: Path | None) -> Path | None:
         return None if p is None else (p if p.is_absolute() else base / p)
 
+    def full_or_auto(p: Path | Literal["auto"]) -> Path | Literal["auto"]:
+        if isinstance(p, str):  # "auto": extracted from the surface at ingest
+            return p
+        return p if p.is_absolute() else base / p
+
     final = case.final.model_copy(
-        update={"centerline": full(case.final.centerline), "surface": full(case.final.surface)}
+        update={"centerline": full_or_auto(case.final.centerline), "surface": full(case.final.surface)}
     )
     initial = case.initial.model_copy(
         update={"centerline": full(case.initial.centerline), "surface": full(case.initial.surface)}

@@ -118,6 +118,30 @@ def distances_from_text(
     return values
 
 
+def point_from_text(text: str, option: str) -> tuple[float, float, float]:
+    """Parse a point ``x,y,z`` (``--inlet``, ``--outlet``): three finite numbers.
+
+    Raises
+    ------
+    ConfigError
+        Not three entries, or an entry that is not a finite number.
+    """
+    parts = text.split(",")
+    fix = f"give the point as three numbers separated by commas, in the surface's units (e.g. {option} 12.5,-3,40)"
+    if len(parts) != 3:
+        raise ConfigError(f"{option} {text!r}: {len(parts)} value(s), expected 3 (x,y,z); {fix}")
+    values = []
+    for part in parts:
+        try:
+            value = float(part)
+        except ValueError:
+            raise ConfigError(f"{option} {text!r}: '{part.strip()}' is not a number; {fix}") from None
+        if not math.isfinite(value):
+            raise ConfigError(f"{option} {text!r}: '{part.strip()}' is not finite; {fix}")
+        values.append(value)
+    return values[0], values[1], values[2]
+
+
 class StageProgress:
     """Progress of a build on stderr: a bar on a terminal, plain lines otherwise (logs, make -j).
 

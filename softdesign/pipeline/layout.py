@@ -20,6 +20,8 @@ INGEST_SURFACE = "ingest/surface.npz"
 INGEST_INITIAL_PATH = "ingest/initial_path.npz"
 INGEST_INITIAL_SURFACE = "ingest/initial_surface.npz"
 INGEST_SUMMARY = "ingest/summary.json"
+#: The centerline extracted from the surface (``final.centerline: auto``), VMTK's layout, in the case's units.
+INGEST_CENTERLINE = "ingest/centerline.vtp"
 BLEND_CURVES = "blend/curves.npz"
 BLEND_SUMMARY = "blend/summary.json"
 LINKS = "links/links.json"

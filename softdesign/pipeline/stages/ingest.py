@@ -21,6 +21,7 @@ from softdesign.io.input_checks import check_input_file
 from softdesign.io.surface import read_surface
 from softdesign.meshing.topology import SurfaceInfo, describe_surface
 from softdesign.pipeline import layout
+from softdesign.pipeline.auto_centerline import extract_for_case, extraction_summary, write_extracted
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 from softdesign.types import UNIT_SCALE_TO_MM, FloatArray
@@ -43,6 +44,7 @@ class IngestResult:
     initial_surface : (vertices, faces) of ``initial.surface``, or None
     summary : the JSON-ready report printed and stored
     notes : what was done on the way (duplicates, orientation, warnings)
+    extracted : the centerline extracted from the surface (``final.centerline: auto``), or None
     """
 
     path: SelectedPath
@@ -54,6 +56,7 @@ class IngestResult:
     initial_surface: tuple[FloatArray, np.ndarray] | None = None
     summary: dict[str, Any] = field(default_factory=dict)
     notes: tuple[str, ...] = ()
+    extracted: Any = None
 
 
 def input_fields(case: Case) -> list[tuple[str, Path]]:
@@ -65,7 +68,7 @@ def input_fields(case: Case) -> list[tuple[str, Path]]:
         ("initial.surface", case.initial.surface),
     ]
     named += [(f"intermediate[{i}].centerline", k.centerline) for i, k in enumerate(case.intermediate)]
-    return [(name, path) for name, path in named if path is not None]
+    return [(name, path) for name, path in named if isinstance(path, Path)]  # not None, not "auto"
 
 
 def input_files(case: Case) -> list[Path]:
@@ -92,13 +95,13 @@ def run_ingest(case: Case) -> IngestResult:
         The vessel's size is not a human vessel's in the declared ``units`` (checked before the surface is read).
     """
     scale = UNIT_SCALE_TO_MM[case.units]
-    network = read_centerline_network(case.final.centerline, scale)
+    network, extracted = _final_network(case, scale)
     inlet = None if case.final.inlet is None else np.asarray(case.final.inlet, float) * scale
     orientation = Orientation(inlet=inlet, reverse=case.final.reverse)
     path = select_path(network, case.final.path, orientation)
-    check_vessel_scale(path.length, path.radius, case.units, f"final.centerline {case.final.centerline.name}")
+    check_vessel_scale(path.length, path.radius, case.units, f"final.centerline {_centerline_name(case)}")
     others = tuple(p for p in all_paths(network, Orientation(inlet=path.points[0])) if p.index != path.index)
-    notes = list(path.notes)
+    notes = list(path.notes) + (list(extracted.notes) if extracted is not None else [])
     vertices, faces, info = _final_surface(case, path, scale)
     initial_path = None
     if case.initial.kind == "file" and case.initial.centerline is not None:
@@ -112,7 +115,23 @@ def run_ingest(case: Case) -> IngestResult:
     if case.initial.surface is not None:
         initial_surface = read_surface(case.initial.surface, scale)
     summary = _summary(case, network, path, info)
-    return IngestResult(path, others, vertices, faces, initial_path, keyframes, initial_surface, summary, tuple(notes))
+    if extracted is not None:
+        summary["centerline"]["extracted"] = extraction_summary(extracted)
+    return IngestResult(
+        path, others, vertices, faces, initial_path, keyframes, initial_surface, summary, tuple(notes), extracted
+    )
+
+
+def _final_network(case: Case, scale: float) -> tuple[CenterlineNetwork, Any]:
+    """The final centerline network (mm), read, or extracted from the surface (then also the extraction)."""
+    if case.final.centerline == "auto":
+        return extract_for_case(case)
+    return read_centerline_network(case.final.centerline, scale), None
+
+
+def _centerline_name(case: Case) -> str:
+    centerline = case.final.centerline
+    return "auto" if centerline == "auto" else Path(centerline).name
 
 
 def _one_path(file: Path, index: int, scale: float, orientation: Orientation) -> SelectedPath:
@@ -137,7 +156,7 @@ def _summary(case: Case, network: CenterlineNetwork, path: SelectedPath, info: S
     return {
         "units": case.units,
         "centerline": {
-            "file": case.final.centerline.name,
+            "file": _centerline_name(case),
             "branch_split": network.branch_split,
             "polylines": len(network.polylines),
             "paths": paths,
@@ -168,6 +187,8 @@ def write_ingest(result: IngestResult, staging: Staging) -> None:
     if result.initial_surface is not None:
         v, f = result.initial_surface
         staging.write_bytes(layout.INGEST_INITIAL_SURFACE, npz_bytes(vertices=v, faces=f))
+    if result.extracted is not None:
+        write_extracted(result.extracted, staging, result.summary["units"])
     staging.write_json(layout.INGEST_SUMMARY, {**result.summary, "notes": list(result.notes)})
 
 
