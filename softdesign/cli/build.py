@@ -14,7 +14,8 @@ from softdesign.cli.common import CaseArg, ForceOpt, JsonOpt, OutOpt, StageProgr
 
 ReportOpt = Annotated[bool, typer.Option("--report", help="Then write BUILD/report/index.html (softdesign report).")]
 StrictOpt = Annotated[
-    bool, typer.Option("--strict", help="Exit 1 when the design is not feasible for the case's material (the build is kept).")
+    bool,
+    typer.Option("--strict", help="Exit 1 when the design is not feasible for the case's material (the build is kept)."),
 ]
 KinematicsQOpt = Annotated[
     str | None, typer.Option("--q", help="One q for every link ('0.5') or one per link ('0.2,0.8,1'), each in [0, 1].")

@@ -166,7 +166,7 @@ def search_morph(extremes_at: Callable[[float], StretchExtremes]) -> tuple[Morph
         best = int(np.argmin(values))
         q_best, e_best = float(qs[best]), pick(found[best])
         lo, hi = qs[max(best - 1, 0)], qs[min(best + 1, len(qs) - 1)]
-        result = minimize_scalar(lambda q: sign * pick(extremes_at(float(q))).value, bounds=(lo, hi),
+        result = minimize_scalar(lambda q, s=sign, p=pick: s * p(extremes_at(float(q))).value, bounds=(lo, hi),
                                  method="bounded", options={"xatol": Q_XTOL})
         if result.fun < values[best]:
             q_best, e_best = float(result.x), pick(extremes_at(float(result.x)))

@@ -31,15 +31,16 @@ import numpy.typing as npt
 
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.strain import SectionDerivatives, curve_terms
+from softdesign.geometry.frames import FramedSpline
 from softdesign.meshing.compare import _squared_distances
 from softdesign.meshing.volume import angle_grid, angular_derivative, section_curves
-from softdesign.types import FloatArray, FramedCurve
+from softdesign.types import FloatArray
 
 #: Arc-length step of the central difference along l of an offset section, mm.
 FD_STEP_MM = 1e-3
 
 
-def offset_sections(curve: FramedCurve, field: RadiusField, q: float, l: npt.ArrayLike, angular_count: int,
+def offset_sections(curve: FramedSpline, field: RadiusField, q: float, l: npt.ArrayLike, angular_count: int,
                     offset_mm: float, frames_mode: str = "rmf") -> SectionDerivatives:
     """The surface offset by ``offset_mm`` along its normal (< 0: inward, the chamber) with its derivatives.
 
@@ -72,7 +73,9 @@ class ThinSpot:
     a: float
 
 
-def wall_distances(inner_points: npt.ArrayLike, outer_vertices: npt.ArrayLike, outer_faces: npt.ArrayLike) -> FloatArray:
+def wall_distances(
+    inner_points: npt.ArrayLike, outer_vertices: npt.ArrayLike, outer_faces: npt.ArrayLike
+) -> FloatArray:
     """True distance (mm) from each inner point (..., 3) to the outer triangle mesh, same leading shape."""
     points = np.asarray(inner_points, float)
     flat = points.reshape(-1, 3)

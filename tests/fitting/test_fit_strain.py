@@ -1,4 +1,4 @@
-"""Principal stretches of the skin: known answers (bent tube, growing tube), the closed form, and the mesh cross-check."""
+"""Principal stretches of the skin: known answers (bent tube, growing tube), the closed form, the mesh cross-check."""
 
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ def _constant_field(radius_initial: float, radius_final: float, breaks=(0.0, 0.5
     knots = bb.open_knots(list(breaks), [6] * (len(breaks) - 1))
     count = len(knots) - bb.DEGREE - 1
     links = []
-    for lo, hi in zip(breaks[:-1], breaks[1:]):
+    for lo, hi in zip(breaks[:-1], breaks[1:], strict=True):
         k = bb.open_knots([lo, hi], [6])
         links.append(RadiusSpline(k, np.full((len(k) - bb.DEGREE - 1, 16), radius_final)))
     assert count > 0

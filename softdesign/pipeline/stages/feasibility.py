@@ -17,7 +17,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -48,6 +48,7 @@ from softdesign.pipeline.stages.export import body_spec
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
+from softdesign.types import FramedCurve
 
 VERSION = 1
 SUMMARY = "feasibility/summary.json"
@@ -135,7 +136,7 @@ def _at_q(body: _Body, q: float, case: Case) -> dict[str, Any]:
         "stretch_max": skin.maximum.value,
         "stretch_min": skin.minimum.value,
         "wall_min_mm": None,
-        "rho_kappa_max": fold_margin(body.shape.curve_at(q), body.field, q).max_rho_kappa,
+        "rho_kappa_max": fold_margin(cast(FramedCurve, body.shape.curve_at(q)), body.field, q).max_rho_kappa,
         "where": {"stretch_max": _where(skin.maximum), "stretch_min": _where(skin.minimum)},
         "per_link": [{"stretch_max": hi, "stretch_min": lo} for hi, lo in skin.per_link],
         "grid": {"spacing_mm": skin.grid.spacing_mm, "angles": skin.grid.angles, "points": skin.grid.points,
@@ -209,8 +210,9 @@ def judge(summary: dict[str, Any], limits: dict[str, Any] | None) -> tuple[bool 
                               ("stretch_min", limits["min_stretch"], np.less)):
         m = morph[key]
         if limit is not None and worse(m["value"], limit):
-            reasons.append(f"over the morph, at q={m['q']:.4f}: skin stretch {m['value']:.4f} beyond {key.replace('stretch_', '')}"
-                           f"_stretch {limit:g} ({name}) at {place(m['where'])}")
+            bound = key.replace("stretch_", "") + "_stretch"
+            reasons.append(f"over the morph, at q={m['q']:.4f}: skin stretch {m['value']:.4f} beyond {bound} "
+                           f"{limit:g} ({name}) at {place(m['where'])}")
     return not reasons, reasons
 
 
@@ -266,8 +268,9 @@ def describe_feasibility(result: FeasibilityResult) -> list[str]:
         lines.append("material: none given, not judged (add material: to the case file)")
         return lines
     verdict = "feasible" if s["feasible"] else "NOT feasible"
-    lines.append(f"material {material['name']}: max_stretch {material['max_stretch']}, min_stretch "
-                 f"{material['min_stretch']}, min_wall_mm {material['min_wall_mm']}: {verdict}")
+    limits = ", ".join(f"{k} {material[k]:g}" for k in ("max_stretch", "min_stretch", "min_wall_mm")
+                       if material[k] is not None)
+    lines.append(f"material {material['name']} ({limits}): {verdict}")
     lines += [f"WARN {reason}" for reason in s["reasons"]]
     return lines
 
