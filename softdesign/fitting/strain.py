@@ -27,13 +27,25 @@ model): a silicone is judged by its stretch against its elongation at break.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
 
 from softdesign.fitting.radius_field import RadiusField
-from softdesign.geometry.frames import FramedSpline
-from softdesign.types import FloatArray
+from softdesign.types import FloatArray, Frames, Points
+
+
+class FramedDerivatives(Protocol):
+    """What the metric needs of a centerline: its l-derivatives and frames (a ``types.FramedCurve`` has both)."""
+
+    def derivative(self, l: npt.ArrayLike, order: int = 1) -> Points:
+        """d^k c / dl^k (n, 3), mm."""
+        ...
+
+    def frames(self, l: npt.ArrayLike) -> Frames:
+        """Frames (n, 3, 3), columns (N, B, T)."""
+        ...
 
 #: A rest metric whose determinant is below this fraction of (E0 G0) is degenerate (a collapsed section).
 DEGENERATE_RTOL = 1e-12
@@ -112,7 +124,7 @@ def principal_stretches(rest: npt.ArrayLike, deformed: npt.ArrayLike) -> tuple[F
     return np.sqrt(mu1), np.sqrt(np.maximum(mu2, 0.0))
 
 
-def frame_twist(curve: FramedSpline, l: npt.ArrayLike, frames_mode: str) -> FloatArray:
+def frame_twist(curve: FramedDerivatives, l: npt.ArrayLike, frames_mode: str) -> FloatArray:
     """The frames' twist per mm: 0 for rotation-minimizing frames, the torsion of the curve for Frenet."""
     l = np.asarray(l, float)
     if frames_mode == "rmf":
@@ -123,7 +135,7 @@ def frame_twist(curve: FramedSpline, l: npt.ArrayLike, frames_mode: str) -> Floa
     return np.einsum("ni,ni->n", cross, c3) / np.maximum(np.einsum("ni,ni->n", cross, cross), 1e-300)
 
 
-def curve_terms(curve: FramedSpline, l: npt.ArrayLike, frames_mode: str) -> tuple[FloatArray, FloatArray, FloatArray]:
+def curve_terms(curve: FramedDerivatives, l: npt.ArrayLike, frames_mode: str) -> tuple[FloatArray, FloatArray, FloatArray]:
     """speed (p,) mm, curvature (k1, k2) (p, 2) 1/mm and twist (p,) 1/mm of a framed centerline at l."""
     l = np.asarray(l, float)
     d1, d2 = curve.derivative(l, 1), curve.derivative(l, 2)
@@ -135,7 +147,7 @@ def curve_terms(curve: FramedSpline, l: npt.ArrayLike, frames_mode: str) -> tupl
     return np.sqrt(speed2), curvature, frame_twist(curve, l, frames_mode)
 
 
-def skin_metric(curve: FramedSpline, field: RadiusField, q: float, l: npt.ArrayLike, a: npt.ArrayLike,
+def skin_metric(curve: FramedDerivatives, field: RadiusField, q: float, l: npt.ArrayLike, a: npt.ArrayLike,
                 frames_mode: str = "rmf") -> FloatArray:
     """(E, F, G) of the outer skin S(q) on the grid l (p,) x a (m,), (p, m, 3), from the spline's derivatives.
 
