@@ -135,7 +135,9 @@ def frame_twist(curve: FramedDerivatives, l: npt.ArrayLike, frames_mode: str) ->
     return np.einsum("ni,ni->n", cross, c3) / np.maximum(np.einsum("ni,ni->n", cross, cross), 1e-300)
 
 
-def curve_terms(curve: FramedDerivatives, l: npt.ArrayLike, frames_mode: str) -> tuple[FloatArray, FloatArray, FloatArray]:
+def curve_terms(
+    curve: FramedDerivatives, l: npt.ArrayLike, frames_mode: str
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """speed (p,) mm, curvature (k1, k2) (p, 2) 1/mm and twist (p,) 1/mm of a framed centerline at l."""
     l = np.asarray(l, float)
     d1, d2 = curve.derivative(l, 1), curve.derivative(l, 2)
