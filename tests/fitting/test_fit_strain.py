@@ -138,3 +138,50 @@ def test_mesh_triangles_agree_with_the_spline_stretches(bent):
     # first-order per triangle (its centroid is off the quad centre): halving both steps halves the error
     assert errors[1] < 0.6 * errors[0]
     assert errors[1] < 5e-3
+
+
+class _FrenetHelix:
+    """A helix that hands out its Frenet frames (twist = torsion) instead of the rotation-minimizing ones."""
+
+    def __init__(self, helix):
+        self.helix = helix
+
+    def derivative(self, l, order=1):
+        return self.helix.derivative(l, order)
+
+    def frames(self, l):
+        return self.helix.frenet_frames(l)
+
+    def points(self, l):
+        return self.helix.points(l)
+
+
+@pytest.mark.parametrize("mode", ["rmf", "frenet"])
+def test_the_metric_is_that_of_the_surface_points_by_finite_differences(mode):
+    """A helix tube with a wavy rho: (E, F, G) against central differences of c + rho (cos a N + sin a B)."""
+    from tests.helpers.analytic import Helix
+
+    helix = Helix(r=8.0, h=3.0, turns=0.6)
+    curve = helix if mode == "rmf" else _FrenetHelix(helix)
+    rng = np.random.default_rng(7)
+    knots = bb.open_knots([0.0, 1.0], [6])
+    coef = 2.0 + 0.3 * rng.random((len(knots) - bb.DEGREE - 1, 12))
+    spline = RadiusSpline(knots, coef)
+    field = RadiusField(np.array([0.0, 1.0]), (spline,), (spline,))
+    l = np.linspace(0.1, 0.9, 9)
+    a = np.linspace(0.0, 2 * np.pi, 10, endpoint=False)
+    metric = skin_metric(curve, field, 1.0, l, a, mode)
+
+    def points(lv, av):
+        frames = curve.frames(lv)
+        rho = field.evaluate_grid(1.0, lv, av)
+        ring = np.cos(av)[None, :, None] * frames[:, None, :, 0] + np.sin(av)[None, :, None] * frames[:, None, :, 1]
+        return helix.points(lv)[:, None, :] + rho[..., None] * ring
+
+    h = 1e-5
+    x_l = (points(l + h, a) - points(l - h, a)) / (2 * h)
+    x_a = (points(l, a + h) - points(l, a - h)) / (2 * h)
+    expected = np.stack([np.einsum("...i,...i", x_l, x_l), np.einsum("...i,...i", x_l, x_a),
+                         np.einsum("...i,...i", x_a, x_a)], axis=-1)
+    # central differences: ~h^2 x third derivatives (E ~ 1e3 mm^2 here) plus rounding ~1e-16 x 1e3 / h
+    np.testing.assert_allclose(metric, expected, rtol=1e-7, atol=1e-6)
