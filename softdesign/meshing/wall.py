@@ -32,8 +32,10 @@ import numpy.typing as npt
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.strain import SectionDerivatives, curve_terms
 from softdesign.geometry.frames import FramedSpline
+from softdesign.meshing.body import body_sections
 from softdesign.meshing.compare import _squared_distances
-from softdesign.meshing.volume import angle_grid, angular_derivative, section_curves
+from softdesign.meshing.tessellate import Sweep, ring_points, sweep_from_sections, tessellate
+from softdesign.meshing.volume import BodySpec, angle_grid, angular_derivative, section_curves
 from softdesign.types import FloatArray
 
 #: Arc-length step of the central difference along l of an offset section, mm.
@@ -119,4 +121,41 @@ def port_wall_mm(outer_points: npt.ArrayLike, base: npt.ArrayLike, axis: npt.Arr
 def tessellation_error_mm(radius_mm: float, angular_count: int) -> float:
     """How far a chord of the na-gon inscribed in a circle of ``radius_mm`` falls inside it, mm."""
     return float(radius_mm * (1.0 - np.cos(np.pi / angular_count)))
+
+
+@dataclass(frozen=True)
+class WallMap:
+    """The wall's thickness at every chamber vertex of a hollow body at one q.
+
+    Attributes
+    ----------
+    l : (p,) float, the chamber's rings in normalized l
+    a : (m,) float, rad, the angle grid
+    thickness_mm : (p, m) float, true distance to the outer surface's mesh
+    outer : the outer sweep (its first ring is the base, where the port enters)
+    """
+
+    l: FloatArray
+    a: FloatArray
+    thickness_mm: FloatArray
+    outer: Sweep
+
+
+def wall_map(curve: FramedSpline, field: RadiusField, q: float, spec: BodySpec, spacing_mm: float,
+             angular_count: int) -> WallMap:
+    """Chamber and outer surface as the exporter builds them at q, and the distance between them.
+
+    Raises
+    ------
+    MeshError
+        As the export would: a fold, or a wall the local radius cannot take.
+    """
+    from softdesign.meshing.solids import _chamber  # the exporter's own chamber, trimmed wall_mm short of the ends
+
+    sections = body_sections(curve, field, q, spacing_mm, angular_count)
+    outer = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
+    body = tessellate(outer)
+    chamber = _chamber(sections, outer, spec)
+    distances = wall_distances(ring_points(chamber), body.vertices, body.faces)
+    return WallMap(chamber.l, angle_grid(angular_count), distances, outer)
 

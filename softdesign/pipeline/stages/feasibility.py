@@ -25,7 +25,6 @@ from softdesign.config import Case
 from softdesign.fitting.radius_field import RadiusField, fold_margin
 from softdesign.fitting.strain import metric_from_sections, skin_metric
 from softdesign.geometry.blend import BlendedShape
-from softdesign.meshing.body import body_sections
 from softdesign.meshing.skin_stretch import (
     Q_SAMPLES,
     Q_XTOL,
@@ -39,10 +38,9 @@ from softdesign.meshing.skin_stretch import (
     make_grid,
     search_morph,
 )
-from softdesign.meshing.solids import _chamber
-from softdesign.meshing.tessellate import ring_points, sweep_from_sections, tessellate
-from softdesign.meshing.volume import BodySpec, angle_grid
-from softdesign.meshing.wall import FD_STEP_MM, offset_sections, port_wall_mm, thinnest, wall_distances
+from softdesign.meshing.tessellate import ring_points
+from softdesign.meshing.volume import BodySpec
+from softdesign.meshing.wall import FD_STEP_MM, offset_sections, port_wall_mm, thinnest, wall_map
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.export import body_spec
 from softdesign.pipeline.stages.fit import FitResult
@@ -104,16 +102,11 @@ def _where(e) -> dict[str, Any]:
 
 def _wall(body: _Body, q: float, spacing_mm: float, angular_count: int) -> dict[str, Any]:
     """True wall thickness chamber -> outer surface at q, per link, and the port's wall."""
-    curve = body.shape.curve_at(q)
-    sections = body_sections(curve, body.field, q, spacing_mm, angular_count)
-    outer = sweep_from_sections(sections, body.spec.offset_mm, body.spec.min_radius_mm)
-    outer_mesh = tessellate(outer)
-    chamber = _chamber(sections, outer, body.spec)
-    distances = wall_distances(ring_points(chamber), outer_mesh.vertices, outer_mesh.faces)
-    angles = angle_grid(angular_count)
-    owner = body.field.link_of(chamber.l)
-    spot = thinnest(distances, chamber.l, angles)
-    per_link = [thinnest(distances, chamber.l, angles, owner == j).thickness_mm if np.any(owner == j) else None
+    walls = wall_map(body.shape.curve_at(q), body.field, q, body.spec, spacing_mm, angular_count)
+    distances, angles, outer = walls.thickness_mm, walls.a, walls.outer
+    owner = body.field.link_of(walls.l)
+    spot = thinnest(distances, walls.l, angles)
+    per_link = [thinnest(distances, walls.l, angles, owner == j).thickness_mm if np.any(owner == j) else None
                 for j in range(len(body.field.final))]
     out: dict[str, Any] = {
         "wall_min_mm": spot.thickness_mm,
