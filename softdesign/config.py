@@ -31,7 +31,7 @@ from pydantic import (
 
 from softdesign.errors import ConfigError
 from softdesign.io.formats import MESH_FORMATS
-from softdesign.materials import PRESETS, MaterialLimits, resolve_material
+from softdesign.materials import MaterialLimits, PresetName, resolve_material
 from softdesign.meshing.checks import MIN_ANGULAR_COUNT, VOLUME_RTOL
 from softdesign.pipeline.layout import q_label
 
@@ -194,7 +194,7 @@ class Export(_Section):
 class Material(_Section):
     """Limits the design is judged against: a preset (``name``) and/or explicit numbers, which win."""
 
-    name: Literal[tuple(PRESETS)] | None = None  # type: ignore[valid-type]
+    name: PresetName | None = None
     max_stretch: float | None = Field(None, gt=1.0, le=100.0)
     min_stretch: float | None = Field(None, gt=0.0, lt=1.0)
     min_wall_mm: float | None = Field(None, gt=0.0, le=100.0)

@@ -19,7 +19,12 @@ temperature and are no substitute for a test of the cured part.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
-from typing import Any
+from typing import Any, Literal, get_args
+
+#: The preset names the case file accepts (``material.name``); :data:`PRESETS` has one entry for each.
+PresetName = Literal[
+    "ecoflex-00-30", "ecoflex-00-50", "dragon-skin-10", "dragon-skin-30", "smooth-sil-950", "sylgard-184", "tpu-85a"
+]
 
 #: Fraction of the datasheet's elongation at break a cyclically stretched skin may use (rule of thumb).
 DESIGN_FRACTION = 0.5
@@ -94,3 +99,7 @@ def resolve_material(name: str | None, max_stretch: float | None, min_stretch: f
                             "; overridden by the case file: " + ", ".join(f"{k} {v:g}" for k, v in given.items()))
     merged = {**asdict(base), **given, "source": source}
     return MaterialLimits(**merged)
+
+
+if set(PRESETS) != set(get_args(PresetName)):  # one list of names, checked at import
+    raise RuntimeError("softdesign.materials: PresetName and PRESETS name different materials")
