@@ -50,7 +50,7 @@ if TYPE_CHECKING:
 REPO = Path(__file__).resolve().parents[1]
 DEMO_CASE = REPO / "configs" / "demo.yaml"
 AORTA_DIR = REPO.parent / "shared" / "data" / "vmtk-aorta"
-STAGE_NAMES = ("ingest", "blend", "links", "kinematics", "fit", "export")
+STAGE_NAMES = ("ingest", "blend", "links", "kinematics", "fit", "export", "feasibility")
 
 #: Targets of the scaled case (issue 5, item 9).
 TARGET_FLOOR_RATIO = 3.0

@@ -43,6 +43,7 @@ from softdesign.limits import (
     MAX_LINKS,
     MEMORY_BUDGET_TEXT,
 )
+from softdesign.materials import MaterialLimits, PresetName, resolve_material
 from softdesign.meshing.checks import MIN_ANGULAR_COUNT, VOLUME_RTOL
 from softdesign.pipeline.layout import q_label
 
@@ -215,6 +216,19 @@ class Export(_Section):
         return sorted(set(self.q if self.q is not None else [0.0, 0.5, 1.0]))
 
 
+class Material(_Section):
+    """Limits the design is judged against: a preset (``name``) and/or explicit numbers, which win."""
+
+    name: PresetName | None = None
+    max_stretch: float | None = Field(None, gt=1.0, le=100.0)
+    min_stretch: float | None = Field(None, gt=0.0, lt=1.0)
+    min_wall_mm: float | None = Field(None, gt=0.0, le=100.0)
+
+    def limits(self) -> MaterialLimits:
+        """The preset's numbers with the explicit ones put over them."""
+        return resolve_material(self.name, self.max_stretch, self.min_stretch, self.min_wall_mm)
+
+
 class Case(_Section):
     """A whole case file, every default filled in."""
 
@@ -229,6 +243,8 @@ class Case(_Section):
     links: Links = Links(count=4)
     fit: Fit = Fit()
     export: Export = Export()
+    #: no material: the feasibility figures are reported and judged against nothing
+    material: Material | None = None
 
     _base: Path = PrivateAttr(default_factory=Path.cwd)
 

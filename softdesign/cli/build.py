@@ -22,6 +22,12 @@ from softdesign.cli.common import (
 )
 
 ReportOpt = Annotated[bool, typer.Option("--report", help="Then write BUILD/report/index.html (softdesign report).")]
+StrictOpt = Annotated[
+    bool,
+    typer.Option(
+        "--strict", help="Exit 1 when the design is not feasible for the case's material (the build is kept)."
+    ),
+]
 KinematicsQOpt = Annotated[
     str | None, typer.Option("--q", help="One q for every link ('0.5') or one per link ('0.2,0.8,1'), each in [0, 1].")
 ]
@@ -66,18 +72,27 @@ def validate(case_file: CaseArg) -> None:
     run_guarded(action)
 
 
-def build(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False, with_report: ReportOpt = False) -> None:
+def build(
+    case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False, with_report: ReportOpt = False,
+    strict: StrictOpt = False,
+) -> None:
     """Run every stage (unchanged stages are skipped) and write the manifest; --report adds the HTML report."""
 
-    def action() -> None:
+    def action() -> bool:
         from softdesign.cli.report import report_after_build
 
         outcome = _run(case_file, out, None, force)
         _print_runs(outcome.build_dir, outcome.runs)
         if with_report:
             report_after_build(outcome.build_dir)
+        feasibility = outcome.results.get("feasibility")
+        return feasibility is not None and feasibility.summary.get("feasible") is False
 
-    run_guarded(action)
+    infeasible = run_guarded(action)
+    if strict and infeasible:
+        typer.echo(f"error: {case_file}: the design is not feasible for its material (WARN lines above); "
+                   "--strict exits 1: change the design or the material", err=True)
+        raise typer.Exit(code=1)
 
 
 def ingest(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:

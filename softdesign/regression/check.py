@@ -13,6 +13,7 @@ from pathlib import Path
 
 from softdesign.errors import ConfigError, InputDataError
 from softdesign.pipeline.layout import MANIFEST
+from softdesign.regression.feasibility import compare_feasibility
 from softdesign.regression.figures import CheckOptions, CheckReport, Figure, missing_figure, read_json, scalar_figure
 from softdesign.regression.kinematics import compare_kinematics_files
 from softdesign.regression.meshes import compare_mesh_folders, read_golden
@@ -52,6 +53,7 @@ def check_build(
         notes.append("no mesh files under meshes/ on either side")
     figures += compare_kinematics_files(build_dir, reference_dir, options, notes)
     figures += compare_fit(build_manifest, ref_manifest, options.distance_mm, notes)
+    figures += compare_feasibility(build_manifest, ref_manifest, options.distance_mm, notes)
     warnings = tuple(case_warnings(build_manifest, ref_manifest))
     return CheckReport(build_dir, reference_dir, options, tuple(figures), tuple(notes), warnings)
 

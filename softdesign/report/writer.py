@@ -20,7 +20,14 @@ from softdesign.pipeline.layout import REPORT_DIR
 from softdesign.pipeline.lock import BuildLock
 from softdesign.pipeline.out_folder import folder_errors
 from softdesign.pipeline.store import process_alive
-from softdesign.report import animation, fit_figures, kinematics_figures, morph_figures, surface_figures
+from softdesign.report import (
+    animation,
+    fit_figures,
+    kinematics_figures,
+    morph_figures,
+    stretch_figures,
+    surface_figures,
+)
 from softdesign.report.build_folder import BuildData, load_build
 from softdesign.report.html_page import (
     Section,
@@ -59,6 +66,7 @@ EXPECTED_SIZES = {
     "kinematics.png": pixel_size(kinematics_figures.SIZE_IN),
     "pcc_chambers.png": pixel_size(kinematics_figures.PCC_SIZE_IN),
     "morph.gif": pixel_size(animation.SIZE_IN),
+    stretch_figures.NAME: pixel_size(stretch_figures.SIZE_IN),
 }
 
 
@@ -132,6 +140,9 @@ def report_sections(data: BuildData, options: ReportOptions) -> tuple[list[Secti
         notes.append(NO_EXPORT)
         tables.notes.append(NO_EXPORT)
     sections = [morph, surfaces, fit, kinematics, tables, Section("animation", "The morph, animated", pictures=[gif])]
+    stretch = stretch_figures.stretch_picture(data)
+    if stretch is not None:
+        sections.insert(3, Section("feasibility", "Skin stretch and wall", pictures=[stretch]))
     return sections, checks, notes
 
 

@@ -82,3 +82,32 @@ def test_missing_required_key_and_bad_yaml(tmp_path):
         load_case(bad)
     with pytest.raises(ConfigError, match="case file not found"):
         load_case(tmp_path / "absent.yaml")
+
+
+def test_material_presets_resolve_and_explicit_numbers_win(tmp_path):
+    from softdesign.config import Material
+    from softdesign.materials import DESIGN_FRACTION, PRESETS
+
+    preset = Material(name="ecoflex-00-30").limits()
+    assert preset.max_stretch == 1 + DESIGN_FRACTION * 9.0 and "900 %" in preset.source
+    mixed = Material(name="dragon-skin-30", max_stretch=2.0, min_wall_mm=1.2).limits()
+    expected = (2.0, PRESETS["dragon-skin-30"].min_stretch, 1.2)
+    assert (mixed.max_stretch, mixed.min_stretch, mixed.min_wall_mm) == expected
+    assert "overridden" in mixed.source
+    custom = Material(max_stretch=1.5).limits()
+    assert (custom.name, custom.max_stretch, custom.min_stretch, custom.min_wall_mm) == ("custom", 1.5, None, None)
+    for name, limits in PRESETS.items():
+        assert limits.max_stretch > 1 and 0 < limits.min_stretch < 1 and limits.min_wall_mm > 0, name
+        assert "data sheet" in limits.source or "bulletin" in limits.source, name
+
+
+def test_a_bad_material_is_refused_with_its_line(tmp_path):
+    from softdesign.config import load_case
+    from softdesign.errors import ConfigError
+
+    path = tmp_path / "case.yaml"
+    path.write_text("final: {centerline: c.vtp}\nmaterial: {name: rubber, max_stretch: 0.5}\n")
+    with pytest.raises(ConfigError) as err:
+        load_case(path)
+    text = str(err.value)
+    assert "material.name" in text and "ecoflex-00-30" in text and "material.max_stretch" in text

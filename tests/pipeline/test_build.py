@@ -20,7 +20,7 @@ from softdesign.versions import software_versions
 from tests.helpers.paths import REPO
 
 runner = CliRunner()
-STAGES = ["ingest", "blend", "links", "kinematics", "fit", "export"]
+STAGES = ["ingest", "blend", "links", "kinematics", "fit", "export", "feasibility"]
 
 
 def snapshot(folder: Path) -> dict[str, str]:
@@ -68,25 +68,29 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     assert statuses(build(demo_case, out)) == dict.fromkeys(STAGES, "skipped")
     edit(demo_case, "fit", smoothing=2.0e-5)
     assert statuses(build(demo_case, out)) == {
-        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
-        "fit": "ran", "export": "ran",
+        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "ran",
+        "export": "ran", "feasibility": "ran",
     }
     edit(demo_case, "export", q=[0, 0.5, 1])
     assert statuses(build(demo_case, out)) == {
-        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "ran",
-        "fit": "skipped", "export": "ran",
+        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "ran", "fit": "skipped",
+        "export": "ran", "feasibility": "ran",
     }
-    # The mesh formats are read by export alone: kinematics (and the fit) stay cached.
+    # The mesh formats are read by export alone: kinematics, the fit and the feasibility figures stay cached.
     edit(demo_case, "export", formats=["stl", "ply"])
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "skipped",
-        "export": "ran",
+        "export": "ran", "feasibility": "skipped",
     }
     # New link breaks: the links, their kinematics and the per-link fit are redone; ingest and blend are not.
     edit(demo_case, "links", count=None, breaks=[0, 0.4, 1])
     assert statuses(build(demo_case, out)) == {
-        "ingest": "skipped", "blend": "skipped", "links": "ran", "kinematics": "ran", "fit": "ran", "export": "ran"
+        "ingest": "skipped", "blend": "skipped", "links": "ran", "kinematics": "ran", "fit": "ran", "export": "ran",
+        "feasibility": "ran",
     }
+    # A material is read by the feasibility verdict alone: every mesh stays.
+    edit(demo_case, "material", name="ecoflex-00-30")
+    assert statuses(build(demo_case, out)) == {**dict.fromkeys(STAGES, "skipped"), "feasibility": "ran"}
     assert statuses(build(demo_case, out, "--force")) == dict.fromkeys(STAGES, "ran")
 
 
@@ -105,7 +109,7 @@ def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tm
     ran, manifest = run_fit()
     assert ran == {
         "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "skipped",
-        "export": "kept",
+        "export": "kept", "feasibility": "kept",
     }
     outputs = {o["path"]: o for o in manifest["outputs"]}
     assert all(outputs[m]["watertight"] and outputs[m]["volume_mm3"] > 0 and "stale" not in outputs[m] for m in meshes)
@@ -113,7 +117,7 @@ def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tm
     # A new fit: the meshes on disk were made from the old one, and the manifest says so.
     edit(demo_case, "fit", smoothing=2.0e-5)
     ran, manifest = run_fit()
-    assert (ran["fit"], ran["export"]) == ("ran", "stale")
+    assert (ran["fit"], ran["export"], ran["feasibility"]) == ("ran", "stale", "stale")
     outputs = {o["path"]: o for o in manifest["outputs"]}
     assert all(outputs[m]["stale"] is True for m in meshes) and "stale" not in outputs["fit/surface.npz"]
     assert {"name": "export", "status": "stale"}.items() <= next(

@@ -2,7 +2,8 @@
 
 ingest -> blend -> links -> kinematics -> fit -> export (DESIGN.md's five
 stages, with the link breaks a product of their own between blend and
-kinematics: both kinematics and the fit consume them).
+kinematics: both kinematics and the fit consume them) -> feasibility (skin
+stretch and wall thickness, judged against the case's material).
 """
 
 from __future__ import annotations
@@ -11,10 +12,12 @@ from pathlib import Path
 
 from softdesign.config import Case
 from softdesign.pipeline.stage import Stage
-from softdesign.pipeline.stages import blend, export, fit, ingest, kinematics, links
+from softdesign.pipeline.stages import blend, export, feasibility, fit, ingest, kinematics, links
 
 #: Every stage, in build order.
-STAGES: list[Stage] = [ingest.STAGE, blend.STAGE, links.STAGE, kinematics.STAGE, fit.STAGE, export.STAGE]
+STAGES: list[Stage] = [
+    ingest.STAGE, blend.STAGE, links.STAGE, kinematics.STAGE, fit.STAGE, export.STAGE, feasibility.STAGE,
+]
 
 
 def stages_through(name: str) -> list[Stage]:

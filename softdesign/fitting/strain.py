@@ -1,0 +1,164 @@
+"""Principal stretches of the skin S(q, l, a) against its rest state S(0, l, a), from the surface's derivatives.
+
+The material is cast at q = 0, so the point (l, a) of the body at q = 0 is
+the same material point at every q (the seed's S(q, l, a) is the motion).  A
+surface point in frame coordinates is ``X = c(l) + x(l, a) N + y(l, a) B``;
+with frames moving by ``N' = v (-k1 T + t B)``, ``B' = v (-k2 T - t N)``
+(v = |dc/dl| mm, (k1, k2) = (T'.N, T'.B) per mm of arc, t the frame's twist
+per mm: 0 for rotation-minimizing frames, the torsion for Frenet)::
+
+    X_l = v (1 - x k1 - y k2) T + (x_l - v t y) N + (y_l + v t x) B
+    X_a = x_a N + y_a B
+
+and the first fundamental form is ``G = [[X_l.X_l, X_l.X_a], [X_l.X_a, X_a.X_a]]``.
+For the seed's tube, (x, y) = rho (cos a, sin a), so
+``X_l.X_l = v^2 (1 - rho kn)^2 + rho_l^2 + (rho v t)^2`` with
+kn = k1 cos a + k2 sin a (the same ``1 - rho kn`` as the volume integral of
+:mod:`softdesign.meshing.volume`).
+
+The principal stretches lambda1 >= lambda2 are the square roots of the
+eigenvalues of ``G0^-1 G`` (the right Cauchy-Green tensor of the surface
+map in the rest metric): the roots mu of ``det(G - mu G0) = 0``, a quadratic
+solved in closed form, vectorised.  Seed 000 names "realistic stress and
+strain metrics" as future work; this is its kinematic half (no constitutive
+model): a silicone is judged by its stretch against its elongation at break.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+import numpy.typing as npt
+
+from softdesign.fitting.radius_field import RadiusField
+from softdesign.types import FloatArray, Frames, Points
+
+
+class FramedDerivatives(Protocol):
+    """What the metric needs of a centerline: its l-derivatives and frames (a ``types.FramedCurve`` has both)."""
+
+    def derivative(self, l: npt.ArrayLike, order: int = 1) -> Points:
+        """d^k c / dl^k (n, 3), mm."""
+        ...
+
+    def frames(self, l: npt.ArrayLike) -> Frames:
+        """Frames (n, 3, 3), columns (N, B, T)."""
+        ...
+
+#: A rest metric whose determinant is below this fraction of (E0 G0) is degenerate (a collapsed section).
+DEGENERATE_RTOL = 1e-12
+
+
+@dataclass(frozen=True)
+class SectionDerivatives:
+    """A surface ``c + x N + y B`` on a grid l (p,) x a (m,) with what its metric needs.
+
+    Attributes
+    ----------
+    speed : (p,) float, mm, v = |dc/dl|
+    curvature : (p, 2) float, 1/mm, (k1, k2) per unit arc length
+    twist : (p,) float, 1/mm, the frame's rotation about T per unit arc length (0 for rmf)
+    xy, xy_l, xy_a : (p, m, 2) float, mm; the section coordinates and their l and a derivatives
+    """
+
+    speed: FloatArray
+    curvature: FloatArray
+    twist: FloatArray
+    xy: FloatArray
+    xy_l: FloatArray
+    xy_a: FloatArray
+
+
+def metric_from_sections(d: SectionDerivatives) -> FloatArray:
+    """First fundamental form (E, F, G) in (l, a), (p, m, 3): mm^2 per unit l^2, per unit l rad, per rad^2."""
+    x, y = d.xy[..., 0], d.xy[..., 1]
+    v = d.speed[:, None]
+    vt = (d.speed * d.twist)[:, None]
+    axial = v * (1.0 - x * d.curvature[:, :1] - y * d.curvature[:, 1:])
+    along_n = d.xy_l[..., 0] - vt * y
+    along_b = d.xy_l[..., 1] + vt * x
+    e = axial**2 + along_n**2 + along_b**2
+    f = along_n * d.xy_a[..., 0] + along_b * d.xy_a[..., 1]
+    g = d.xy_a[..., 0] ** 2 + d.xy_a[..., 1] ** 2
+    return np.stack([e, f, g], axis=-1)
+
+
+def tube_sections(
+    speed: npt.ArrayLike, curvature: npt.ArrayLike, twist: npt.ArrayLike,
+    angles: npt.ArrayLike, rho: npt.ArrayLike, rho_l: npt.ArrayLike, rho_a: npt.ArrayLike,
+) -> SectionDerivatives:
+    """The seed's tube, (x, y) = rho (cos a, sin a), with its exact derivatives; rho arrays (p, m) mm."""
+    a = np.asarray(angles, float)
+    u = np.stack([np.cos(a), np.sin(a)], axis=-1)
+    w = np.stack([-np.sin(a), np.cos(a)], axis=-1)
+    rho, rho_l, rho_a = (np.asarray(v, float)[..., None] for v in (rho, rho_l, rho_a))
+    return SectionDerivatives(
+        np.asarray(speed, float), np.asarray(curvature, float), np.asarray(twist, float),
+        rho * u, rho_l * u, rho_a * u + rho * w,
+    )
+
+
+def principal_stretches(rest: npt.ArrayLike, deformed: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """lambda1 >= lambda2 (dimensionless) from metrics (..., 3) = (E, F, G) at rest and deformed.
+
+    The squares are the roots of ``det G0 mu^2 - (E0 G + G0 E - 2 F0 F) mu + det G = 0``.
+
+    Raises
+    ------
+    ValueError
+        A rest metric is degenerate (det G0 <= DEGENERATE_RTOL E0 G0): no stretch is defined there.
+    """
+    e0, f0, g0 = np.moveaxis(np.asarray(rest, float), -1, 0)
+    e, f, g = np.moveaxis(np.asarray(deformed, float), -1, 0)
+    det0 = e0 * g0 - f0 * f0
+    if np.any(~(det0 > DEGENERATE_RTOL * np.abs(e0 * g0))):
+        raise ValueError("principal_stretches: a rest metric is degenerate (collapsed or folded rest surface)")
+    half_trace = 0.5 * (e0 * g + g0 * e - 2.0 * f0 * f) / det0
+    det_ratio = (e * g - f * f) / det0
+    root = np.sqrt(np.maximum(half_trace**2 - det_ratio, 0.0))
+    mu1 = half_trace + root
+    # the smaller root as det / mu1 keeps its digits when mu2 << mu1
+    mu2 = np.where(mu1 > 0.0, det_ratio / np.where(mu1 > 0.0, mu1, 1.0), 0.0)
+    return np.sqrt(mu1), np.sqrt(np.maximum(mu2, 0.0))
+
+
+def frame_twist(curve: FramedDerivatives, l: npt.ArrayLike, frames_mode: str) -> FloatArray:
+    """The frames' twist per mm: 0 for rotation-minimizing frames, the torsion of the curve for Frenet."""
+    l = np.asarray(l, float)
+    if frames_mode == "rmf":
+        return np.zeros(len(l))
+    c1, c2, c3 = (curve.derivative(l, k) for k in (1, 2, 3))
+    cross = np.cross(c1, c2)
+    # torsion (c' x c'') . c''' / |c' x c''|^2 is per unit arc length whatever the parameter
+    return np.einsum("ni,ni->n", cross, c3) / np.maximum(np.einsum("ni,ni->n", cross, cross), 1e-300)
+
+
+def curve_terms(
+    curve: FramedDerivatives, l: npt.ArrayLike, frames_mode: str
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """speed (p,) mm, curvature (k1, k2) (p, 2) 1/mm and twist (p,) 1/mm of a framed centerline at l."""
+    l = np.asarray(l, float)
+    d1, d2 = curve.derivative(l, 1), curve.derivative(l, 2)
+    frames = curve.frames(l)
+    speed2 = np.einsum("ni,ni->n", d1, d1)
+    tangent = d1 / np.sqrt(speed2)[:, None]
+    kvec = (d2 - np.einsum("ni,ni->n", d2, tangent)[:, None] * tangent) / speed2[:, None]
+    curvature = np.einsum("ni,nij->nj", kvec, frames[:, :, :2])
+    return np.sqrt(speed2), curvature, frame_twist(curve, l, frames_mode)
+
+
+def skin_metric(curve: FramedDerivatives, field: RadiusField, q: float, l: npt.ArrayLike, a: npt.ArrayLike,
+                frames_mode: str = "rmf") -> FloatArray:
+    """(E, F, G) of the outer skin S(q) on the grid l (p,) x a (m,), (p, m, 3), from the spline's derivatives.
+
+    ``curve`` is c(q, .) with its frames; rho, rho_l and rho_a come from the
+    radius field's own basis derivatives (no finite differences).
+    """
+    l = np.asarray(l, float)
+    speed, curvature, twist = curve_terms(curve, l, frames_mode)
+    rho = field.evaluate_grid(q, l, a)
+    rho_l = field.evaluate_grid(q, l, a, dl=1)
+    rho_a = field.evaluate_grid(q, l, a, da=1)
+    return metric_from_sections(tube_sections(speed, curvature, twist, a, rho, rho_l, rho_a))

@@ -1,0 +1,287 @@
+"""Stage 7, feasibility: can the body cast at q = 0 stretch into every q, and is its wall thick enough?
+
+Reads the blended shape (kinematics) and the radius field (fit), and the
+export keys that shape the solid (offset, wall, port, mesh resolution).
+Per export q: the principal stretches of the outer skin (and of the chamber
+of a hollow body) against q = 0, converged on a grid
+(:mod:`softdesign.meshing.skin_stretch`), the largest rho * kappa, the true
+wall thickness and the port's wall (:mod:`softdesign.meshing.wall`); over
+the whole morph q in [0, 1], the extremes of the skin's stretches by a
+search in q.  Judged against ``material:`` when the case has one
+(:mod:`softdesign.materials`); without it ``feasible`` is null.
+Output: ``feasibility/summary.json``; the manifest's ``metrics.feasibility``.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, cast
+
+import numpy as np
+
+from softdesign.config import Case
+from softdesign.fitting.radius_field import RadiusField, fold_margin
+from softdesign.fitting.strain import metric_from_sections, skin_metric
+from softdesign.geometry.blend import BlendedShape
+from softdesign.meshing.skin_stretch import (
+    Q_SAMPLES,
+    Q_XTOL,
+    START_ANGLES_PER_INTERVAL,
+    START_SPACING_MM,
+    STRETCH_TOL,
+    MetricAt,
+    StretchExtremes,
+    converged_extremes,
+    extremes_on,
+    make_grid,
+    search_morph,
+)
+from softdesign.meshing.tessellate import ring_points
+from softdesign.meshing.volume import BodySpec
+from softdesign.meshing.wall import FD_STEP_MM, offset_sections, port_wall_mm, thinnest, wall_map
+from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.export import body_spec
+from softdesign.pipeline.stages.fit import FitResult
+from softdesign.pipeline.stages.kinematics import KinematicsResult
+from softdesign.pipeline.store import Staging
+from softdesign.types import FramedCurve
+
+VERSION = 1
+SUMMARY = "feasibility/summary.json"
+
+
+@dataclass(frozen=True)
+class FeasibilityResult:
+    """The figures (JSON-ready) and the violations, one line each."""
+
+    summary: dict[str, Any]
+
+
+@dataclass(frozen=True)
+class _Body:
+    """What every evaluation needs: the shape, the field, the solid's spec, the frames mode."""
+
+    shape: BlendedShape
+    field: RadiusField
+    spec: BodySpec
+    frames: str
+
+    @property
+    def length(self) -> float:
+        return float(self.shape.keys[-1].length)
+
+    def surface(self, q: float, offset_mm: float) -> MetricAt:
+        curve = self.shape.curve_at(q)
+        if offset_mm == 0.0:
+            return lambda l, a: skin_metric(curve, self.field, q, l, a, self.frames)
+        return lambda l, a: metric_from_sections(offset_sections(curve, self.field, q, l, len(a), offset_mm,
+                                                                 self.frames))
+
+    def span(self, q: float, margin_mm: float) -> tuple[float, float]:
+        """The l range at least ``margin_mm`` of arc from both ends at q = 0 and at q."""
+        lo, hi = 0.0, 1.0
+        for at in (0.0, q):
+            curve = self.shape.curve_at(at).curve
+            l = curve.dense_l()
+            s = curve.arc_length(l)
+            lo = max(lo, float(np.interp(margin_mm, s, l)))
+            hi = min(hi, float(np.interp(s[-1] - margin_mm, s, l)))
+        return lo, hi
+
+
+def _extremes(body: _Body, q: float, offset_mm: float, span: tuple[float, float]) -> StretchExtremes:
+    return converged_extremes(body.surface(0.0, offset_mm), body.surface(q, offset_mm), body.length,
+                              body.field.breaks, body.field.final[0].angular_intervals, span)
+
+
+def _where(e) -> dict[str, Any]:
+    return e.as_dict()
+
+
+def _wall(body: _Body, q: float, spacing_mm: float, angular_count: int) -> dict[str, Any]:
+    """True wall thickness chamber -> outer surface at q, per link, and the port's wall."""
+    walls = wall_map(body.shape.curve_at(q), body.field, q, body.spec, spacing_mm, angular_count)
+    distances, angles, outer = walls.thickness_mm, walls.a, walls.outer
+    owner = body.field.link_of(walls.l)
+    spot = thinnest(distances, walls.l, angles)
+    per_link = [thinnest(distances, walls.l, angles, owner == j).thickness_mm if np.any(owner == j) else None
+                for j in range(len(body.field.final))]
+    out: dict[str, Any] = {
+        "wall_min_mm": spot.thickness_mm,
+        "where": {"link": int(body.field.link_of([spot.l])[0]), "l": spot.l, "angle_deg": float(np.degrees(spot.a))},
+        "per_link_mm": per_link,
+    }
+    if body.spec.port_mm > 0:
+        port = port_wall_mm(ring_points(outer), outer.centers[0], outer.frames[0][:, 2], body.spec.port_mm,
+                            body.spec.wall_mm)
+        out["port_wall_mm"] = port.thickness_mm
+        out["port_where"] = {"l": float(outer.l[int(port.l)]), "angle_deg": float(np.degrees(angles[int(port.a)]))}
+    return out
+
+
+def _at_q(body: _Body, q: float, case: Case) -> dict[str, Any]:
+    skin = _extremes(body, q, body.spec.offset_mm, (0.0, 1.0) if body.spec.offset_mm == 0 else
+                     body.span(q, 2 * FD_STEP_MM))
+    row: dict[str, Any] = {
+        "q": q,
+        "stretch_max": skin.maximum.value,
+        "stretch_min": skin.minimum.value,
+        "wall_min_mm": None,
+        "rho_kappa_max": fold_margin(cast(FramedCurve, body.shape.curve_at(q)), body.field, q).max_rho_kappa,
+        "where": {"stretch_max": _where(skin.maximum), "stretch_min": _where(skin.minimum)},
+        "per_link": [{"stretch_max": hi, "stretch_min": lo} for hi, lo in skin.per_link],
+        "grid": {"spacing_mm": skin.grid.spacing_mm, "angles": skin.grid.angles, "points": skin.grid.points,
+                 "change": skin.change, "converged": skin.converged},
+    }
+    if body.spec.wall_mm > 0:
+        span = body.span(q, body.spec.wall_mm + 2 * FD_STEP_MM)
+        chamber = _extremes(body, q, body.spec.offset_mm - body.spec.wall_mm, span)
+        row["chamber"] = {"stretch_max": chamber.maximum.value, "stretch_min": chamber.minimum.value,
+                          "where": {"stretch_max": _where(chamber.maximum), "stretch_min": _where(chamber.minimum)}}
+        wall = _wall(body, q, case.export.spacing_mm, case.export.angular_count)
+        row["wall_min_mm"] = wall.pop("wall_min_mm")
+        row["where"]["wall_min"] = wall.pop("where")
+        row.update(wall)
+        for j, mm in enumerate(row.pop("per_link_mm")):
+            row["per_link"][j]["wall_min_mm"] = mm
+    return row
+
+
+def _morph(body: _Body) -> dict[str, Any]:
+    """Extremes of the skin's stretches over q in [0, 1]: searched on the first grid, then converged at that q."""
+    g = make_grid(body.length, body.field.breaks, START_SPACING_MM,
+                  START_ANGLES_PER_INTERVAL * body.field.final[0].angular_intervals)
+    rest = body.surface(0.0, 0.0)
+    cache: dict[float, StretchExtremes] = {}
+
+    def at(q: float) -> StretchExtremes:
+        if q not in cache:
+            cache[q] = extremes_on(g, rest, body.surface(q, 0.0), body.field.breaks)
+        return cache[q]
+
+    high, low = search_morph(at)
+    out: dict[str, Any] = {}
+    for key, found in (("stretch_max", high), ("stretch_min", low)):
+        polished = _extremes(body, found.q, 0.0, (0.0, 1.0))
+        e = polished.maximum if key == "stretch_max" else polished.minimum
+        out[key] = {"value": e.value, "q": found.q, "where": _where(e)}
+    out["method"] = (f"{Q_SAMPLES} q samples, then a bounded search to {Q_XTOL:g} in q near the best, on the first "
+                     "grid; the value at the q found on a converged grid; the outer skin without offset")
+    return out
+
+
+def judge(summary: dict[str, Any], limits: dict[str, Any] | None) -> tuple[bool | None, list[str]]:
+    """The verdict and one reason per violated limit (link, l and angle named)."""
+    if limits is None:
+        return None, []
+    reasons = []
+
+    def place(w: dict[str, Any]) -> str:
+        return f"link {w['link']} l={w['l']:.4f} angle {w['angle_deg']:.0f} deg"
+
+    name = limits["name"]
+    for row in summary["per_q"]:
+        q = row["q"]
+        if limits["max_stretch"] is not None and row["stretch_max"] > limits["max_stretch"]:
+            reasons.append(f"q={q:.3f}: skin stretch {row['stretch_max']:.4f} > max_stretch {limits['max_stretch']:g} "
+                           f"({name}) at {place(row['where']['stretch_max'])}")
+        if limits["min_stretch"] is not None and row["stretch_min"] < limits["min_stretch"]:
+            reasons.append(f"q={q:.3f}: skin stretch {row['stretch_min']:.4f} < min_stretch {limits['min_stretch']:g} "
+                           f"({name}) at {place(row['where']['stretch_min'])}")
+        wall = row["wall_min_mm"]
+        if limits["min_wall_mm"] is not None and wall is not None and wall < limits["min_wall_mm"]:
+            reasons.append(f"q={q:.3f}: wall {wall:.3f} mm < min_wall_mm {limits['min_wall_mm']:g} ({name}) at "
+                           f"{place(row['where']['wall_min'])}")
+        port = row.get("port_wall_mm")
+        if limits["min_wall_mm"] is not None and port is not None and port < limits["min_wall_mm"]:
+            reasons.append(f"q={q:.3f}: port wall {port:.3f} mm < min_wall_mm {limits['min_wall_mm']:g} ({name}) "
+                           f"at l={row['port_where']['l']:.4f} angle {row['port_where']['angle_deg']:.0f} deg")
+    morph = summary["morph"]
+    for key, limit, worse in (("stretch_max", limits["max_stretch"], np.greater),
+                              ("stretch_min", limits["min_stretch"], np.less)):
+        m = morph[key]
+        if limit is not None and worse(m["value"], limit):
+            bound = key.replace("stretch_", "") + "_stretch"
+            reasons.append(f"over the morph, at q={m['q']:.4f}: skin stretch {m['value']:.4f} beyond {bound} "
+                           f"{limit:g} ({name}) at {place(m['where'])}")
+    return not reasons, reasons
+
+
+def run_feasibility(case: Case, kinematics: KinematicsResult, fit: FitResult) -> FeasibilityResult:
+    """Every figure, then the verdict against the case's material (if any)."""
+    body = _Body(kinematics.chain.shape, fit.field, body_spec(case), case.frames)
+    rows = [_at_q(body, q, case) for q in case.export.q_values()]
+    per_link = []
+    for j in range(len(fit.field.final)):
+        links = [r["per_link"][j] for r in rows]
+        walls = [p["wall_min_mm"] for p in links if p.get("wall_min_mm") is not None]
+        per_link.append({"link": j, "stretch_max": max(p["stretch_max"] for p in links),
+                         "stretch_min": min(p["stretch_min"] for p in links),
+                         "wall_min_mm": min(walls) if walls else None})
+    limits = case.material.limits().as_dict() if case.material is not None else None
+    summary: dict[str, Any] = {
+        "per_q": rows,
+        "per_link": per_link,
+        "morph": _morph(body),
+        "material": limits,
+        "tolerance": {"stretch": STRETCH_TOL, "q": Q_XTOL},
+    }
+    feasible, reasons = judge(summary, limits)
+    summary["feasible"] = feasible
+    summary["reasons"] = reasons if limits is not None else ["no material: in the case file: figures only, not judged"]
+    return FeasibilityResult(summary)
+
+
+def write_feasibility(result: FeasibilityResult, staging: Staging) -> None:
+    """Keep the figures."""
+    staging.write_json(SUMMARY, result.summary)
+
+
+def load_feasibility(build_dir: Path) -> FeasibilityResult:
+    """The kept figures."""
+    return FeasibilityResult(json.loads((Path(build_dir) / SUMMARY).read_text(encoding="utf-8")))
+
+
+def describe_feasibility(result: FeasibilityResult) -> list[str]:
+    """The feasibility table, then a WARN line per violation."""
+    s = result.summary
+    lines = ["     q  stretch_max  stretch_min  rho*kappa  wall_min_mm  port_wall_mm"]
+    for r in s["per_q"]:
+        wall = "-" if r["wall_min_mm"] is None else f"{r['wall_min_mm']:.3f}"
+        port = "-" if r.get("port_wall_mm") is None else f"{r['port_wall_mm']:.3f}"
+        lines.append(f"{r['q']:6.3f}  {r['stretch_max']:11.4f}  {r['stretch_min']:11.4f}  {r['rho_kappa_max']:9.3f}  "
+                     f"{wall:>11}  {port:>12}")
+    m = s["morph"]
+    lines.append(f"over q in [0, 1]: stretch max {m['stretch_max']['value']:.4f} at q={m['stretch_max']['q']:.3f}, "
+                 f"min {m['stretch_min']['value']:.4f} at q={m['stretch_min']['q']:.3f}")
+    material = s["material"]
+    if material is None:
+        lines.append("material: none given, not judged (add material: to the case file)")
+        return lines
+    verdict = "feasible" if s["feasible"] else "NOT feasible"
+    limits = ", ".join(f"{k} {material[k]:g}" for k in ("max_stretch", "min_stretch", "min_wall_mm")
+                       if material[k] is not None)
+    lines.append(f"material {material['name']} ({limits}): {verdict}")
+    lines += [f"WARN {reason}" for reason in s["reasons"]]
+    return lines
+
+
+def feasibility_metrics(result: FeasibilityResult) -> dict[str, Any]:
+    """The manifest's block: every figure and the verdict."""
+    return result.summary
+
+
+STAGE = Stage(
+    name="feasibility",
+    version=VERSION,
+    reads=("export.q", "export.frames", "export.offset_mm", "export.wall_mm", "export.port_mm", "export.spacing_mm",
+           "export.angular_count", "frames", "material"),
+    upstream=("kinematics", "fit"),
+    compute=lambda case, results: run_feasibility(case, results["kinematics"], results["fit"]),
+    write=write_feasibility,
+    load=lambda build_dir, results: load_feasibility(build_dir),
+    describe=describe_feasibility,
+    metrics=feasibility_metrics,
+)
