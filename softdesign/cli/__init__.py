@@ -7,8 +7,8 @@ notes, progress and warnings go to stderr.
 One module per command family: :mod:`~softdesign.cli.build` (validate, build
 and one command per stage), :mod:`~softdesign.cli.pose`,
 :mod:`~softdesign.cli.check`, :mod:`~softdesign.cli.report`,
-:mod:`~softdesign.cli.sample` and :mod:`~softdesign.cli.pcc` (the ``pcc``
-group); what they share is :mod:`~softdesign.cli.common`.
+:mod:`~softdesign.cli.sample`, :mod:`~softdesign.cli.design` and
+:mod:`~softdesign.cli.pcc` (the ``pcc`` group); what they share is :mod:`~softdesign.cli.common`.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ import typer
 
 from softdesign.cli.build import blend, build, export, fit, ingest, kinematics, links, validate
 from softdesign.cli.check import check
+from softdesign.cli.design import design
 from softdesign.cli.pcc import pcc_app
 from softdesign.cli.pose import pose
 from softdesign.cli.report import report
@@ -28,7 +29,7 @@ app = typer.Typer(
     help="Patient-specific soft actuators from VMTK vessel exports.",
 )
 app.add_typer(pcc_app, name="pcc")
-for command in (validate, build, ingest, blend, links, kinematics, fit, export, pose, check, report, sample):
+for command in (validate, build, ingest, blend, links, kinematics, fit, export, pose, check, report, sample, design):
     app.command()(command)
 
 
@@ -39,5 +40,5 @@ def main() -> None:
 
 __all__ = [
     "app", "main", "validate", "build", "ingest", "blend", "links", "kinematics", "fit", "export",
-    "pose", "check", "report", "sample",
+    "pose", "check", "report", "sample", "design",
 ]
