@@ -121,7 +121,7 @@ def check_centerline(
     Raises
     ------
     ConfigError
-        Wrong shapes, fewer than 2 or more than MAX_SAMPLES samples, non-finite values, or s not rising.
+        Wrong shapes, fewer than 2 samples, non-finite values, or s not rising.
     """
     points, frames, s = (np.asarray(x, float) for x in (points, frames, arc_length))
     n = len(points)
@@ -130,15 +130,20 @@ def check_centerline(
             f"design: expected points (n, 3), frames (n, 3, 3), arc length (n,), n >= 2; "
             f"got {points.shape}, {frames.shape}, {s.shape}"
         )
-    if n > MAX_SAMPLES:
-        raise ConfigError(
-            f"design: {n} samples along the centerline, at most {MAX_SAMPLES} (the cost grows as n^3); "
-            f"raise resample.spacing_mm to about {s[-1] / (MAX_SAMPLES - 1):.3g} mm or more"
-        )
     finite = all(np.all(np.isfinite(x)) for x in (points, frames, s))
     if not (finite and s[0] == 0.0 and np.all(np.diff(s) > 0)):
         raise ConfigError("design: points and frames must be finite and arc length must rise strictly from 0")
     return points, frames, s
+
+
+def check_sample_count(arc_length: FloatArray) -> None:
+    """ConfigError when a design would have more than MAX_SAMPLES candidate breaks (its cost grows as n^3)."""
+    n = len(arc_length)
+    if n > MAX_SAMPLES:
+        raise ConfigError(
+            f"design: {n} samples along the centerline, at most {MAX_SAMPLES} (the cost grows as n^3); "
+            f"raise resample.spacing_mm to about {arc_length[-1] / (MAX_SAMPLES - 1):.3g} mm or more"
+        )
 
 
 def curvature_vectors(local: Points) -> FloatArray:
@@ -212,6 +217,7 @@ def link_costs(
     min_link_mm : shortest link allowed, mm
     """
     points, frames, s = check_centerline(points, frames, arc_length)
+    check_sample_count(s)
     n = len(points)
     cost = np.full((n, n), np.inf)
     shortest = min_link_mm * (1.0 - LENGTH_RTOL)
@@ -339,6 +345,7 @@ def design_links(
         Bad options (tolerance or shortest link not > 0, max_links < 1, a shortest link longer than the centerline).
     """
     points, frames, s = check_centerline(points, frames, arc_length)
+    check_sample_count(s)
     _check_options(options, float(s[-1]))
     cost = link_costs(points, frames, s, options.min_link_mm)
     breaks = fewest_links(cost, options.tolerance_mm)

@@ -168,6 +168,8 @@ def _tables_section(data: BuildData) -> tuple[Section, list[Check]]:
         check_table(checks),
     ]
     notes = [f"ingest: {n}" for n in data.ingest.notes]
+    notes += [f"kinematics: warning: {n}" for n in data.manifest.get("metrics", {}).get("kinematics", {})
+              .get("arc_check", {}).get("warnings", [])]
     notes += [f"{s['name']}: {STALE_NOTE}" for s in data.manifest.get("stages", []) if s.get("status") == "stale"]
     return Section("tables", "Figures, inputs, software and checks", notes=notes, tables=tables), checks
 

@@ -129,7 +129,8 @@ def test_aorta_design_keeps_every_link_within_the_tolerance(tmp_path, aorta_dir)
     case = tmp_path / "aorta.yaml"
     case.write_text(yaml.safe_dump({
         "name": "aorta",
-        "final": {"centerline": str(aorta_dir / "aorta-centerline.vtp"), "surface": str(aorta_dir / "aorta-surface.stl")},
+        "final": {"centerline": str(aorta_dir / "aorta-centerline.vtp"),
+                  "surface": str(aorta_dir / "aorta-surface.stl")},
     }, sort_keys=False))
     counts = []
     for tolerance in ("2", "1", "0.5"):
