@@ -18,7 +18,7 @@ from pathlib import Path
 from softdesign.errors import ConfigError
 from softdesign.pipeline.layout import REPORT_DIR
 from softdesign.pipeline.store import process_alive
-from softdesign.report import animation, fit_figures, kinematics_figures, morph_figures, surface_figures
+from softdesign.report import animation, design_figures, fit_figures, kinematics_figures, morph_figures, surface_figures
 from softdesign.report.build_folder import BuildData, load_build
 from softdesign.report.html_page import (
     Section,
@@ -56,6 +56,7 @@ EXPECTED_SIZES = {
     "fit_distances.png": pixel_size(fit_figures.DISTANCE_SIZE_IN),
     "kinematics.png": pixel_size(kinematics_figures.SIZE_IN),
     "pcc_chambers.png": pixel_size(kinematics_figures.PCC_SIZE_IN),
+    "design.png": pixel_size(design_figures.SIZE_IN),
     "morph.gif": pixel_size(animation.SIZE_IN),
 }
 
@@ -106,7 +107,7 @@ def write_report(build_dir: str | Path, options: ReportOptions = ReportOptions()
 
 
 def report_sections(data: BuildData, options: ReportOptions) -> tuple[list[Section], list[Check], list[str]]:
-    """The six sections of the page, every check, and the notes on what was left out."""
+    """The seven sections of the page, every check, and the notes on what was left out."""
     notes: list[str] = []
     morph = Section("morph", "The morph", pictures=[morph_figures.morph_picture(data.kinematics.chain, data.export_q)])
     surfaces, fit = Section("surfaces", "The surfaces"), Section("fit", "Fit quality")
@@ -125,7 +126,10 @@ def report_sections(data: BuildData, options: ReportOptions) -> tuple[list[Secti
     if data.export_summary is None:
         notes.append(NO_EXPORT)
         tables.notes.append(NO_EXPORT)
-    sections = [morph, surfaces, fit, kinematics, tables, Section("animation", "The morph, animated", pictures=[gif])]
+    design = Section("design", "Link design: one constant-curvature arc per link",
+                     pictures=[design_figures.design_picture(data.kinematics.chain)])
+    sections = [morph, surfaces, fit, kinematics, design, tables,
+                Section("animation", "The morph, animated", pictures=[gif])]
     return sections, checks, notes
 
 
