@@ -22,7 +22,8 @@ MAX_LINKS_LIMIT = 200
 
 CONVENTION = (
     "Centerline at q = 1, sampled at the resampled points (the candidate breaks); each link's arc starts at the link's "
-    "start frame F(l_start) = [N B T c], tangent to T, phi (rad) from N towards B, bending towards phi (seed 003); "
+    "start frame F(l_start) = [N B T c] (rotation-minimizing, whatever frames: says), tangent to T, phi (rad) from "
+    "N towards B, bending towards phi (seed 003); "
     "max_deviation_mm is the largest true distance from the link's samples to its arc; the arcs are chained by "
     "seed 003's improved D-H from the base frame and tip_error_mm / tip_error_rad are the position and rotation angle "
     "between the chain's tip frame and the centerline's tip frame inv(F(0)) F(1); chamber_lengths (mm) at 90, 210, "
@@ -130,6 +131,7 @@ def design(
 
     def action() -> None:
         from softdesign.cli.pcc_options import spacing_from_text
+        from softdesign.kinematics.arc_check import final_shape_rmf
         from softdesign.kinematics.arc_design import DesignOptions, design_links
         from softdesign.pipeline.api import build_through
 
@@ -143,7 +145,7 @@ def design(
             raise ConfigError(f"--output {target}: is the case file itself; write the design to another file")
         outcome = build_through(case_file, out, target="blend", progress=note)
         shape = outcome.results["blend"].shape
-        curve = shape.curve_at(1.0)
+        curve = final_shape_rmf(shape)
         l_grid = shape.smooth_curve_at(1.0).l_grid
         shortest = min_link_mm if min_link_mm is not None else _median_diameter(
             outcome.results["ingest"].path.radius, case_file)

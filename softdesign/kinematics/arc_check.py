@@ -16,6 +16,8 @@ from typing import Any
 
 import numpy as np
 
+from softdesign.geometry.blend import BlendedShape
+from softdesign.geometry.frames import FramedSpline, framed_curve
 from softdesign.kinematics.arc_design import DesignedLink, fit_link
 from softdesign.kinematics.links import LinkChain
 
@@ -27,9 +29,22 @@ ARC_TOLERANCE_MM = 1.0
 SNAP_L = 1e-6
 
 
+def final_shape_rmf(shape: BlendedShape) -> FramedSpline:
+    """The q = 1 centerline with rotation-minimizing frames: the case's own with ``frames: rmf``.
+
+    A PCC chain's sections continue one another without twist (seed 003's D-H), which is the
+    rmf transport; Frenet frames roll with the torsion, so a bending plane measured from them
+    would not chain.  With ``frames: frenet`` the rmf starts from the shape's base normal.
+    """
+    curve = shape.curve_at(1.0)
+    if curve.mode == "rmf":
+        return curve
+    return framed_curve(shape.smooth_curve_at(1.0), "rmf", shape.base_normal, label="q = 1 (rmf)")
+
+
 def link_arcs_at_final_shape(chain: LinkChain) -> list[DesignedLink]:
     """Per link of ``chain``: its best arc at q = 1 and largest deviation (``start``, ``end`` index its samples)."""
-    curve = chain.shape.curve_at(1.0)
+    curve = final_shape_rmf(chain.shape)
     grid = chain.shape.smooth_curve_at(1.0).l_grid
     out = []
     for l_start, l_end in zip(chain.breaks[:-1], chain.breaks[1:], strict=True):

@@ -35,9 +35,9 @@ def _link_samples(chain: LinkChain, j: int) -> FloatArray:
 
 def design_series(chain: LinkChain) -> dict[str, list]:
     """Per link: its samples' arc length (mm), their distance to its arc (mm), the arc in world mm; and the chain."""
-    from softdesign.kinematics.arc_check import link_arcs_at_final_shape
+    from softdesign.kinematics.arc_check import final_shape_rmf, link_arcs_at_final_shape
 
-    curve = chain.shape.curve_at(1.0)
+    curve = final_shape_rmf(chain.shape)
     arcs = link_arcs_at_final_shape(chain)
     along, distance, drawn = [], [], []
     for j, arc in enumerate(arcs):

@@ -152,3 +152,21 @@ def test_the_designed_demo_case_builds(tmp_path):
     manifest = json.loads((tmp_path / "built" / "manifest.json").read_text())
     assert manifest["metrics"]["links"]["breaks"] == doc["breaks"]
     assert all(o["watertight"] for o in manifest["outputs"] if o["path"].startswith("meshes/"))
+
+
+def test_frenet_frames_give_the_same_design_as_rmf(tmp_path):
+    # a PCC chain continues without twist: the design measures phi in rmf frames whatever frames: says
+    case = yaml.safe_load(DEMO.read_text())
+    case.update(name="demo-frenet", frames="frenet", initial={"kind": "arc", "bend_radius_mm": 200.0})
+    for key in ("centerline", "surface"):
+        case["final"][key] = str((DEMO.parent / case["final"][key]).resolve())
+    frenet = tmp_path / "frenet.yaml"
+    frenet.write_text(yaml.safe_dump(case, sort_keys=False))
+    _, rmf_doc, _ = design_json(DEMO, tmp_path / "b1", tmp_path / "d1.yaml", "--tolerance-mm", "1")
+    code, frenet_doc, err = design_json(frenet, tmp_path / "b2", tmp_path / "d2.yaml", "--tolerance-mm", "1")
+    assert code == 0, err
+    assert frenet_doc["breaks"] == rmf_doc["breaks"]
+    for key in ("kappa", "phi", "length", "max_deviation_mm"):
+        np.testing.assert_allclose([k[key] for k in frenet_doc["links"]], [k[key] for k in rmf_doc["links"]],
+                                   rtol=0, atol=1e-9)
+    np.testing.assert_allclose(frenet_doc["tip_error_mm"], rmf_doc["tip_error_mm"], rtol=0, atol=1e-9)
