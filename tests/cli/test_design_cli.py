@@ -170,3 +170,20 @@ def test_frenet_frames_give_the_same_design_as_rmf(tmp_path):
         np.testing.assert_allclose([k[key] for k in frenet_doc["links"]], [k[key] for k in rmf_doc["links"]],
                                    rtol=0, atol=1e-9)
     np.testing.assert_allclose(frenet_doc["tip_error_mm"], rmf_doc["tip_error_mm"], rtol=0, atol=1e-9)
+
+
+def test_a_straight_vessel_is_one_straight_link_and_without_radii_needs_min_link_mm(tmp_path):
+    z = np.linspace(0.0, 40.0, 81)
+    (tmp_path / "line.csv").write_text("x,y,z\n" + "".join(f"0,0,{float(v)!r}\n" for v in z))
+    case = tmp_path / "line.yaml"
+    case.write_text("final: {centerline: line.csv}\n")
+    result = runner.invoke(app, ["design", str(case), "--tolerance-mm", "0.1", "--out", str(tmp_path / "b")])
+    assert result.exit_code == 2 and "carries no radius" in result.stderr and "--min-link-mm" in result.stderr
+    code, doc, err = design_json(case, tmp_path / "b", tmp_path / "d.yaml", "--tolerance-mm", "0.1",
+                                 "--min-link-mm", "5")
+    assert code == 0, err
+    (link,) = doc["links"]
+    assert (link["kappa"], link["phi"], link["theta"]) == (0.0, 0.0, 0.0) and doc["breaks"] == [0.0, 1.0]
+    np.testing.assert_allclose([link["length"], link["max_deviation_mm"], doc["tip_error_mm"], doc["tip_error_rad"]],
+                               [40.0, 0.0, 0.0, 0.0], rtol=0, atol=1e-9)
+    assert (tmp_path / "d.yaml").read_text() == "final: {centerline: line.csv}\nlinks: {breaks: [0.0, 1.0]}\n"
