@@ -7,7 +7,7 @@ notes, progress and warnings go to stderr.
 One module per command family: :mod:`~softdesign.cli.build` (validate, build
 and one command per stage), :mod:`~softdesign.cli.pose`,
 :mod:`~softdesign.cli.check`, :mod:`~softdesign.cli.report`, :mod:`~softdesign.cli.centerline`,
-:mod:`~softdesign.cli.sample` and :mod:`~softdesign.cli.pcc` (the ``pcc``
+:mod:`~softdesign.cli.sample`, :mod:`~softdesign.cli.design` and :mod:`~softdesign.cli.pcc` (the ``pcc``
 group); what they share is :mod:`~softdesign.cli.common`.
 """
 
@@ -18,6 +18,7 @@ import typer
 from softdesign.cli.build import blend, build, export, fit, ingest, kinematics, links, validate
 from softdesign.cli.centerline import centerline
 from softdesign.cli.check import check
+from softdesign.cli.design import design
 from softdesign.cli.pcc import pcc_app
 from softdesign.cli.pose import pose
 from softdesign.cli.report import report
@@ -30,7 +31,7 @@ app = typer.Typer(
 )
 app.add_typer(pcc_app, name="pcc")
 for command in (
-    validate, build, ingest, blend, links, kinematics, fit, export, pose, check, report, sample, centerline
+    validate, build, ingest, blend, links, kinematics, fit, export, pose, check, report, sample, centerline, design
 ):
     app.command()(command)
 
@@ -42,5 +43,5 @@ def main() -> None:
 
 __all__ = [
     "app", "main", "validate", "build", "ingest", "blend", "links", "kinematics", "fit", "export",
-    "pose", "check", "report", "sample", "centerline",
+    "pose", "check", "report", "sample", "centerline", "design",
 ]

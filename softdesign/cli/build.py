@@ -39,7 +39,20 @@ def _run(case_file: Path, out: Path | None, target: str | None, force: bool):
     """Load the case and run the stages through ``target`` (every stage when None)."""
     from softdesign.pipeline.api import build_through
 
-    return build_through(case_file, out, target, force, progress=StageProgress())
+    outcome = build_through(case_file, out, target, force, progress=StageProgress())
+    _warn_arc_misses(case_file, outcome.results)
+    return outcome
+
+
+def _warn_arc_misses(case_file: Path, results: dict[str, Any]) -> None:
+    """On stderr: every link one constant-curvature arc misses at q = 1 by more than the stated tolerance."""
+    if "kinematics" not in results:
+        return
+    from softdesign.cli.common import note
+    from softdesign.kinematics.arc_check import arc_misses, link_arcs_at_final_shape
+
+    for line in arc_misses(link_arcs_at_final_shape(results["kinematics"].chain)):
+        note(f"warning: {case_file}: {line}")
 
 
 def _print_runs(build_dir: Path, runs) -> None:

@@ -14,7 +14,8 @@ import typer
 
 from softdesign.cli.common import CaseArg, JsonOpt, OutOpt, emit_json, note, run_guarded
 from softdesign.cli.pcc_options import spacing_from_text
-from softdesign.errors import errors_named_for
+from softdesign.errors import ConfigError, errors_named_for
+from softdesign.kinematics.arc_check import ARC_TOLERANCE_MM
 
 
 def _print_design(document: dict, case_file: Path) -> None:
@@ -40,7 +41,19 @@ def _print_design(document: dict, case_file: Path) -> None:
             f"(rms {w['backbone_rms_mm']:.3g} mm), tip {w['tip_error_mm']:.3g} mm, "
             f"tangent {w['tangent_error_rad']:.3g} rad, rotation {w['rotation_error_rad']:.3g} rad"
         )
+    for line in document.get("warnings", []):
+        typer.echo(f"warning: {line}")
     typer.echo(f"\nangles in rad unless marked; convention: {document['convention']}")
+
+
+def arc_warnings(document: dict, warn_mm: float) -> list[str]:
+    """One sentence per q and link whose arc misses the backbone by more than ``warn_mm`` (backbone_max_mm)."""
+    return [
+        f"q = {pose['q']:g}, link {k['index']}: one constant-curvature arc misses the design by up to "
+        f"{k['backbone_max_mm']:.3g} mm (--warn-mm {warn_mm:g}) and {k['tangent_error_rad']:.3g} rad of end tangent; "
+        f"a PCC section cannot make this link: use more links (softdesign design CASE --tolerance-mm {warn_mm:g})"
+        for pose in document["poses"] for k in pose["links"] if k["backbone_max_mm"] > warn_mm
+    ]
 
 
 def design(
@@ -53,6 +66,8 @@ def design(
     json_out: JsonOpt = False,
     out: OutOpt = None,
     samples: Annotated[int, typer.Option("--samples", min=3, help="Backbone samples per link for the fit.")] = 201,
+    warn_mm: Annotated[float, typer.Option(
+        "--warn-mm", help="Warn when a link's arc misses its backbone by more than this, mm.")] = ARC_TOLERANCE_MM,
 ) -> None:
     """One PCC section per link of the built design at every export q, and the chambers it needs.
 
@@ -65,7 +80,8 @@ def design(
     "length", "theta", "chamber_lengths", "chamber_strain", "backbone_max_mm",
     "backbone_rms_mm", "tip_error_mm", "tangent_error_rad",
     "rotation_error_rad"}], "worst": {"index", and those five errors}}],
-    "convention"}.
+    "convention", "warnings": [one sentence per q and link whose backbone_max_mm
+    exceeds --warn-mm]}.
     """
 
     def action() -> None:
@@ -73,6 +89,8 @@ def design(
         from softdesign.pipeline.api import build_through
 
         spacing_from_text(d, None)  # numbers > 0: fail before building
+        if not (math.isfinite(warn_mm) and warn_mm > 0.0):
+            raise ConfigError(f"--warn-mm must be a finite number > 0 mm, got {warn_mm:g}")
         outcome = build_through(case_file, out, target="kinematics", progress=note)
         chain = outcome.results["kinematics"].chain
         spacing = spacing_from_text(d, chain.count, where=f"{case_file} ({chain.count} links, one section each)")
@@ -81,6 +99,9 @@ def design(
         for line in result.notes:
             note(f"warning: {case_file}: {line}")
         document = design_document(result)
+        document["warnings"] = arc_warnings(document, warn_mm)
+        for line in document["warnings"]:
+            note(f"warning: {case_file}: {line}")
         if json_out:
             emit_json(document)
         else:

@@ -22,6 +22,7 @@ from softdesign.pipeline.out_folder import folder_errors
 from softdesign.pipeline.store import process_alive
 from softdesign.report import (
     animation,
+    design_figures,
     fit_figures,
     kinematics_figures,
     morph_figures,
@@ -65,6 +66,7 @@ EXPECTED_SIZES = {
     "fit_distances.png": pixel_size(fit_figures.DISTANCE_SIZE_IN),
     "kinematics.png": pixel_size(kinematics_figures.SIZE_IN),
     "pcc_chambers.png": pixel_size(kinematics_figures.PCC_SIZE_IN),
+    "design.png": pixel_size(design_figures.SIZE_IN),
     "morph.gif": pixel_size(animation.SIZE_IN),
     stretch_figures.NAME: pixel_size(stretch_figures.SIZE_IN),
 }
@@ -118,7 +120,7 @@ def write_report(build_dir: str | Path, options: ReportOptions = ReportOptions()
 
 
 def report_sections(data: BuildData, options: ReportOptions) -> tuple[list[Section], list[Check], list[str]]:
-    """The six sections of the page, every check, and the notes on what was left out."""
+    """The seven sections of the page, every check, and the notes on what was left out."""
     notes: list[str] = []
     morph = Section("morph", "The morph", pictures=[morph_figures.morph_picture(data.kinematics.chain, data.export_q)])
     surfaces, fit = Section("surfaces", "The surfaces"), Section("fit", "Fit quality")
@@ -139,7 +141,13 @@ def report_sections(data: BuildData, options: ReportOptions) -> tuple[list[Secti
     if data.export_summary is None:
         notes.append(NO_EXPORT)
         tables.notes.append(NO_EXPORT)
-    sections = [morph, surfaces, fit, kinematics, tables, Section("animation", "The morph, animated", pictures=[gif])]
+    design = Section(
+        "design", "Link design: one constant-curvature arc per link",
+        pictures=[design_figures.design_picture(data.kinematics.chain)],
+    )
+    sections = [
+        morph, surfaces, fit, kinematics, design, tables, Section("animation", "The morph, animated", pictures=[gif])
+    ]
     stretch = stretch_figures.stretch_picture(data)
     if stretch is not None:
         sections.insert(3, Section("feasibility", "Skin stretch and wall", pictures=[stretch]))
@@ -185,6 +193,8 @@ def _tables_section(data: BuildData) -> tuple[Section, list[Check]]:
         check_table(checks),
     ]
     notes = [f"ingest: {n}" for n in data.ingest.notes]
+    notes += [f"kinematics: warning: {n}" for n in data.manifest.get("metrics", {}).get("kinematics", {})
+              .get("arc_check", {}).get("warnings", [])]
     notes += [f"{s['name']}: {STALE_NOTE}" for s in data.manifest.get("stages", []) if s.get("status") == "stale"]
     return Section("tables", "Figures, inputs, software and checks", notes=notes, tables=tables), checks
 

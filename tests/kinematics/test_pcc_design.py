@@ -258,7 +258,7 @@ def test_demo_case_reports_finite_figures(tmp_path):
     result = runner.invoke(app, ["pcc", "design", str(DEMO), "--d", "2", "--out", str(tmp_path / "build"), "--json"])
     assert result.exit_code == 0, result.output
     payload = json.loads(result.stdout)
-    assert list(payload) == ["d", "poses", "convention"]
+    assert list(payload) == ["d", "poses", "convention", "warnings"]
     assert [pose["q"] for pose in payload["poses"]] == [0.0, 0.5, 1.0]
     keys = [
         "index", "l_start", "l_end", "kappa", "phi", "length", "theta", "chamber_lengths", "chamber_strain",

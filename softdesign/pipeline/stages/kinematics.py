@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from softdesign.config import Case
+from softdesign.kinematics.arc_check import arc_check_metrics, arc_misses, link_arcs_at_final_shape
 from softdesign.kinematics.links import LinkChain, LinkReport
 from softdesign.kinematics.poe import PoeSplit
 from softdesign.pipeline import layout
@@ -140,6 +141,7 @@ def describe_kinematics(result: KinematicsResult) -> list[str]:
                 f"theta1 {p['theta1']:.3f} mm, theta2 {p['theta2']:.4f} rad, "
                 f"stretch {link['stretch'][0]:.3f}..{link['stretch'][1]:.3f}"
             )
+    lines += [f"  warning: {line}" for line in arc_misses(link_arcs_at_final_shape(result.chain))]
     return lines
 
 
@@ -152,5 +154,6 @@ STAGE = Stage(
     write=write_kinematics,
     load=lambda build_dir, results: load_kinematics(build_dir, results["links"]),
     describe=describe_kinematics,
-    metrics=lambda result: {"links": len(result.document["links"]), "file": layout.KINEMATICS},
+    metrics=lambda result: {"links": len(result.document["links"]), "file": layout.KINEMATICS,
+                            "arc_check": arc_check_metrics(result.chain)},
 )

@@ -1,0 +1,42 @@
+"""The report's design panel (issue 14, item 3): what it draws is the build's own arc check."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+from PIL import Image
+
+from softdesign.kinematics.arc_design import chain_tip_error
+from softdesign.pipeline.api import build_through
+from softdesign.report.design_figures import design_picture, design_series
+from softdesign.report.writer import EXPECTED_SIZES
+from tests.helpers.paths import REPO
+
+#: Distances and chained points are the same computations on the same samples: rounding only, mm.
+SAME_TOL_MM = 1e-9
+
+
+def test_the_panel_draws_the_manifests_deviations_and_the_chained_tip(tmp_path):
+    outcome = build_through(REPO / "configs" / "demo.yaml", tmp_path / "build", target="kinematics")
+    chain = outcome.results["kinematics"].chain
+    series = design_series(chain)
+    manifest = json.loads((tmp_path / "build" / "manifest.json").read_text())
+    deviations = manifest["metrics"]["kinematics"]["arc_check"]["max_deviation_mm"]
+    np.testing.assert_allclose([d.max() for d in series["distance"]], deviations, rtol=0, atol=SAME_TOL_MM)
+    # each drawn arc starts on its link's start point; the chain starts at the base and ends where the D-H tip is
+    curve = chain.shape.curve_at(1.0)
+    np.testing.assert_allclose([a[0] for a in series["arcs"]], curve.points(chain.breaks[:-1]), rtol=0,
+                               atol=SAME_TOL_MM)
+    chained = series["chained"][0]
+    from softdesign.kinematics.arc_check import link_arcs_at_final_shape
+
+    grid = chain.shape.smooth_curve_at(1.0).l_grid
+    tip_mm, _ = chain_tip_error(tuple(link_arcs_at_final_shape(chain)), curve.frames(grid), curve.points(grid))
+    np.testing.assert_allclose(np.linalg.norm(chained[-1] - curve.points([1.0])[0]), tip_mm, rtol=0, atol=1e-6)
+    assert tip_mm > 1.0  # four links of the tortuous demo, each 1.9-2.8 mm off: the chain drifts by more
+    picture = design_picture(chain)
+    path = tmp_path / picture.name
+    path.write_bytes(picture.data)
+    with Image.open(path) as image:
+        assert image.size == EXPECTED_SIZES["design.png"]
