@@ -113,7 +113,7 @@ def case_inputs(case_file: Path) -> list[Path]:
     """
     # imported here: `run` and `summary` start once per case and need neither pydantic nor vtk
     from softdesign.config import load_case
-    from softdesign.pipeline.stages.ingest import input_fields
+    from softdesign.pipeline.inputs import input_fields
 
     return [path for _, path in input_fields(load_case(case_file))]
 

@@ -33,7 +33,7 @@ from pydantic import (
 from softdesign.config_types import FiniteFloat, Integer
 from softdesign.errors import ConfigError
 from softdesign.io.case_yaml import parse_case_yaml, read_case_text
-from softdesign.io.formats import MESH_FORMATS
+from softdesign.io.format_names import MESH_FORMATS
 from softdesign.limits import (
     MAX_ANGULAR_COUNT,
     MAX_ANGULAR_INTERVALS,
@@ -44,7 +44,7 @@ from softdesign.limits import (
     MEMORY_BUDGET_TEXT,
 )
 from softdesign.materials import MaterialLimits, PresetName, resolve_material
-from softdesign.meshing.checks import MIN_ANGULAR_COUNT, VOLUME_RTOL
+from softdesign.meshing.volume_tolerance import MIN_ANGULAR_COUNT, VOLUME_RTOL
 from softdesign.pipeline.layout import q_label
 
 

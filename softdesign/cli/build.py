@@ -76,7 +76,7 @@ def validate(case_file: CaseArg) -> None:
 
     def action() -> None:
         from softdesign.config import load_case
-        from softdesign.pipeline.stages import input_files
+        from softdesign.pipeline.inputs import input_files
 
         case = load_case(case_file)
         files = input_files(case)

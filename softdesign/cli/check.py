@@ -7,12 +7,14 @@ Register with ``app.command()(check)`` in :mod:`softdesign.cli`.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
 from softdesign.cli.common import emit_json, note, run_guarded
-from softdesign.regression import CheckOptions, CheckReport, Figure, check_build
+
+if TYPE_CHECKING:  # the comparison imports scipy, trimesh and vtk: only when a check runs
+    from softdesign.regression import CheckReport, Figure
 
 #: Significant digits of the figures in the table (JSON keeps full precision).
 TABLE_DIGITS = 4
@@ -49,6 +51,8 @@ def check(
     """
 
     def action() -> None:
+        from softdesign.regression import CheckOptions, check_build
+
         options = CheckOptions(distance_mm=tolerance_mm, rtol=rtol, rotation_rad=rotation_tol)
         report = check_build(build_dir, reference, options, progress=note)
         for warning in report.warnings:

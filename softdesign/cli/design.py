@@ -9,13 +9,15 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
-import numpy as np
 import typer
 
 from softdesign.cli.common import CaseArg, JsonOpt, OutOpt, emit_json, note, run_guarded
 from softdesign.errors import ConfigError, SoftdesignError, errors_named_for
+
+if TYPE_CHECKING:  # numpy is imported where it is used: `softdesign --help` starts without it
+    import numpy as np
 
 #: Most links a user may ask for (a bound on the minimax programme's levels, each n^2).
 MAX_LINKS_LIMIT = 200
@@ -46,6 +48,8 @@ def _checked_options(tolerance_mm: float, min_link_mm: float | None, max_links: 
 
 
 def _median_diameter(radius: np.ndarray | None, case_file: Path) -> float:
+    import numpy as np
+
     if radius is None or not len(radius):
         raise ConfigError(
             f"{case_file}: the centerline carries no radius (MaximumInscribedSphereRadius), so the default shortest "
@@ -173,6 +177,8 @@ def design(
 
 def _chamber_lengths(result: Any, d: str) -> np.ndarray:
     """(links, 3) mm, seed 003's inverse (``pcc.lengths_from_arcs``) per designed arc; a note for a chamber <= 0."""
+    import numpy as np
+
     from softdesign.cli.pcc_options import spacing_from_text
     from softdesign.kinematics import pcc
 

@@ -13,9 +13,8 @@ import io
 import math
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Annotated, Any, NamedTuple
+from typing import TYPE_CHECKING, Annotated, Any, NamedTuple
 
-import numpy as np
 import typer
 
 from softdesign.cli.common import JsonOpt, emit_json, note, run_guarded
@@ -23,6 +22,9 @@ from softdesign.cli.pcc_design import design
 from softdesign.cli.pcc_options import DOpt, LengthsOpt, lengths_from_text, spacing_from_text
 from softdesign.errors import ConfigError, InputDataError
 from softdesign.io.atomic import write_bytes_atomically
+
+if TYPE_CHECKING:  # numpy is imported where it is used: `softdesign --help` starts without it
+    import numpy as np
 
 CONVENTION = (
     "Encoders at 90, 210, 330 degrees from the section's base x axis, d mm from the backbone; "
@@ -122,6 +124,8 @@ def _header_sections(path: Path, header: list[str]) -> int:
 
 def _parse_row(values: list[str], sections: int) -> tuple[float | None, np.ndarray | None, list[str]]:
     """Time and (k, 3) lengths of a data row, or the reasons it is unusable."""
+    import numpy as np
+
     reasons = []
     try:
         time = float(values[0])
@@ -148,6 +152,8 @@ def _rate_reasons(
     time: float, lengths: np.ndarray, previous: tuple[int, float, np.ndarray], max_rate: float | None
 ) -> list[str]:
     """Why a row cannot follow the previous accepted row in time (empty when it can)."""
+    import numpy as np
+
     line, last_time, last_lengths = previous
     dt = time - last_time
     if dt <= 0:
@@ -173,6 +179,8 @@ def read_readings(path: Path, max_rate: float | None = None) -> Readings:
     InputDataError
         Missing or unreadable file, a bad header, or a row with the wrong number of columns.
     """
+    import numpy as np
+
     if not path.is_file():
         raise InputDataError(f"{path}: readings file not found; check the path")
     try:
@@ -215,6 +223,8 @@ def _write_text_atomically(path: Path, text: str) -> Path:
 
 
 def _csv_text(header: list[str], rows: Sequence[Sequence[Any]]) -> str:
+    import numpy as np
+
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(header)
@@ -223,6 +233,8 @@ def _csv_text(header: list[str], rows: Sequence[Sequence[Any]]) -> str:
 
 
 def _tips_csv(readings: Readings, arcs, tip2base: np.ndarray) -> str:
+    import numpy as np
+
     sections = readings.lengths.shape[1]
     header = ["time", "tip_x", "tip_y", "tip_z"] + [f"r{i}{j}" for i in range(1, 4) for j in range(1, 4)]
     header += [f"{name}_{s}" for s in range(1, sections + 1) for name in ("kappa", "phi", "length", "theta")]
@@ -234,6 +246,8 @@ def _tips_csv(readings: Readings, arcs, tip2base: np.ndarray) -> str:
 
 
 def _write_backbones(path: Path, readings: Readings, arcs, points_per_section: int) -> Path:
+    import numpy as np
+
     from softdesign.io.polylines_vtp import write_polylines_vtp
     from softdesign.kinematics import pcc
 

@@ -15,7 +15,7 @@ import typer
 from softdesign.cli.common import CaseArg, JsonOpt, OutOpt, emit_json, note, run_guarded
 from softdesign.cli.pcc_options import spacing_from_text
 from softdesign.errors import ConfigError, errors_named_for
-from softdesign.kinematics.arc_check import ARC_TOLERANCE_MM
+from softdesign.kinematics.arc_tolerance import ARC_TOLERANCE_MM
 
 
 def _print_design(document: dict, case_file: Path) -> None:

@@ -6,13 +6,15 @@ Parsing raises :class:`~softdesign.errors.ConfigError` naming the option and the
 from __future__ import annotations
 
 import math
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
-import numpy as np
 import typer
 
 from softdesign.cli.common import distances_from_text
 from softdesign.errors import ConfigError
+
+if TYPE_CHECKING:  # numpy is imported where it is used: `softdesign --help` starts without it
+    import numpy as np
 
 LengthsOpt = Annotated[
     str,
@@ -44,6 +46,8 @@ def _number(text: str, what: str, fix: str) -> float:
 
 def lengths_from_text(text: str) -> np.ndarray:
     """Parse ``--lengths`` ("l11,l12,l13;l21,l22,l23") into a (k, 3) array, mm, each > 0."""
+    import numpy as np
+
     fix = 'give three lengths in mm per section, sections separated by ";", e.g. "120,123,124;125,123,121"'
     sections = [part for part in text.split(";") if part.strip()]
     if not sections:
@@ -68,5 +72,7 @@ def spacing_from_text(text: str, sections: int | None, where: str = "--lengths")
 
     With ``sections`` None (not known yet) the values are checked and returned as given.
     """
+    import numpy as np
+
     values = distances_from_text(text, "--d", "cable distance from the backbone", sections, "section", where)
     return np.array(values, dtype=np.float64)

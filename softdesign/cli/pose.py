@@ -26,7 +26,7 @@ from softdesign.cli.common import (
     run_guarded,
 )
 from softdesign.errors import ConfigError, errors_named_for
-from softdesign.io.formats import MESH_FORMATS
+from softdesign.io.format_names import MESH_FORMATS
 
 OutputOpt = Annotated[
     Path,

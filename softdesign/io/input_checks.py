@@ -16,8 +16,6 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-import numpy as np
-
 from softdesign.errors import InputDataError
 from softdesign.io.case_yaml import file_kind
 
@@ -77,6 +75,8 @@ def check_npy_header(path: Path) -> None:
 
     Reads the header only (numpy.lib.format), so nothing is allocated for what the header claims.
     """
+    import numpy as np
+
     size = path.stat().st_size
     try:
         with path.open("rb") as handle:

@@ -19,11 +19,9 @@ import numpy as np
 from softdesign.geometry.blend import BlendedShape
 from softdesign.geometry.frames import FramedSpline, framed_curve
 from softdesign.kinematics.arc_design import DesignedLink, fit_link
+from softdesign.kinematics.arc_tolerance import ARC_TOLERANCE_MM
 from softdesign.kinematics.links import LinkChain
 
-#: The stated tolerance of the warning, mm: about the placement noise of a VMTK centerline on a vessel of a few
-#: mm, and a tenth of a typical link's diameter; a link farther than this from every arc needs more sections.
-ARC_TOLERANCE_MM = 1.0
 #: A resampled point this close to a link's end (in l) is that end: breaks written with six decimals (as
 #: ``softdesign design`` writes them) then give the design's own samples, not the end point twice.
 SNAP_L = 1e-6

@@ -11,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from softdesign.config import Case
+from softdesign.pipeline import inputs
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages import blend, export, feasibility, fit, ingest, kinematics, links
 
@@ -28,4 +29,4 @@ def stages_through(name: str) -> list[Stage]:
 
 def input_files(case: Case) -> list[Path]:
     """Files the build reads (ConfigError naming the field when one is missing)."""
-    return ingest.input_files(case)
+    return inputs.input_files(case)

@@ -17,7 +17,6 @@ from softdesign.config import Case
 from softdesign.geometry.network import CenterlineNetwork, Orientation, SelectedPath, all_paths, select_path
 from softdesign.geometry.plausibility import check_surface_surrounds, check_vessel_scale
 from softdesign.io.centerline import read_centerline_network
-from softdesign.io.input_checks import check_input_file
 from softdesign.io.surface import read_surface
 from softdesign.meshing.topology import SurfaceInfo, describe_surface
 from softdesign.pipeline import layout
@@ -57,31 +56,6 @@ class IngestResult:
     summary: dict[str, Any] = field(default_factory=dict)
     notes: tuple[str, ...] = ()
     extracted: Any = None
-
-
-def input_fields(case: Case) -> list[tuple[str, Path]]:
-    """Every file ingest reads, with the case field that names it."""
-    named = [
-        ("final.centerline", case.final.centerline),
-        ("final.surface", case.final.surface),
-        ("initial.centerline", case.initial.centerline),
-        ("initial.surface", case.initial.surface),
-    ]
-    named += [(f"intermediate[{i}].centerline", k.centerline) for i, k in enumerate(case.intermediate)]
-    return [(name, path) for name, path in named if isinstance(path, Path)]  # not None, not "auto"
-
-
-def input_files(case: Case) -> list[Path]:
-    """Every file ingest reads (for the cache key and the manifest).
-
-    Raises
-    ------
-    InputDataError
-        A named file does not exist.
-    """
-    for name, path in input_fields(case):
-        check_input_file(path, name)
-    return [path for _, path in input_fields(case)]
 
 
 def run_ingest(case: Case) -> IngestResult:
