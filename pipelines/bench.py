@@ -22,9 +22,15 @@ I/O floor
     the build wrote (the build's own meshes, re-read untimed).  The ingest
     row compares with the read, the export row with the writes, the total
     with both.
+Workers
+    A build runs its per-q work (export's meshes, feasibility's figures) on
+    ``--jobs`` forked worker processes (default: the cores available, as
+    ``softdesign build``); their CPU time is in the stage's cpu s, and the
+    largest worker's peak RSS is printed apart (a worker shares the build
+    process's pages, so build peak + jobs x worker peak bounds the whole).
 
 Usage: ``python pipelines/bench.py [--triangles 250000,500000,1000000]
-[--frames 11,41] [--profile] [--keep DIR]``; ``make bench`` runs the defaults.
+[--frames 11,41] [--jobs N] [--profile] [--keep DIR]``; ``make bench`` runs the defaults.
 """
 
 from __future__ import annotations
@@ -34,6 +40,7 @@ import json
 import math
 import os
 import re
+import resource
 import shutil
 import subprocess
 import sys
@@ -43,6 +50,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+from softdesign.pipeline.parallel import MAX_JOBS, available_cores
 
 if TYPE_CHECKING:
     import cProfile
@@ -126,10 +135,10 @@ class StageClock:
 
             self._profiler = cProfile.Profile()
             self._profiler.enable()
-        self._start = (time.perf_counter(), time.process_time())
+        self._start = (time.perf_counter(), _cpu_s())
 
     def end(self, name: str) -> None:
-        wall, cpu = time.perf_counter() - self._start[0], time.process_time() - self._start[1]
+        wall, cpu = time.perf_counter() - self._start[0], _cpu_s() - self._start[1]
         if self._profiler is not None and self.profile_dir is not None:  # a profiler runs only with a folder
             self._profiler.disable()
             self._profiler.dump_stats(str(self.profile_dir / f"{name}.prof"))
@@ -137,6 +146,17 @@ class StageClock:
         peak = self.memory.peak_mib()
         self.overall_peak = max(self.overall_peak, peak)
         self.rows[name] = {"wall_s": wall, "cpu_s": cpu, "peak_mib": peak}
+
+
+def _cpu_s() -> float:
+    """CPU seconds of this process and of its workers that have ended (a stage's pool ends within the stage)."""
+    own, workers = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + workers.ru_utime + workers.ru_stime
+
+
+def worker_peak_mib() -> float:
+    """Peak RSS of the largest worker process that has ended, MiB (Linux reports ru_maxrss in KiB)."""
+    return resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0
 
 
 def measured(stages: list, clock: StageClock) -> list:
@@ -200,7 +220,7 @@ def io_floor(surface: Path, meshes: list[Path], scratch: Path) -> dict[str, floa
     return {"read_s": min(reads), "write_s": min(writes)}
 
 
-def run_worker(case_file: Path, out_dir: Path, profile_dir: Path | None) -> dict[str, Any]:
+def run_worker(case_file: Path, out_dir: Path, profile_dir: Path | None, jobs: int = 1) -> dict[str, Any]:
     """Build ``case_file`` into ``out_dir`` (forced), then measure the I/O floor; returns the figures.
 
     With ``profile_dir``, every stage is profiled into ``profile_dir/<stage>.prof``.
@@ -215,9 +235,10 @@ def run_worker(case_file: Path, out_dir: Path, profile_dir: Path | None) -> dict
     clock = StageClock(memory, profile_dir)
     baseline = memory.current_mib()
     memory.reset()
-    start = time.perf_counter(), time.process_time()
-    run_stages(case, out_dir / "build", measured(STAGES, clock), input_files(case), RunOptions(force=True))
-    total = {"wall_s": time.perf_counter() - start[0], "cpu_s": time.process_time() - start[1]}
+    start = time.perf_counter(), _cpu_s()
+    options = RunOptions(force=True, jobs=jobs)
+    run_stages(case, out_dir / "build", measured(STAGES, clock), input_files(case), options)
+    total = {"wall_s": time.perf_counter() - start[0], "cpu_s": _cpu_s() - start[1]}
     total["peak_mib"] = max(clock.overall_peak, memory.peak_mib())
     manifest = json.loads((out_dir / "build" / "manifest.json").read_text())
     meshes = [o for o in manifest["outputs"] if o["path"].startswith("meshes/") and o["path"].endswith(".stl")]
@@ -229,6 +250,8 @@ def run_worker(case_file: Path, out_dir: Path, profile_dir: Path | None) -> dict
         "import_s": import_s,
         "baseline_mib": baseline,
         "peak_resettable": memory.resettable,
+        "jobs": jobs,
+        "worker_peak_mib": worker_peak_mib(),
         "stages": clock.rows,
         "total": total,
         "input": {"triangles": surface["faces"], "vertices": surface["vertices"]},
@@ -297,10 +320,11 @@ def synthetic_case(folder: Path, triangles: int, frames: int) -> BenchCase:
     return BenchCase(f"synthetic {triangles / 1e6:g}M triangles, {frames} frames", case, triangles, frames)
 
 
-def measure(case: BenchCase, scratch: Path, profile_dir: Path | None = None) -> dict[str, Any]:
-    """Run the worker on ``case`` in a fresh process; its figures, with the label and sizes."""
+def measure(case: BenchCase, scratch: Path, profile_dir: Path | None = None, jobs: int = 1) -> dict[str, Any]:
+    """Run the worker on ``case`` in a fresh process with ``jobs`` workers; its figures, with the label and sizes."""
     out_dir = Path(tempfile.mkdtemp(prefix="run-", dir=scratch))
-    command = [sys.executable, str(Path(__file__).resolve()), "--worker", str(case.case_file), str(out_dir)]
+    command = [sys.executable, str(Path(__file__).resolve()), "--worker", str(case.case_file), str(out_dir),
+               "--jobs", str(jobs)]
     if profile_dir is not None:
         profile_dir.mkdir(parents=True, exist_ok=True)
         command += ["--profile-dir", str(profile_dir)]
@@ -330,6 +354,9 @@ def stage_table(result: dict[str, Any]) -> list[str]:
         f"  input {i['triangles']:,} triangles ({i['vertices']:,} vertices); writes {o['meshes']} STL meshes, "
         f"{o['triangles']:,} triangles; imports before the clock {result['import_s']:.2f} s, "
         f"RSS after imports {result['baseline_mib']:.0f} MiB",
+        f"  {result['jobs']} worker process(es) for the per-q work; largest worker's peak RSS "
+        f"{result['worker_peak_mib']:.0f} MiB (shared with the build process; bound on the whole: "
+        f"{result['total']['peak_mib'] + result['jobs'] * result['worker_peak_mib']:.0f} MiB)",
         f"  {'stage':<11}{'wall s':>9}{'cpu s':>9}{'peak MiB':>10}{'floor s':>9}{'build/floor':>13}",
     ]
     rows = [(name, result["stages"][name]) for name in STAGE_NAMES] + [("total", result["total"])]
@@ -499,12 +526,12 @@ def emit(lines: Sequence[str]) -> None:
     print("\n".join(lines), flush=True)
 
 
-def run_synthetic(plan: list[BenchCase], scratch: Path) -> list[dict[str, Any]]:
+def run_synthetic(plan: list[BenchCase], scratch: Path, jobs: int) -> list[dict[str, Any]]:
     """Measure every synthetic run, telling stderr as each one ends."""
     results = []
     for case in plan:
         start = time.perf_counter()
-        results.append(measure(case, scratch))
+        results.append(measure(case, scratch, jobs=jobs))
         print(f"  ({case.label}: measured in {time.perf_counter() - start:.0f} s)", file=sys.stderr, flush=True)
     return results
 
@@ -513,15 +540,15 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
     """Measure and print every case, the scaling of the synthetic case and the targets."""
     started = time.perf_counter()
     emit(header_lines() + [""])
-    emit(stage_table(measure(BenchCase("sample case (configs/demo.yaml)", DEMO_CASE), scratch)) + [""])
+    emit(stage_table(measure(BenchCase("sample case (configs/demo.yaml)", DEMO_CASE), scratch, jobs=args.jobs)) + [""])
     aorta = aorta_case(scratch / "aorta")
     if aorta is None:
         emit([f"VMTK aorta: skipped, {AORTA_DIR} not found", ""])
     else:
-        emit(stage_table(measure(aorta, scratch)) + [""])
+        emit(stage_table(measure(aorta, scratch, jobs=args.jobs)) + [""])
     emit(centerline_lines() + [""])
     plan = synthetic_plan(scratch, args.triangles, args.frames)
-    results = run_synthetic(plan, scratch)
+    results = run_synthetic(plan, scratch, args.jobs)
     top_t, top_f = max(args.triangles), max(args.frames)
     scaled = next(r for r in results if r["size"] == {"triangles": top_t, "frames": top_f})
     emit([f"scaled case ({SYNTHETIC_LINKS} links):"] + stage_table(scaled) + [""])
@@ -537,7 +564,8 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
               "(adds one profiled build of the scaled case)"])
     if args.profile:
         profile_dir = scratch / "profile"
-        measure(next(c for c in plan if (c.triangles, c.frames) == (top_t, top_f)), scratch, profile_dir)
+        # one process, so that the profiler sees the per-q work too
+        measure(next(c for c in plan if (c.triangles, c.frames) == (top_t, top_f)), scratch, profile_dir, jobs=1)
         emit(
             ["", "hot spots of the scaled case (cProfile per stage; times inflated by the profiler):"]
             + profile_lines(profile_dir)
@@ -568,12 +596,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--frames", type=parse_counts, default=list(DEFAULT_FRAMES), help="synthetic frame counts")
     parser.add_argument("--profile", action="store_true", help="also profile the scaled case and list hot spots")
     parser.add_argument("--keep", type=Path, help="work in this folder and keep it (default: a temporary folder)")
+    parser.add_argument("--jobs", type=int, default=available_cores(),
+                        help="worker processes per build (default: the cores available, as softdesign build)")
     parser.add_argument("--worker", nargs=2, type=Path, metavar=("CASE", "OUT"), help=argparse.SUPPRESS)
     parser.add_argument("--profile-dir", type=Path, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker:
-        print(json.dumps(run_worker(args.worker[0], args.worker[1], args.profile_dir)))
+        print(json.dumps(run_worker(args.worker[0], args.worker[1], args.profile_dir, args.jobs)))
         return 0
+    if not 1 <= args.jobs <= MAX_JOBS:
+        parser.error(f"--jobs: 1 to {MAX_JOBS}, got {args.jobs}")
     if min(args.frames) < 2:
         parser.error("--frames: each count must be >= 2 (both ends are exported)")
     scratch = args.keep or Path(tempfile.mkdtemp(prefix="softdesign-bench-"))

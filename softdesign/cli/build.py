@@ -31,15 +31,23 @@ StrictOpt = Annotated[
 KinematicsQOpt = Annotated[
     str | None, typer.Option("--q", help="One q for every link ('0.5') or one per link ('0.2,0.8,1'), each in [0, 1].")
 ]
+JobsOpt = Annotated[
+    int | None,
+    typer.Option("--jobs", "-j", help="Worker processes for the per-q work (meshes, feasibility) [default: the cores "
+                 "available]; 1 runs everything in this process. The outputs are the same bytes whatever N.",
+                 show_default=False),
+]
 #: The keys of each link in ``kinematics --q --json`` (DESIGN.md).
 KINEMATICS_LINK_KEYS = ("index", "l_start", "l_end", "length", "transform", "poe")
 
 
-def _run(case_file: Path, out: Path | None, target: str | None, force: bool):
-    """Load the case and run the stages through ``target`` (every stage when None)."""
+def _run(case_file: Path, out: Path | None, target: str | None, force: bool, jobs: int | None = 1):
+    """Load the case and run the stages through ``target`` (every stage when None); ``jobs`` None: every core."""
     from softdesign.pipeline.api import build_through
+    from softdesign.pipeline.parallel import checked_jobs
 
-    outcome = build_through(case_file, out, target, force, progress=StageProgress())
+    workers = checked_jobs(jobs)
+    outcome = build_through(case_file, out, target, force, progress=StageProgress(), jobs=workers)
     _warn_arc_misses(case_file, outcome.results)
     return outcome
 
@@ -63,9 +71,9 @@ def _print_runs(build_dir: Path, runs) -> None:
     typer.echo(f"build folder: {build_dir}")
 
 
-def _stage_command(case_file: Path, out: Path | None, target: str, force: bool) -> None:
+def _stage_command(case_file: Path, out: Path | None, target: str, force: bool, jobs: int | None = 1) -> None:
     def action() -> None:
-        outcome = _run(case_file, out, target, force)
+        outcome = _run(case_file, out, target, force, jobs)
         _print_runs(outcome.build_dir, outcome.runs)
 
     run_guarded(action)
@@ -87,14 +95,14 @@ def validate(case_file: CaseArg) -> None:
 
 def build(
     case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False, with_report: ReportOpt = False,
-    strict: StrictOpt = False,
+    strict: StrictOpt = False, jobs: JobsOpt = None,
 ) -> None:
     """Run every stage (unchanged stages are skipped) and write the manifest; --report adds the HTML report."""
 
     def action() -> bool:
         from softdesign.cli.report import report_after_build
 
-        outcome = _run(case_file, out, None, force)
+        outcome = _run(case_file, out, None, force, jobs)
         _print_runs(outcome.build_dir, outcome.runs)
         if with_report:
             report_after_build(outcome.build_dir)
@@ -128,9 +136,9 @@ def fit(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None
     _stage_command(case_file, out, "fit", force)
 
 
-def export(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:
+def export(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False, jobs: JobsOpt = None) -> None:
     """Checked watertight solids of S(q) at every export q (STL and the other formats asked for)."""
-    _stage_command(case_file, out, "export", force)
+    _stage_command(case_file, out, "export", force, jobs)
 
 
 def kinematics(

@@ -36,13 +36,17 @@ def build_through(
     target: str | None = None,
     force: bool = False,
     progress: Callable[[str], None] = lambda line: None,
+    jobs: int = 1,
 ) -> BuildOutcome:
-    """Run the stages up to ``target`` (every stage when None); errors name the case file."""
+    """Run the stages up to ``target`` (every stage when None), per-q work on ``jobs`` processes.
+
+    Errors name the case file.
+    """
     case = load_case(case_file)
     build_dir = default_build_dir(case, out)
     stages = STAGES if target is None else stages_through(target)
     later = tuple(s for s in STAGES if s not in stages)
-    options = RunOptions(force=force, progress=progress, later=later)
+    options = RunOptions(force=force, progress=progress, later=later, jobs=jobs)
     with errors_named_for(case_file):
         inputs = input_files(case)
         with input_os_errors(inputs):

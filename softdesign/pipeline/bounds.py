@@ -12,6 +12,7 @@ budget they keep a build within is derived.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 from softdesign.config import Case
 from softdesign.errors import ConfigError
@@ -23,7 +24,9 @@ from softdesign.limits import (
     MAX_MESH_VERTICES,
     MEMORY_BUDGET_TEXT,
 )
-from softdesign.pipeline.stages.ingest import IngestResult
+
+if TYPE_CHECKING:  # the export and feasibility stages import this module: no import of the stages here
+    from softdesign.pipeline.stages.ingest import IngestResult
 
 #: A length ratio counts as a whole number of intervals within this (for the "at least" spacing in messages).
 _GRACE = 1.0 + 1e-9
@@ -95,11 +98,26 @@ def _at_most(key: str, spacing: float, what: str, length: float, limit: int, nam
         )
 
 
+def mesh_vertices(case: Case, longest: float) -> int:
+    """About how many vertices each export mesh has on a shape ``longest`` mm long (rings x around, x 2 hollow)."""
+    e = case.export
+    walls = 1 if e.wall_mm is None else 2  # a hollow body has the chamber's rings too
+    return (math.ceil(longest / e.spacing_mm) + 1) * e.angular_count * walls
+
+
+def meshes_at_once(case: Case, longest: float) -> int:
+    """How many export meshes may be built at the same time (by parallel workers) within the memory budget.
+
+    The budget holds one mesh of MAX_MESH_VERTICES while it is built (softdesign/limits.py); as many
+    meshes as together have that many vertices fit in the same memory, each in its own worker.
+    """
+    return max(1, MAX_MESH_VERTICES // max(1, mesh_vertices(case, longest)))
+
+
 def _check_meshes(case: Case, longest: float) -> None:
     e = case.export
     walls = 1 if e.wall_mm is None else 2  # a hollow body has the chamber's rings too
-    rings = math.ceil(longest / e.spacing_mm) + 1
-    per_mesh = rings * e.angular_count * walls
+    per_mesh = mesh_vertices(case, longest)
     if per_mesh > MAX_MESH_VERTICES:
         least = longest / (MAX_MESH_VERTICES / (e.angular_count * walls) - 1)
         raise ConfigError(

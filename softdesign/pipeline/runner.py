@@ -23,6 +23,7 @@ from softdesign.pipeline.bounds import check_sizes
 from softdesign.pipeline.lock import BuildLock
 from softdesign.pipeline.manifest import build_manifest
 from softdesign.pipeline.out_folder import check_out_folder, folder_errors
+from softdesign.pipeline.parallel import jobs_for_build
 from softdesign.pipeline.stage import Results, Stage, StageRun, Status, stage_key
 from softdesign.pipeline.store import Staging, read_record, sha256_file
 from softdesign.pipeline.swap import repair
@@ -58,6 +59,8 @@ class RunOptions:
     #: stages after the target: not run, but their outputs kept from an earlier run are checked
     #: against what they would be built from now (``kept`` and loaded, or ``stale``)
     later: tuple[Stage, ...] = ()
+    #: worker processes for the per-q work of a stage (:mod:`softdesign.pipeline.parallel`); outputs do not depend on it
+    jobs: int = 1
 
 
 def run_stages(
@@ -80,7 +83,7 @@ def run_stages(
     with folder_errors(build_dir), BuildLock(target):
         for line in repair(target):
             options.progress(line)
-        with Staging(build_dir) as staging:
+        with Staging(build_dir) as staging, jobs_for_build(options.jobs):
             results, runs = _run_all(case, staging, stages, input_hashes, options)
             stages_run = [*stages, *options.later]
             manifest = build_manifest(case, staging.folder, stages_run, runs, results, inputs, input_hashes)

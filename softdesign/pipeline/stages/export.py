@@ -30,6 +30,8 @@ from softdesign.meshing.regions import RegionPiece, split_by_region
 from softdesign.meshing.solids import Solid, build_solid
 from softdesign.meshing.volume import BodySpec, integrate_body
 from softdesign.pipeline import layout
+from softdesign.pipeline.bounds import meshes_at_once
+from softdesign.pipeline.parallel import map_per_q
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
@@ -124,8 +126,10 @@ def centerline_arrays(kinematics: KinematicsResult, q: float) -> dict[str, np.nd
 
 
 def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult) -> ExportResult:
-    """A checked solid at every export q."""
-    meshes = tuple(solid_at(kinematics, fit, q, case) for q in case.export.q_values())
+    """A checked solid at every export q (on the build's worker processes, as many as fit in memory at once)."""
+    longest = max(key.length for key in kinematics.chain.shape.keys)
+    meshes = tuple(map_per_q(lambda q: solid_at(kinematics, fit, q, case), case.export.q_values(),
+                             most=meshes_at_once(case, longest)))
     summary = {
         "formats": list(case.export.formats),
         "spec": {"offset_mm": case.export.offset_mm, "wall_mm": case.export.wall_mm, "port_mm": case.export.port_mm},

@@ -41,6 +41,8 @@ from softdesign.meshing.skin_stretch import (
 from softdesign.meshing.tessellate import ring_points
 from softdesign.meshing.volume import BodySpec
 from softdesign.meshing.wall import FD_STEP_MM, offset_sections, port_wall_mm, thinnest, wall_map
+from softdesign.pipeline.bounds import meshes_at_once
+from softdesign.pipeline.parallel import map_per_q
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.export import body_spec
 from softdesign.pipeline.stages.fit import FitResult
@@ -212,7 +214,8 @@ def judge(summary: dict[str, Any], limits: dict[str, Any] | None) -> tuple[bool 
 def run_feasibility(case: Case, kinematics: KinematicsResult, fit: FitResult) -> FeasibilityResult:
     """Every figure, then the verdict against the case's material (if any)."""
     body = _Body(kinematics.chain.shape, fit.field, body_spec(case), case.frames)
-    rows = [_at_q(body, q, case) for q in case.export.q_values()]
+    most = meshes_at_once(case, max(key.length for key in body.shape.keys))  # a wall map is one mesh's rings
+    rows = map_per_q(lambda q: _at_q(body, q, case), case.export.q_values(), most=most)
     per_link = []
     for j in range(len(fit.field.final)):
         links = [r["per_link"][j] for r in rows]
