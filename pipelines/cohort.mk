@@ -23,6 +23,9 @@ COHORT ?= configs/cohort
 COHORT_BUILD ?= build
 COHORT_PYTHON ?= $(BIN)/python
 COHORT_SOFTDESIGN ?= $(BIN)/softdesign
+# Worker processes per case build (softdesign build --jobs): make -jN already builds N cases at a
+# time, so each case runs in one process; raise it for a few large cases on a machine with cores to spare.
+COHORT_JOBS ?= 1
 # What a case build needs first (not a reason to rebuild): the installed venv.
 COHORT_NEEDS ?= $(STAMP)
 COHORT_TOOL = $(COHORT_PYTHON) pipelines/cohort_tool.py
@@ -44,7 +47,7 @@ $(COHORT_SUMMARY): $(COHORT_STAMPS) $(COHORT_DIR) | $(COHORT_NEEDS)
 $(COHORT_BUILD)/%/manifest.json: $(COHORT_DIR)/%.yaml | $(COHORT_NEEDS)
 	@echo "cohort: building $* ($<)"
 	@$(COHORT_TOOL) run --case $* --log $(COHORT_BUILD)/$*.log --status $(COHORT_BUILD)/$*.status.json \
-		-- $(COHORT_SOFTDESIGN) build $< --out $(COHORT_BUILD)/$*
+		-- $(COHORT_SOFTDESIGN) build $< --out $(COHORT_BUILD)/$* --jobs $(COHORT_JOBS)
 
 $(COHORT_BUILD)/.deps/%.mk: $(COHORT_DIR)/%.yaml | $(COHORT_NEEDS)
 	@$(COHORT_TOOL) deps $< --target $(COHORT_BUILD)/$*/manifest.json --out $@

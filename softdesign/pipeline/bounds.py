@@ -114,6 +114,18 @@ def meshes_at_once(case: Case, longest: float) -> int:
     return max(1, MAX_MESH_VERTICES // max(1, mesh_vertices(case, longest)))
 
 
+#: Mesh vertices worth one export worker: a pool of forked workers takes about 0.25 s to start (measured with a
+#: 400 MB build process on the 2-core benchmark machine), about what building, checking and keeping 50,000
+#: vertices of mesh takes there (the benchmark case: 28,600 vertices a mesh, 0.15 to 0.25 s each).
+VERTICES_PER_WORKER = 50_000
+
+
+def export_workers(case: Case, longest: float) -> int:
+    """The most worker processes the export stage uses: as many meshes as fit in memory, and worth starting."""
+    total = mesh_vertices(case, longest) * len(case.export.q_values())
+    return max(1, min(meshes_at_once(case, longest), total // VERTICES_PER_WORKER))
+
+
 def _check_meshes(case: Case, longest: float) -> None:
     e = case.export
     walls = 1 if e.wall_mm is None else 2  # a hollow body has the chamber's rings too

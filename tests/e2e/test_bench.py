@@ -34,6 +34,8 @@ def fake_result(bench, triangles: int, frames: int, per_stage: dict[str, float])
         "label": f"fake {triangles} {frames}",
         "import_s": 1.0,
         "baseline_mib": 250.0,
+        "jobs": 2,
+        "worker_peak_mib": 200.0,
         "stages": stages,
         "total": {"wall_s": sum(wall.values()), "cpu_s": 0.9 * sum(wall.values()), "peak_mib": 310.0},
         "input": {"triangles": triangles, "vertices": triangles // 2},
@@ -52,6 +54,7 @@ def test_stage_table_has_every_stage_the_total_and_the_ratio_to_the_floor(bench)
     assert rows["export"][-2:] == ["0.250", "2.0x"]
     assert rows["fit"][-2:] == ["-", "-"]  # no I/O floor for a stage that reads and writes nothing required
     assert rows["total"][-1] == f"{result['total']['wall_s'] / 0.75:.1f}x"
+    assert "--jobs 2, largest worker's peak 200 MiB" in lines[1] and "at most 710 MiB" in lines[1]  # 310 + 2 x 200
 
 
 def test_linear_fit_recovers_a_line(bench):

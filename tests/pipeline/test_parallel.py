@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 from pathlib import Path
 
 import pytest
@@ -12,6 +13,7 @@ from typer.testing import CliRunner
 
 from softdesign.cli import app
 from softdesign.errors import MeshError
+from softdesign.pipeline.bounds import VERTICES_PER_WORKER
 from softdesign.pipeline.parallel import MAX_JOBS, available_cores, checked_jobs, jobs_for_build, map_per_q
 from tests.helpers.paths import REPO
 
@@ -74,7 +76,7 @@ def test_a_build_is_the_same_bytes_with_one_and_two_jobs(tmp_path):
     case = yaml.safe_load((REPO / "configs" / "demo.yaml").read_text())
     for key in ("centerline", "surface"):
         case["final"][key] = str((REPO / "configs" / case["final"][key]).resolve())
-    case["export"] = {"q": [0, 0.25, 0.5, 0.75, 1], "angular_count": 48, "spacing_mm": 1.0,
+    case["export"] = {"q": [0, 0.25, 0.5, 0.75, 1], "angular_count": 64, "spacing_mm": 0.3,
                       "formats": ["stl", "ply", "vtp"], "split_regions": True}
     path = tmp_path / "demo.yaml"
     path.write_text(yaml.safe_dump(case, sort_keys=False))
@@ -93,4 +95,7 @@ def test_a_build_is_the_same_bytes_with_one_and_two_jobs(tmp_path):
         for key in RUN_KEYS:
             manifest.pop(key)
     assert manifests[0] == manifests[1]
+    vertices = [o["vertices"] for o in manifests[0]["outputs"] if re.fullmatch(r"meshes/q_[0-9.]+\.stl", o["path"])]
+    assert len(vertices) == 5
+    assert sum(vertices) >= 2 * VERTICES_PER_WORKER  # so that export, too, ran on two workers
     assert [name for name in one if one[name] != two[name]] == []

@@ -30,7 +30,7 @@ from softdesign.meshing.regions import RegionPiece, split_by_region
 from softdesign.meshing.solids import Solid, build_solid
 from softdesign.meshing.volume import BodySpec, integrate_body
 from softdesign.pipeline import layout
-from softdesign.pipeline.bounds import meshes_at_once
+from softdesign.pipeline.bounds import export_workers
 from softdesign.pipeline.parallel import map_per_q
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.fit import FitResult
@@ -126,10 +126,10 @@ def centerline_arrays(kinematics: KinematicsResult, q: float) -> dict[str, np.nd
 
 
 def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult) -> ExportResult:
-    """A checked solid at every export q (on the build's worker processes, as many as fit in memory at once)."""
+    """A checked solid at every export q (on the build's worker processes: as many as fit in memory, and worth it)."""
     longest = max(key.length for key in kinematics.chain.shape.keys)
     meshes = tuple(map_per_q(lambda q: solid_at(kinematics, fit, q, case), case.export.q_values(),
-                             most=meshes_at_once(case, longest)))
+                             most=export_workers(case, longest)))
     summary = {
         "formats": list(case.export.formats),
         "spec": {"offset_mm": case.export.offset_mm, "wall_mm": case.export.wall_mm, "port_mm": case.export.port_mm},
