@@ -29,6 +29,11 @@ Workers
     largest worker's peak RSS is printed apart (a worker shares the build
     process's pages, so build peak + jobs x worker peak bounds the whole).
 
+Start-up
+    The median of STARTUP_REPEATS runs of ``softdesign --help`` and of
+    ``softdesign validate configs/demo.yaml``, each a fresh process (the
+    console script beside this Python), wall time from start to exit.
+
 Usage: ``python pipelines/bench.py [--triangles 250000,500000,1000000]
 [--frames 11,41] [--jobs N] [--profile] [--keep DIR]``; ``make bench`` runs the defaults.
 """
@@ -42,6 +47,7 @@ import os
 import re
 import resource
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -64,6 +70,10 @@ STAGE_NAMES = ("ingest", "blend", "links", "kinematics", "fit", "export", "feasi
 #: Targets of the scaled case (issue 5, item 9; the build/floor ratio is issue 19's, on 2 cores).
 TARGET_FLOOR_RATIO = 2.0
 TARGET_PEAK_MIB = 2048.0
+#: Start-up targets (issue 19), seconds, median of STARTUP_REPEATS fresh processes.
+TARGET_HELP_S = 0.3
+TARGET_VALIDATE_S = 0.6
+STARTUP_REPEATS = 5
 #: Time ~ size^e counts as linear up to this e (timings on a shared machine jitter by ~10 %).
 LINEAR_EXPONENT_MAX = 1.15
 #: The scaled case's links and default sizes.
@@ -336,6 +346,44 @@ def measure(case: BenchCase, scratch: Path, profile_dir: Path | None = None, job
     return {**figures, "label": case.label, "size": {"triangles": case.triangles, "frames": case.frames}}
 
 
+def softdesign_command() -> list[str]:
+    """The ``softdesign`` console script beside this Python (as a user runs it), or the same entry point via -c."""
+    script = Path(sys.executable).with_name("softdesign")
+    if script.is_file():
+        return [str(script)]
+    return [sys.executable, "-c", "import sys; from softdesign.cli import main; sys.argv[0] = 'softdesign'; main()"]
+
+
+def median_run_s(command: Sequence[str], repeats: int = STARTUP_REPEATS) -> float:
+    """Median wall seconds of ``repeats`` runs of ``command`` in fresh processes; RuntimeError if one fails."""
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        done = subprocess.run(list(command), capture_output=True, text=True, cwd=REPO, stdin=subprocess.DEVNULL)
+        times.append(time.perf_counter() - start)
+        if done.returncode != 0:
+            raise RuntimeError(f"{' '.join(command)} exited {done.returncode}:\n{done.stderr[-3000:]}")
+    return statistics.median(times)
+
+
+def startup_figures(repeats: int = STARTUP_REPEATS) -> dict[str, float]:
+    """Median seconds of ``softdesign --help`` and of ``softdesign validate`` on the sample case."""
+    base = softdesign_command()
+    return {"help_s": median_run_s([*base, "--help"], repeats),
+            "validate_s": median_run_s([*base, "validate", str(DEMO_CASE)], repeats)}
+
+
+def startup_lines(figures: dict[str, float]) -> list[str]:
+    """The start-up times against the issue's targets."""
+    return [
+        f"start-up, median of {STARTUP_REPEATS} fresh processes:",
+        f"  softdesign --help      {figures['help_s']:6.2f} s  target <= {TARGET_HELP_S:g} s     "
+        f"{verdict(figures['help_s'] <= TARGET_HELP_S)}",
+        f"  softdesign validate    {figures['validate_s']:6.2f} s  target <= {TARGET_VALIDATE_S:g} s     "
+        f"{verdict(figures['validate_s'] <= TARGET_VALIDATE_S)}  (configs/demo.yaml)",
+    ]
+
+
 # ---------------------------------------------------------------- tables
 
 
@@ -539,6 +587,7 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
     """Measure and print every case, the scaling of the synthetic case and the targets."""
     started = time.perf_counter()
     emit(header_lines() + [""])
+    emit(startup_lines(startup_figures()) + [""])
     emit(stage_table(measure(BenchCase("sample case (configs/demo.yaml)", DEMO_CASE), scratch, jobs=args.jobs)) + [""])
     aorta = aorta_case(scratch / "aorta")
     if aorta is None:

@@ -109,3 +109,23 @@ def test_worker_measures_a_tiny_synthetic_build(bench, tmp_path):
     assert all(row["peak_mib"] > 0 for row in result["stages"].values())
     result.update(label="tiny", size={"triangles": 20_000, "frames": 2})
     assert len(bench.stage_table(result)) == 3 + len(bench.STAGE_NAMES) + 1
+
+
+def test_startup_lines_judge_each_median_against_its_target(bench):
+    lines = bench.startup_lines({"help_s": 0.2, "validate_s": 0.9})
+    help_line = next(line for line in lines if "--help" in line)
+    validate_line = next(line for line in lines if "validate" in line)
+    assert "0.20 s" in help_line and help_line.rstrip().endswith("met")
+    assert "0.90 s" in validate_line and "MISSED" in validate_line
+
+
+def test_a_failing_startup_command_stops_the_benchmark_with_its_error(bench):
+    with pytest.raises(RuntimeError, match="exited 3"):
+        bench.median_run_s([sys.executable, "-c", "import sys; sys.exit(3)"], repeats=2)
+
+
+def test_the_startup_command_is_the_softdesign_entry_point(bench):
+    import subprocess
+
+    done = subprocess.run([*bench.softdesign_command(), "--help"], capture_output=True, text=True, cwd=REPO)
+    assert done.returncode == 0 and "Usage" in done.stdout
