@@ -8,10 +8,16 @@ STAMP := $(VENV)/.installed-stamp
 # editable build): the same environment on every machine.  `make lock` remakes it.
 CONSTRAINTS := requirements/constraints.txt
 LOCK_VENV := build/.lock-venv
+# Snakemake and its SLURM executor (pyproject's [cluster] extra) for pipelines/Snakefile, in a venv of
+# their own: snakemake pins packaging<26, which the main venv's lock does not allow.  `make lock-cluster`.
+CLUSTER_VENV := .venv-cluster
+CLUSTER_STAMP := $(CLUSTER_VENV)/.installed-stamp
+CLUSTER_CONSTRAINTS := requirements/cluster.txt
+CLUSTER_PACKAGES = $$($(PYTHON) -c 'import tomllib; print(" ".join(tomllib.load(open("pyproject.toml", "rb"))["project"]["optional-dependencies"]["cluster"]))')
 
-.PHONY: demo test test-fast lint lock bench install clean
+.PHONY: demo test test-fast lint lock lock-cluster bench install clean
 
-install: $(STAMP)
+install: $(STAMP) $(CLUSTER_STAMP)
 
 # A fresh venv each time (--clear), so a package dropped from the pins leaves it too.
 # The venv's own pip predates --build-constraint: it first installs the pinned pip.
@@ -19,6 +25,14 @@ $(STAMP): pyproject.toml $(CONSTRAINTS)
 	$(PYTHON) -m venv --clear $(VENV)
 	$(BIN)/python -m pip install --quiet -c $(CONSTRAINTS) pip setuptools
 	$(BIN)/python -m pip install --quiet -c $(CONSTRAINTS) --build-constraint $(CONSTRAINTS) -e '.[test,lint]'
+	touch $@
+
+# The workflow engine only (the workflow runs softdesign from .venv); its pins: requirements/cluster.txt.
+$(CLUSTER_STAMP): pyproject.toml $(CLUSTER_CONSTRAINTS)
+	$(PYTHON) -m venv --clear $(CLUSTER_VENV)
+	$(CLUSTER_VENV)/bin/python -m pip install --quiet -c $(CLUSTER_CONSTRAINTS) pip setuptools
+	$(CLUSTER_VENV)/bin/python -m pip install --quiet -c $(CLUSTER_CONSTRAINTS) --build-constraint $(CLUSTER_CONSTRAINTS) \
+		$(CLUSTER_PACKAGES)
 	touch $@
 
 # `make lock`: on purpose only.  Resolves the newest releases pyproject.toml
@@ -37,16 +51,30 @@ lock:
 	mv $(CONSTRAINTS).new $(CONSTRAINTS)
 	rm -rf $(LOCK_VENV)
 
+# `make lock-cluster`: on purpose only, as `make lock`, for the [cluster] extra's venv.
+lock-cluster:
+	rm -rf $(LOCK_VENV)
+	$(PYTHON) -m venv --clear $(LOCK_VENV)
+	$(LOCK_VENV)/bin/python -m pip install --quiet --upgrade pip setuptools
+	$(LOCK_VENV)/bin/python -m pip install --quiet $(CLUSTER_PACKAGES)
+	{ echo "# Exact versions of every package 'make install' puts in $(CLUSTER_VENV) (snakemake, its SLURM executor, their deps)."; \
+	  echo "# Made by 'make lock-cluster' (the newest releases pyproject.toml's [cluster] extra allows) on $$(date -u +%Y-%m-%d)"; \
+	  $(LOCK_VENV)/bin/python -c 'import platform; print("# with", platform.python_implementation(), platform.python_version(), "on", platform.platform())'; \
+	  echo "# Do not edit by hand: change pyproject.toml, run 'make lock-cluster', then 'make install test'."; \
+	  $(LOCK_VENV)/bin/python -m pip freeze --all; } > $(CLUSTER_CONSTRAINTS).new
+	mv $(CLUSTER_CONSTRAINTS).new $(CLUSTER_CONSTRAINTS)
+	rm -rf $(LOCK_VENV)
+
 demo: $(STAMP)
 	$(BIN)/softdesign build configs/demo.yaml --report
 	@echo "Results in build/demo/: meshes/q_*.stl (the actuator at each q), kinematics.json,"
 	@echo "manifest.json, and the report to open in a browser: build/demo/report/index.html"
 
-test: $(STAMP)
+test: $(STAMP) $(CLUSTER_STAMP)
 	$(BIN)/python -m pytest
 
 # Everything but the tests marked slow (whole builds, cohorts, reports): under a minute.
-test-fast: $(STAMP)
+test-fast: $(STAMP) $(CLUSTER_STAMP)
 	$(BIN)/python -m pytest -m "not slow"
 
 # ruff (style, imports, bugbear, pyupgrade, numpy rules) and mypy, both

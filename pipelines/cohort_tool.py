@@ -1,17 +1,21 @@
 """The commands pipelines/cohort.mk runs (see that file); each does one small job.
 
     cohort_tool.py deps CASE.yaml --target BUILD/<case>/manifest.json --out BUILD/.deps/<case>.mk
-    cohort_tool.py run --case NAME --log BUILD/<case>.log --status BUILD/<case>.status.json -- COMMAND...
+    cohort_tool.py run --case NAME --log BUILD/<case>.log --status BUILD/<case>.status.json [--exit-code] -- COMMAND...
+    cohort_tool.py inputs --cohort DIR          (JSON: each case's existing input files; pipelines/Snakefile)
     cohort_tool.py summary --cohort DIR --build BUILD --out BUILD/cohort-summary.csv
     cohort_tool.py sample DATA_DIR      (writes the sample cohort's inputs, data/cohort)
 
-``run`` always exits 0, so that make goes on with the other cases; the
-summary exits 1 when any case failed, after writing the table.
+``run`` exits 0, so that make goes on with the other cases (with
+``--exit-code``, the build's exit code: Snakemake then marks the job failed
+and goes on with ``--keep-going``); the summary exits 1 when any case
+failed, after writing the table.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 from pathlib import Path
@@ -43,6 +47,14 @@ def run(args: argparse.Namespace) -> int:
         print(f"cohort: {args.case} built in {record.seconds:.1f} s")
     else:
         print(f"cohort: {args.case} FAILED (exit {record.exit_code}): {record.message} [log: {record.log}]")
+        if args.exit_code:
+            return record.exit_code if record.exit_code else 1
+    return 0
+
+
+def inputs(args: argparse.Namespace) -> int:
+    found = {case.stem: cohort.existing_inputs(case, Path.cwd()) for case in cohort.cohort_cases(Path(args.cohort))}
+    print(json.dumps(found, indent=1))
     return 0
 
 
@@ -84,8 +96,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--case", required=True)
     p.add_argument("--log", required=True)
     p.add_argument("--status", required=True)
+    p.add_argument("--exit-code", action="store_true", help="exit with the build's exit code (default: 0)")
     p.add_argument("command", nargs=argparse.REMAINDER)
     p.set_defaults(action=run)
+    p = commands.add_parser("inputs", help="print each case's existing input files as JSON")
+    p.add_argument("--cohort", required=True)
+    p.set_defaults(action=inputs)
     p = commands.add_parser("summary", help="write the one-row-per-case table; exit 1 when a case failed")
     p.add_argument("--cohort", required=True)
     p.add_argument("--build", required=True)

@@ -137,6 +137,19 @@ def deps_text(case_file: Path, target: str, relative_to: Path) -> str:
     return header + f"{_make_path(Path(target))}: {names}\n{names}:\n"
 
 
+def existing_inputs(case_file: Path, relative_to: Path) -> list[str]:
+    """The case's input files that exist, relative to ``relative_to`` when inside it (for the Snakemake workflow).
+
+    As with :func:`deps_text`, a missing input or an unreadable case file is left to the build to report
+    (in the case's log and the summary), rather than stopping every other case before any starts.
+    """
+    try:
+        inputs = case_inputs(case_file)
+    except ConfigError:
+        return []
+    return [_near_path(p, relative_to).as_posix() for p in inputs if p.is_file()]
+
+
 def _near_path(path: Path, relative_to: Path) -> Path:
     """``path`` relative to ``relative_to`` when it lies inside it, else absolute."""
     absolute = Path(os.path.abspath(path))
