@@ -58,13 +58,20 @@ def test_the_default_is_the_cores_this_process_may_use():
     assert checked_jobs(1) == 1 and checked_jobs(MAX_JOBS) == MAX_JOBS
 
 
+@pytest.mark.parametrize("command", ["build", "export"])
 @pytest.mark.parametrize("jobs", ["0", "-1", str(MAX_JOBS + 1)])
-def test_jobs_outside_the_bound_is_refused_before_any_work(tmp_path, jobs):
+def test_jobs_outside_the_bound_is_refused_before_any_work(tmp_path, jobs, command):
     out = tmp_path / "out"
-    result = runner.invoke(app, ["build", str(REPO / "configs" / "demo.yaml"), "--out", str(out), "--jobs", jobs])
+    result = runner.invoke(app, [command, str(REPO / "configs" / "demo.yaml"), "--out", str(out), "--jobs", jobs])
     assert result.exit_code == 2, result.output
     assert f"--jobs must be 1 to {MAX_JOBS} worker processes, got {jobs}" in result.output
     assert "Traceback" not in result.output and not out.exists()
+
+
+def test_jobs_that_is_not_a_whole_number_is_refused(tmp_path):
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["build", str(REPO / "configs" / "demo.yaml"), "--out", str(out), "--jobs", "two"])
+    assert result.exit_code == 2 and "--jobs" in result.output and not out.exists()
 
 
 def _files(folder: Path) -> dict[str, bytes]:
