@@ -7,6 +7,7 @@ Register with ``app.command()(report)`` in :mod:`softdesign.cli`; ``build
 
 from __future__ import annotations
 
+import sys
 import time
 from pathlib import Path
 from typing import Annotated
@@ -29,10 +30,15 @@ def report_after_build(build_dir: Path, pcc_d: str | None = None) -> None:
 
     options = ReportOptions(pcc_d=pcc_d_from_text(pcc_d))
     start = time.perf_counter()
-    result = write_report(build_dir, options)
+    live = sys.stderr.isatty()  # progress line by line on a terminal only; logs get the one summary line below
+    result = write_report(build_dir, options, (lambda name, s: note(f"report: {name} ({s:.1f} s)")) if live else None)
     seconds = time.perf_counter() - start
     for line in result.notes:
         note(f"report: {line}")
+    slowest = sorted(result.seconds.items(), key=lambda item: -item[1])[:5]
+    note("report: slowest parts: " + ", ".join(f"{name} {s:.1f} s" for name, s in slowest))
+    for line in result.warnings:
+        note(f"report: WARNING: {line}")
     size = sum(result.files.values())
     typer.echo(
         f"report: {result.page} ({len(result.files)} files, {size / 1e6:.2f} MB, "
