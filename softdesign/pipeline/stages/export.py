@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from softdesign.config import Case
-from softdesign.io.formats import mesh_bytes
+from softdesign.io.formats import FILE_UNITS, mesh_bytes
 from softdesign.io.polylines_vtp import write_polylines_vtp
 from softdesign.meshing.body import body_breaks, body_sections, body_stations
 from softdesign.meshing.checks import check_solid
@@ -35,7 +35,7 @@ from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 
-VERSION = 1
+VERSION = 2  # 2: .glb in metres (glTF's unit), metrics.export.units
 
 
 @dataclass(frozen=True)
@@ -128,6 +128,7 @@ def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Expo
     meshes = tuple(solid_at(kinematics, fit, q, case) for q in case.export.q_values())
     summary = {
         "formats": list(case.export.formats),
+        "units": {fmt: FILE_UNITS[fmt] for fmt in case.export.formats},
         "spec": {"offset_mm": case.export.offset_mm, "wall_mm": case.export.wall_mm, "port_mm": case.export.port_mm},
         "resolution": {"spacing_mm": case.export.spacing_mm, "angular_count": case.export.angular_count},
         "volume_method": "Gauss-Legendre in l (8 points between knots and joints) x trapezoid in angle",
