@@ -30,6 +30,7 @@ from softdesign.report import (
     interactive,
     kinematics_figures,
     morph_figures,
+    profile_figures,
     stretch_figures,
     surface_figures,
 )
@@ -80,6 +81,7 @@ EXPECTED_SIZES = {
     "design.png": pixel_size(design_figures.SIZE_IN),
     "morph.gif": pixel_size(animation.SIZE_IN),
     stretch_figures.NAME: pixel_size(stretch_figures.SIZE_IN),
+    profile_figures.NAME: pixel_size(profile_figures.SIZE_IN),
 }
 
 
@@ -182,6 +184,9 @@ def report_sections(
         surface = run("surfaces.png", lambda: surface_figures.surface_picture(data))  # None only without a fit
         if surface is not None:
             surfaces.pictures.append(surface)
+        profile = run(profile_figures.NAME, lambda: profile_figures.profile_picture(data))
+        if profile is not None:
+            surfaces.pictures.append(profile)
         distances = run("fit distances", lambda: fit_figures.true_distances(data))
         fit.pictures.extend([run("fit_residuals.png", lambda: fit_figures.residual_picture(data)),
                              run("fit_distances.png", lambda: fit_figures.distance_picture(data, distances))])
