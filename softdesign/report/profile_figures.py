@@ -62,7 +62,7 @@ def profile_picture(data: BuildData) -> Picture | None:
         figure = new_figure(SIZE_IN)
         grid = figure.add_gridspec(1, 1 + len(cuts), width_ratios=[2.2] + [1.0] * len(cuts))
         ax = figure.add_subplot(grid[0, 0])
-        for q, colour, style in ((1.0, "#d62728", "-"), (0.0, "#1f77b4", ":")):  # q = 0 on top: it often equals the mean
+        for q, colour, style in ((1.0, "#d62728", "-"), (0.0, "#1f77b4", ":")):  # q = 0 on top: often the same mean
             s, mean, low, high = radius_profile(data, q)
             ax.fill_between(s, low, high, color=colour, alpha=0.2, linewidth=0, label=f"q = {q:g}: smallest to largest")
             ax.plot(s, mean, color=colour, lw=1.8, ls=style, label=f"q = {q:g}: mean over the angle")
@@ -71,16 +71,16 @@ def profile_picture(data: BuildData) -> Picture | None:
         ax.set(xlabel="arc length along the centerline at that q (mm)", ylabel="radius rho (mm)",
                title="radius profile", ylim=(0.0, None))
         ax.legend(loc="best", fontsize=7)
-        vertices, faces = read_surface(mesh_file) if mesh_file is not None else (None, None)
+        mesh = read_surface(mesh_file) if mesh_file is not None else None
         colours = link_colours(data.link_count)
         for k, l in enumerate(cuts):
             cut_ax = figure.add_subplot(grid[0, k + 1])
             cut_ax.set(aspect="equal", xlabel="N (mm)", ylabel="B (mm)" if k == 0 else "")
-            if vertices is None:
+            if mesh is None:
                 cut_ax.axis("off")
                 cut_ax.text(0.5, 0.5, "no q = 1 mesh exported", ha="center", transform=cut_ax.transAxes)
                 continue
-            segments = cross_section(data, vertices, faces, l)
+            segments = cross_section(data, *mesh, l)
             link = int(data.fit.field.link_of(np.array([l]))[0])
             cut_ax.add_collection(LineCollection(list(segments), colors=[colours[link]], linewidths=1.2,
                                                  label=f"mesh at q = 1 (link {link})"))

@@ -41,8 +41,8 @@ def test_every_kind_of_warning_is_listed_stale_first():
 
 def test_a_clean_build_has_no_warning_and_says_so():
     manifest = {"stages": [{"name": "fit", "status": "ran"}],
-                "metrics": {"feasibility": {"feasible": None, "reasons": ["no material"]}, "fit": {"max_rho_kappa": 0.3},
-                            "kinematics": {"arc_check": {"warnings": []}}}}
+                "metrics": {"feasibility": {"feasible": None, "reasons": ["no material"]},
+                            "fit": {"max_rho_kappa": 0.3}, "kinematics": {"arc_check": {"warnings": []}}}}
     assert summary_warnings(_data(manifest), [Check("a", "b", "c", "d", True)]) == []  # type: ignore[arg-type]
     assert 'class="allclear"' in banner_html([])
 
