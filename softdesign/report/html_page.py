@@ -81,6 +81,9 @@ def key_figure_table(figures: list[KeyFigure]) -> Table:
     return Table("Key figures of manifest.json", ("figure", "value", "unit", "where in manifest.json"), rows)
 
 
+CHECK_HEADER = ("subject", "check", "found", "required", "status")
+
+
 def check_table(checks: list[Check]) -> Table:
     """Every check with its status, failures first (in their order), then the passed ones."""
     ordered = [c for c in checks if not c.passed] + [c for c in checks if c.passed]
@@ -90,21 +93,28 @@ def check_table(checks: list[Check]) -> Table:
         for c in ordered
     ]
     passed = sum(c.passed for c in checks)
-    return Table(f"Checks: {passed} of {len(checks)} passed", ("subject", "check", "found", "required", "status"), rows)
+    return Table(f"Checks: {passed} of {len(checks)} passed", CHECK_HEADER, rows)
 
 
-def compact_check_tables(checks: list[Check], folded_names: tuple[str, ...]) -> list[Table]:
-    """The checks as two tables: the failures and the passed checks not named in ``folded_names`` first, then
-    the passed ones named there (the files' sha256) folded away in a <details> whose summary gives their tally."""
-    shown = [c for c in checks if not c.passed or c.name not in folded_names]
-    hidden = [c for c in checks if c.passed and c.name in folded_names]
-    passed = sum(c.passed for c in checks)
-    main = check_table(shown)
-    tables = [Table(f"Checks: {passed} of {len(checks)} passed (failures first)", main.header, main.rows)]
-    if hidden:
-        rest = check_table(hidden)
-        tables.append(Table(rest.caption, rest.header, rest.rows,
-                            folded=f"{len(hidden)} more checks passed: {', '.join(sorted(set(folded_names)))}"))
+def compact_check_tables(checks: list[Check]) -> list[Table]:
+    """The checks in at most three tables: the failures (when any), one row per kind of check with its tally,
+    and every passed check (a row each: subject, figure found, limit) folded away in a <details>."""
+    failed = [c for c in checks if not c.passed]
+    passed = [c for c in checks if c.passed]
+    tables = []
+    if failed:
+        rows = check_table(failed).rows
+        tables.append(Table(f"Checks FAILED: {len(failed)} of {len(checks)}", CHECK_HEADER, rows))
+    kinds: dict[str, list[Check]] = {}
+    for c in checks:
+        kinds.setdefault(c.name, []).append(c)
+    tally = [(Cell(name), Cell(str(sum(c.passed for c in group)), "num"), Cell(str(len(group)), "num"),
+              Cell("all passed", "pass") if all(c.passed for c in group) else Cell("some failed", "fail"))
+             for name, group in kinds.items()]
+    tables.append(Table(f"Checks: {len(passed)} of {len(checks)} passed", ("check", "passed", "of", ""), tally))
+    if passed:
+        tables.append(Table(f"The {len(passed)} passed checks", CHECK_HEADER, check_table(passed).rows,
+                            folded=f"every passed check, one row each ({len(passed)})"))
     return tables
 
 

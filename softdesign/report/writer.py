@@ -58,8 +58,6 @@ from softdesign.report.tables import (
 )
 
 T = TypeVar("T")
-#: Checks folded away under the checks table when they pass (one per output file).
-FOLDED_CHECKS = ("file as recorded (sha256)",)
 
 PAGE = "index.html"
 TEMP_PREFIX = ".report-"
@@ -259,7 +257,7 @@ def _tables_section(data: BuildData) -> tuple[Section, list[Check]]:
                     ("", "hash", "num")),
         plain_table("Software", ("package", "build (manifest.json)", "this report"), software_rows(data.manifest)),
         plain_table("Stages of the last run", ("stage", "status", "time (s)"), stages, ("", "", "num")),
-        *compact_check_tables(checks, FOLDED_CHECKS),
+        *compact_check_tables(checks),
     ]
     notes = [f"ingest: {n}" for n in data.ingest.notes]
     notes += [f"kinematics: warning: {n}" for n in data.manifest.get("metrics", {}).get("kinematics", {})

@@ -47,16 +47,21 @@ def test_a_clean_build_has_no_warning_and_says_so():
     assert 'class="allclear"' in banner_html([])
 
 
-def test_failures_come_first_and_passing_hashes_are_folded():
+def test_failures_first_then_a_tally_per_kind_and_every_passed_check_folded():
     checks = [Check("a.stl", "file as recorded (sha256)", "matches", "x", True),
               Check("a.stl", "watertight", "yes", "yes", True),
               Check("b.stl", "file as recorded (sha256)", "differs", "x", False),
-              Check("b.stl", "watertight", "no", "yes", False)]
-    shown, folded = compact_check_tables(checks, ("file as recorded (sha256)",))
-    assert [(r[0].text, r[1].text) for r in shown.rows] == [("b.stl", "file as recorded (sha256)"),
-                                                              ("b.stl", "watertight"), ("a.stl", "watertight")]
-    assert [(r[0].text, r[1].text) for r in folded.rows] == [("a.stl", "file as recorded (sha256)")]
-    assert folded.folded and shown.caption.startswith("Checks: 2 of 4 passed")
+              Check("b.stl", "watertight", "no", "yes", False),
+              Check("c.stl", "watertight", "yes", "yes", True)]
+    failed, tally, folded = compact_check_tables(checks)
+    assert [(r[0].text, r[1].text) for r in failed.rows] == [("b.stl", "file as recorded (sha256)"),
+                                                               ("b.stl", "watertight")]
+    assert [tuple(c.text for c in r) for r in tally.rows] == [("file as recorded (sha256)", "1", "2", "some failed"),
+                                                               ("watertight", "2", "3", "some failed")]
+    assert [(r[0].text, r[1].text) for r in folded.rows] == [("a.stl", "file as recorded (sha256)"),
+                                                               ("a.stl", "watertight"), ("c.stl", "watertight")]
+    assert folded.folded and not failed.folded and tally.caption == "Checks: 3 of 5 passed"
+    assert len(compact_check_tables(checks[:2])) == 2  # no failure: no failures table
 
 
 #: Display tolerance for a decimated 10 mm sphere: 1 % of its radius.
