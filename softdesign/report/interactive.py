@@ -174,8 +174,9 @@ def _layout(per_q: list[list[dict[str, Any]]], traces: list[Any], q_values: Floa
         "scene": {**{f"{k}axis": v for k, v in axes.items()}, "aspectmode": "manual",
                   "aspectratio": {k: float(r) for k, r in zip("xyz", ratio, strict=True)}},
         "sliders": [{"active": len(q_values) - 1, "steps": steps, "currentvalue": {"prefix": "q = "},
-                     "pad": {"t": 20}}],
-        "updatemenus": [{"type": "buttons", "showactive": False, "x": 0.0, "y": 0.0, "xanchor": "right",
+                     "pad": {"t": 20}, "x": 0.1, "len": 0.9}],
+        "updatemenus": [{"type": "buttons", "showactive": False, "x": 0.0, "y": 0.0, "xanchor": "left",
+                         "yanchor": "top", "pad": {"t": 20},
                          "buttons": [{"label": "play", "method": "animate", "args": [None, play]},
                                      {"label": "pause", "method": "animate", "args": [[None], animate]}]}],
     }
