@@ -7,7 +7,6 @@ Register with ``app.command()(report)`` in :mod:`softdesign.cli`; ``build
 
 from __future__ import annotations
 
-import sys
 import time
 from pathlib import Path
 from typing import Annotated
@@ -15,6 +14,7 @@ from typing import Annotated
 import typer
 
 from softdesign.cli.common import distances_from_text, note, run_guarded
+from softdesign.cli.progress import part_progress
 
 
 def pcc_d_from_text(text: str | None) -> tuple[float, ...] | None:
@@ -30,8 +30,8 @@ def report_after_build(build_dir: Path, pcc_d: str | None = None) -> None:
 
     options = ReportOptions(pcc_d=pcc_d_from_text(pcc_d))
     start = time.perf_counter()
-    live = sys.stderr.isatty()  # progress line by line on a terminal only; logs get the one summary line below
-    result = write_report(build_dir, options, (lambda name, s: note(f"report: {name} ({s:.1f} s)")) if live else None)
+    with part_progress("report") as tick:  # a bar on a terminal only; logs get the one summary line below
+        result = write_report(build_dir, options, tick)
     seconds = time.perf_counter() - start
     for line in result.notes:
         note(f"report: {line}")

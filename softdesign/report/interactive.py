@@ -8,9 +8,12 @@ fixed over every frame so the camera does not jump.
 
 For display only, the tube is tessellated coarser than the export
 (:data:`SPACING_MM`, :data:`ANGLES`) and the vessel surface is decimated by
-VTK's quadric decimation to at most :data:`VESSEL_FACES` triangles; the caption
-states both measured display errors (the largest distance from the fine
-surface's points to the displayed mesh, mm).  Coordinates are written as
+VTK's quadric decimation to at most :data:`VESSEL_FACES` triangles, both
+within :data:`DISPLAY_TOLERANCE_MM`: the display error (the largest distance
+from the fine surface's points to the displayed mesh, mm) is measured, and
+while it exceeds the tolerance the tube's rings and angles are doubled (at
+most :data:`MAX_REFINEMENTS` times) and the vessel keeps twice the triangles.
+The caption states both measured errors.  Coordinates are written as
 float32 (0.01 um at 100 mm, far below those errors).
 
 plotly (MIT licence) ships plotly.js; the report writes it once as the file
@@ -41,8 +44,13 @@ SPACING_MM, ANGLES = 1.0, 32
 #: The fine tessellation the display error is measured against: half the display's spacing and angle, so its
 #: points include every displayed cell's edge midpoints and centre, where a chord strays farthest from the surface.
 FINE_FACTOR = 2
-#: At most this many triangles of the vessel surface are shown.
+#: At most this many triangles of the vessel surface are shown (more only to meet the display tolerance).
 VESSEL_FACES = 20000
+#: The view shows each surface to this distance (mm), a few pixels of a ~100 mm scene 720 px high; the
+#: exported files carry the exact body.
+DISPLAY_TOLERANCE_MM = 0.5
+#: The tube is refined at most this many times (each doubles rings and angles: 4x the page's tube data).
+MAX_REFINEMENTS = 2
 #: Centerline samples per link and frame.
 CURVE_SAMPLES = 40
 VESSEL_OPACITY = 0.25
@@ -70,45 +78,65 @@ def max_distance_to_mesh(points: FloatArray, vertices: FloatArray, faces: np.nda
     return float(np.sqrt(largest))
 
 
-def decimated_vessel(vertices: FloatArray, faces: np.ndarray, target: int = VESSEL_FACES):
-    """(vertices, faces, error_mm): the vessel surface with at most ``target`` triangles and its display error.
+def decimated_vessel(vertices: FloatArray, faces: np.ndarray, target: int = VESSEL_FACES,
+                     tolerance_mm: float = DISPLAY_TOLERANCE_MM):
+    """(vertices, faces, error_mm): the vessel surface with about ``target`` triangles and its display error.
 
-    The error is the largest distance from an original vertex to the decimated surface (0 when kept whole).
+    The error is the largest distance from an original vertex to the decimated surface (0 when kept whole);
+    while it exceeds ``tolerance_mm`` the target doubles (up to the whole surface).
     """
-    if len(faces) <= target:
-        return np.asarray(vertices, float), np.asarray(faces, np.int64), 0.0
     import vtk
 
     from softdesign.io.vtk_polydata import polydata_from_triangles, triangles_from_polydata
 
-    decimate = vtk.vtkQuadricDecimation()
-    decimate.SetInputData(polydata_from_triangles(np.asarray(vertices, float), np.asarray(faces, np.int64)))
-    decimate.SetTargetReduction(1.0 - target / len(faces))
-    decimate.Update()
-    small_vertices, small_faces = triangles_from_polydata(decimate.GetOutput())
-    return small_vertices, small_faces, max_distance_to_mesh(vertices, small_vertices, small_faces)
+    while len(faces) > target:
+        decimate = vtk.vtkQuadricDecimation()
+        decimate.SetInputData(polydata_from_triangles(np.asarray(vertices, float), np.asarray(faces, np.int64)))
+        decimate.SetTargetReduction(1.0 - target / len(faces))
+        decimate.Update()
+        small_vertices, small_faces = triangles_from_polydata(decimate.GetOutput())
+        error = max_distance_to_mesh(vertices, small_vertices, small_faces)
+        if error <= tolerance_mm:
+            return small_vertices, small_faces, error
+        target *= 2
+    return np.asarray(vertices, float), np.asarray(faces, np.int64), 0.0
 
 
-def tube_display_error_mm(data: BuildData, q: float = 1.0) -> float:
+def tube_display_error_mm(data: BuildData, q: float = 1.0, spacing_mm: float = SPACING_MM,
+                          angles: int = ANGLES) -> float:
     """Largest distance from the fine tube's vertices at ``q`` to the displayed (coarse) tube, mm."""
     assert data.fit is not None
     chain, field = data.kinematics.chain, data.fit.field
-    coarse_vertices, coarse_faces, _ = tube_mesh(chain, field, q, SPACING_MM, ANGLES)
-    fine_vertices, _, _ = tube_mesh(chain, field, q, SPACING_MM / FINE_FACTOR, ANGLES * FINE_FACTOR)
+    coarse_vertices, coarse_faces, _ = tube_mesh(chain, field, q, spacing_mm, angles)
+    fine_vertices, _, _ = tube_mesh(chain, field, q, spacing_mm / FINE_FACTOR, angles * FINE_FACTOR)
     return max_distance_to_mesh(fine_vertices, coarse_vertices, coarse_faces)
+
+
+def display_tube(data: BuildData, tolerance_mm: float = DISPLAY_TOLERANCE_MM) -> tuple[float, int, float]:
+    """(ring spacing mm, vertices around, display error mm at q = 1): the coarsest tube within ``tolerance_mm``
+    (or the finest of :data:`MAX_REFINEMENTS` refinements)."""
+    spacing, angles = SPACING_MM, ANGLES
+    error = tube_display_error_mm(data, 1.0, spacing, angles)
+    for _ in range(MAX_REFINEMENTS):
+        if error <= tolerance_mm:
+            break
+        spacing, angles = spacing / 2, angles * 2
+        error = tube_display_error_mm(data, 1.0, spacing, angles)
+    return spacing, angles, error
 
 
 def _rgb(colour) -> str:
     return "rgb({:d},{:d},{:d})".format(*(int(round(255 * c)) for c in colour[:3]))
 
 
-def _frame_traces(data: BuildData, q: float, colours: list[str]) -> list[dict[str, Any]]:
+def _frame_traces(data: BuildData, q: float, spacing_mm: float = SPACING_MM, angles: int = ANGLES
+                  ) -> list[dict[str, Any]]:
     """The traces that change with q: the tube (when fitted), then one centerline trace per link."""
     chain = data.kinematics.chain
     curve = chain.shape.curve_at(q)
     traces: list[dict[str, Any]] = []
     if data.fit is not None:
-        vertices, _, _ = tube_mesh(chain, data.fit.field, q, SPACING_MM, ANGLES)
+        vertices, _, _ = tube_mesh(chain, data.fit.field, q, spacing_mm, angles)
         v = vertices.astype(np.float32)
         traces.append({"type": "mesh3d", "x": v[:, 0], "y": v[:, 1], "z": v[:, 2]})
     for j in range(chain.count):
@@ -124,18 +152,19 @@ def morph_figure(data: BuildData, frames: int = FRAMES):
     chain = data.kinematics.chain
     colours = [_rgb(c) for c in link_colours(chain.count)]
     q_values = np.linspace(0.0, 1.0, int(frames))
-    per_q = [_frame_traces(data, float(q), colours) for q in q_values]
+    spacing, angles, tube_error = display_tube(data) if data.fit is not None else (SPACING_MM, ANGLES, 0.0)
+    per_q = [_frame_traces(data, float(q), spacing, angles) for q in q_values]
     first = per_q[-1]  # the page opens on q = 1, inside the vessel
     traces: list[Any] = []
     notes: list[str] = []
     if data.fit is not None:
-        _, faces, face_l = tube_mesh(chain, data.fit.field, 1.0, SPACING_MM, ANGLES)
+        _, faces, face_l = tube_mesh(chain, data.fit.field, 1.0, spacing, angles)
         face_colours = np.array(colours, dtype=object)[data.fit.field.link_of(face_l)]
         traces.append(go.Mesh3d(**{k: first[0][k] for k in "xyz"}, i=faces[:, 0], j=faces[:, 1], k=faces[:, 2],
                                 facecolor=face_colours, flatshading=False, name="actuator", showlegend=True,
                                 hoverinfo="skip"))
-        notes.append(f"actuator: {SPACING_MM:g} mm rings, {ANGLES} vertices around; display error at q = 1 "
-                     f"{tube_display_error_mm(data):.3f} mm (against {FINE_FACTOR}x finer)")
+        notes.append(f"actuator: {spacing:g} mm rings, {angles} vertices around; display error at q = 1 "
+                     f"{tube_error:.3f} mm (against {FINE_FACTOR}x finer; tolerance {DISPLAY_TOLERANCE_MM:g} mm)")
     for j, trace in enumerate(first[len(first) - chain.count:]):
         traces.append(go.Scatter3d(**{k: trace[k] for k in "xyz"}, mode="lines", line={"color": colours[j], "width": 6},
                                    name=f"link {j} (centerline)", hoverinfo="name"))
@@ -146,7 +175,8 @@ def morph_figure(data: BuildData, frames: int = FRAMES):
         traces.append(go.Mesh3d(x=v[:, 0], y=v[:, 1], z=v[:, 2], i=f[:, 0], j=f[:, 1], k=f[:, 2],
                                 color=_rgb(VESSEL_RGB), opacity=VESSEL_OPACITY, name="patient's vessel (input)",
                                 showlegend=True, hoverinfo="skip"))
-        notes.append(f"vessel: {len(f)} of {len(data.ingest.faces)} triangles; display error {error:.3f} mm")
+        notes.append(f"vessel: {len(f)} of {len(data.ingest.faces)} triangles; display error {error:.3f} mm "
+                     f"(tolerance {DISPLAY_TOLERANCE_MM:g} mm)")
     figure = go.Figure(data=traces, frames=[
         go.Frame(name=f"{q:.3f}", data=per_q[k], traces=moving) for k, q in enumerate(q_values)
     ])

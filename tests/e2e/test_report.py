@@ -22,7 +22,7 @@ from PIL import Image
 from typer.testing import CliRunner
 
 from softdesign.pipeline.api import build_through
-from softdesign.report.interactive import DIV_ID, JS_NAME
+from softdesign.report.interactive import DISPLAY_TOLERANCE_MM, DIV_ID, JS_NAME
 from softdesign.report.writer import EXPECTED_SIZES, PAGE, REPORT_DIR, ReportOptions, commit_folder, write_report
 from softdesign.versions import software_versions
 from tests.helpers.cases import write_case
@@ -500,6 +500,8 @@ def test_the_3d_view_is_offline_and_holds_a_frame_per_q(built):
     names = re.findall(r'"name":"(\d\.\d{3})"', text)
     assert names == [f"{q:.3f}" for q in np.linspace(0.0, 1.0, 21)]
     assert sum(result.files.values()) < DEMO_REPORT_BYTES
+    stated = [float(x) for x in re.findall(r"display error(?: at q = 1)? ([0-9.]+) mm", text)]
+    assert stated and max(stated) <= DISPLAY_TOLERANCE_MM  # the page states each display error, within tolerance
 
 
 def test_the_hollow_body_is_cut_through_its_wall_and_chamber(tmp_path):

@@ -78,3 +78,12 @@ def test_the_vessel_is_decimated_for_display_within_a_measured_error():
     assert 0.0 < error < SPHERE_DISPLAY_MM
     kept_v, kept_f, none = decimated_vessel(np.asarray(sphere.vertices), np.asarray(sphere.faces), target=30000)
     assert none == 0.0 and len(kept_f) == 20480
+
+
+def test_a_vessel_decimated_past_the_tolerance_keeps_more_triangles_until_within_it():
+    sphere = trimesh.creation.icosphere(subdivisions=5, radius=10.0)  # 20480 faces
+    vertices, faces = np.asarray(sphere.vertices), np.asarray(sphere.faces)
+    _, coarse, coarse_error = decimated_vessel(vertices, faces, target=500, tolerance_mm=10.0)
+    tolerance = 0.5 * coarse_error  # the 500-face decimation misses it: the target must grow
+    _, kept, error = decimated_vessel(vertices, faces, target=500, tolerance_mm=tolerance)
+    assert len(coarse) <= 500 < len(kept) and error <= tolerance
