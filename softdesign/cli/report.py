@@ -14,6 +14,7 @@ from typing import Annotated
 import typer
 
 from softdesign.cli.common import distances_from_text, note, run_guarded
+from softdesign.cli.progress import part_progress
 
 
 def pcc_d_from_text(text: str | None) -> tuple[float, ...] | None:
@@ -29,10 +30,15 @@ def report_after_build(build_dir: Path, pcc_d: str | None = None) -> None:
 
     options = ReportOptions(pcc_d=pcc_d_from_text(pcc_d))
     start = time.perf_counter()
-    result = write_report(build_dir, options)
+    with part_progress("report") as tick:  # a bar on a terminal only; logs get the one summary line below
+        result = write_report(build_dir, options, tick)
     seconds = time.perf_counter() - start
     for line in result.notes:
         note(f"report: {line}")
+    slowest = sorted(result.seconds.items(), key=lambda item: -item[1])[:5]
+    note("report: slowest parts: " + ", ".join(f"{name} {s:.1f} s" for name, s in slowest))
+    for line in result.warnings:
+        note(f"report: WARNING: {line}")
     size = sum(result.files.values())
     typer.echo(
         f"report: {result.page} ({len(result.files)} files, {size / 1e6:.2f} MB, "

@@ -13,6 +13,13 @@ gives the same file.  PLY keeps a per-face ``region`` label and VTP a
 array ``RegionNames``) when labels are given; the other formats drop them.
 Reading merges the vertices that faces share (STL stores none), so a closed
 surface reads as a closed mesh.
+
+Units (:data:`FILE_UNITS`): glTF 2.0 defines its unit as the metre, so .glb is
+written in metres (mm x 0.001 at write time) and read back into mm; Blender and
+glTF viewers then show the body at its true size.  STL, PLY and OBJ carry no
+unit and are written in mm, the convention of slicers and CAD imports (a
+Blender user imports them with scale 0.001); .vtp is in mm as VMTK and 3D
+Slicer expect.
 """
 
 from __future__ import annotations
@@ -43,6 +50,7 @@ class MeshFormat:
         empty arrays when the file holds no triangles
     encode : the writer's bytes, or None for a format that is only read
     carries_regions : whether the file keeps a region label per face
+    unit : the length unit of the file's coordinates (the package converts from and to mm)
     """
 
     name: str
@@ -50,6 +58,7 @@ class MeshFormat:
     read: Callable[[Path], Mesh]
     encode: Encoder | None
     carries_regions: bool = False
+    unit: str = "mm"
 
     @property
     def suffix(self) -> str:
@@ -105,6 +114,20 @@ def _trimesh_encoder(file_type: str) -> Encoder:
     return encode
 
 
+#: mm per metre: glTF's coordinates are metres.
+MM_PER_M = 1000.0
+
+
+def _read_glb(path: Path) -> Mesh:
+    vertices, faces = _read_trimesh(path)
+    return vertices * MM_PER_M, faces
+
+
+def _glb_bytes(vertices: np.ndarray, faces: np.ndarray, regions: np.ndarray | None) -> bytes:
+    """Binary glTF in metres, as the glTF 2.0 specification requires (softdesign's mm / 1000)."""
+    return _trimesh_encoder("glb")(np.asarray(vertices, float) / MM_PER_M, faces, regions)
+
+
 def _vtp_bytes(vertices: np.ndarray, faces: np.ndarray, regions: np.ndarray | None) -> bytes:
     """VTK XML PolyData of the triangles, binary (base64) and zlib-compressed, as VMTK writes it."""
     import vtk
@@ -137,11 +160,13 @@ FORMATS: dict[str, MeshFormat] = {
         MeshFormat("stl", "binary STL (float32 corners, no shared vertices)", _read_trimesh, _trimesh_encoder("stl")),
         MeshFormat("ply", "binary PLY with a region label per face", _read_trimesh, _trimesh_encoder("ply"), True),
         MeshFormat("obj", "Wavefront OBJ (text)", _read_trimesh, _trimesh_encoder("obj")),
-        MeshFormat("glb", "binary glTF 2.0, for viewers", _read_trimesh, _trimesh_encoder("glb")),
+        MeshFormat("glb", "binary glTF 2.0 in metres, for viewers", _read_glb, _glb_bytes, unit="m"),
         MeshFormat("vtp", "VTK XML PolyData (binary, zlib) with a Region cell array", _read_vtk, _vtp_bytes, True),
         MeshFormat("vtk", "legacy VTK PolyData (read only)", _read_vtk, None),
     )
 }
+#: The length unit of each format's files (the manifest records it in ``metrics.export.units``).
+FILE_UNITS = {name: f.unit for name, f in FORMATS.items()}
 #: Formats a mesh can be written in: ``export.formats`` and ``pose --output``.
 MESH_FORMATS = tuple(name for name, f in FORMATS.items() if f.encode is not None)
 

@@ -29,6 +29,11 @@ FIT_SURFACE = "fit/surface.npz"
 FIT_POINTS = "fit/points.npz"
 FIT_SUMMARY = "fit/summary.json"
 EXPORT_SUMMARY = "export/summary.json"
+#: ParaView time series (q as the time) of the centerlines and, when .vtp is exported, of the meshes.
+CENTERLINES_PVD = "centerlines.pvd"
+MESHES_PVD = "meshes.pvd"
+#: One glTF binary with a morph target per export q and an animation over q (when .glb is exported).
+MORPH_GLB = "morph.glb"
 
 
 # Beside the build folder ``<name>``, in the same parent (so a rename never crosses file systems), named

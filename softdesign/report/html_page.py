@@ -31,6 +31,10 @@ th { background: #f4f4f4; } td.num { text-align: right; font-variant-numeric: ta
 td.hash { font-family: ui-monospace, Menlo, Consolas, monospace; font-size: 0.85em; word-break: break-all; }
 td.pass { color: #1a7f37; font-weight: 600; } td.fail { color: #c62828; font-weight: 600; }
 caption { text-align: left; font-weight: 600; padding-bottom: 0.3em; }
+.banner { border: 3px solid #c62828; background: #fdecea; color: #8e0000; padding: 0.6em 1em; margin: 1em 0;
+          font-size: 1.05em; } .banner h2 { border: 0; margin: 0 0 0.3em; color: #c62828; }
+.allclear { border: 2px solid #1a7f37; background: #e9f7ee; padding: 0.5em 1em; margin: 1em 0; }
+details { margin: 0.4em 0 1.2em; } summary { cursor: pointer; color: #333; }
 """
 
 
@@ -50,6 +54,7 @@ class Table:
     caption: str
     header: tuple[str, ...]
     rows: Sequence[tuple[Cell, ...]]
+    folded: str = ""  #: when set, the table is folded away in a <details> with this summary text
 
 
 @dataclass(frozen=True)
@@ -61,6 +66,7 @@ class Section:
     notes: list[str] = field(default_factory=list)
     pictures: list[Picture] = field(default_factory=list)
     tables: list[Table] = field(default_factory=list)
+    embeds: list[str] = field(default_factory=list)  #: HTML fragments made by the package (never user text)
 
 
 def key_figure_table(figures: list[KeyFigure]) -> Table:
@@ -75,15 +81,41 @@ def key_figure_table(figures: list[KeyFigure]) -> Table:
     return Table("Key figures of manifest.json", ("figure", "value", "unit", "where in manifest.json"), rows)
 
 
+CHECK_HEADER = ("subject", "check", "found", "required", "status")
+
+
 def check_table(checks: list[Check]) -> Table:
-    """Every check with its status."""
+    """Every check with its status, failures first (in their order), then the passed ones."""
+    ordered = [c for c in checks if not c.passed] + [c for c in checks if c.passed]
     rows = [
         (Cell(c.subject), Cell(c.name), Cell(c.found), Cell(c.required),
          Cell("pass", "pass") if c.passed else Cell("FAIL", "fail"))
-        for c in checks
+        for c in ordered
     ]
     passed = sum(c.passed for c in checks)
-    return Table(f"Checks: {passed} of {len(checks)} passed", ("subject", "check", "found", "required", "status"), rows)
+    return Table(f"Checks: {passed} of {len(checks)} passed", CHECK_HEADER, rows)
+
+
+def compact_check_tables(checks: list[Check]) -> list[Table]:
+    """The checks in at most three tables: the failures (when any), one row per kind of check with its tally,
+    and every passed check (a row each: subject, figure found, limit) folded away in a <details>."""
+    failed = [c for c in checks if not c.passed]
+    passed = [c for c in checks if c.passed]
+    tables = []
+    if failed:
+        rows = check_table(failed).rows
+        tables.append(Table(f"Checks FAILED: {len(failed)} of {len(checks)}", CHECK_HEADER, rows))
+    kinds: dict[str, list[Check]] = {}
+    for c in checks:
+        kinds.setdefault(c.name, []).append(c)
+    tally = [(Cell(name), Cell(str(sum(c.passed for c in group)), "num"), Cell(str(len(group)), "num"),
+              Cell("all passed", "pass") if all(c.passed for c in group) else Cell("some failed", "fail"))
+             for name, group in kinds.items()]
+    tables.append(Table(f"Checks: {len(passed)} of {len(checks)} passed", ("check", "passed", "of", ""), tally))
+    if passed:
+        tables.append(Table(f"The {len(passed)} passed checks", CHECK_HEADER, check_table(passed).rows,
+                            folded=f"every passed check, one row each ({len(passed)})"))
+    return tables
 
 
 def plain_table(
@@ -107,7 +139,13 @@ def _table_html(table: Table) -> str:
             for c in row
         )
         body.append(f"<tr>{cells}</tr>")
-    return f"<table><caption>{escape(table.caption)}</caption>\n<tr>{head}</tr>\n" + "\n".join(body) + "\n</table>"
+    html = f"<table><caption>{escape(table.caption)}</caption>\n<tr>{head}</tr>\n" + "\n".join(body) + "\n</table>"
+    return f"<details><summary>{escape(table.folded)}</summary>\n{html}\n</details>" if table.folded else html
+
+
+def table_html(table: Table) -> str:
+    """One table (folded in a <details> when ``table.folded``) as HTML."""
+    return _table_html(table)
 
 
 def _picture_html(p: Picture) -> str:
@@ -122,12 +160,22 @@ def _section_html(number: int, section: Section) -> str:
     parts += [f'<p class="note">{escape(note)}</p>' for note in section.notes]
     for picture in section.pictures:
         parts += [f"<h3>{escape(picture.title)}</h3>", _picture_html(picture)]
+    parts += section.embeds
     parts += [_table_html(t) for t in section.tables]
     return "\n".join(parts + ["</section>"])
 
 
-def render_page(title: str, summary: list[str], sections: list[Section]) -> str:
-    """The whole page as text."""
+def banner_html(warnings: list[str]) -> str:
+    """Every warning in one box at the top that cannot be missed, or a plain all-clear line."""
+    if not warnings:
+        return '<p class="allclear">No warnings: no stale outputs, every check passed, no arc misfit or fold.</p>'
+    items = "".join(f"<li>{escape(w)}</li>" for w in warnings)
+    return (f'<div class="banner" id="warnings" role="alert"><h2>{len(warnings)} warning(s)</h2>'
+            f"<ul>{items}</ul></div>")
+
+
+def render_page(title: str, summary: list[str], sections: list[Section], top: str = "") -> str:
+    """The whole page as text; ``top`` (HTML made by the package: banner, summary table) follows the summary lines."""
     nav = " ".join(
         f'<a href="#{escape(s.anchor, quote=True)}">{k} {escape(s.title)}</a>' for k, s in enumerate(sections, 1)
     )
@@ -136,7 +184,7 @@ def render_page(title: str, summary: list[str], sections: list[Section]) -> str:
     return (
         '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
         f'<meta name="viewport" content="width=device-width, initial-scale=1">\n<title>{escape(title)}</title>\n'
-        f"<style>{STYLE}</style>\n</head>\n<body>\n<h1>{escape(title)}</h1>\n{lines}\n<nav>{nav}</nav>\n{body}\n"
+        f"<style>{STYLE}</style>\n</head>\n<body>\n<h1>{escape(title)}</h1>\n{lines}\n{top}<nav>{nav}</nav>\n{body}\n"
         "</body>\n</html>\n"
     )
 

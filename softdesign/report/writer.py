@@ -11,9 +11,12 @@ from __future__ import annotations
 
 import os
 import shutil
+import time
 import uuid
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TypeVar
 
 from softdesign.errors import ConfigError
 from softdesign.pipeline.layout import REPORT_DIR
@@ -24,21 +27,26 @@ from softdesign.report import (
     animation,
     design_figures,
     fit_figures,
+    interactive,
     kinematics_figures,
     morph_figures,
+    profile_figures,
     stretch_figures,
     surface_figures,
 )
 from softdesign.report.build_folder import BuildData, load_build
 from softdesign.report.html_page import (
     Section,
-    check_table,
+    banner_html,
+    compact_check_tables,
     key_figure_table,
     plain_table,
     referenced_files,
     render_page,
+    table_html,
 )
 from softdesign.report.plotting import pixel_size
+from softdesign.report.summary import facts_table, summary_facts, summary_warnings
 from softdesign.report.tables import (
     Check,
     fit_checks,
@@ -48,6 +56,8 @@ from softdesign.report.tables import (
     output_checks,
     software_rows,
 )
+
+T = TypeVar("T")
 
 PAGE = "index.html"
 TEMP_PREFIX = ".report-"
@@ -69,6 +79,7 @@ EXPECTED_SIZES = {
     "design.png": pixel_size(design_figures.SIZE_IN),
     "morph.gif": pixel_size(animation.SIZE_IN),
     stretch_figures.NAME: pixel_size(stretch_figures.SIZE_IN),
+    profile_figures.NAME: pixel_size(profile_figures.SIZE_IN),
 }
 
 
@@ -79,6 +90,27 @@ class ReportOptions:
     pcc_d: tuple[float, ...] | None = None
     q_samples: int = kinematics_figures.Q_SAMPLES
     gif_frames: int = animation.FRAMES
+    view_frames: int = interactive.FRAMES
+
+
+#: Called after each part of the report with its name and the seconds it took (the CLI prints progress).
+Progress = Callable[[str, float], None]
+
+
+class _Timer:
+    """Runs each part of the report, records its time and tells ``progress``."""
+
+    def __init__(self, progress: Progress | None) -> None:
+        self.progress = progress
+        self.seconds: dict[str, float] = {}
+
+    def __call__(self, name: str, action: Callable[[], T]) -> T:
+        start = time.perf_counter()
+        result = action()
+        self.seconds[name] = time.perf_counter() - start
+        if self.progress is not None:
+            self.progress(name, self.seconds[name])
+        return result
 
 
 @dataclass(frozen=True)
@@ -90,10 +122,16 @@ class ReportResult:
     checks_passed: int
     checks_total: int
     notes: list[str] = field(default_factory=list)
+    seconds: dict[str, float] = field(default_factory=dict)  #: time of each part, s (not written to the page)
+    warnings: list[str] = field(default_factory=list)
 
 
-def write_report(build_dir: str | Path, options: ReportOptions = ReportOptions()) -> ReportResult:
+def write_report(
+    build_dir: str | Path, options: ReportOptions = ReportOptions(), progress: Progress | None = None
+) -> ReportResult:
     """Draw the report of ``build_dir`` into ``build_dir/report/`` (replacing an older one).
+
+    ``progress(name, seconds)`` is called after each part (loading, each figure, the page, the write).
 
     Raises
     ------
@@ -102,61 +140,89 @@ def write_report(build_dir: str | Path, options: ReportOptions = ReportOptions()
     SoftdesignError
         A PCC design fails (e.g. a bad ``pcc_d``).
     """
-    data = load_build(build_dir)
-    sections, checks, notes = report_sections(data, options)
+    timer = _Timer(progress)
+    data = timer("load the build", lambda: load_build(build_dir))
+    sections, checks, notes = report_sections(data, options, timer)
     passed = sum(c.passed for c in checks)
     summary = _summary(data, passed, len(checks))
-    page = render_page(f"softdesign report: {data.name}", summary, sections)
+    warnings = summary_warnings(data, checks)
+    top = timer("summary", lambda: banner_html(warnings) + table_html(facts_table(summary_facts(data), data.manifest)))
+    page = render_page(f"softdesign report: {data.name}", summary, sections, top)
     files = {p.name: p.data for s in sections for p in s.pictures}
     files[PAGE] = page.encode("utf-8")
+    if any(interactive.JS_NAME in embed for s in sections for embed in s.embeds):
+        files[interactive.JS_NAME] = interactive.plotly_js()
     missing = sorted(set(referenced_files(page)) - set(files))
     if missing:
         raise RuntimeError(f"report page links to files it does not write: {missing}")  # a bug, not a user error
     target = Path(build_dir) / REPORT_DIR
     # under the build's lock, so a build cannot swap the folder away mid-commit; OSErrors name the folder, exit 2
     with folder_errors(Path(build_dir)), BuildLock(Path(os.path.realpath(build_dir))):
-        commit_folder(target, files)
-    return ReportResult(target / PAGE, {k: len(v) for k, v in sorted(files.items())}, passed, len(checks), notes)
+        timer("write the files", lambda: commit_folder(target, files))
+    return ReportResult(target / PAGE, {k: len(v) for k, v in sorted(files.items())}, passed, len(checks), notes,
+                        timer.seconds, warnings)
 
 
-def report_sections(data: BuildData, options: ReportOptions) -> tuple[list[Section], list[Check], list[str]]:
-    """The seven sections of the page, every check, and the notes on what was left out."""
+def report_sections(
+    data: BuildData, options: ReportOptions, timer: _Timer | None = None
+) -> tuple[list[Section], list[Check], list[str]]:
+    """The sections of the page, every check, and the notes on what was left out."""
+    run = timer or _Timer(None)
     notes: list[str] = []
-    morph = Section("morph", "The morph", pictures=[morph_figures.morph_picture(data.kinematics.chain, data.export_q)])
+    view = _view_section(data, options, run)
+    morph = Section("morph", "The morph", pictures=[
+        run("morph.png", lambda: morph_figures.morph_picture(data.kinematics.chain, data.export_q))
+    ])
     surfaces, fit = Section("surfaces", "The surfaces"), Section("fit", "Fit quality")
     if data.fit is None:
         notes.append(NO_FIT)
         surfaces.notes.append(NO_FIT)
         fit.notes.append(NO_FIT)
     else:
-        surface = surface_figures.surface_picture(data)  # None only without a fit
+        surface = run("surfaces.png", lambda: surface_figures.surface_picture(data))  # None only without a fit
         if surface is not None:
             surfaces.pictures.append(surface)
-        distances = fit_figures.true_distances(data)
-        fit.pictures.extend([fit_figures.residual_picture(data), fit_figures.distance_picture(data, distances)])
-    kinematics = _kinematics_section(data, options, notes)
+        profile = run(profile_figures.NAME, lambda: profile_figures.profile_picture(data))
+        if profile is not None:
+            surfaces.pictures.append(profile)
+        distances = run("fit distances", lambda: fit_figures.true_distances(data))
+        fit.pictures.extend([run("fit_residuals.png", lambda: fit_figures.residual_picture(data)),
+                             run("fit_distances.png", lambda: fit_figures.distance_picture(data, distances))])
+    kinematics = _kinematics_section(data, options, notes, run)
     field = data.fit.field if data.fit is not None else None
-    gif = animation.morph_gif(data.kinematics.chain, field, options.gif_frames)
-    tables, checks = _tables_section(data)
+    gif = run("morph.gif", lambda: animation.morph_gif(data.kinematics.chain, field, options.gif_frames))
+    tables, checks = run("tables and checks", lambda: _tables_section(data))
     if data.export_summary is None:
         notes.append(NO_EXPORT)
         tables.notes.append(NO_EXPORT)
     design = Section(
         "design", "Link design: one constant-curvature arc per link",
-        pictures=[design_figures.design_picture(data.kinematics.chain)],
+        pictures=[run("design.png", lambda: design_figures.design_picture(data.kinematics.chain))],
     )
     sections = [
-        morph, surfaces, fit, kinematics, design, tables, Section("animation", "The morph, animated", pictures=[gif])
+        view, morph, surfaces, fit, kinematics, design, tables,
+        Section("animation", "The morph, animated", pictures=[gif]),
     ]
-    stretch = stretch_figures.stretch_picture(data)
+    stretch = run(stretch_figures.NAME, lambda: stretch_figures.stretch_picture(data))
     if stretch is not None:
-        sections.insert(3, Section("feasibility", "Skin stretch and wall", pictures=[stretch]))
+        sections.insert(4, Section("feasibility", "Skin stretch and wall", pictures=[stretch]))
     return sections, checks, notes
 
 
-def _kinematics_section(data: BuildData, options: ReportOptions, notes: list[str]) -> Section:
+def _view_section(data: BuildData, options: ReportOptions, run: _Timer) -> Section:
+    """The interactive 3D view of the morph over the patient's vessel."""
+    html, display_notes = run("3D view", lambda: interactive.morph_html(data, options.view_frames))
+    what = "the actuator (coloured by link)" if data.fit is not None else "the centerline (no fit in this build)"
+    note = (f"{what} at {options.view_frames} q values from 0 to 1 (slider, play), its centerline per link, and the "
+            "patient's vessel surface, semi-transparent; drag to turn, scroll to zoom. Decimated for display only: "
+            + "; ".join(display_notes) + ". Needs JavaScript; nothing is fetched from the network.")
+    return Section("view", "The morph in 3D (interactive)", notes=[note], embeds=[html])
+
+
+def _kinematics_section(data: BuildData, options: ReportOptions, notes: list[str], run: _Timer) -> Section:
     series = kinematics_figures.kinematics_series(data.kinematics.chain, data.export_q, options.q_samples)
-    section = Section("kinematics", "Kinematics over q", pictures=[kinematics_figures.kinematics_picture(series)])
+    section = Section("kinematics", "Kinematics over q",
+                      pictures=[run("kinematics.png", lambda: kinematics_figures.kinematics_picture(series))])
     if options.pcc_d is None:
         section.notes.append("PCC chamber lengths: not drawn; give --pcc-d D (mm, one or one per link) to add them.")
         return section
@@ -173,7 +239,8 @@ def _kinematics_section(data: BuildData, options: ReportOptions, notes: list[str
             f"give one value for every link or {data.link_count}, one per link"
         )
     d = options.pcc_d[0] if len(options.pcc_d) == 1 else list(options.pcc_d)
-    picture, design_notes = kinematics_figures.pcc_picture(data.kinematics.chain, series, d)
+    picture, design_notes = run("pcc_chambers.png", lambda: kinematics_figures.pcc_picture(data.kinematics.chain,
+                                                                                      series, d))
     section.pictures.append(picture)
     section.notes.extend(design_notes)
     return section
@@ -190,7 +257,7 @@ def _tables_section(data: BuildData) -> tuple[Section, list[Check]]:
                     ("", "hash", "num")),
         plain_table("Software", ("package", "build (manifest.json)", "this report"), software_rows(data.manifest)),
         plain_table("Stages of the last run", ("stage", "status", "time (s)"), stages, ("", "", "num")),
-        check_table(checks),
+        *compact_check_tables(checks),
     ]
     notes = [f"ingest: {n}" for n in data.ingest.notes]
     notes += [f"kinematics: warning: {n}" for n in data.manifest.get("metrics", {}).get("kinematics", {})

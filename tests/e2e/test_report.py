@@ -22,6 +22,7 @@ from PIL import Image
 from typer.testing import CliRunner
 
 from softdesign.pipeline.api import build_through
+from softdesign.report.interactive import DISPLAY_TOLERANCE_MM, DIV_ID, JS_NAME
 from softdesign.report.writer import EXPECTED_SIZES, PAGE, REPORT_DIR, ReportOptions, commit_folder, write_report
 from softdesign.versions import software_versions
 from tests.helpers.cases import write_case
@@ -299,7 +300,11 @@ def test_tampered_outputs_fail_their_checks(demo, tmp_path):
     summary["meshes"][mesh]["volume_rel_error"] = 0.02
     summary_file.write_text(json.dumps(summary))
     result = write_report(copy, ReportOptions(gif_frames=3))
-    failed = {(r[0], r[1]) for r in parse_page(copy / REPORT_DIR).rows if r[-1:] == ["FAIL"]}
+    checks = [r for r in parse_page(copy / REPORT_DIR).rows if r[-1:] in (["FAIL"], ["pass"])]
+    assert [r[-1] for r in checks[:3]] == ["FAIL"] * 3 and "FAIL" not in [r[-1] for r in checks[3:]]  # failures first
+    text = (copy / REPORT_DIR / PAGE).read_text(encoding="utf-8")
+    assert "3 of " in text[text.index('<div class="banner"'):text.index("<nav>")]  # and in the banner
+    failed = {(r[0], r[1]) for r in checks if r[-1] == "FAIL"}
     assert failed == {(mesh, "watertight"), (mesh, "volume vs integrated volume"),
                       ("export/summary.json", "file as recorded (sha256)")}
     assert result.checks_total - result.checks_passed == 3
@@ -318,6 +323,8 @@ def test_a_stale_stage_is_noted_on_the_page(demo, tmp_path):
     write_report(copy, ReportOptions(gif_frames=3))
     text = (copy / REPORT_DIR / PAGE).read_text(encoding="utf-8")
     assert "export: out of date" in text
+    banner = text[text.index('<div class="banner"'):text.index("<nav>")]  # the warnings sit above every section
+    assert "stale: stage export is out of date" in banner
     assert "out of date" not in (demo[0] / REPORT_DIR / PAGE).read_text(encoding="utf-8")
 
 
@@ -337,7 +344,7 @@ def test_a_build_without_fit_gets_a_report_with_the_centerline_only(tmp_path):
     build_dir = tmp_path / "build"
     build_through(DEMO_CASE, build_dir, target="kinematics")
     result = write_report(build_dir, ReportOptions(gif_frames=4))
-    assert set(result.files) == {PAGE, "morph.png", "kinematics.png", "design.png", "morph.gif"}
+    assert set(result.files) == {PAGE, "morph.png", "kinematics.png", "design.png", "morph.gif", JS_NAME}
     text = (build_dir / REPORT_DIR / PAGE).read_text(encoding="utf-8")
     assert "no fit in this build folder" in text and "no export in this build folder" in text
     with Image.open(build_dir / REPORT_DIR / "morph.gif") as gif:
@@ -445,3 +452,79 @@ def test_a_killed_runs_temporary_folder_is_removed_a_running_ones_kept(tmp_path)
         (folder / PAGE).write_bytes(b"half written")
     commit_folder(tmp_path / REPORT_DIR, {PAGE: b"page"})
     assert not dead.exists() and alive.exists()
+
+
+def test_summary_and_banner_come_first_and_name_every_arc_misfit(built):
+    build_dir, result = built
+    manifest = json.loads((build_dir / "manifest.json").read_text())
+    text = (build_dir / REPORT_DIR / PAGE).read_text(encoding="utf-8")
+    top = text[:text.index("<nav>")]
+    misfits = manifest["metrics"]["kinematics"]["arc_check"]["warnings"]
+    if misfits:
+        assert '<div class="banner"' in top
+    assert all(w.replace("'", "&#x27;") in top for w in misfits)
+    assert len(result.warnings) >= len(misfits)
+    for i, entry in enumerate(manifest["outputs"]):  # every exported q's volume is in the summary, traced
+        if entry["path"].startswith("meshes/q_") and entry["path"].endswith(".stl"):
+            assert f'data-pointer="/outputs/{i}/volume_mm3"' in top, entry["path"]
+    assert 'data-pointer="/metrics/feasibility/morph/stretch_max/value"' in top
+    assert 'data-pointer="/metrics/fit/max_rho_kappa"' in top
+
+
+def test_passed_checks_are_folded_away_under_a_tally(built):
+    build_dir, result = built
+    text = (build_dir / REPORT_DIR / PAGE).read_text(encoding="utf-8")
+    folded = text[text.index("<details>"):text.index("</details>")]
+    assert folded.count("<tr><td>") == result.checks_passed  # each passed check once, folded
+    outputs = json.loads((build_dir / "manifest.json").read_text())["outputs"]
+    assert f"<td>file as recorded (sha256)</td><td class=\"num\">{len(outputs)}</td>" in text  # the tally row
+
+
+#: The demo's page and its files, at most (issue 17: 10 MB).
+DEMO_REPORT_BYTES = 10_000_000
+
+
+def test_the_3d_view_is_offline_and_holds_a_frame_per_q(built):
+    import re
+
+    from plotly.offline import get_plotlyjs
+
+    build_dir, result = built
+    report_dir = build_dir / REPORT_DIR
+    text = (report_dir / PAGE).read_text(encoding="utf-8")
+    scripts = re.findall(r"<script[^>]*\bsrc=\"([^\"]+)\"", text)
+    assert scripts == [JS_NAME]  # one script file, beside the page
+    assert (report_dir / JS_NAME).read_bytes() == get_plotlyjs().encode("utf-8")
+    assert "http://" not in text and "https://" not in text  # no address the browser could fetch
+    assert f'id="{DIV_ID}"' in text
+    names = re.findall(r'"name":"(\d\.\d{3})"', text)
+    assert names == [f"{q:.3f}" for q in np.linspace(0.0, 1.0, 21)]
+    assert sum(result.files.values()) < DEMO_REPORT_BYTES
+    stated = [float(x) for x in re.findall(r"display error(?: at q = 1)? ([0-9.]+) mm", text)]
+    assert stated and max(stated) <= DISPLAY_TOLERANCE_MM  # the page states each display error, within tolerance
+
+
+def test_the_hollow_body_is_cut_through_its_wall_and_chamber(tmp_path):
+    """A hollow build's q = 1 cut half way is two closed loops: the outer skin and the chamber."""
+    from softdesign.io.surface import read_surface
+    from softdesign.report.build_folder import load_build
+    from softdesign.report.profile_figures import cross_section
+
+    case = tmp_path / "hollow.yaml"
+    text = DEMO_CASE.read_text().replace("../data", str(REPO / "data"))
+    case.write_text(text.replace("formats: [stl]}", "formats: [stl, glb], wall_mm: 1.0, port_mm: 1.5}"))
+    build_through(case, tmp_path / "build")
+    data = load_build(tmp_path / "build")
+    segments = cross_section(data, *read_surface(data.mesh_file(1.0)), 0.5)
+    radii = np.linalg.norm(segments.reshape(-1, 2), axis=1)
+    mean_rho = float(data.fit.field.evaluate_grid(1.0, np.array([0.5]), np.linspace(0, 2 * np.pi, 96))[0].mean())
+    outer, inner = radii[radii > mean_rho - 0.5], radii[radii < mean_rho - 0.5]
+    # the wall is 1 mm: the chamber's loop sits 1 mm inside the skin's (to the mesh's chord error, 0.1 mm)
+    np.testing.assert_allclose(outer.mean() - inner.mean(), 1.0, rtol=0, atol=0.1)
+    result = write_report(tmp_path / "build", ReportOptions(gif_frames=3))
+    assert "profile.png" in result.files
+    import trimesh
+
+    glb = trimesh.load(tmp_path / "build" / "meshes" / "q_1.000.glb", force="mesh")
+    stl = trimesh.load(tmp_path / "build" / "meshes" / "q_1.000.stl")
+    np.testing.assert_allclose(glb.extents * 1000.0, stl.extents, rtol=1e-6, atol=0)  # glTF in metres

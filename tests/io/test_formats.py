@@ -10,7 +10,7 @@ from scipy.spatial import cKDTree
 
 from softdesign.config import Export
 from softdesign.errors import InputDataError
-from softdesign.io.formats import FORMATS, MESH_FORMATS, mesh_bytes, read_mesh, write_mesh
+from softdesign.io.formats import FILE_UNITS, FORMATS, MESH_FORMATS, mesh_bytes, read_mesh, write_mesh
 from softdesign.io.vtk_polydata import read_polydata, triangles_from_polydata
 from softdesign.meshing.solids import build_solid
 from softdesign.meshing.tessellate import Region
@@ -23,6 +23,8 @@ FLOAT32_RTOL = 1e-6
 #: float32 (STL, glTF) rounds coordinates below 25 mm by at most 1e-6 mm, OBJ's text by 1e-8 mm; the
 #: tube's closest vertices are 0.5 mm apart, so matching within 1e-5 mm cannot pick a wrong vertex.
 ROUND_TRIP_MM = 1e-5
+#: mm in one unit of each file unit (written here, not taken from the package).
+MM_PER_UNIT = {"mm": 1.0, "m": 1000.0}
 
 
 @pytest.fixture(scope="module")
@@ -32,10 +34,11 @@ def ported():
 
 
 def _read_back(path, fmt):
+    """Vertices in mm and faces, read by trimesh or vtk (not the package), from the file's own unit."""
     if fmt == "vtp":
         return triangles_from_polydata(read_polydata(path))
     mesh = trimesh.load(path, force="mesh", process=False)
-    return np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    return np.asarray(mesh.vertices) * MM_PER_UNIT[FILE_UNITS[fmt]], np.asarray(mesh.faces)
 
 
 @pytest.mark.parametrize("fmt", MESH_FORMATS)
@@ -48,6 +51,21 @@ def test_every_format_reads_back_as_the_same_solid(ported, tmp_path, fmt):
         assert measure(vertices, faces) == pytest.approx(expected, rel=FLOAT32_RTOL), measure.__name__
     # the same arrays give the same bytes
     assert path.read_bytes() == mesh_bytes(ported.vertices, ported.faces, fmt, ported.regions)
+
+
+def test_glb_is_in_metres_as_gltf_requires_and_the_others_in_mm(ported, tmp_path):
+    # glTF 2.0: "the units for all linear distances are meters"; STL, PLY, OBJ carry no unit (mm by convention)
+    assert FILE_UNITS == {"stl": "mm", "ply": "mm", "obj": "mm", "glb": "m", "vtp": "mm", "vtk": "mm"}
+    # the tube runs 20 mm along z with an outer radius of 3 mm
+    expected_mm = np.ptp(ported.vertices, axis=0)
+    np.testing.assert_allclose(expected_mm, [6.0, 6.0, 20.0], rtol=0, atol=0.05)
+    for fmt in ("glb", "stl", "obj", "ply"):
+        mesh = trimesh.load(write_mesh(tmp_path / f"body.{fmt}", ported.vertices, ported.faces), force="mesh",
+                            process=False)
+        scale = 1e-3 if fmt == "glb" else 1.0  # file units per mm
+        np.testing.assert_allclose(mesh.extents, expected_mm * scale, rtol=FLOAT32_RTOL, atol=0, err_msg=fmt)
+    vertices, _ = read_mesh(tmp_path / "body.glb")  # the package reads it back into mm
+    np.testing.assert_allclose(np.ptp(vertices, axis=0), expected_mm, rtol=FLOAT32_RTOL, atol=0)
 
 
 def test_ply_and_vtp_keep_the_region_of_every_face(ported, tmp_path):

@@ -9,7 +9,10 @@ labels, .vtp with a Region cell array, .obj, .glb when asked), with ``export.spl
 region as well (``meshes/q_0.500/wall.stl``, ``base_cap.stl``, ...: open
 surfaces that together tile the solid), and ``centerlines/q_0.500.vtp``
 carrying the frames (N, B, T) and the axial stretch, for VMTK, ParaView and
-3D Slicer.
+3D Slicer.  ``centerlines.pvd`` (and ``meshes.pvd`` when .vtp is exported)
+lists those files as a ParaView time series with q as the time; with .glb and
+two or more q, ``morph.glb`` holds the outer surface with a morph target per q
+and an animation over q (see :mod:`softdesign.meshing.morph_body`).
 """
 
 from __future__ import annotations
@@ -22,10 +25,13 @@ from typing import Any
 import numpy as np
 
 from softdesign.config import Case
-from softdesign.io.formats import mesh_bytes
+from softdesign.io.formats import FILE_UNITS, mesh_bytes
+from softdesign.io.gltf_morph import morph_glb_bytes
 from softdesign.io.polylines_vtp import write_polylines_vtp
+from softdesign.io.pvd import pvd_bytes
 from softdesign.meshing.body import body_breaks, body_sections, body_stations
 from softdesign.meshing.checks import check_solid
+from softdesign.meshing.morph_body import MorphSurfaces, morph_surfaces
 from softdesign.meshing.regions import RegionPiece, split_by_region
 from softdesign.meshing.solids import Solid, build_solid
 from softdesign.meshing.volume import BodySpec, integrate_body
@@ -37,7 +43,7 @@ from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 
-VERSION = 1
+VERSION = 3  # 2: .glb in metres (glTF's unit), metrics.export.units; 3: .pvd time series, morph.glb
 
 
 @dataclass(frozen=True)
@@ -57,6 +63,7 @@ class ExportResult:
 
     meshes: tuple[ExportedMesh, ...]
     summary: dict[str, Any]
+    morph: MorphSurfaces | None = None
 
 
 def mesh_name(q: float, fmt: str) -> str:
@@ -130,8 +137,14 @@ def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Expo
     longest = max(key.length for key in kinematics.chain.shape.keys)
     meshes = tuple(map_per_q(lambda q: solid_at(kinematics, fit, q, case), case.export.q_values(),
                              most=export_workers(case, longest)))
+    morph = None
+    if "glb" in case.export.formats and len(meshes) >= 2:
+        e = case.export
+        morph = morph_surfaces(kinematics.chain.shape, fit.field, np.array([m.q for m in meshes]), body_spec(case),
+                               e.spacing_mm, e.angular_count)
     summary = {
         "formats": list(case.export.formats),
+        "units": {fmt: FILE_UNITS[fmt] for fmt in case.export.formats},
         "spec": {"offset_mm": case.export.offset_mm, "wall_mm": case.export.wall_mm, "port_mm": case.export.port_mm},
         "resolution": {"spacing_mm": case.export.spacing_mm, "angular_count": case.export.angular_count},
         "volume_method": "Gauss-Legendre in l (8 points between knots and joints) x trapezoid in angle",
@@ -143,7 +156,12 @@ def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Expo
                                   "area_mm2": p.area()}
             for m in meshes for p in m.pieces
         }
-    return ExportResult(meshes, summary)
+    summary["time_series"] = [layout.CENTERLINES_PVD] + ([layout.MESHES_PVD] if "vtp" in case.export.formats else [])
+    if morph is not None:
+        summary["morph"] = {"path": layout.MORPH_GLB, "targets": len(morph.q), "vertices": morph.vertices.shape[1],
+                            "faces": len(morph.faces), "rings": len(morph.l), "unit": "m",
+                            "surface": "outer skin (offset_mm), end caps; no chamber or port"}
+    return ExportResult(meshes, summary, morph)
 
 
 def write_export(result: ExportResult, staging: Staging) -> None:
@@ -158,6 +176,13 @@ def write_export(result: ExportResult, staging: Staging) -> None:
         arrays = {k: [v] for k, v in mesh.centerline.items() if k != "points"}
         write_polylines_vtp(staging.staged_path(relative), [mesh.centerline["points"]], arrays)
         staging.record(relative)
+    series = {layout.CENTERLINES_PVD: [(m.q, layout.centerline_path(m.q)) for m in result.meshes],
+              layout.MESHES_PVD: [(m.q, mesh_name(m.q, "vtp")) for m in result.meshes]}
+    for name in result.summary.get("time_series", []):
+        staging.write_bytes(name, pvd_bytes(series[name]))
+    morph = result.morph
+    if morph is not None:
+        staging.write_bytes(layout.MORPH_GLB, morph_glb_bytes(morph.vertices, morph.faces, morph.q))
     staging.write_json(layout.EXPORT_SUMMARY, result.summary)
 
 

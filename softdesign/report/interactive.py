@@ -1,0 +1,227 @@
+"""The interactive 3D view (issue 17, item 2): the actuator morphing over q with a slider and play, in plotly.
+
+One plotly figure: the actuator's tube S(q) tessellated from the radius field
+(faces coloured by link), the centerline c(q) per link (in the legend), and the
+patient's vessel surface, semi-transparent, around the q = 1 body.  The frames
+(one per q) change only the actuator and the centerline; the scene's ranges are
+fixed over every frame so the camera does not jump.
+
+For display only, the tube is tessellated coarser than the export
+(:data:`SPACING_MM`, :data:`ANGLES`) and the vessel surface is decimated by
+VTK's quadric decimation to at most :data:`VESSEL_FACES` triangles, both
+within :data:`DISPLAY_TOLERANCE_MM`: the display error (the largest distance
+from the fine surface's points to the displayed mesh, mm) is measured, and
+while it exceeds the tolerance the tube's rings and angles are doubled (at
+most :data:`MAX_REFINEMENTS` times) and the vessel keeps twice the triangles.
+The caption states both measured errors.  Coordinates are written as
+float32 (0.01 um at 100 mm, far below those errors).
+
+plotly (MIT licence) ships plotly.js; the report writes it once as the file
+:data:`JS_NAME` beside the page, so the view needs no network.  The figure's
+div has a fixed id and plotly writes no time or random id: the same build gives
+the same bytes.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from softdesign.report.build_folder import BuildData
+from softdesign.report.plotting import link_colours
+from softdesign.report.surface_figures import VESSEL_RGB, tube_mesh
+from softdesign.types import FloatArray
+
+#: plotly.js, written beside the page.
+JS_NAME = "plotly.min.js"
+#: The fixed id of the figure's element.
+DIV_ID = "morph3d"
+#: Frames from q = 0 to q = 1, both included.
+FRAMES = 21
+#: Display tessellation of the tube: ring spacing along the centerline (mm) and vertices around.
+SPACING_MM, ANGLES = 1.0, 32
+#: The fine tessellation the display error is measured against: half the display's spacing and angle, so its
+#: points include every displayed cell's edge midpoints and centre, where a chord strays farthest from the surface.
+FINE_FACTOR = 2
+#: At most this many triangles of the vessel surface are shown (more only to meet the display tolerance).
+VESSEL_FACES = 20000
+#: The view shows each surface to this distance (mm), a few pixels of a ~100 mm scene 720 px high; the
+#: exported files carry the exact body.
+DISPLAY_TOLERANCE_MM = 0.5
+#: The tube is refined at most this many times (each doubles rings and angles: 4x the page's tube data).
+MAX_REFINEMENTS = 2
+#: Centerline samples per link and frame.
+CURVE_SAMPLES = 40
+VESSEL_OPACITY = 0.25
+HEIGHT_PX = 720
+
+
+def max_distance_to_mesh(points: FloatArray, vertices: FloatArray, faces: np.ndarray) -> float:
+    """Largest true distance (mm) from ``points`` (n, 3) to the triangle mesh (vertices, faces).
+
+    VTK's static cell locator finds each point's closest point on the triangles (vtkImplicitPolyDataDistance
+    gives the same figures some twenty times slower).
+    """
+    import vtk
+
+    from softdesign.io.vtk_polydata import polydata_from_triangles
+
+    locator = vtk.vtkStaticCellLocator()
+    locator.SetDataSet(polydata_from_triangles(np.asarray(vertices, float), np.asarray(faces, np.int64)))
+    locator.BuildLocator()
+    closest, cell, sub, squared = [0.0, 0.0, 0.0], vtk.reference(0), vtk.reference(0), vtk.reference(0.0)
+    largest = 0.0
+    for point in np.asarray(points, float):
+        locator.FindClosestPoint(point, closest, cell, sub, squared)
+        largest = max(largest, float(squared))
+    return float(np.sqrt(largest))
+
+
+def decimated_vessel(vertices: FloatArray, faces: np.ndarray, target: int = VESSEL_FACES,
+                     tolerance_mm: float = DISPLAY_TOLERANCE_MM):
+    """(vertices, faces, error_mm): the vessel surface with about ``target`` triangles and its display error.
+
+    The error is the largest distance from an original vertex to the decimated surface (0 when kept whole);
+    while it exceeds ``tolerance_mm`` the target doubles (up to the whole surface).
+    """
+    import vtk
+
+    from softdesign.io.vtk_polydata import polydata_from_triangles, triangles_from_polydata
+
+    while len(faces) > target:
+        decimate = vtk.vtkQuadricDecimation()
+        decimate.SetInputData(polydata_from_triangles(np.asarray(vertices, float), np.asarray(faces, np.int64)))
+        decimate.SetTargetReduction(1.0 - target / len(faces))
+        decimate.Update()
+        small_vertices, small_faces = triangles_from_polydata(decimate.GetOutput())
+        error = max_distance_to_mesh(vertices, small_vertices, small_faces)
+        if error <= tolerance_mm:
+            return small_vertices, small_faces, error
+        target *= 2
+    return np.asarray(vertices, float), np.asarray(faces, np.int64), 0.0
+
+
+def tube_display_error_mm(data: BuildData, q: float = 1.0, spacing_mm: float = SPACING_MM,
+                          angles: int = ANGLES) -> float:
+    """Largest distance from the fine tube's vertices at ``q`` to the displayed (coarse) tube, mm."""
+    assert data.fit is not None
+    chain, field = data.kinematics.chain, data.fit.field
+    coarse_vertices, coarse_faces, _ = tube_mesh(chain, field, q, spacing_mm, angles)
+    fine_vertices, _, _ = tube_mesh(chain, field, q, spacing_mm / FINE_FACTOR, angles * FINE_FACTOR)
+    return max_distance_to_mesh(fine_vertices, coarse_vertices, coarse_faces)
+
+
+def display_tube(data: BuildData, tolerance_mm: float = DISPLAY_TOLERANCE_MM) -> tuple[float, int, float]:
+    """(ring spacing mm, vertices around, display error mm at q = 1): the coarsest tube within ``tolerance_mm``
+    (or the finest of :data:`MAX_REFINEMENTS` refinements)."""
+    spacing, angles = SPACING_MM, ANGLES
+    error = tube_display_error_mm(data, 1.0, spacing, angles)
+    for _ in range(MAX_REFINEMENTS):
+        if error <= tolerance_mm:
+            break
+        spacing, angles = spacing / 2, angles * 2
+        error = tube_display_error_mm(data, 1.0, spacing, angles)
+    return spacing, angles, error
+
+
+def _rgb(colour) -> str:
+    return "rgb({:d},{:d},{:d})".format(*(int(round(255 * c)) for c in colour[:3]))
+
+
+def _frame_traces(data: BuildData, q: float, spacing_mm: float = SPACING_MM, angles: int = ANGLES
+                  ) -> list[dict[str, Any]]:
+    """The traces that change with q: the tube (when fitted), then one centerline trace per link."""
+    chain = data.kinematics.chain
+    curve = chain.shape.curve_at(q)
+    traces: list[dict[str, Any]] = []
+    if data.fit is not None:
+        vertices, _, _ = tube_mesh(chain, data.fit.field, q, spacing_mm, angles)
+        v = vertices.astype(np.float32)
+        traces.append({"type": "mesh3d", "x": v[:, 0], "y": v[:, 1], "z": v[:, 2]})
+    for j in range(chain.count):
+        p = curve.points(np.linspace(chain.breaks[j], chain.breaks[j + 1], CURVE_SAMPLES)).astype(np.float32)
+        traces.append({"type": "scatter3d", "x": p[:, 0], "y": p[:, 1], "z": p[:, 2]})
+    return traces
+
+
+def morph_figure(data: BuildData, frames: int = FRAMES):
+    """The plotly figure and the notes on what was decimated (display errors, mm)."""
+    import plotly.graph_objects as go
+
+    chain = data.kinematics.chain
+    colours = [_rgb(c) for c in link_colours(chain.count)]
+    q_values = np.linspace(0.0, 1.0, int(frames))
+    spacing, angles, tube_error = display_tube(data) if data.fit is not None else (SPACING_MM, ANGLES, 0.0)
+    per_q = [_frame_traces(data, float(q), spacing, angles) for q in q_values]
+    first = per_q[-1]  # the page opens on q = 1, inside the vessel
+    traces: list[Any] = []
+    notes: list[str] = []
+    if data.fit is not None:
+        _, faces, face_l = tube_mesh(chain, data.fit.field, 1.0, spacing, angles)
+        face_colours = np.array(colours, dtype=object)[data.fit.field.link_of(face_l)]
+        traces.append(go.Mesh3d(**{k: first[0][k] for k in "xyz"}, i=faces[:, 0], j=faces[:, 1], k=faces[:, 2],
+                                facecolor=face_colours, flatshading=False, name="actuator", showlegend=True,
+                                hoverinfo="skip"))
+        notes.append(f"actuator: {spacing:g} mm rings, {angles} vertices around; display error at q = 1 "
+                     f"{tube_error:.3f} mm (against {FINE_FACTOR}x finer; tolerance {DISPLAY_TOLERANCE_MM:g} mm)")
+    for j, trace in enumerate(first[len(first) - chain.count:]):
+        traces.append(go.Scatter3d(**{k: trace[k] for k in "xyz"}, mode="lines", line={"color": colours[j], "width": 6},
+                                   name=f"link {j} (centerline)", hoverinfo="name"))
+    moving = list(range(len(traces)))
+    if len(data.ingest.faces):
+        v, f, error = decimated_vessel(data.ingest.vertices, data.ingest.faces)
+        v = v.astype(np.float32)
+        traces.append(go.Mesh3d(x=v[:, 0], y=v[:, 1], z=v[:, 2], i=f[:, 0], j=f[:, 1], k=f[:, 2],
+                                color=_rgb(VESSEL_RGB), opacity=VESSEL_OPACITY, name="patient's vessel (input)",
+                                showlegend=True, hoverinfo="skip"))
+        notes.append(f"vessel: {len(f)} of {len(data.ingest.faces)} triangles; display error {error:.3f} mm "
+                     f"(tolerance {DISPLAY_TOLERANCE_MM:g} mm)")
+    figure = go.Figure(data=traces, frames=[
+        go.Frame(name=f"{q:.3f}", data=per_q[k], traces=moving) for k, q in enumerate(q_values)
+    ])
+    figure.update_layout(**_layout(per_q, traces, q_values))
+    return figure, notes
+
+
+def _layout(per_q: list[list[dict[str, Any]]], traces: list[Any], q_values: FloatArray) -> dict[str, Any]:
+    """Fixed scene ranges over every frame and the vessel, a q slider and a play button."""
+    points = [np.column_stack([t["x"], t["y"], t["z"]]) for frame in per_q for t in frame]
+    points += [np.column_stack([t.x, t.y, t.z]) for t in traces if t.name and t.name.startswith("patient")]
+    stacked = np.concatenate(points).astype(float)
+    low, high = stacked.min(axis=0), stacked.max(axis=0)
+    span = np.maximum(high - low, 1e-6)
+    pad = 0.03 * span.max()
+    ratio = (span + 2 * pad) / (span + 2 * pad).max()
+    axes = {name: {"range": [float(low[i] - pad), float(high[i] + pad)], "title": {"text": f"{name} (mm)"}}
+            for i, name in enumerate(("x", "y", "z"))}
+    animate = {"mode": "immediate", "frame": {"duration": 0, "redraw": True}, "transition": {"duration": 0}}
+    steps = [{"label": f"{q:.2f}", "method": "animate", "args": [[f"{q:.3f}"], animate]} for q in q_values]
+    play = {"frame": {"duration": 120, "redraw": True}, "fromcurrent": True, "transition": {"duration": 0}}
+    return {
+        "template": "none", "height": HEIGHT_PX, "margin": {"l": 0, "r": 0, "t": 30, "b": 0},
+        "legend": {"x": 0.0, "y": 1.0},
+        "scene": {**{f"{k}axis": v for k, v in axes.items()}, "aspectmode": "manual",
+                  "aspectratio": {k: float(r) for k, r in zip("xyz", ratio, strict=True)}},
+        "sliders": [{"active": len(q_values) - 1, "steps": steps, "currentvalue": {"prefix": "q = "},
+                     "pad": {"t": 20}, "x": 0.1, "len": 0.9}],
+        "updatemenus": [{"type": "buttons", "showactive": False, "x": 0.0, "y": 0.0, "xanchor": "left",
+                         "yanchor": "top", "pad": {"t": 20},
+                         "buttons": [{"label": "play", "method": "animate", "args": [None, play]},
+                                     {"label": "pause", "method": "animate", "args": [[None], animate]}]}],
+    }
+
+
+def morph_html(data: BuildData, frames: int = FRAMES) -> tuple[str, list[str]]:
+    """The figure's HTML fragment (a div and its script; plotly.js is :data:`JS_NAME`) and the display notes."""
+    figure, notes = morph_figure(data, frames)
+    html = figure.to_html(include_plotlyjs=False, full_html=False, div_id=DIV_ID,
+                          config={"displaylogo": False, "responsive": True})
+    return f'<script src="{JS_NAME}" charset="utf-8"></script>\n{html}', notes
+
+
+def plotly_js() -> bytes:
+    """plotly.js as plotly's Python package ships it (the same bytes for one plotly version)."""
+    from plotly.offline import get_plotlyjs
+
+    return get_plotlyjs().encode("utf-8")

@@ -1,0 +1,89 @@
+"""The summary's warnings and the checks' order, from hand-made manifests (no build)."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import trimesh
+
+from softdesign.report.html_page import banner_html, compact_check_tables
+from softdesign.report.interactive import decimated_vessel
+from softdesign.report.summary import summary_warnings
+from softdesign.report.tables import Check
+
+
+def _data(manifest):
+    return SimpleNamespace(manifest=manifest)  # summary_warnings reads only the manifest
+
+
+def test_every_kind_of_warning_is_listed_stale_first():
+    manifest = {
+        "stages": [{"name": "fit", "status": "ran"}, {"name": "export", "status": "stale"}],
+        "metrics": {
+            "feasibility": {"feasible": False, "reasons": ["q=1.000: wall 0.400 mm < min_wall_mm 1 (x) at link 2",
+                                                           "q=1.000: skin stretch 3.1 > max_stretch 2.8 (x)"]},
+            "fit": {"max_rho_kappa": 1.2},
+            "kinematics": {"arc_check": {"warnings": ["link 0: 1.9 mm from its arc"]}},
+        },
+    }
+    checks = [Check("a.stl", "watertight", "no", "yes", False), Check("a.stl", "one body", "1", "1", True)]
+    warnings = summary_warnings(_data(manifest), checks)  # type: ignore[arg-type]
+    assert warnings[0].startswith("stale: stage export")
+    assert warnings[1].startswith("1 of 2 checks FAILED (a.stl: watertight)")
+    assert warnings[2].startswith("infeasible (thin wall): q=1.000: wall 0.400 mm")
+    assert warnings[3].startswith("infeasible: q=1.000: skin stretch")
+    assert "rho * kappa 1.2 >= 1" in warnings[4]
+    assert warnings[5] == "large arc misfit: link 0: 1.9 mm from its arc"
+    assert len(warnings) == 6
+    assert banner_html(warnings).count("<li>") == 6 and 'role="alert"' in banner_html(warnings)
+
+
+def test_a_clean_build_has_no_warning_and_says_so():
+    manifest = {"stages": [{"name": "fit", "status": "ran"}],
+                "metrics": {"feasibility": {"feasible": None, "reasons": ["no material"]},
+                            "fit": {"max_rho_kappa": 0.3}, "kinematics": {"arc_check": {"warnings": []}}}}
+    assert summary_warnings(_data(manifest), [Check("a", "b", "c", "d", True)]) == []  # type: ignore[arg-type]
+    assert 'class="allclear"' in banner_html([])
+
+
+def test_failures_first_then_a_tally_per_kind_and_every_passed_check_folded():
+    checks = [Check("a.stl", "file as recorded (sha256)", "matches", "x", True),
+              Check("a.stl", "watertight", "yes", "yes", True),
+              Check("b.stl", "file as recorded (sha256)", "differs", "x", False),
+              Check("b.stl", "watertight", "no", "yes", False),
+              Check("c.stl", "watertight", "yes", "yes", True)]
+    failed, tally, folded = compact_check_tables(checks)
+    assert [(r[0].text, r[1].text) for r in failed.rows] == [("b.stl", "file as recorded (sha256)"),
+                                                               ("b.stl", "watertight")]
+    assert [tuple(c.text for c in r) for r in tally.rows] == [("file as recorded (sha256)", "1", "2", "some failed"),
+                                                               ("watertight", "2", "3", "some failed")]
+    assert [(r[0].text, r[1].text) for r in folded.rows] == [("a.stl", "file as recorded (sha256)"),
+                                                               ("a.stl", "watertight"), ("c.stl", "watertight")]
+    assert folded.folded and not failed.folded and tally.caption == "Checks: 3 of 5 passed"
+    assert len(compact_check_tables(checks[:2])) == 2  # no failure: no failures table
+
+
+#: Display tolerance for a decimated 10 mm sphere: 1 % of its radius.
+SPHERE_DISPLAY_MM = 0.1
+
+
+def test_the_vessel_is_decimated_for_display_within_a_measured_error():
+    sphere = trimesh.creation.icosphere(subdivisions=5, radius=10.0)  # 20480 faces
+    vertices, faces, error = decimated_vessel(np.asarray(sphere.vertices), np.asarray(sphere.faces), target=2000)
+    assert len(faces) <= 2000
+    # every decimated vertex is one of the sphere's kept or moved ones: close to the sphere
+    np.testing.assert_allclose(np.linalg.norm(vertices, axis=1), 10.0, rtol=0, atol=SPHERE_DISPLAY_MM)
+    # chords of ~2000 triangles on R = 10 mm sag by about 0.05 mm: the measured error is that, not 0
+    assert 0.0 < error < SPHERE_DISPLAY_MM
+    kept_v, kept_f, none = decimated_vessel(np.asarray(sphere.vertices), np.asarray(sphere.faces), target=30000)
+    assert none == 0.0 and len(kept_f) == 20480
+
+
+def test_a_vessel_decimated_past_the_tolerance_keeps_more_triangles_until_within_it():
+    sphere = trimesh.creation.icosphere(subdivisions=5, radius=10.0)  # 20480 faces
+    vertices, faces = np.asarray(sphere.vertices), np.asarray(sphere.faces)
+    _, coarse, coarse_error = decimated_vessel(vertices, faces, target=500, tolerance_mm=10.0)
+    tolerance = 0.5 * coarse_error  # the 500-face decimation misses it: the target must grow
+    _, kept, error = decimated_vessel(vertices, faces, target=500, tolerance_mm=tolerance)
+    assert len(coarse) <= 500 < len(kept) and error <= tolerance
