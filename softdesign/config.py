@@ -239,7 +239,7 @@ class Case(_Section):
     intermediate: list[IntermediateShape] = []
     resample: Resample = Resample()
     frames: Literal["rmf", "frenet"] = "rmf"
-    blend: Literal["linear", "intrinsic"] = "linear"
+    blend: Literal["auto", "linear", "intrinsic"] = "auto"
     links: Links = Links(count=4)
     fit: Fit = Fit()
     export: Export = Export()

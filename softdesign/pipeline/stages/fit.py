@@ -19,6 +19,7 @@ import numpy as np
 from softdesign.config import Case
 from softdesign.errors import ConfigError, FitError
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
+from softdesign.fitting.end_checks import thin_end_warnings
 from softdesign.fitting.metrics import HoldoutSettings
 from softdesign.fitting.projection import project_points
 from softdesign.fitting.radius_field import RadiusField
@@ -186,7 +187,17 @@ def describe_fit(result: FitResult) -> list[str]:
         f"joints: value jump {m['joint_value_jump_mm']:.2e} mm, slope jump {m['joint_slope_jump']:.2e}",
         f"max rho * kappa at q = 1: {m['max_rho_kappa']:.3f} (folds at 1; every export q is checked at export)",
         f"radius at q = 0: {result.summary['initial_radius']}",
+    ] + end_lines(result.summary)
+
+
+def end_lines(summary: dict[str, Any]) -> list[str]:
+    """Where an end's wall was unseen and held at the inscribed radius, and thin end rings (warnings)."""
+    lines = [
+        f"{end}: wall not seen all round over the last {e['unseen_mm']:.1f} mm; {e['empty_cells']:.0f} empty cells "
+        f"held at the inscribed radius ({e['reference_min_mm']:.3f} to {e['reference_max_mm']:.3f} mm)"
+        for end, e in summary.get("end_prior", {}).items()
     ]
+    return lines + [f"  warning: {w}" for w in thin_end_warnings(summary.get("ends", {}))]
 
 
 def _sampled_note(distance: dict[str, Any]) -> str:
