@@ -1,0 +1,71 @@
+"""Synthetic vessels that reproduce the failure kinds of real trees (issue 20), written VMTK-style.
+
+Each is a tube of known radius swept along a known centerline (tests/helpers/vessels.tube_along),
+with the centerline written with ``MaximumInscribedSphereRadius`` and the open surface as STL.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from tests.helpers.vessels import tube_along
+
+EDGE_MM = 0.5
+
+
+def u_turn_axis(bend_mm: float = 10.0, lead_mm: float = 10.0, step: float = 0.25) -> tuple[np.ndarray, np.ndarray]:
+    """A straight lead, a half turn of radius ``bend_mm`` in the xy plane, a straight return: points and normals."""
+    lead = np.arange(0.0, lead_mm, step)
+    turn = np.arange(0.0, np.pi, step / bend_mm)
+    tail = np.arange(0.0, lead_mm + step / 2, step)
+    points = np.concatenate([
+        np.column_stack([np.zeros_like(lead), lead - lead_mm, np.zeros_like(lead)]),
+        np.column_stack([bend_mm * (1 - np.cos(turn)), bend_mm * np.sin(turn), np.zeros_like(turn)]),
+        np.column_stack([np.full_like(tail, 2 * bend_mm), -tail, np.zeros_like(tail)]),
+    ])
+    return points, np.tile([0.0, 0.0, 1.0], (len(points), 1))
+
+
+def stub_turn_axis(stub_mm: float, bend_mm: float, turn_deg: float, tail_mm: float,
+                   step: float = 0.1) -> tuple[np.ndarray, np.ndarray]:
+    """A straight stub, a turn of ``turn_deg`` with radius ``bend_mm`` in the xy plane, a straight tail."""
+    angle = np.radians(turn_deg)
+    stub = np.arange(0.0, stub_mm, step)
+    turn = np.arange(0.0, angle, step / bend_mm)
+    end = np.array([bend_mm * (1 - np.cos(angle)), stub_mm + bend_mm * np.sin(angle), 0.0])
+    direction = np.array([np.sin(angle), np.cos(angle), 0.0])
+    tail = np.arange(0.0, tail_mm + step / 2, step)
+    points = np.concatenate([
+        np.column_stack([np.zeros_like(stub), stub, np.zeros_like(stub)]),
+        np.column_stack([bend_mm * (1 - np.cos(turn)), stub_mm + bend_mm * np.sin(turn), np.zeros_like(turn)]),
+        end + tail[:, None] * direction,
+    ])
+    return points, np.tile([0.0, 0.0, 1.0], (len(points), 1))
+
+
+def write_tube_vessel(folder: Path, points: np.ndarray, normals: np.ndarray, radius: float) -> tuple[Path, Path]:
+    """Centerline .vtp (radius ``radius`` everywhere) and the open tube's surface .stl, in mm."""
+    import trimesh
+
+    from softdesign.io.polylines_vtp import write_polylines_vtp
+
+    folder.mkdir(parents=True, exist_ok=True)
+    centerline = folder / "centerline.vtp"
+    write_polylines_vtp(centerline, [points], {"MaximumInscribedSphereRadius": [np.full(len(points), radius)]})
+    # the wall runs a little past both ends of the centerline, as a VMTK surface does
+    t0 = points[1] - points[0]
+    t1 = points[-1] - points[-2]
+    t0, t1 = t0 / np.linalg.norm(t0), t1 / np.linalg.norm(t1)
+    extra = np.arange(1, 5)[:, None] * EDGE_MM
+    wall_axis = np.concatenate([points[0] - extra[::-1] * t0, points, points[-1] + extra * t1])
+    wall_normals = np.concatenate([np.repeat(normals[:1], 4, 0), normals, np.repeat(normals[-1:], 4, 0)])
+    ring_step = EDGE_MM * np.sqrt(3) / 2
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(wall_axis, axis=0), axis=1))])
+    keep = np.searchsorted(s, np.arange(0.0, s[-1], ring_step))
+    around = int(np.ceil(2 * np.pi * radius / EDGE_MM))
+    vertices, faces = tube_along(wall_axis[keep], wall_normals[keep], radius, around)
+    surface = folder / "surface.stl"
+    trimesh.Trimesh(vertices, faces, process=False).export(surface)
+    return centerline, surface
