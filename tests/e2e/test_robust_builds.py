@@ -3,9 +3,9 @@
 * a U-turn (radius 3 mm vessel, 10 mm bend) whose straight-to-curved linear blend folds back on itself
   at q = 1/2: ``blend: auto`` builds it with the intrinsic blend and says why; ``blend: linear`` fails
   with a message naming the blend;
-* a 6 mm vessel whose centerline runs a 4.5 mm stub and then turns 60 degrees with a 3 mm bend radius:
-  refused at the blend stage, before any fit, naming the cause and the fix that works (straightened
-  end), which is then shown to build.
+* a 6 mm vessel whose centerline runs a 4.5 mm stub and then turns 60 degrees within 3 mm (half the
+  radius): the backbone is regularized at ingest, the wall fitted around it, and the manifest says how far
+  it moved and the fit error there.
 """
 
 from __future__ import annotations
@@ -13,12 +13,14 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
 from softdesign.cli import app
+from softdesign.geometry.backbone import TARGET_REACH
 from tests.helpers.cases import write_case
-from tests.helpers.robust_vessels import stub_turn_axis, u_turn_axis, write_tube_vessel
+from tests.helpers.robust_vessels import u_turn_axis, wall_to_body_mm, write_elbow_vessel, write_tube_vessel
 
 runner = CliRunner()
 #: The q = 1 body's largest true distance from the input wall, as a fraction of the radius (issue 20: 3%).
@@ -55,12 +57,32 @@ def test_a_u_turn_with_the_linear_blend_asked_for_fails_naming_the_blend(tmp_pat
     assert "the linear blend is the likelier cause" in result.output and "use blend: intrinsic" in result.output
 
 
-def test_a_turn_tighter_than_the_vessel_is_refused_before_the_fit_and_the_named_fix_builds(tmp_path):
-    centerline, surface = write_tube_vessel(tmp_path / "stub", *stub_turn_axis(4.5, 3.0, 60.0, 30.0), 6.0)
+def test_a_stub_then_a_60_degree_turn_within_half_a_radius_builds_on_a_regularized_backbone(tmp_path):
+    import trimesh
+
+    radius = 6.0
+    centerline, surface, axis = write_elbow_vessel(tmp_path / "elbow", radius, 4.5, 60.0, 30.0)
     final = {"centerline": str(centerline), "surface": str(surface)}
-    result = build(write_case(tmp_path, "stub", final=final), tmp_path / "out")
-    assert result.exit_code == 2
-    assert "turns tighter than the vessel is wide" in result.output and "fit: running" not in result.output
-    assert "resample.end_straight_mm: 12" in result.output
-    fixed = build(write_case(tmp_path, "fixed", final=final, resample={"end_straight_mm": 12.0}), tmp_path / "fixed")
-    assert fixed.exit_code == 0, fixed.output
+    result = build(write_case(tmp_path, "elbow", final=final), tmp_path / "out")
+    assert result.exit_code == 0, result.output
+    assert "backbone regularized: the centerline turns tighter than the vessel is wide" in result.output
+    manifest = json.loads((tmp_path / "out" / "manifest.json").read_text())
+    backbone = manifest["metrics"]["ingest"]["backbone"]
+    assert backbone["regularized"] and backbone["reach_before"] >= 1.0 > TARGET_REACH > backbone["reach_after"]
+    assert 0.0 < backbone["max_moved_mm"] < radius
+    [stretch] = backbone["stretches"]
+    [fitted] = manifest["metrics"]["fit"]["backbone"]
+    assert fitted["points"] > 0 and fitted["max_mm"] > 0.0
+    meshes = [o for o in manifest["outputs"] if o["path"].startswith("meshes/")]
+    assert len(meshes) == 3 and all(m["watertight"] for m in meshes)
+    # the q = 1 body against the input wall, away from the stretch (where the backbone moved > 1% of r), off the caps
+    wall = trimesh.load(surface, process=False).vertices
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(axis, axis=0), axis=1))])
+    nearest = arc[np.argmin(np.linalg.norm(wall[:, None, :] - axis[None, ::5, :], axis=2), axis=1) * 5]
+    ends = [(axis[0], axis[1] - axis[0]), (axis[-1], axis[-1] - axis[-2])]
+    on_cap = np.any([np.abs((wall - p) @ (t / np.linalg.norm(t))) < 1e-6 for p, t in ends], axis=0)
+    away = ((nearest < stretch["from_mm"]) | (nearest > stretch["to_mm"])) & ~on_cap
+    body = trimesh.load(tmp_path / "out" / "meshes" / "q_1.000.stl", process=False)
+    distance = wall_to_body_mm(wall[away], (np.asarray(body.vertices), np.asarray(body.faces)))
+    assert away.sum() > 500
+    assert distance.max() < WALL_FRACTION * radius

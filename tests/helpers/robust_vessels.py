@@ -69,3 +69,59 @@ def write_tube_vessel(folder: Path, points: np.ndarray, normals: np.ndarray, rad
     surface = folder / "surface.stl"
     trimesh.Trimesh(vertices, faces, process=False).export(surface)
     return centerline, surface
+
+
+def capped_tube(axis: np.ndarray, radius: float, label: str):
+    """A capped tube of constant ``radius`` swept along ``axis`` (n, 3) by the sample generators, as a Manifold."""
+    from softdesign.meshing.solids import manifold_from_mesh
+    from softdesign.samples.surfaces import framed_polyline, swept_tube
+
+    framed = framed_polyline(axis, label)
+    rings = int(np.ceil(framed.length / EDGE_MM)) + 1
+    around = int(np.ceil(2 * np.pi * radius / EDGE_MM))
+    vertices, faces = swept_tube(framed, rings, around, np.full(2, radius), 0.0, np.zeros(2))
+    return manifold_from_mesh(vertices, faces, label)[0]
+
+
+def segment(a: np.ndarray, b: np.ndarray, step: float = 0.25) -> np.ndarray:
+    """Points from ``a`` to ``b`` about ``step`` mm apart."""
+    count = max(2, int(np.ceil(np.linalg.norm(b - a) / step)) + 1)
+    return a + np.linspace(0.0, 1.0, count)[:, None] * (b - a)
+
+
+def write_elbow_vessel(folder: Path, radius: float, stub_mm: float, turn_deg: float,
+                       tail_mm: float) -> tuple[Path, Path, np.ndarray]:
+    """A capped elbow: a straight stub, then a turn of ``turn_deg`` within half a radius of arc, then a tail.
+
+    The wall is what a vessel of radius ``radius`` is there: two capped cylinders whose axes meet at the
+    corner, joined by a ball at the corner (boolean union, as the sample vessel's trunk and branch are);
+    the centerline (``stub_turn_axis``, bend radius = half the radius / turn) cuts the corner inside it.
+    Returns the centerline .vtp, the surface .stl and the centerline points.
+    """
+    import manifold3d as m3
+
+    from softdesign.io.formats import write_mesh
+    from softdesign.io.polylines_vtp import write_polylines_vtp
+    from softdesign.meshing.solids import checked
+
+    angle = np.radians(turn_deg)
+    bend = 0.5 * radius / angle
+    points, _ = stub_turn_axis(stub_mm, bend, turn_deg, tail_mm)
+    corner = np.array([0.0, stub_mm + bend * np.tan(angle / 2), 0.0])
+    wall = (capped_tube(segment(points[0], corner), radius, "elbow stub")
+            + capped_tube(segment(corner, points[-1]), radius, "elbow tail")
+            + m3.Manifold.sphere(radius, int(np.ceil(2 * np.pi * radius / EDGE_MM))).translate(tuple(corner)))
+    mesh = checked(wall, "elbow").to_mesh64()
+    folder.mkdir(parents=True, exist_ok=True)
+    centerline = folder / "centerline.vtp"
+    write_polylines_vtp(centerline, [points], {"MaximumInscribedSphereRadius": [np.full(len(points), radius)]})
+    surface = write_mesh(folder / "surface.stl", np.asarray(mesh.vert_properties, float)[:, :3],
+                         np.asarray(mesh.tri_verts, np.int64))
+    return centerline, surface, points
+
+
+def wall_to_body_mm(wall: np.ndarray, body: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """Exact distance, mm, from each wall point (n, 3) to the body mesh (vertices, faces)."""
+    from softdesign.meshing.compare import _squared_distances
+
+    return np.sqrt(_squared_distances(np.asarray(wall, float), *body))

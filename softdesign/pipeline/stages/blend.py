@@ -19,12 +19,12 @@ from softdesign.config import Case
 from softdesign.geometry.blend import BlendedShape, Shortening, blend_shapes
 from softdesign.geometry.curves import (
     TORSION_KAPPA_FLOOR,
-    CurveOptions,
     smooth_curve_from_polyline,
     smooth_curve_from_samples,
 )
 from softdesign.geometry.initial import InitialSpec, build_initial_shape, initial_shape_from_polyline
 from softdesign.pipeline import layout
+from softdesign.pipeline.backbone_step import curve_options
 from softdesign.pipeline.blend_choice import choose_blend, describe_choice
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.ingest import IngestResult
@@ -42,17 +42,6 @@ class BlendResult:
 
     shape: BlendedShape
     summary: dict[str, Any]
-
-
-def curve_options(case: Case, count: int | None = None) -> CurveOptions:
-    """The case's resampling settings (``count`` forces the final shape's sample count)."""
-    r = case.resample
-    return CurveOptions(
-        spacing_mm=r.spacing_mm,
-        count=count if count is not None else r.count,
-        smoothing_mm=r.smoothing_mm,
-        end_straight_mm=r.end_straight_mm,
-    )
 
 
 def run_blend(case: Case, ingest: IngestResult) -> BlendResult:

@@ -28,13 +28,15 @@ from softdesign.fitting.wall_fit import WallFitOptions, fit_wall
 from softdesign.geometry.curves import SmoothCurve, measure_deviation
 from softdesign.geometry.network import SelectedPath
 from softdesign.pipeline import layout
+from softdesign.pipeline.backbone_step import describe_backbone_fit, stretch_fit_errors
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.ingest import IngestResult
 from softdesign.pipeline.stages.links import LinksResult
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 
-VERSION = 3  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
+VERSION = 4  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
 # 3: points fitted in path order; distances sampled above 200k points (max still over all)
+# 4: end prior and end radii (issue 20); true distances on the regularized backbone's stretches (``backbone``)
 #: Seed of the hold-out folds: the same case always gets the same folds.
 HOLDOUT_SEED = 4
 #: A failed fit is blamed on the centerline when the smoothed one strays from the input by this fraction of the
@@ -86,7 +88,8 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     field = wall.field
     if ingest.initial_surface is not None:
         field = _with_fitted_initial(chain, wall.settings, ingest.initial_surface[0], wall.field)
-    summary = {**wall.summary(), "initial_radius": _initial_kind(case)}
+    summary = {**wall.summary(), "initial_radius": _initial_kind(case),
+               "backbone": stretch_fit_errors(ingest.summary.get("backbone"), wall, curve)}
     residual = wall.polar.rho - field.evaluate_pairs(1.0, wall.polar.l, wall.polar.angle)
     points = {
         "l": wall.polar.l,
@@ -168,6 +171,7 @@ def fit_metrics(result: FitResult) -> dict[str, Any]:
         "joint_value_jump_mm": max(s["joint_value_jump_mm"], default=0.0),
         "joint_slope_jump": max(s["joint_slope_jump"], default=0.0),
         "max_rho_kappa": s["max_rho_kappa"],
+        "backbone": s.get("backbone", []),
     }
 
 
@@ -187,7 +191,7 @@ def describe_fit(result: FitResult) -> list[str]:
         f"joints: value jump {m['joint_value_jump_mm']:.2e} mm, slope jump {m['joint_slope_jump']:.2e}",
         f"max rho * kappa at q = 1: {m['max_rho_kappa']:.3f} (folds at 1; every export q is checked at export)",
         f"radius at q = 0: {result.summary['initial_radius']}",
-    ] + end_lines(result.summary)
+    ] + end_lines(result.summary) + describe_backbone_fit(result.summary.get("backbone", []))
 
 
 def end_lines(summary: dict[str, Any]) -> list[str]:
