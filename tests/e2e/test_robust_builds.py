@@ -5,7 +5,9 @@
   with a message naming the blend;
 * a 6 mm vessel whose centerline runs a 4.5 mm stub and then turns 60 degrees within 3 mm (half the
   radius): the backbone is regularized at ingest, the wall fitted around it, and the manifest says how far
-  it moved and the fit error there.
+  it moved and the fit error there;
+* the sample vessel's centerlines seeded at the side branch's outlet: path 0 starts at the widest end (the
+  vessel's inlet) and builds as the same path of the ordinarily seeded network.
 """
 
 from __future__ import annotations
@@ -20,11 +22,19 @@ from typer.testing import CliRunner
 from softdesign.cli import app
 from softdesign.geometry.backbone import TARGET_REACH
 from tests.helpers.cases import write_case
-from tests.helpers.robust_vessels import u_turn_axis, wall_to_body_mm, write_elbow_vessel, write_tube_vessel
+from tests.helpers.robust_vessels import (
+    u_turn_axis,
+    wall_to_body_mm,
+    write_elbow_vessel,
+    write_outlet_seeded_sample,
+    write_tube_vessel,
+)
 
 runner = CliRunner()
 #: The q = 1 body's largest true distance from the input wall, as a fraction of the radius (issue 20: 3%).
 WALL_FRACTION = 0.03
+#: Two fits of the same wall around the same path (its points written in the other order): equal up to rounding.
+SAME_FIT_MM = 1e-6
 
 pytestmark = pytest.mark.slow
 
@@ -86,3 +96,25 @@ def test_a_stub_then_a_60_degree_turn_within_half_a_radius_builds_on_a_regulariz
     distance = wall_to_body_mm(wall[away], (np.asarray(body.vertices), np.asarray(body.faces)))
     assert away.sum() > 500
     assert distance.max() < WALL_FRACTION * radius
+
+
+def test_a_network_seeded_at_an_outlet_starts_at_the_widest_end_and_builds_as_the_ordinary_one(tmp_path):
+    from softdesign.samples.files import write_sample
+
+    centerline, surface, inlet = write_outlet_seeded_sample(tmp_path / "seeded")
+    seeded = build(write_case(tmp_path, "seeded", final={"centerline": str(centerline), "surface": str(surface)}),
+                   tmp_path / "out")
+    assert seeded.exit_code == 0, seeded.output
+    assert "l = 0 at the widest end (the inlet)" in seeded.output
+    manifest = json.loads((tmp_path / "out" / "manifest.json").read_text())
+    chosen = manifest["metrics"]["ingest"]["centerline"]
+    assert np.allclose(chosen["inlet_mm"], inlet) and chosen["inlet_rule"].startswith("l = 0 at the widest end")
+    assert all(o["watertight"] for o in manifest["outputs"] if o["path"].startswith("meshes/"))
+    # the same vessel with its centerlines seeded at the inlet, as the sample writes them: the same path, same fit
+    ordinary_files = write_sample(tmp_path / "ordinary")
+    final = {"centerline": str(ordinary_files[0]), "surface": str(ordinary_files[1]), "path": 1}
+    assert build(write_case(tmp_path, "ordinary", final=final), tmp_path / "ordinary_out").exit_code == 0
+    ordinary = json.loads((tmp_path / "ordinary_out" / "manifest.json").read_text())["metrics"]["fit"]
+    fit = manifest["metrics"]["fit"]
+    assert fit["points"]["kept"] == ordinary["points"]["kept"]
+    assert abs(fit["rms_mm"] - ordinary["rms_mm"]) < SAME_FIT_MM

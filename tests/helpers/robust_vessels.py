@@ -125,3 +125,29 @@ def wall_to_body_mm(wall: np.ndarray, body: tuple[np.ndarray, np.ndarray]) -> np
     from softdesign.meshing.compare import _squared_distances
 
     return np.sqrt(_squared_distances(np.asarray(wall, float), *body))
+
+
+def write_outlet_seeded_sample(folder: Path) -> tuple[Path, Path, np.ndarray]:
+    """The project's sample vessel with its centerlines as VMTK writes them when seeded at the branch's outlet.
+
+    Both polylines start at the side branch's outlet (radius 2 mm) and share the branch up to the junction:
+    0 runs on through the trunk to the vessel's inlet (radius 3.7 mm), 1 turns into the main vessel's
+    outlet.  Returns the centerline .vtp, the capped surface .stl and the vessel's true inlet point.
+    """
+    from softdesign.io.formats import write_mesh
+    from softdesign.io.polylines_vtp import write_polylines_vtp
+    from softdesign.samples.sample_vessel import make_sample_vessel
+    from softdesign.samples.surfaces import sample_surface
+
+    vessel = make_sample_vessel()
+    junction = vessel.trunk_count() - 1
+    branch_radius, main_radius = vessel.inscribed_radius("branch"), vessel.inscribed_radius("main")
+    limb = vessel.branch[junction + 1:][::-1]
+    lines = [np.concatenate([limb, vessel.main[: junction + 1][::-1]]),
+             np.concatenate([limb, vessel.main[junction:]])]
+    radii = [np.concatenate([branch_radius[junction + 1:][::-1], main_radius[: junction + 1][::-1]]),
+             np.concatenate([branch_radius[junction + 1:][::-1], main_radius[junction:]])]
+    folder.mkdir(parents=True, exist_ok=True)
+    centerline = write_polylines_vtp(folder / "centerline.vtp", lines, {"MaximumInscribedSphereRadius": radii})
+    surface = write_mesh(folder / "surface.stl", *sample_surface(vessel))
+    return centerline, surface, vessel.main[0]
