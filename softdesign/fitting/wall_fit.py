@@ -44,6 +44,7 @@ class WallFitOptions:
     holdout : folds, the spacings ``auto`` tries, and the most points the hold-out uses
     initial_radius_mm : constant rho0; None for the axially symmetric mean of the fit
     fold_limit : the largest rho * kappa allowed at q = 1
+    end_margin_mm : kept points within this arc length of either end are left out of the fit, mm
     """
 
     fit: FitSettings = field(default_factory=FitSettings)
@@ -52,6 +53,7 @@ class WallFitOptions:
     holdout: HoldoutSettings = field(default_factory=HoldoutSettings)
     initial_radius_mm: float | None = None
     fold_limit: float = 1.0
+    end_margin_mm: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -119,6 +121,9 @@ def fit_wall(
     # in order along the path: every later evaluation then reads the splines' pieces in turn
     kept_index = np.flatnonzero(selection.keep)
     kept = polar.subset(kept_index[np.argsort(polar.l[kept_index], kind="stable")])
+    margin = options.end_margin_mm / curve.length
+    inside = (kept.l >= margin) & (kept.l <= 1.0 - margin)
+    kept = kept if inside.all() else kept.subset(inside)
     settings, scores = options.fit, dict[float, float]()
     reference = None if network.inscribed_l is None or network.inscribed_radius is None else (
         np.asarray(network.inscribed_l, float), np.asarray(network.inscribed_radius, float))
@@ -144,5 +149,5 @@ def fit_wall(
         rho = radius.evaluate_grid(1.0, l, np.linspace(0.0, 2.0 * np.pi, 96, endpoint=False)).min(axis=1)
         raise FitError(f"{str(err).split('; ')[0]}; {negative_radius_cause(prior, curve.length, l[np.argmin(rho)])}"
                        ) from err
-    ends = end_radii(radius, reference)
+    ends = end_radii(radius, reference) | {"margin": {"mm": options.end_margin_mm, "points": float((~inside).sum())}}
     return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius, ends)

@@ -7,7 +7,9 @@
   radius): the backbone is regularized at ingest, the wall fitted around it, and the manifest says how far
   it moved and the fit error there;
 * the sample vessel's centerlines seeded at the side branch's outlet: path 0 starts at the widest end (the
-  vessel's inlet) and builds as the same path of the ordinarily seeded network.
+  vessel's inlet) and builds as the same path of the ordinarily seeded network;
+* a straight vessel whose flat inlet cap is tilted 3 and 14 degrees to the end tangent: full end rings, the
+  side wall matched; an end margin longer than a quarter of the path is refused before the fit.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import pytest
 from typer.testing import CliRunner
 
 from softdesign.cli import app
+from softdesign.fitting.end_checks import THIN_END_RATIO
 from softdesign.geometry.backbone import TARGET_REACH
 from tests.helpers.cases import write_case
 from tests.helpers.robust_vessels import (
@@ -27,6 +30,7 @@ from tests.helpers.robust_vessels import (
     wall_to_body_mm,
     write_elbow_vessel,
     write_outlet_seeded_sample,
+    write_tilted_cap_vessel,
     write_tube_vessel,
 )
 
@@ -118,3 +122,36 @@ def test_a_network_seeded_at_an_outlet_starts_at_the_widest_end_and_builds_as_th
     fit = manifest["metrics"]["fit"]
     assert fit["points"]["kept"] == ordinary["points"]["kept"]
     assert abs(fit["rms_mm"] - ordinary["rms_mm"]) < SAME_FIT_MM
+
+
+@pytest.mark.parametrize("tilt_deg", [3.0, 14.0])
+def test_a_flat_cap_tilted_to_the_end_tangent_builds_with_full_ends(tmp_path, tilt_deg):
+    import trimesh
+
+    radius, length = 3.0, 40.0
+    centerline, surface = write_tilted_cap_vessel(tmp_path / "tilted", radius, length, tilt_deg)
+    result = build(write_case(tmp_path, "tilted", final={"centerline": str(centerline), "surface": str(surface)}),
+                   tmp_path / "out")
+    assert result.exit_code == 0, result.output
+    manifest = json.loads((tmp_path / "out" / "manifest.json").read_text())
+    ends = manifest["metrics"]["fit"]["ends"]
+    assert min(ends["inlet"]["ratio"], ends["outlet"]["ratio"]) > THIN_END_RATIO
+    assert "ring's smallest radius" not in result.output
+    assert all(o["watertight"] for o in manifest["outputs"] if o["path"].startswith("meshes/"))
+    # the side wall along the body (0 <= z <= length; the cap's rim past z = 0 is not the body's to match)
+    wall = trimesh.load(surface, process=False).vertices
+    side = np.abs(np.hypot(wall[:, 0], wall[:, 1]) - radius) < 1e-6 * radius
+    side &= (wall[:, 2] >= 0.0) & (wall[:, 2] <= length)
+    body = trimesh.load(tmp_path / "out" / "meshes" / "q_1.000.stl", process=False)
+    distance = wall_to_body_mm(wall[side], (np.asarray(body.vertices), np.asarray(body.faces)))
+    assert side.sum() > 1000 and distance.max() < WALL_FRACTION * radius
+
+
+def test_an_end_margin_longer_than_a_quarter_of_the_path_is_refused_after_ingest(tmp_path):
+    centerline, surface = write_tilted_cap_vessel(tmp_path / "tilted", 3.0, 40.0, 8.0)
+    case = write_case(tmp_path, "margin", final={"centerline": str(centerline), "surface": str(surface)},
+                      fit={"end_margin_mm": 12.0})
+    result = build(case, tmp_path / "out")
+    assert result.exit_code == 2
+    assert "fit.end_margin_mm: 12 mm is more than 0.25 of the 40.0 mm final path" in result.output
+    assert "fit: running" not in result.output

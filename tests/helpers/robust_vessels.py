@@ -151,3 +151,27 @@ def write_outlet_seeded_sample(folder: Path) -> tuple[Path, Path, np.ndarray]:
     centerline = write_polylines_vtp(folder / "centerline.vtp", lines, {"MaximumInscribedSphereRadius": radii})
     surface = write_mesh(folder / "surface.stl", *sample_surface(vessel))
     return centerline, surface, vessel.main[0]
+
+
+def write_tilted_cap_vessel(folder: Path, radius: float, length_mm: float, tilt_deg: float) -> tuple[Path, Path]:
+    """A straight capped vessel along +z whose inlet cap is flat but tilted ``tilt_deg`` to the end tangent.
+
+    The wall is a sample-generator tube from z = -radius to ``length_mm`` (capped square there) cut by the
+    plane through the origin whose normal leans ``tilt_deg`` from +z towards +x; the centerline runs from
+    the origin (the cap's centre) to ``length_mm`` along z, as VMTK's does from a cap's centre.
+    """
+    from softdesign.io.formats import write_mesh
+    from softdesign.io.polylines_vtp import write_polylines_vtp
+    from softdesign.meshing.solids import checked
+
+    tilt = np.radians(tilt_deg)
+    tube = capped_tube(segment(np.array([0.0, 0.0, -radius]), np.array([0.0, 0.0, length_mm])), radius, "tilted")
+    cut = checked(tube.trim_by_plane((-np.sin(tilt), 0.0, np.cos(tilt)), 0.0), "tilted cap").to_mesh64()
+    folder.mkdir(parents=True, exist_ok=True)
+    z = np.arange(0.0, length_mm + 1e-9, 0.25)
+    points = np.column_stack([np.zeros_like(z), np.zeros_like(z), z])
+    centerline = write_polylines_vtp(folder / "centerline.vtp", [points],
+                                     {"MaximumInscribedSphereRadius": [np.full(len(z), radius)]})
+    surface = write_mesh(folder / "surface.stl", np.asarray(cut.vert_properties, float)[:, :3],
+                         np.asarray(cut.tri_verts, np.int64))
+    return centerline, surface

@@ -77,6 +77,7 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
         selection=SelectionSettings(outlier_factor=fit.outlier_factor),
         holdout=HoldoutSettings(folds=fit.holdout_folds),
         initial_radius_mm=case.initial.radius_mm,
+        end_margin_mm=case.fit.end_margin_mm,
     )
     try:
         wall = fit_wall(curve, ingest.vertices, network, options, np.random.default_rng(HOLDOUT_SEED))
@@ -172,6 +173,8 @@ def fit_metrics(result: FitResult) -> dict[str, Any]:
         "joint_slope_jump": max(s["joint_slope_jump"], default=0.0),
         "max_rho_kappa": s["max_rho_kappa"],
         "backbone": s.get("backbone", []),
+        "ends": s.get("ends", {}),
+        "end_prior": s.get("end_prior", {}),
     }
 
 
