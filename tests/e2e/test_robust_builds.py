@@ -9,7 +9,9 @@
 * the sample vessel's centerlines seeded at the side branch's outlet: path 0 starts at the widest end (the
   vessel's inlet) and builds as the same path of the ordinarily seeded network;
 * a straight vessel whose flat inlet cap is tilted 3 and 14 degrees to the end tangent: full end rings, the
-  side wall matched; an end margin longer than a quarter of the path is refused before the fit.
+  side wall matched; an end margin longer than a quarter of the path is refused before the fit;
+* a 6 mm trunk whose 5 mm side branch leaves 2 mm from its inlet: the inlet's kept points are one-sided,
+  the empty cells are held at the inscribed radius.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from tests.helpers.cases import write_case
 from tests.helpers.robust_vessels import (
     u_turn_axis,
     wall_to_body_mm,
+    write_branch_near_inlet_vessel,
     write_elbow_vessel,
     write_outlet_seeded_sample,
     write_tilted_cap_vessel,
@@ -155,3 +158,15 @@ def test_an_end_margin_longer_than_a_quarter_of_the_path_is_refused_after_ingest
     assert result.exit_code == 2
     assert "fit.end_margin_mm: 12 mm is more than 0.25 of the 40.0 mm final path" in result.output
     assert "fit: running" not in result.output
+
+
+def test_a_wide_trunk_with_a_side_branch_at_its_inlet_holds_the_one_sided_end_at_the_inscribed_radius(tmp_path):
+    centerline, surface = write_branch_near_inlet_vessel(tmp_path / "trunk", 6.0, 5.0, 2.0)
+    final = {"centerline": str(centerline), "surface": str(surface), "path": 0}
+    result = build(write_case(tmp_path, "trunk", final=final), tmp_path / "out")
+    assert result.exit_code == 0, result.output
+    fit = json.loads((tmp_path / "out" / "manifest.json").read_text())["metrics"]["fit"]
+    # the branch's mouth takes a side of the trunk's wall away near the inlet: the end prior fills it
+    assert fit["end_prior"]["inlet"]["empty_cells"] > 0 and "outlet" not in fit["end_prior"]
+    assert fit["ends"]["inlet"]["ratio"] > THIN_END_RATIO and fit["points"]["other_branch"] > 1000
+    assert fit["max_mm"] < WALL_FRACTION * 6.0

@@ -175,3 +175,34 @@ def write_tilted_cap_vessel(folder: Path, radius: float, length_mm: float, tilt_
     surface = write_mesh(folder / "surface.stl", np.asarray(cut.vert_properties, float)[:, :3],
                          np.asarray(cut.tri_verts, np.int64))
     return centerline, surface
+
+
+def write_branch_near_inlet_vessel(folder: Path, radius: float = 6.0, branch_radius: float = 3.0,
+                                   branch_at_mm: float = 4.0, length_mm: float = 50.0) -> tuple[Path, Path]:
+    """A wide straight trunk along +z, capped flat at both ends, with a side branch leaving near its inlet.
+
+    The branch (radius ``branch_radius``) leaves the trunk's axis at ``branch_at_mm`` at 60 degrees towards
+    +x and runs 30 mm; the wall is the boolean union of the two sample-generator tubes.  Path 0 is the
+    trunk, path 1 the trunk's first ``branch_at_mm`` then the branch, both from the inlet (VMTK-style).
+    Near the trunk's inlet the branch's mouth takes a side of the wall away: the kept points are one-sided.
+    """
+    from softdesign.io.formats import write_mesh
+    from softdesign.io.polylines_vtp import write_polylines_vtp
+    from softdesign.meshing.solids import checked
+
+    step = 0.25
+    trunk = segment(np.zeros(3), np.array([0.0, 0.0, length_mm]), step)
+    fork = np.array([0.0, 0.0, branch_at_mm])
+    direction = np.array([np.sin(np.pi / 3), 0.0, np.cos(np.pi / 3)])
+    limb = segment(fork, fork + 30.0 * direction, step)
+    wall = (capped_tube(trunk, radius, "trunk") + capped_tube(limb, branch_radius, "branch"))
+    mesh = checked(wall, "trunk and branch").to_mesh64()
+    head = trunk[trunk[:, 2] < branch_at_mm - 1e-9]
+    lines = [trunk, np.concatenate([head, limb])]
+    radii = [np.full(len(trunk), radius),
+             np.concatenate([np.full(len(head), radius), np.full(len(limb), branch_radius)])]
+    folder.mkdir(parents=True, exist_ok=True)
+    centerline = write_polylines_vtp(folder / "centerline.vtp", lines, {"MaximumInscribedSphereRadius": radii})
+    surface = write_mesh(folder / "surface.stl", np.asarray(mesh.vert_properties, float)[:, :3],
+                         np.asarray(mesh.tri_verts, np.int64))
+    return centerline, surface
