@@ -91,6 +91,10 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
         field = _with_fitted_initial(chain, wall.settings, ingest.initial_surface[0], wall.field)
     summary = {**wall.summary(), "initial_radius": _initial_kind(case),
                "backbone": stretch_fit_errors(ingest.summary.get("backbone"), wall, curve)}
+    # the end prior can hold the ends a straying centerline leaves one-sided: the fit then succeeds, so say it
+    stray = centerline_stray(case, curve.curve, path)
+    if stray is not None:
+        summary["centerline_stray"] = stray.replace("the cause is the centerline, not the fit: ", "the centerline, ")
     residual = wall.polar.rho - field.evaluate_pairs(1.0, wall.polar.l, wall.polar.angle)
     points = {
         "l": wall.polar.l,
@@ -194,7 +198,12 @@ def describe_fit(result: FitResult) -> list[str]:
         f"joints: value jump {m['joint_value_jump_mm']:.2e} mm, slope jump {m['joint_slope_jump']:.2e}",
         f"max rho * kappa at q = 1: {m['max_rho_kappa']:.3f} (folds at 1; every export q is checked at export)",
         f"radius at q = 0: {result.summary['initial_radius']}",
-    ] + end_lines(result.summary) + describe_backbone_fit(result.summary.get("backbone", []))
+    ] + end_lines(result.summary) + describe_backbone_fit(result.summary.get("backbone", [])) + _stray_lines(result)
+
+
+def _stray_lines(result: FitResult) -> list[str]:
+    stray = result.summary.get("centerline_stray")
+    return [] if stray is None else [f"  warning: {stray}"]
 
 
 def end_lines(summary: dict[str, Any]) -> list[str]:
