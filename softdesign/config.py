@@ -141,6 +141,11 @@ def _check_breaks(breaks: list[float]) -> None:
         raise ValueError(f"breaks must be strictly increasing, got {breaks}")
 
 
+#: The largest fit.end_margin_mm (a path's end cap region is a few millimetres; ingest also keeps it within a
+#: quarter of the path's length, pipeline/bounds.py).
+MAX_END_MARGIN_MM = 20.0
+
+
 class Fit(_Section):
     """Least-squares spline surface rho(l, a) per link."""
 
@@ -152,6 +157,9 @@ class Fit(_Section):
     smoothing: FiniteFloat = Field(1.0e-5, ge=0.0)
     holdout_folds: Integer = Field(5, ge=2, le=MAX_HOLDOUT_FOLDS)
     outlier_factor: FiniteFloat = Field(2.0, gt=1.0)
+    # wall points within this of either end are not fitted (a tilted cap's rim, one-sided ends); the end's
+    # rings are then held at the inscribed radius by the end prior (fitting/end_prior.py)
+    end_margin_mm: FiniteFloat = Field(0.0, ge=0.0, le=MAX_END_MARGIN_MM)
 
     @field_validator("knot_spacing_mm", mode="before")
     @classmethod
@@ -239,7 +247,7 @@ class Case(_Section):
     intermediate: list[IntermediateShape] = []
     resample: Resample = Resample()
     frames: Literal["rmf", "frenet"] = "rmf"
-    blend: Literal["linear", "intrinsic"] = "linear"
+    blend: Literal["auto", "linear", "intrinsic"] = "auto"
     links: Links = Links(count=4)
     fit: Fit = Fit()
     export: Export = Export()

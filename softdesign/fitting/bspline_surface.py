@@ -25,7 +25,7 @@ in value and derivatives up to rounding.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
@@ -34,6 +34,7 @@ import scipy.sparse.linalg as spla
 
 from softdesign.errors import ConfigError, FitError, InputFitError
 from softdesign.fitting import bspline_basis as bb
+from softdesign.fitting.end_prior import EndPrior
 from softdesign.fitting.projection import PolarPoints
 from softdesign.types import FloatArray, IntArray
 
@@ -62,12 +63,15 @@ class FitSettings:
     angular_intervals : M, knot intervals around the centerline (>= 4)
     smoothing : dimensionless weight of the roughness penalty (>= 0)
     breaks : link breaks in normalized l, from 0 to 1, strictly increasing
+    prior : pseudo-observations where an end's wall is unseen (:mod:`softdesign.fitting.end_prior`),
+        added to the least squares with their weights; None (or empty) for the plain fit
     """
 
     knot_spacing_mm: float = DEFAULT_KNOT_SPACING_MM
     angular_intervals: int = DEFAULT_ANGULAR_INTERVALS
     smoothing: float = DEFAULT_SMOOTHING
     breaks: tuple[float, ...] = (0.0, 1.0)
+    prior: EndPrior | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         if not self.knot_spacing_mm > 0:
@@ -255,6 +259,8 @@ def path_knots(length_mm: float, settings: FitSettings) -> FloatArray:
 def _solve(gram, moment, count: int, knots: FloatArray, scale: float, length_mm: float, settings: FitSettings):
     """Coefficients minimizing ``|A c - rho|^2 / n + smoothing * c^T P c`` from ``A^T A`` and ``A^T rho``.
 
+    With ``settings.prior``, its weighted pseudo-observations add ``sum_p w_p (rho_p - rho(l_p, a_p))^2 / n``.
+
     Raises
     ------
     FitError
@@ -263,7 +269,13 @@ def _solve(gram, moment, count: int, knots: FloatArray, scale: float, length_mm:
     normal = gram / count
     if settings.smoothing > 0:
         normal = normal + settings.smoothing * roughness_matrix(knots, settings.angular_intervals, scale / length_mm)
-    coef = spla.spsolve(sp.csc_matrix(normal), moment / count)
+    rhs = moment / count
+    prior = settings.prior
+    if prior is not None and not prior.empty:
+        pseudo = design_matrix(knots, settings.angular_intervals, prior.l, prior.angle)
+        normal = normal + (pseudo.T @ sp.diags(prior.weight) @ pseudo) / count
+        rhs = rhs + pseudo.T @ (prior.weight * prior.rho) / count
+    coef = spla.spsolve(sp.csc_matrix(normal), rhs)
     if not np.all(np.isfinite(coef)):
         raise FitError(
             f"surface fit: the least-squares system is singular (fit.smoothing = {settings.smoothing}); "

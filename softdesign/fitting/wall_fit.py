@@ -7,13 +7,17 @@ manifest.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
+from softdesign.errors import FitError
 from softdesign.fitting.bspline_surface import FitSettings, SurfaceFit, fit_radius_surface
+from softdesign.fitting.end_checks import end_radii, negative_radius_cause
+from softdesign.fitting.end_prior import end_prior
 from softdesign.fitting.metrics import (
     FitMetrics,
     HoldoutReport,
@@ -23,7 +27,7 @@ from softdesign.fitting.metrics import (
     measure_distances,
 )
 from softdesign.fitting.projection import PolarPoints, project_points
-from softdesign.fitting.radius_field import FoldReport, RadiusField, check_self_folding
+from softdesign.fitting.radius_field import FOLD_SPACING_MM, FoldReport, RadiusField, check_self_folding, fold_margin
 from softdesign.fitting.selection import NetworkContext, SelectionSettings, WallSelection, select_wall_points
 from softdesign.types import FramedCurve
 
@@ -40,6 +44,7 @@ class WallFitOptions:
     holdout : folds, the spacings ``auto`` tries, and the most points the hold-out uses
     initial_radius_mm : constant rho0; None for the axially symmetric mean of the fit
     fold_limit : the largest rho * kappa allowed at q = 1
+    end_margin_mm : kept points within this arc length of either end are left out of the fit, mm
     """
 
     fit: FitSettings = field(default_factory=FitSettings)
@@ -48,6 +53,7 @@ class WallFitOptions:
     holdout: HoldoutSettings = field(default_factory=HoldoutSettings)
     initial_radius_mm: float | None = None
     fold_limit: float = 1.0
+    end_margin_mm: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -63,6 +69,7 @@ class WallFit:
     holdout: HoldoutReport
     folding: FoldReport
     field: RadiusField
+    ends: dict[str, dict[str, float]] = dataclasses.field(default_factory=dict)
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready figures for the manifest (mm, rad; snake_case keys)."""
@@ -82,6 +89,8 @@ class WallFit:
             "max_rho_kappa": self.folding.max_rho_kappa,
             "max_rho_kappa_at": {"l": self.folding.l, "arc_mm": self.folding.arc_mm, "angle": self.folding.angle},
             "min_rho_mm": self.folding.min_rho_mm,
+            "end_prior": {} if self.settings.prior is None else self.settings.prior.ends,
+            "ends": self.ends,
         }
 
 
@@ -112,7 +121,14 @@ def fit_wall(
     # in order along the path: every later evaluation then reads the splines' pieces in turn
     kept_index = np.flatnonzero(selection.keep)
     kept = polar.subset(kept_index[np.argsort(polar.l[kept_index], kind="stable")])
+    margin = options.end_margin_mm / curve.length
+    inside = (kept.l >= margin) & (kept.l <= 1.0 - margin)
+    kept = kept if inside.all() else kept.subset(inside)
     settings, scores = options.fit, dict[float, float]()
+    reference = None if network.inscribed_l is None or network.inscribed_radius is None else (
+        np.asarray(network.inscribed_l, float), np.asarray(network.inscribed_radius, float))
+    prior = end_prior(kept, curve.length, settings.knot_spacing_mm, settings.angular_intervals, reference)
+    settings = replace(settings, prior=prior)
     if options.auto_spacing:
         spacing, scores = choose_knot_spacing(curve, kept, settings, rng, options.holdout)
         settings = replace(settings, knot_spacing_mm=spacing)
@@ -123,5 +139,15 @@ def fit_wall(
                           start=(measured.l, measured.angle))
     metrics = measured.metrics
     radius = RadiusField.from_links(settings.breaks, surface.links, options.initial_radius_mm)
-    folding = check_self_folding(curve, radius, q=1.0, limit=options.fold_limit)
-    return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius)
+    try:
+        folding = check_self_folding(curve, radius, q=1.0, limit=options.fold_limit)
+    except FitError as err:
+        report = fold_margin(curve, radius, 1.0)
+        if report.min_rho_mm > 0.0:
+            raise
+        l = np.linspace(0.0, 1.0, max(int(np.ceil(curve.length / FOLD_SPACING_MM)), 16) + 1)
+        rho = radius.evaluate_grid(1.0, l, np.linspace(0.0, 2.0 * np.pi, 96, endpoint=False)).min(axis=1)
+        raise FitError(f"{str(err).split('; ')[0]}; {negative_radius_cause(prior, curve.length, l[np.argmin(rho)])}"
+                       ) from err
+    ends = end_radii(radius, reference) | {"margin": {"mm": options.end_margin_mm, "points": float((~inside).sum())}}
+    return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius, ends)

@@ -131,7 +131,15 @@ class BlendedShape:
         """The centerline with its frames at q (a ``types.FramedCurve``)."""
         q = float(q)
         if q not in self._framed:
-            self._framed[q] = framed_curve(self.smooth_curve_at(q), self.frames, self.base_normal, label=f"q = {q:g}")
+            try:
+                framed = framed_curve(self.smooth_curve_at(q), self.frames, self.base_normal, label=f"q = {q:g}")
+            except GeometryError as err:
+                if self.mode != "linear" or q in (0.0, 1.0):
+                    raise
+                raise GeometryError(f"{err}; at an intermediate q the linear blend is the likelier cause (a straight-"
+                                    "to-curved linear blend shortens and kinks the middle): use blend: intrinsic "
+                                    "(or auto, the default)") from err
+            self._framed[q] = framed
         return self._framed[q]
 
     def stats_at(self, q: float, l_range: tuple[float, float] = (0.0, 1.0)) -> BlendStats:

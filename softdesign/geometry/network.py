@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from softdesign.errors import InputDataError
+from softdesign.geometry.inlet import widest_end_flip
 from softdesign.types import FloatArray, Points
 
 #: VMTK's cell arrays that identify tracts of a branch-split network.
@@ -115,7 +116,7 @@ def select_path(network: CenterlineNetwork, index: int, orientation: Orientation
     points, radius = assemble_path(network, index)
     points, radius, notes = _drop_consecutive_duplicates(points, radius, f"{network.source}: path {index}")
     _check_points(points, f"{network.source}: path {index}")
-    flip, why = _needs_flip(network, index, points, orientation)
+    flip, why = _needs_flip(network, index, points, orientation, radius)
     if flip:
         points = points[::-1].copy()
         radius = None if radius is None else radius[::-1].copy()
@@ -178,14 +179,14 @@ def _check_points(points: Points, where: str) -> None:
 
 
 def _needs_flip(
-    network: CenterlineNetwork, index: int, points: Points, orientation: Orientation
+    network: CenterlineNetwork, index: int, points: Points, orientation: Orientation, radius: FloatArray | None
 ) -> tuple[bool, str]:
     if orientation.inlet is not None:
         inlet = np.asarray(orientation.inlet, float)
         d0, d1 = (float(np.linalg.norm(points[i] - inlet)) for i in (0, -1))
         flip, why = d1 < d0, f"l = 0 at the end nearest final.inlet ({min(d0, d1):.3g} mm from it)"
     else:
-        flip, why = _shared_end_flip(network, index, points)
+        flip, why = widest_end_flip(points, radius) or _shared_end_flip(network, index, points)
     if orientation.reverse:
         flip, why = not flip, why + "; then reversed (final.reverse: true)"
     return flip, why

@@ -30,6 +30,8 @@ if TYPE_CHECKING:  # the export and feasibility stages import this module: no im
 
 #: A length ratio counts as a whole number of intervals within this (for the "at least" spacing in messages).
 _GRACE = 1.0 + 1e-9
+#: fit.end_margin_mm is at most this share of the final path's length (both margins leave half of it).
+END_MARGIN_SHARE = 0.25
 
 
 def longest_shape_mm(case: Case, ingest: IngestResult) -> float:
@@ -75,6 +77,12 @@ def check_sizes(case: Case, ingest: IngestResult) -> None:
                 f"{MAX_FIT_COEFFICIENTS} ({_BUDGET}); use fit.knot_spacing_mm >= {_up(least)} mm "
                 "or fewer fit.angular_intervals"
             )
+    if case.fit.end_margin_mm > END_MARGIN_SHARE * final:
+        raise ConfigError(
+            f"fit.end_margin_mm: {case.fit.end_margin_mm:g} mm is more than {END_MARGIN_SHARE:g} of the "
+            f"{final:.1f} mm final path (the margins at both ends would leave too little wall to fit); "
+            f"use fit.end_margin_mm <= {END_MARGIN_SHARE * final:.3g}"
+        )
     _check_meshes(case, longest)
 
 

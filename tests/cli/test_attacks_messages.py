@@ -69,20 +69,22 @@ def test_a_flip_of_rotation_minimizing_frames_does_not_advise_frames_rmf():
     assert "resample.smoothing_mm" in message and "kink" in message
 
 
-def test_a_fit_that_fails_because_the_centerline_strays_names_the_resample_keys(prior_build, tmp_path):
-    """resample.smoothing_mm 2 pulls the demo's centerline 2.7 mm off its axis (radius 2.9 mm): rho goes negative."""
+def test_a_centerline_that_strays_is_warned_about_naming_the_resample_keys(prior_build, tmp_path):
+    """resample.smoothing_mm 2 pulls the demo's centerline 2.7 mm off its axis (radius 2.9 mm) near its ends.
+
+    It made rho negative there (a FitError, then blamed on the centerline); since the end prior holds the
+    one-sided ends at the inscribed radius (issue 20) the fit succeeds, and the build warns with the same cause.
+    """
     out = tmp_path / "build"
     shutil.copytree(prior_build, out)
-    before = snapshot(out)
     case = demo_case(tmp_path, resample={"smoothing_mm": 2.0})
     result = runner.invoke(app, ["build", str(case), "--out", str(out)])
-    assert result.exit_code == 2, result.output
+    assert result.exit_code == 0, result.output
     assert "Traceback" not in result.output
-    assert "the cause is the centerline, not the fit" in result.output
+    assert "warning: the centerline, resampled every" in result.output
     assert "smoothed by 2 mm (resample.smoothing_mm)" in result.output
     assert "lower resample.smoothing_mm" in result.output
     assert "raise fit.smoothing" not in result.output
-    assert snapshot(out) == before
 
 
 def test_a_surface_that_does_not_surround_the_path_is_bad_input_exit_2():

@@ -250,7 +250,8 @@ def test_sample_is_a_vmtk_style_network_with_a_capped_wall(tmp_path):
     runner.invoke(app, ["sample", str(tmp_path)])
     network = read_centerline_network(tmp_path / "centerline.vtp")
     main, branch = (select_path(network, i) for i in (0, 1))
-    assert "shared with 1 other path" in main.notes[-1] and "shared with 1 other path" in branch.notes[-1]
+    # both start at the trunk's inlet: the widest end of each (issue 20's default), also the end they share
+    assert "l = 0 at the widest end" in main.notes[-1] and "l = 0 at the widest end" in branch.notes[-1]
     np.testing.assert_array_equal(main.points[0], branch.points[0])
     assert np.linalg.norm(main.points[-1] - branch.points[-1]) > 20.0  # a real side branch
     assert 2.9 < main.radius.min() < main.radius.max() < 4.0  # minor semi-axis of the elliptical lumen

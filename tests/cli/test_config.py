@@ -30,7 +30,7 @@ def test_defaults_are_filled_in_and_paths_are_relative_to_the_case(tmp_path):
     case = load_case(write_case(sub, final={"centerline": "../data/cl.vtp"}))
     assert case.name == "case"
     assert case.units == "mm"
-    assert case.frames == "rmf" and case.blend == "linear"
+    assert case.frames == "rmf" and case.blend == "auto"
     assert case.links.count == 4
     assert case.fit.knot_spacing_mm == 1.5 and case.fit.angular_intervals == 24
     assert case.export.q_values() == [0.0, 0.5, 1.0]

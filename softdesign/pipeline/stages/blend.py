@@ -19,19 +19,21 @@ from softdesign.config import Case
 from softdesign.geometry.blend import BlendedShape, Shortening, blend_shapes
 from softdesign.geometry.curves import (
     TORSION_KAPPA_FLOOR,
-    CurveOptions,
     smooth_curve_from_polyline,
     smooth_curve_from_samples,
 )
 from softdesign.geometry.initial import InitialSpec, build_initial_shape, initial_shape_from_polyline
 from softdesign.pipeline import layout
+from softdesign.pipeline.backbone_step import curve_options
+from softdesign.pipeline.blend_choice import choose_blend, describe_choice
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.ingest import IngestResult
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 
 #: 2: the final path's torsion only where curvature >= TORSION_KAPPA_FLOOR (null when nowhere), with the
 #: fraction of the path where it is defined and the floor.
-VERSION = 2
+#: 3: the morph's reach r * kappa over q (``morph``), ``blend: auto`` and the blend it chose.
+VERSION = 3
 
 
 @dataclass(frozen=True)
@@ -40,17 +42,6 @@ class BlendResult:
 
     shape: BlendedShape
     summary: dict[str, Any]
-
-
-def curve_options(case: Case, count: int | None = None) -> CurveOptions:
-    """The case's resampling settings (``count`` forces the final shape's sample count)."""
-    r = case.resample
-    return CurveOptions(
-        spacing_mm=r.spacing_mm,
-        count=count if count is not None else r.count,
-        smoothing_mm=r.smoothing_mm,
-        end_straight_mm=r.end_straight_mm,
-    )
 
 
 def run_blend(case: Case, ingest: IngestResult) -> BlendResult:
@@ -71,8 +62,8 @@ def run_blend(case: Case, ingest: IngestResult) -> BlendResult:
         (q, initial_shape_from_polyline(final, p.points, same_grid, case.initial.align_base))
         for q, p in ingest.keyframes
     )
-    shape = blend_shapes(initial, final, keyframes, case.blend, case.frames)
-    return BlendResult(shape, _summary(case, shape))
+    choice = choose_blend(initial, final, keyframes, case.blend, case.frames, ingest.path)
+    return BlendResult(choice.shape, {**_summary(case, choice.shape), **choice.summary()})
 
 
 def _summary(case: Case, shape: BlendedShape) -> dict[str, Any]:
@@ -149,7 +140,7 @@ def describe_blend(result: BlendResult) -> list[str]:
             f"no intermediate shape is shorter than both end shapes (q = 0: {s['initial_length_mm']:.2f} mm, "
             f"q = 1: {f['length_mm']:.2f} mm)"
         )
-    return lines
+    return lines + describe_choice(s)
 
 
 STAGE = Stage(

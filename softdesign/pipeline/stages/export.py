@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from softdesign.config import Case
+from softdesign.errors import MeshError
 from softdesign.io.formats import FILE_UNITS, mesh_bytes
 from softdesign.io.gltf_morph import morph_glb_bytes
 from softdesign.io.polylines_vtp import write_polylines_vtp
@@ -116,6 +117,19 @@ def solid_at(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case)
     return ExportedMesh(q, solid, figures, centerline_arrays(kinematics, q), pieces)
 
 
+def _solid_naming_blend(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case) -> ExportedMesh:
+    """:func:`solid_at`; a fold at an intermediate q of a linear blend also names the blend as the likely cause."""
+    try:
+        return solid_at(kinematics, fit, q, case)
+    except MeshError as err:
+        if not (0.0 < q < 1.0 and kinematics.chain.shape.mode == "linear" and "folds" in str(err)):
+            raise
+        raise MeshError(
+            f"{err}; at an intermediate q the linear blend is the likelier cause (a straight-to-curved linear "
+            "blend shortens and kinks the middle): use blend: intrinsic (or auto, the default)"
+        ) from err
+
+
 def centerline_arrays(kinematics: KinematicsResult, q: float) -> dict[str, np.ndarray]:
     """c(q, l) on the final shape's sample grid with l, the frames (N, B, T) and the axial stretch."""
     shape = kinematics.chain.shape
@@ -135,7 +149,7 @@ def centerline_arrays(kinematics: KinematicsResult, q: float) -> dict[str, np.nd
 def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult) -> ExportResult:
     """A checked solid at every export q (on the build's worker processes: as many as fit in memory, and worth it)."""
     longest = max(key.length for key in kinematics.chain.shape.keys)
-    meshes = tuple(map_per_q(lambda q: solid_at(kinematics, fit, q, case), case.export.q_values(),
+    meshes = tuple(map_per_q(lambda q: _solid_naming_blend(kinematics, fit, q, case), case.export.q_values(),
                              most=export_workers(case, longest)))
     morph = None
     if "glb" in case.export.formats and len(meshes) >= 2:

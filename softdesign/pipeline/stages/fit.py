@@ -19,6 +19,7 @@ import numpy as np
 from softdesign.config import Case
 from softdesign.errors import ConfigError, FitError
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
+from softdesign.fitting.end_checks import thin_end_warnings
 from softdesign.fitting.metrics import HoldoutSettings
 from softdesign.fitting.projection import project_points
 from softdesign.fitting.radius_field import RadiusField
@@ -27,13 +28,15 @@ from softdesign.fitting.wall_fit import WallFitOptions, fit_wall
 from softdesign.geometry.curves import SmoothCurve, measure_deviation
 from softdesign.geometry.network import SelectedPath
 from softdesign.pipeline import layout
+from softdesign.pipeline.backbone_step import describe_backbone_fit, stretch_fit_errors
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.ingest import IngestResult
 from softdesign.pipeline.stages.links import LinksResult
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 
-VERSION = 3  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
+VERSION = 4  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
 # 3: points fitted in path order; distances sampled above 200k points (max still over all)
+# 4: end prior and end radii (issue 20); true distances on the regularized backbone's stretches (``backbone``)
 #: Seed of the hold-out folds: the same case always gets the same folds.
 HOLDOUT_SEED = 4
 #: A failed fit is blamed on the centerline when the smoothed one strays from the input by this fraction of the
@@ -74,6 +77,7 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
         selection=SelectionSettings(outlier_factor=fit.outlier_factor),
         holdout=HoldoutSettings(folds=fit.holdout_folds),
         initial_radius_mm=case.initial.radius_mm,
+        end_margin_mm=case.fit.end_margin_mm,
     )
     try:
         wall = fit_wall(curve, ingest.vertices, network, options, np.random.default_rng(HOLDOUT_SEED))
@@ -85,7 +89,12 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     field = wall.field
     if ingest.initial_surface is not None:
         field = _with_fitted_initial(chain, wall.settings, ingest.initial_surface[0], wall.field)
-    summary = {**wall.summary(), "initial_radius": _initial_kind(case)}
+    summary = {**wall.summary(), "initial_radius": _initial_kind(case),
+               "backbone": stretch_fit_errors(ingest.summary.get("backbone"), wall, curve)}
+    # the end prior can hold the ends a straying centerline leaves one-sided: the fit then succeeds, so say it
+    stray = centerline_stray(case, curve.curve, path)
+    if stray is not None:
+        summary["centerline_stray"] = stray.replace("the cause is the centerline, not the fit: ", "the centerline, ")
     residual = wall.polar.rho - field.evaluate_pairs(1.0, wall.polar.l, wall.polar.angle)
     points = {
         "l": wall.polar.l,
@@ -167,6 +176,9 @@ def fit_metrics(result: FitResult) -> dict[str, Any]:
         "joint_value_jump_mm": max(s["joint_value_jump_mm"], default=0.0),
         "joint_slope_jump": max(s["joint_slope_jump"], default=0.0),
         "max_rho_kappa": s["max_rho_kappa"],
+        "backbone": s.get("backbone", []),
+        "ends": s.get("ends", {}),
+        "end_prior": s.get("end_prior", {}),
     }
 
 
@@ -186,7 +198,22 @@ def describe_fit(result: FitResult) -> list[str]:
         f"joints: value jump {m['joint_value_jump_mm']:.2e} mm, slope jump {m['joint_slope_jump']:.2e}",
         f"max rho * kappa at q = 1: {m['max_rho_kappa']:.3f} (folds at 1; every export q is checked at export)",
         f"radius at q = 0: {result.summary['initial_radius']}",
+    ] + end_lines(result.summary) + describe_backbone_fit(result.summary.get("backbone", [])) + _stray_lines(result)
+
+
+def _stray_lines(result: FitResult) -> list[str]:
+    stray = result.summary.get("centerline_stray")
+    return [] if stray is None else [f"  warning: {stray}"]
+
+
+def end_lines(summary: dict[str, Any]) -> list[str]:
+    """Where an end's wall was unseen and held at the inscribed radius, and thin end rings (warnings)."""
+    lines = [
+        f"{end}: wall not seen all round over the last {e['unseen_mm']:.1f} mm; {e['empty_cells']:.0f} empty cells "
+        f"held at the inscribed radius ({e['reference_min_mm']:.3f} to {e['reference_max_mm']:.3f} mm)"
+        for end, e in summary.get("end_prior", {}).items()
     ]
+    return lines + [f"  warning: {w}" for w in thin_end_warnings(summary.get("ends", {}))]
 
 
 def _sampled_note(distance: dict[str, Any]) -> str:

@@ -21,12 +21,15 @@ from softdesign.io.surface import read_surface
 from softdesign.meshing.topology import SurfaceInfo, describe_surface
 from softdesign.pipeline import layout
 from softdesign.pipeline.auto_centerline import extract_for_case, extraction_summary, write_extracted
+from softdesign.pipeline.backbone_step import regularized_path
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 from softdesign.types import UNIT_SCALE_TO_MM, FloatArray
 
 #: 2: a vessel whose size is not human in the declared units is refused (it was a warning on radii only).
-VERSION = 2
+#: 3: a final path that turns tighter than the vessel is wide is regularized here (``backbone``); reads resample;
+#: the rule that chose the inlet (``centerline.inlet_rule``: the clearly widest end first).
+VERSION = 3
 
 
 @dataclass(frozen=True)
@@ -77,6 +80,9 @@ def run_ingest(case: Case) -> IngestResult:
     others = tuple(p for p in all_paths(network, Orientation(inlet=path.points[0])) if p.index != path.index)
     notes = list(path.notes) + (list(extracted.notes) if extracted is not None else [])
     vertices, faces, info = _final_surface(case, path, scale)
+    inlet_rule = path.notes[-1]
+    path, backbone = regularized_path(case, path)
+    notes += [n for n in path.notes if n not in notes]
     initial_path = None
     if case.initial.kind == "file" and case.initial.centerline is not None:
         initial_path = _one_path(case.initial.centerline, case.initial.path, scale, Orientation())
@@ -88,7 +94,8 @@ def run_ingest(case: Case) -> IngestResult:
     initial_surface = None
     if case.initial.surface is not None:
         initial_surface = read_surface(case.initial.surface, scale)
-    summary = _summary(case, network, path, info)
+    summary = {**_summary(case, network, path, info), "backbone": backbone}
+    summary["centerline"]["inlet_rule"] = inlet_rule
     if extracted is not None:
         summary["centerline"]["extracted"] = extraction_summary(extracted)
     return IngestResult(
@@ -225,7 +232,10 @@ def describe_ingest(result: IngestResult) -> list[str]:
 STAGE = Stage(
     name="ingest",
     version=VERSION,
-    reads=("units", "final", "initial.kind", "initial.centerline", "initial.path", "initial.surface", "intermediate"),
+    reads=(
+        "units", "final", "resample", "initial.kind", "initial.centerline", "initial.path", "initial.surface",
+        "intermediate",
+    ),
     upstream=(),
     compute=lambda case, results: run_ingest(case),
     write=write_ingest,

@@ -1,0 +1,135 @@
+"""Which blend the build uses, and the morph-fold checks made before any fit (seconds, not minutes).
+
+``blend: auto`` (the default) is the seed's linear blend unless some shape
+of it folds where neither end shape does; then it is the intrinsic blend,
+whose curvature never exceeds the end shapes' (:mod:`softdesign.geometry.morph_fold`).
+When the linear blend does not fold, ``auto`` builds exactly what
+``blend: linear`` builds.  An explicit ``blend: linear`` that folds is
+warned about (the meshes of exported q values away from the
+fold still build), naming the q, the place and the fix; a q = 1 centerline that turns
+tighter than the vessel is wide is refused whatever the blend.
+
+Without inscribed radii (a centerline file without
+``MaximumInscribedSphereRadius``) nothing is checked here and ``auto`` is linear.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from softdesign.errors import InputDataError
+from softdesign.geometry.blend import BlendedShape, BlendMode, blend_shapes
+from softdesign.geometry.curves import SmoothCurve, l_from_points
+from softdesign.geometry.frames import FrameMode
+from softdesign.geometry.morph_fold import MORPH_REACH_LIMIT, MorphReach, morph_reach, radius_profile_on
+from softdesign.geometry.network import SelectedPath
+
+#: A shape whose reach r * kappa (r the inscribed radius, a lower bound of the wall's rho) is at
+#: least this folds whatever the fit gives.
+SURE_FOLD = 1.0
+
+
+@dataclass(frozen=True)
+class BlendChoice:
+    """The shape built, the blend asked for, the reach of the shape (None without radii), and why."""
+
+    shape: BlendedShape
+    requested: str
+    reach: MorphReach | None
+    linear_reach: MorphReach | None
+    reason: str
+    warning: str | None = None
+
+    def summary(self) -> dict[str, Any]:
+        """The blend summary's extra keys: ``requested``, ``morph`` (reach figures), ``choice`` (text)."""
+        return {
+            "requested": self.requested,
+            "morph": None if self.reach is None else self.reach.as_dict(),
+            "linear_morph": None if self.linear_reach is None else self.linear_reach.as_dict(),
+            "choice": self.reason,
+            "warning": self.warning,
+        }
+
+
+def choose_blend(
+    initial: SmoothCurve,
+    final: SmoothCurve,
+    keyframes: tuple[tuple[float, SmoothCurve], ...],
+    requested: str,
+    frames: FrameMode,
+    path: SelectedPath,
+) -> BlendChoice:
+    """Build the blend ``requested`` ("auto", "linear" or "intrinsic") and check its morph for folds.
+
+    Raises
+    ------
+    InputDataError
+        The q = 1 centerline itself turns tighter than the inscribed radius allows.
+    """
+    mode: BlendMode = "intrinsic" if requested == "intrinsic" else "linear"
+    shape = blend_shapes(initial, final, keyframes, mode, frames)
+    if path.radius is None:
+        return BlendChoice(shape, requested, None, None, f"{mode} ({requested}; no inscribed radii to check folds)")
+    profile = radius_profile_on(l_from_points(final, path.points), path.radius)
+    reach = morph_reach(shape, *profile)
+    if reach.final_reach >= SURE_FOLD:
+        raise InputDataError(_final_fold_message(reach, final))
+    if mode == "intrinsic" or not reach.blend_folds:
+        why = "asked for" if requested == mode else "the linear blend does not fold"
+        return BlendChoice(shape, requested, reach, None, f"{mode} ({why}: {_figure(reach)})")
+    if requested == "linear":
+        warning = (f"blend: linear {_fold_text(reach)}; meshes at export q near {reach.q:.3f} will fail: use "
+                   "blend: intrinsic (or auto, the default), whose curvature stays within the end shapes'")
+        return BlendChoice(shape, requested, reach, None, f"linear (asked for: {_figure(reach)})", warning)
+    intrinsic = blend_shapes(initial, final, keyframes, "intrinsic", frames)
+    fold = morph_reach(intrinsic, *profile)
+    why = f"intrinsic (auto: the linear blend {_fold_text(reach)}; intrinsic: {_figure(fold)})"
+    return BlendChoice(intrinsic, requested, fold, reach, why)
+
+
+def describe_choice(summary: dict[str, Any]) -> list[str]:
+    """The blend stage's line on the chosen blend (summaries of builds before ``choice`` existed have none)."""
+    if "choice" not in summary:
+        return []
+    warning = summary.get("warning")
+    return [f"blend chosen: {summary['choice']}"] + ([] if warning is None else [f"  warning: {warning}"])
+
+
+def _figure(reach: MorphReach) -> str:
+    return f"largest r * kappa {reach.reach:.3f} at q = {reach.q:.3f}"
+
+
+def _fold_text(reach: MorphReach) -> str:
+    return (
+        f"folds mid-morph: at q = {reach.q:.3f}, l = {reach.l:.4f} ({reach.arc_mm:.1f} mm from the inlet) the "
+        f"centerline's curvature is {reach.curvature_per_mm:.4f} 1/mm where the inscribed radius is "
+        f"{reach.radius_mm:.3f} mm (r * kappa = {reach.reach:.3f}, the tube folds at 1; both end shapes stay "
+        f"below {reach.end_reach:.3f}): the straight-to-curved linear blend shortens and kinks the middle"
+    )
+
+
+def _final_fold_message(reach: MorphReach, final: SmoothCurve) -> str:
+    l = reach.final_l
+    s = float(final.arc_length([l])[0])
+    kappa = float(final.curvature([l])[0])
+    to_end = min(s, final.length - s)
+    end = "inlet" if s <= final.length - s else "outlet"
+    hint = (
+        f"; it is {to_end:.1f} mm from the {end}: straightening that end over more than this "
+        f"(resample.end_straight_mm: {np.ceil(to_end + reach.final_reach / kappa):g}) lets the backbone cut the turn"
+        if to_end <= 4.0 * reach.final_reach / kappa else ""
+    )
+    return (
+        f"final.centerline: the centerline turns tighter than the vessel is wide: at l = {l:.4f} ({s:.1f} mm from "
+        f"the inlet) its radius of curvature is {1.0 / kappa:.3f} mm where the inscribed radius is "
+        f"{reach.final_reach / kappa:.3f} mm (r * kappa = {reach.final_reach:.3f}, expected < {SURE_FOLD:g}), so "
+        "the tube around it folds through itself whatever the fit or the blend does; centerline smoothing at the "
+        f"scale of resample.smoothing_mm does not remove a turn this sharp{hint}; otherwise choose another "
+        "final.path or final.inlet, or give a centerline that turns no tighter than the vessel's radius there"
+    )
+
+
+__all__ = ["MORPH_REACH_LIMIT", "BlendChoice", "choose_blend", "describe_choice"]
