@@ -167,6 +167,19 @@ class Fit(_Section):
         return float(value)
 
 
+class Mould(_Section):
+    """A two-part casting mould around the body at q = 0 (and a core for a hollow body): every size in mm."""
+
+    margin_mm: FiniteFloat = Field(10.0, gt=0.0, le=200.0)
+    clearance_mm: FiniteFloat = Field(0.2, ge=0.0, le=5.0)
+    key_mm: FiniteFloat = Field(4.0, gt=0.0, le=100.0)
+    pour_mm: FiniteFloat = Field(4.0, gt=0.0, le=50.0)
+    vent_mm: FiniteFloat = Field(2.0, gt=0.0, le=50.0)
+    print_mm: FiniteFloat = Field(10.0, gt=0.0, le=200.0)
+    #: casting orientation: which end of the body is up (the pour and vent enter at the top)
+    up: Literal["base", "tip"] = "base"
+
+
 class Export(_Section):
     """Meshes at the requested q values."""
 
@@ -181,6 +194,8 @@ class Export(_Section):
     angular_count: Integer = Field(64, ge=MIN_ANGULAR_COUNT, le=MAX_ANGULAR_COUNT)
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...
     split_regions: bool = False
+    #: a casting mould of the body at q = 0: meshes/mould/{half_a,half_b,core}.stl (the mould stage)
+    mould: Mould | None = None
 
     @field_validator("q")
     @classmethod

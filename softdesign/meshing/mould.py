@@ -40,6 +40,9 @@ MIN_MOULD_WALL_MM = 1.0
 KEY_STATIONS = (0.2, 0.8)
 #: How far channels and sockets reach past a surface they open through, mm (no coplanar faces).
 OVERSHOOT_MM = 1.0
+#: How far pour and vent reach into the cavity from its top, mm (an overlap, not a shared face; well
+#: inside the thinnest wall a hollow body may have, so they stay off its core).
+CHANNEL_DEPTH_MM = 0.05
 #: Slice points within this height of the highest one count as the top of the cavity, mm.
 PEAK_TOL_MM = 1e-3
 
@@ -191,9 +194,9 @@ def _channel_points(body: m3.Manifold, up: FloatArray, spec: MouldSpec) -> tuple
 
 
 def _channel(at: FloatArray, up: FloatArray, radius: float, top: float, spec: MouldSpec) -> m3.Manifold:
-    """A channel centred on the parting line's point ``at``, from ``radius`` inside the cavity up through the
-    box's top face (half of it beside the cavity's edge: a nub the casting's trim removes with the sprue)."""
-    start = at - radius * up
+    """A channel centred on the parting line's point ``at``, from ``CHANNEL_DEPTH_MM`` inside the cavity up through
+    the box's top face (half of it beside the cavity's edge: a nub trimmed off with the sprue)."""
+    start = at - CHANNEL_DEPTH_MM * up
     return _cylinder(start, up, float(top - start @ up) + OVERSHOOT_MM, radius, spec.segments)
 
 

@@ -29,6 +29,7 @@ FIT_SURFACE = "fit/surface.npz"
 FIT_POINTS = "fit/points.npz"
 FIT_SUMMARY = "fit/summary.json"
 EXPORT_SUMMARY = "export/summary.json"
+MOULD_SUMMARY = "mould/summary.json"
 
 
 # Beside the build folder ``<name>``, in the same parent (so a rename never crosses file systems), named
@@ -97,3 +98,8 @@ def region_path(q: float, region: str) -> str:
 def centerline_path(q: float) -> str:
     """``centerlines/q_0.500.vtp``: c(q, l) with its frames."""
     return f"centerlines/{q_label(q)}.vtp"
+
+
+def mould_path(part: str, fmt: str) -> str:
+    """``meshes/mould/half_a.stl``: a part of the casting mould of the body at q = 0."""
+    return f"{MESHES_DIR}/mould/{part}.{fmt}"
