@@ -18,8 +18,10 @@ parting plane's normal), then mapped back to the body's coordinates:
              holds half of it and the two locate it)
     channels pour and vent, cylinders along the stated up direction in the
              parting plane from the cavity's highest points to the box's top
-Casting orientation: ``up: base`` stands the mould with the base end up (the
-core print on top, the core hanging from it), ``up: tip`` the other way.
+Casting orientation: ``up: base`` stands the mould with the base end up, up
+along -T at the base (the core print on top, the core hanging from it, the
+channels parallel to it), ``up: tip`` along T at the tip; each in the parting
+plane.
 """
 
 from __future__ import annotations
@@ -201,7 +203,7 @@ def _channel(at: FloatArray, up: FloatArray, radius: float, top: float, spec: Mo
 
 
 def build_mould(body: m3.Manifold, casting: m3.Manifold, core: Core | None, frame: PartingFrame,
-                spec: MouldSpec) -> MouldParts:
+                spec: MouldSpec, up_world: FloatArray | None = None) -> MouldParts:
     """The mould's parts in the mould frame (see the module docstring).
 
     Parameters
@@ -210,13 +212,20 @@ def build_mould(body: m3.Manifold, casting: m3.Manifold, core: Core | None, fram
     casting : the export's solid at q = 0 (world): the part the mould must leave
     core : the chamber and port of a hollow body, None for a solid one
     frame, spec : the parting frame and the case's mould keys
+    up_world : (3,) float, the casting's up direction (its part in the parting plane is used); default the
+        frame's -x (``spec.up == "base"``) or +x
     """
     to_frame = frame.frame_from_world()
     body_f, casting_f = body.transform(to_frame), casting.transform(to_frame)
     box, lo, hi = _box(body_f, spec.margin_mm)
     up = np.array([-1.0, 0.0, 0.0]) if spec.up == "base" else np.array([1.0, 0.0, 0.0])
+    if up_world is not None:
+        up = frame.direction_to_frame(up_world) * np.array([1.0, 1.0, 0.0])
+        up /= np.linalg.norm(up)
     box_lo, box_hi = lo - spec.margin_mm, hi + spec.margin_mm
-    top = float(np.max([box_lo @ up, box_hi @ up]))
+    corners = np.array([[x, y, z] for x in (box_lo[0], box_hi[0]) for y in (box_lo[1], box_hi[1])
+                        for z in (box_lo[2], box_hi[2])])
+    top = float(np.max(corners @ up))
     core_f = None if core is None else _core(core, frame, box_lo, box_hi, spec).as_original()
     pour_at, vent_at = _channel_points(body_f, up, spec)
     channels = _union([_channel(pour_at, up, 0.5 * spec.pour_mm, top, spec),

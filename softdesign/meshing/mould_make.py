@@ -124,7 +124,8 @@ def make_mould(sections: TubeSections, body_spec: BodySpec, spec: MouldSpec,
     casting, _ = manifold_from_mesh(solid.vertices, solid.faces, "mould: cast part")
     core, core_figures = _core(sections, body_spec)
     frame = parting_frame(sections.centers, sections.frames[0])
-    parts = build_mould(body, casting, core, frame, spec)
+    up = -sections.frames[0][:, 2] if spec.up == "base" else sections.frames[-1][:, 2]
+    parts = build_mould(body, casting, core, frame, spec, up)
     features = {parts.channels.original_id(): "the pour or vent channel", parts.bumps.original_id(): "a key bump",
                 parts.sockets.original_id(): "a key socket"}
     if parts.core is not None:
