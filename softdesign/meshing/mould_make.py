@@ -90,8 +90,11 @@ def _core(sections: TubeSections, spec: BodySpec) -> tuple[Core | None, dict[str
 
 def _refuse_undercut(half: str, pull: FloatArray, frame: PartingFrame, failures: list, total: int) -> None:
     world = frame.axes.T @ pull
+    worst: dict[str, Any] = {}
+    for f in failures:  # worst first: keep each place's worst face
+        worst.setdefault(f.where, f)
     named = "; ".join(f"{f.where} (normal {f.component:+.3f} along the pull{', ray blocked' if f.blocked else ''})"
-                      for f in failures[:NAMED_FACES])
+                      for f in list(worst.values())[:NAMED_FACES])
     raise MouldRefused(
         f"export.mould: half {half} cannot be pulled off along {np.round(world, 4).tolist()} (the parting plane's "
         f"normal): {total} face(s) of the cavity face against the pull or lie under the body, worst first: {named}. "
