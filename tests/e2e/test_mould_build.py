@@ -13,6 +13,7 @@ from typer.testing import CliRunner
 from softdesign.cli import app
 from softdesign.io.formats import read_mesh
 from softdesign.meshing.checks import inspect_mesh
+from softdesign.mould_figure import mould_figure_png
 from tests.helpers.paths import REPO
 
 runner = CliRunner()
@@ -77,6 +78,8 @@ def test_demo_hollow_mould_is_written_listed_and_checked(tmp_path):
     assert block["cavity"]["rel_difference"] <= 0.005 and block["disjoint"]["ok"]
     assert all(p["ok"] and p["against_pull"] == 0 and p["blocked_rays"] == 0 for p in block["pull"].values())
     assert block["core"]["process"] == "removable"
+    png = mould_figure_png(out)
+    assert png is not None and png.startswith(b"\x89PNG") and png == mould_figure_png(out)  # same bytes each time
 
 
 @pytest.mark.slow
@@ -90,6 +93,7 @@ def test_a_mould_leaves_every_other_output_byte_for_byte(tmp_path):
     assert set(after) - set(before) == {"mould/summary.json", "meshes/mould/half_a.stl", "meshes/mould/half_b.stl"}
     # only the manifest (it holds the case) and the mould stage's own record differ
     assert {k for k in before if before[k] != after[k]} == {"manifest.json", "mould/stage.json"}
+    assert mould_figure_png(plain) is None
 
 
 @pytest.mark.slow
