@@ -45,6 +45,7 @@ from softdesign.limits import (
 )
 from softdesign.materials import MaterialLimits, PresetName, resolve_material
 from softdesign.meshing.checks import MIN_ANGULAR_COUNT, VOLUME_RTOL
+from softdesign.meshing.mould_spec import MIN_MOULD_WALL_MM
 from softdesign.pipeline.layout import q_label
 
 
@@ -179,6 +180,18 @@ class Mould(_Section):
     #: casting orientation: which end of the body is up (the pour and vent enter at the top)
     up: Literal["base", "tip"] = "base"
 
+    @model_validator(mode="after")
+    def _keys_fit(self) -> Mould:
+        # the keys sit margin_mm / 2 beside the body (softdesign.meshing.mould), a wall from the cavity
+        need = 2.0 * (0.5 * self.key_mm + self.clearance_mm + MIN_MOULD_WALL_MM)
+        if self.margin_mm < need:
+            raise ValueError(
+                f"a key of key_mm={self.key_mm:g} with clearance_mm={self.clearance_mm:g} needs margin_mm >= {need:g} "
+                f"(keys sit margin_mm / 2 beside the body, {MIN_MOULD_WALL_MM:g} mm of mould from the cavity), got "
+                f"{self.margin_mm:g}; raise margin_mm or lower key_mm"
+            )
+        return self
+
 
 class Export(_Section):
     """Meshes at the requested q values."""
@@ -218,6 +231,9 @@ class Export(_Section):
             raise ValueError("give q (a list) or frames (a count), not both")
         if self.port_mm is not None and self.wall_mm is None:
             raise ValueError("port_mm needs wall_mm (a port opens into the hollow chamber)")
+        if self.mould is not None and self.wall_mm is not None and self.port_mm is None:
+            raise ValueError("mould of a hollow body needs port_mm: a sealed chamber cannot be cast around a core "
+                             "(the core is held and removed through the port)")
         if self.q is not None:
             bad = [v for v in self.q if not 0.0 <= v <= 1.0]
             if bad or not self.q:

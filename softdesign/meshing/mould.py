@@ -33,11 +33,10 @@ import numpy as np
 
 from softdesign.errors import InputDataError, MeshError
 from softdesign.meshing.mould_frame import PartingFrame
+from softdesign.meshing.mould_spec import MIN_MOULD_WALL_MM, MouldSpec
 from softdesign.meshing.solids import PORT_INSIDE_WALLS, checked
 from softdesign.types import FloatArray
 
-#: Least material between a key's socket and the cavity, or between two channels, mm.
-MIN_MOULD_WALL_MM = 1.0
 #: Where along the body's length (fractions) the keys sit, two on each side.
 KEY_STATIONS = (0.2, 0.8)
 #: How far channels and sockets reach past a surface they open through, mm (no coplanar faces).
@@ -49,22 +48,11 @@ CHANNEL_DEPTH_MM = 0.05
 PEAK_TOL_MM = 1e-3
 
 
+__all__ = ["MIN_MOULD_WALL_MM", "Core", "MouldParts", "MouldRefused", "MouldSpec", "build_mould", "inside_mm"]
+
+
 class MouldRefused(InputDataError):
     """The body cannot be moulded as asked (undercut, no opening for a core, no room for a key): exit 2."""
-
-
-@dataclass(frozen=True)
-class MouldSpec:
-    """The case file's ``export.mould`` keys (mm)."""
-
-    margin_mm: float = 10.0
-    clearance_mm: float = 0.2
-    key_mm: float = 4.0
-    pour_mm: float = 4.0
-    vent_mm: float = 2.0
-    print_mm: float = 10.0
-    up: str = "base"
-    segments: int = 48
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,11 @@ def files(folder: Path) -> dict[str, str]:
             for p in sorted(folder.rglob("*")) if p.is_file()}
 
 
+def test_a_hollow_body_without_port_is_refused_before_building(tmp_path):
+    result = runner.invoke(app, ["validate", str(demo_case(tmp_path, wall_mm=1.0, mould={}))])
+    assert result.exit_code == 2 and "needs port_mm" in result.output, result.output
+
+
 def test_mould_command_needs_export_mould(tmp_path):
     case = demo_case(tmp_path)
     result = runner.invoke(app, ["mould", str(case), "--out", str(tmp_path / "b")])
@@ -53,6 +58,7 @@ def test_mould_command_needs_export_mould(tmp_path):
     ({"clearance_mm": 9}, "export.mould.clearance_mm must be <= 5"),
     ({"up": "side"}, "export.mould.up"),
     ({"margin": 5}, "did you mean 'margin_mm'"),
+    ({"margin_mm": 6, "key_mm": 6}, "needs margin_mm >= 8.4"),
 ])
 def test_mould_keys_are_bounded(tmp_path, mould, message):
     result = runner.invoke(app, ["validate", str(demo_case(tmp_path, mould=mould))])
