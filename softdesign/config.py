@@ -43,6 +43,7 @@ from softdesign.limits import (
     MAX_LINKS,
     MEMORY_BUDGET_TEXT,
 )
+from softdesign.limits_volume import MAX_MESHER_SECONDS, MAX_VOLUME_MESHES, MIN_TET_SIZE_MM
 from softdesign.materials import MaterialLimits, PresetName, resolve_material
 from softdesign.meshing.checks import MIN_ANGULAR_COUNT, VOLUME_RTOL
 from softdesign.meshing.mould_spec import MIN_MOULD_WALL_MM
@@ -193,6 +194,31 @@ class Mould(_Section):
         return self
 
 
+class VolumeMesh(_Section):
+    """Tetrahedral meshes of the body for simulators (fTetWild in a child process): sizes in mm."""
+
+    #: the q values to mesh: [0] (the state the actuator is cast in, which a simulator deforms) by default
+    q: list[FiniteFloat] = Field([0.0], min_length=1, max_length=MAX_VOLUME_MESHES)
+    #: target edge length of the tetrahedra
+    size_mm: FiniteFloat = Field(1.0, ge=MIN_TET_SIZE_MM, le=50.0)
+    #: largest distance of the mesh's boundary from the body's surface
+    envelope_mm: FiniteFloat = Field(0.05, ge=0.001, le=1.0)
+    #: the mesher is stopped after this long (per q) and the build fails with a clear message
+    timeout_s: FiniteFloat = Field(600.0, gt=0.0, le=MAX_MESHER_SECONDS)
+
+    @field_validator("q")
+    @classmethod
+    def _q_in_range(cls, values: list[float]) -> list[float]:
+        bad = [v for v in values if not 0.0 <= v <= 1.0]
+        if bad:
+            raise ValueError(f"q values must lie in [0, 1], got {bad}")
+        labels = [q_label(v) for v in values]
+        if len(set(labels)) != len(labels):
+            raise ValueError(f"give each q once, at least 0.001 apart (files are named with three decimals), "
+                             f"got {values}")
+        return sorted(values)
+
+
 class Export(_Section):
     """Meshes at the requested q values."""
 
@@ -209,6 +235,8 @@ class Export(_Section):
     split_regions: bool = False
     #: a casting mould of the body at q = 0: meshes/mould/{half_a,half_b,core}.stl (the mould stage)
     mould: Mould | None = None
+    #: tetrahedral meshes of the body for simulators: meshes/volume/q_0.000.{vtu,msh} (the volume_mesh stage)
+    volume_mesh: VolumeMesh | None = None
 
     @field_validator("q")
     @classmethod

@@ -30,6 +30,7 @@ FIT_POINTS = "fit/points.npz"
 FIT_SUMMARY = "fit/summary.json"
 EXPORT_SUMMARY = "export/summary.json"
 MOULD_SUMMARY = "mould/summary.json"
+VOLUME_SUMMARY = "volume_mesh/summary.json"
 
 
 # Beside the build folder ``<name>``, in the same parent (so a rename never crosses file systems), named
@@ -103,3 +104,13 @@ def centerline_path(q: float) -> str:
 def mould_path(part: str, fmt: str) -> str:
     """``meshes/mould/half_a.stl``: a part of the casting mould of the body at q = 0."""
     return f"{MESHES_DIR}/mould/{part}.{fmt}"
+
+
+def volume_mesh_path(q: float, suffix: str) -> str:
+    """``meshes/volume/q_0.000.vtu`` (or ``.msh``): the tetrahedral mesh of the body at q."""
+    return f"{MESHES_DIR}/volume/{q_label(q)}.{suffix}"
+
+
+def chamber_surface_path(q: float) -> str:
+    """``meshes/volume/chamber_q_0.000.stl``: the closed chamber surface of a hollow body at q, normals outwards."""
+    return f"{MESHES_DIR}/volume/chamber_{q_label(q)}.stl"
