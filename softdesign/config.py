@@ -200,11 +200,11 @@ class VolumeMesh(_Section):
     #: the q values to mesh: [0] (the state the actuator is cast in, which a simulator deforms) by default
     q: list[FiniteFloat] = Field([0.0], min_length=1, max_length=MAX_VOLUME_MESHES)
     #: target edge length of the tetrahedra
-    size_mm: FiniteFloat = Field(1.0, ge=MIN_TET_SIZE_MM, le=50.0)
+    size_mm: FiniteFloat = Field(2.0, ge=MIN_TET_SIZE_MM, le=50.0)
     #: largest distance of the mesh's boundary from the body's surface
     envelope_mm: FiniteFloat = Field(0.05, ge=0.001, le=1.0)
     #: the mesher is stopped after this long (per q) and the build fails with a clear message
-    timeout_s: FiniteFloat = Field(600.0, gt=0.0, le=MAX_MESHER_SECONDS)
+    timeout_s: FiniteFloat = Field(1800.0, gt=0.0, le=MAX_MESHER_SECONDS)
 
     @field_validator("q")
     @classmethod

@@ -9,6 +9,7 @@ import os
 import time
 from pathlib import Path
 
+import meshio
 import numpy as np
 import pytest
 from typer.testing import CliRunner
@@ -132,6 +133,12 @@ def test_hollow_tube_volume_mesh_files_figures_and_mesher_failures(tmp_path, mon
     chamber = mesh_topology(chamber_v, chamber_f)
     assert chamber.watertight and chamber.winding_consistent and chamber.shells == 1 and chamber.volume > 0
     assert listed["meshes/volume/chamber_q_0.000.stl"]["normals"] == "outward"
+    # ... and meshio, which SOFA users convert with, reads the same closed surface
+    stl = meshio.stl.read(str(out / "meshes/volume/chamber_q_0.000.stl"))
+    triangles = stl.cells_dict["triangle"]
+    assert len(triangles) == chamber.faces
+    np.testing.assert_allclose(mesh_topology(stl.points, triangles).shell_volumes.sum(), chamber.volume,
+                               rtol=0, atol=STL_ATOL_MM * chamber.area)
     assert np.all(winding_numbers(tet_centroids(points, tets), chamber_v, chamber_f) < HALF)
     assert entry["chamber_centroids_inside"] == 0
     # the chamber is about the tube's inside: radius 2.5 - 0.8, length 14 - 2 x 0.8 (the 40-gon's area: rel 1 %)
