@@ -34,7 +34,7 @@ def snapshot(folder: Path) -> dict[str, str]:
 
 def statuses(output: str) -> dict[str, str]:
     """{stage: 'ran' | 'skipped'} from a build's report lines."""
-    return dict(re.findall(r"^\[([a-z]+)\] (ran|skipped|kept|stale)", output, flags=re.MULTILINE))
+    return dict(re.findall(r"^\[([a-z_]+)\] (ran|skipped|kept|stale)", output, flags=re.MULTILINE))
 
 
 @pytest.fixture
