@@ -46,8 +46,8 @@ def failing_mesher(vertices, faces, settings):  # noqa: ARG001
     raise RuntimeError("fTetWild: envelope check failed")
 
 
-def tube_case(folder: Path, **volume) -> Path:
-    """A straight hollow tube, radius 2.5 mm, 14 mm long, wall 0.8 mm, port 1.2 mm, meshed at 2 mm."""
+def tube_case(folder: Path, port_mm: float | None = 1.2, **volume) -> Path:
+    """A straight hollow tube, radius 2.5 mm, 14 mm long, wall 0.8 mm, port 1.2 mm (None: sealed), meshed at 2 mm."""
     vertices, faces = straight_tube(radius=2.5, length=14.0, edge=0.5)
     from softdesign.io.formats import write_mesh
 
@@ -58,8 +58,8 @@ def tube_case(folder: Path, **volume) -> Path:
     return write_case(
         folder, "tube", final={"centerline": "centerline.vtp", "surface": "surface.stl"}, links={"count": 2},
         fit={"knot_spacing_mm": 2.0, "angular_intervals": 12},
-        export={"q": [0, 1], "wall_mm": 0.8, "port_mm": 1.2, "spacing_mm": 1.0, "angular_count": 40,
-                "volume_mesh": {"size_mm": 2.0, **volume}},
+        export={"q": [0, 1], "wall_mm": 0.8, "spacing_mm": 1.0, "angular_count": 40,
+                "volume_mesh": {"size_mm": 2.0, **volume}, **({} if port_mm is None else {"port_mm": port_mm})},
     )
 
 
@@ -159,3 +159,21 @@ def test_hollow_tube_volume_mesh_files_figures_and_mesher_failures(tmp_path, mon
         assert "fTetWild on the body at q=0.000" in result.output and message in result.output, result.output
         assert "Traceback" not in result.output
         assert files(out) == before
+
+
+@pytest.mark.slow
+def test_a_sealed_chamber_stays_empty(tmp_path):
+    # no port: the chamber is a closed void inside the body, which the mesher must leave empty
+    out = tmp_path / "build"
+    result = runner.invoke(app, ["build", str(tube_case(tmp_path, port_mm=None)), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    points, tets = read_volume_mesh(out / "meshes/volume/q_0.000.vtu")
+    chamber_v, chamber_f = read_mesh(out / "meshes/volume/chamber_q_0.000.stl")
+    assert np.all(winding_numbers(tet_centroids(points, tets), chamber_v, chamber_f) < HALF)
+    body_v, body_f = read_mesh(out / "meshes/q_0.000.stl")
+    body = mesh_topology(body_v, body_f)
+    assert body.shells == 2  # the outer skin and the void's, wound inwards
+    assert abs(tet_volumes(points, tets).sum() / body.volume - 1.0) <= VOLUME_RTOL
+    figures = json.loads((out / "manifest.json").read_text())["metrics"]["volume_mesh"]["per_q"][0]
+    # the tetrahedra's boundary is two closed shells too: the skin and the chamber's wall (Euler 2 + 2)
+    assert figures["boundary_shells"] == 2 and figures["boundary_euler"] == 4 and figures["body_kind"] == "hollow"
