@@ -102,7 +102,7 @@ def mesh_body(case: Case, kinematics: KinematicsResult, fit: FitResult, q: float
         chamber = chamber_surface(sections, spec)
     what = f"fTetWild on the body at q={q:.3f} ({len(body.solid.faces)} faces, size_mm {vm.size_mm:g})"
     fix = ("raise export.volume_mesh.timeout_s, or make the mesh coarser (size_mm, envelope_mm); a crash in fTetWild "
-           "is a bug to report with the body's STL (meshes/" + f"{layout.q_label(q)}.stl)")
+           f"is a bug to report with the body (`softdesign export` writes it: {layout.mesh_path(q, 'stl')})")
     start = time.perf_counter()
     points, tets = run_in_child(MESHER, (body.solid.vertices, body.solid.faces,
                                          TetSettings(vm.size_mm, vm.envelope_mm)), vm.timeout_s, what, fix,
