@@ -43,7 +43,9 @@ from softdesign.limits import (
     MAX_LINKS,
     MEMORY_BUDGET_TEXT,
 )
+from softdesign.limits_volume import MAX_MESHER_SECONDS, MAX_VOLUME_MESHES, MIN_TET_SIZE_MM
 from softdesign.materials import MaterialLimits, PresetName, resolve_material
+from softdesign.meshing.mould_spec import MIN_MOULD_WALL_MM
 from softdesign.meshing.volume_tolerance import MIN_ANGULAR_COUNT, VOLUME_RTOL
 from softdesign.pipeline.layout import q_label
 
@@ -175,6 +177,56 @@ class Fit(_Section):
         return float(value)
 
 
+class Mould(_Section):
+    """A two-part casting mould around the body at q = 0 (and a core for a hollow body): every size in mm."""
+
+    margin_mm: FiniteFloat = Field(10.0, gt=0.0, le=200.0)
+    clearance_mm: FiniteFloat = Field(0.2, ge=0.0, le=5.0)
+    key_mm: FiniteFloat = Field(4.0, gt=0.0, le=100.0)
+    pour_mm: FiniteFloat = Field(4.0, gt=0.0, le=50.0)
+    vent_mm: FiniteFloat = Field(2.0, gt=0.0, le=50.0)
+    print_mm: FiniteFloat = Field(10.0, gt=0.0, le=200.0)
+    #: casting orientation: which end of the body is up (the pour and vent enter at the top)
+    up: Literal["base", "tip"] = "base"
+
+    @model_validator(mode="after")
+    def _keys_fit(self) -> Mould:
+        # the keys sit margin_mm / 2 beside the body (softdesign.meshing.mould), a wall from the cavity
+        need = 2.0 * (0.5 * self.key_mm + self.clearance_mm + MIN_MOULD_WALL_MM)
+        if self.margin_mm < need:
+            raise ValueError(
+                f"a key of key_mm={self.key_mm:g} with clearance_mm={self.clearance_mm:g} needs margin_mm >= {need:g} "
+                f"(keys sit margin_mm / 2 beside the body, {MIN_MOULD_WALL_MM:g} mm of mould from the cavity), got "
+                f"{self.margin_mm:g}; raise margin_mm or lower key_mm"
+            )
+        return self
+
+
+class VolumeMesh(_Section):
+    """Tetrahedral meshes of the body for simulators (fTetWild in a child process): sizes in mm."""
+
+    #: the q values to mesh: [0] (the state the actuator is cast in, which a simulator deforms) by default
+    q: list[FiniteFloat] = Field([0.0], min_length=1, max_length=MAX_VOLUME_MESHES)
+    #: target edge length of the tetrahedra
+    size_mm: FiniteFloat = Field(2.0, ge=MIN_TET_SIZE_MM, le=50.0)
+    #: largest distance of the mesh's boundary from the body's surface
+    envelope_mm: FiniteFloat = Field(0.05, ge=0.001, le=1.0)
+    #: the mesher is stopped after this long (per q) and the build fails with a clear message
+    timeout_s: FiniteFloat = Field(1800.0, gt=0.0, le=MAX_MESHER_SECONDS)
+
+    @field_validator("q")
+    @classmethod
+    def _q_in_range(cls, values: list[float]) -> list[float]:
+        bad = [v for v in values if not 0.0 <= v <= 1.0]
+        if bad:
+            raise ValueError(f"q values must lie in [0, 1], got {bad}")
+        labels = [q_label(v) for v in values]
+        if len(set(labels)) != len(labels):
+            raise ValueError(f"give each q once, at least 0.001 apart (files are named with three decimals), "
+                             f"got {values}")
+        return sorted(values)
+
+
 class Export(_Section):
     """Meshes at the requested q values."""
 
@@ -189,6 +241,10 @@ class Export(_Section):
     angular_count: Integer = Field(64, ge=MIN_ANGULAR_COUNT, le=MAX_ANGULAR_COUNT)
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...
     split_regions: bool = False
+    #: a casting mould of the body at q = 0: meshes/mould/{half_a,half_b,core}.stl (the mould stage)
+    mould: Mould | None = None
+    #: tetrahedral meshes of the body for simulators: meshes/volume/q_0.000.{vtu,msh} (the volume_mesh stage)
+    volume_mesh: VolumeMesh | None = None
 
     @field_validator("q")
     @classmethod
@@ -211,6 +267,9 @@ class Export(_Section):
             raise ValueError("give q (a list) or frames (a count), not both")
         if self.port_mm is not None and self.wall_mm is None:
             raise ValueError("port_mm needs wall_mm (a port opens into the hollow chamber)")
+        if self.mould is not None and self.wall_mm is not None and self.port_mm is None:
+            raise ValueError("mould of a hollow body needs port_mm: a sealed chamber cannot be cast around a core "
+                             "(the core is held and removed through the port)")
         if self.q is not None:
             bad = [v for v in self.q if not 0.0 <= v <= 1.0]
             if bad or not self.q:

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import typer
 
-from softdesign.cli.build import blend, build, export, fit, ingest, kinematics, links, validate
+from softdesign.cli.build import blend, build, export, fit, ingest, kinematics, links, mould, validate
 from softdesign.cli.centerline import centerline
 from softdesign.cli.check import check
 from softdesign.cli.design import design
@@ -31,7 +31,8 @@ app = typer.Typer(
 )
 app.add_typer(pcc_app, name="pcc")
 for command in (
-    validate, build, ingest, blend, links, kinematics, fit, export, pose, check, report, sample, centerline, design
+    validate, build, ingest, blend, links, kinematics, fit, export, mould, pose, check, report, sample, centerline,
+    design,
 ):
     app.command()(command)
 
@@ -42,6 +43,6 @@ def main() -> None:
 
 
 __all__ = [
-    "app", "main", "validate", "build", "ingest", "blend", "links", "kinematics", "fit", "export",
+    "app", "main", "validate", "build", "ingest", "blend", "links", "kinematics", "fit", "export", "mould",
     "pose", "check", "report", "sample", "centerline", "design",
 ]

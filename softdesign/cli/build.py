@@ -1,4 +1,4 @@
-"""`softdesign validate|build|ingest|blend|links|kinematics|fit|export CASE.yaml`: the case file and its stages.
+"""`softdesign validate|build|ingest|blend|links|kinematics|fit|export|mould CASE.yaml`: the case file and its stages.
 
 Parsing and printing live here; the stages are :mod:`softdesign.pipeline`.
 """
@@ -139,6 +139,22 @@ def fit(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None
 def export(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False, jobs: JobsOpt = None) -> None:
     """Checked watertight solids of S(q) at every export q (STL and the other formats asked for)."""
     _stage_command(case_file, out, "export", force, jobs)
+
+
+def mould(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> None:
+    """A two-part casting mould of the body at q = 0 (and a core for a hollow body): export.mould in the case."""
+
+    def action() -> None:
+        from softdesign.config import load_case
+        from softdesign.errors import ConfigError
+
+        if load_case(case_file).export.mould is None:
+            raise ConfigError(f"{case_file}: no export.mould in the case file, so there is no mould to build; add "
+                              "e.g. `mould: {margin_mm: 10, clearance_mm: 0.2}` under export: (README: the case file)")
+        outcome = _run(case_file, out, "mould", force)
+        _print_runs(outcome.build_dir, outcome.runs)
+
+    run_guarded(action)
 
 
 def kinematics(

@@ -34,6 +34,8 @@ CENTERLINES_PVD = "centerlines.pvd"
 MESHES_PVD = "meshes.pvd"
 #: One glTF binary with a morph target per export q and an animation over q (when .glb is exported).
 MORPH_GLB = "morph.glb"
+MOULD_SUMMARY = "mould/summary.json"
+VOLUME_SUMMARY = "volume_mesh/summary.json"
 
 
 # Beside the build folder ``<name>``, in the same parent (so a rename never crosses file systems), named
@@ -102,3 +104,18 @@ def region_path(q: float, region: str) -> str:
 def centerline_path(q: float) -> str:
     """``centerlines/q_0.500.vtp``: c(q, l) with its frames."""
     return f"centerlines/{q_label(q)}.vtp"
+
+
+def mould_path(part: str, fmt: str) -> str:
+    """``meshes/mould/half_a.stl``: a part of the casting mould of the body at q = 0."""
+    return f"{MESHES_DIR}/mould/{part}.{fmt}"
+
+
+def volume_mesh_path(q: float, suffix: str) -> str:
+    """``meshes/volume/q_0.000.vtu`` (or ``.msh``): the tetrahedral mesh of the body at q."""
+    return f"{MESHES_DIR}/volume/{q_label(q)}.{suffix}"
+
+
+def chamber_surface_path(q: float) -> str:
+    """``meshes/volume/chamber_q_0.000.stl``: the closed chamber surface of a hollow body at q, normals outwards."""
+    return f"{MESHES_DIR}/volume/chamber_{q_label(q)}.stl"

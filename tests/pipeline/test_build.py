@@ -20,7 +20,7 @@ from softdesign.versions import software_versions
 from tests.helpers.paths import REPO
 
 runner = CliRunner()
-STAGES = ["ingest", "blend", "links", "kinematics", "fit", "export", "feasibility"]
+STAGES = ["ingest", "blend", "links", "kinematics", "fit", "export", "mould", "volume_mesh", "feasibility"]
 
 
 def snapshot(folder: Path) -> dict[str, str]:
@@ -34,7 +34,7 @@ def snapshot(folder: Path) -> dict[str, str]:
 
 def statuses(output: str) -> dict[str, str]:
     """{stage: 'ran' | 'skipped'} from a build's report lines."""
-    return dict(re.findall(r"^\[([a-z]+)\] (ran|skipped|kept|stale)", output, flags=re.MULTILINE))
+    return dict(re.findall(r"^\[([a-z_]+)\] (ran|skipped|kept|stale)", output, flags=re.MULTILINE))
 
 
 @pytest.fixture
@@ -69,24 +69,29 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     edit(demo_case, "fit", smoothing=2.0e-5)
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "ran",
-        "export": "ran", "feasibility": "ran",
+        "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
     edit(demo_case, "export", q=[0, 0.5, 1])
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "ran", "fit": "skipped",
-        "export": "ran", "feasibility": "ran",
+        "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
-    # The mesh formats are read by export alone: kinematics, the fit and the feasibility figures stay cached.
+    # The mesh formats are read by export (and the mould's formats): kinematics, the fit and the feasibility
+    # figures stay cached.
     edit(demo_case, "export", formats=["stl", "ply"])
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "skipped",
-        "export": "ran", "feasibility": "skipped",
+        "export": "ran", "mould": "ran", "volume_mesh": "skipped", "feasibility": "skipped",
     }
+    # A mould is read by the mould stage alone: the export's meshes stay.
+    edit(demo_case, "export", mould={"margin_mm": 8})
+    assert statuses(build(demo_case, out)) == {**dict.fromkeys(STAGES, "skipped"), "mould": "ran"}
+    assert (out / "meshes" / "mould" / "half_a.ply").is_file()
     # New link breaks: the links, their kinematics and the per-link fit are redone; ingest and blend are not.
     edit(demo_case, "links", count=None, breaks=[0, 0.4, 1])
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "blend": "skipped", "links": "ran", "kinematics": "ran", "fit": "ran", "export": "ran",
-        "feasibility": "ran",
+        "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
     # A material is read by the feasibility verdict alone: every mesh stays.
     edit(demo_case, "material", name="ecoflex-00-30")
@@ -109,7 +114,7 @@ def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tm
     ran, manifest = run_fit()
     assert ran == {
         "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "skipped",
-        "export": "kept", "feasibility": "kept",
+        "export": "kept", "mould": "kept", "volume_mesh": "kept", "feasibility": "kept",
     }
     outputs = {o["path"]: o for o in manifest["outputs"]}
     assert all(outputs[m]["watertight"] and outputs[m]["volume_mm3"] > 0 and "stale" not in outputs[m] for m in meshes)

@@ -2,7 +2,9 @@
 
 ingest -> blend -> links -> kinematics -> fit -> export (DESIGN.md's five
 stages, with the link breaks a product of their own between blend and
-kinematics: both kinematics and the fit consume them) -> feasibility (skin
+kinematics: both kinematics and the fit consume them) -> mould (a casting
+mould of the q = 0 body, when the case asks for one) -> volume_mesh (tetrahedra of
+the body for simulators, when asked for) -> feasibility (skin
 stretch and wall thickness, judged against the case's material).
 """
 
@@ -13,11 +15,22 @@ from pathlib import Path
 from softdesign.config import Case
 from softdesign.pipeline import inputs
 from softdesign.pipeline.stage import Stage
-from softdesign.pipeline.stages import blend, export, feasibility, fit, ingest, kinematics, links
+from softdesign.pipeline.stages import (
+    blend,
+    export,
+    feasibility,
+    fit,
+    ingest,
+    kinematics,
+    links,
+    mould,
+    volume_mesh,
+)
 
 #: Every stage, in build order.
 STAGES: list[Stage] = [
-    ingest.STAGE, blend.STAGE, links.STAGE, kinematics.STAGE, fit.STAGE, export.STAGE, feasibility.STAGE,
+    ingest.STAGE, blend.STAGE, links.STAGE, kinematics.STAGE, fit.STAGE, export.STAGE, mould.STAGE, volume_mesh.STAGE,
+    feasibility.STAGE,
 ]
 
 

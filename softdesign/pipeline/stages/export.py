@@ -233,7 +233,9 @@ def output_figures(result: ExportResult) -> dict[str, dict[str, Any]]:
 STAGE = Stage(
     name="export",
     version=VERSION,
-    reads=("export",),
+    # every export key but mould, which only the mould stage reads
+    reads=("export.q", "export.frames", "export.offset_mm", "export.wall_mm", "export.port_mm", "export.formats",
+           "export.spacing_mm", "export.angular_count", "export.split_regions"),
     upstream=("kinematics", "fit"),
     compute=lambda case, results: run_export(case, results["kinematics"], results["fit"]),
     write=write_export,

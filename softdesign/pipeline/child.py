@@ -1,0 +1,116 @@
+"""Run one function in a child process with a time limit, so native code that crashes or hangs fails the stage cleanly.
+
+A mesher written in C++ (fTetWild) can abort, segfault or loop inside one
+call; in the build's own process that would kill it without a word or hang
+it for ever.  :func:`run_in_child` starts a fresh interpreter (``spawn``: no
+copy of the parent's threads or locks), calls the function there and waits
+at most ``timeout_s`` for its answer.  A crash (the child died without
+answering), a timeout (the child is killed) or an exception raised in the
+child becomes a :class:`~softdesign.errors.MeshError` that says which, with
+the child's exit signal or error, and what to change; a memory limit on the
+child turns a runaway allocation into one of these too (Linux ``RLIMIT_AS``).
+The child works in a scratch folder of its own, so files a library writes
+into the working folder (fTetWild's ``__tracked_surface.stl``) go with it.  The function and its
+arguments and result travel by pickle, so the function must be importable
+by name (a module-level function).
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import resource
+import signal
+import tempfile
+from collections.abc import Callable
+from multiprocessing.connection import Connection
+from typing import Any
+
+from softdesign.errors import MeshError
+
+#: How long a killed child may take to be reaped, s.
+_REAP_S = 10.0
+
+
+def _child_main(send: Connection, target: Callable[..., Any], args: tuple[Any, ...], memory_bytes: int | None) -> None:
+    try:
+        if memory_bytes is not None:
+            # address space, not resident memory: what a native allocation (malloc, new) is refused beyond
+            resource.setrlimit(resource.RLIMIT_AS, (memory_bytes, memory_bytes))
+        # native code may write files of its own into the working folder (fTetWild writes
+        # __tracked_surface.stl): a scratch folder of the child's, removed with it, takes them
+        with tempfile.TemporaryDirectory(prefix="softdesign-child-") as scratch:
+            os.chdir(scratch)
+            result = target(*args)
+    except MemoryError as err:
+        limit = "" if memory_bytes is None else f" of {memory_bytes / 2**30:.2f} GiB"
+        send.send(("error", f"it ran out of memory (the child's limit{limit}): {type(err).__name__} {err}".strip()))
+    except BaseException as err:  # noqa: BLE001 - every failure goes back to the parent as a message
+        send.send(("error", f"{type(err).__name__}: {err}"))
+    else:
+        send.send(("ok", result))
+    finally:
+        send.close()
+
+
+def _how_it_ended(exitcode: int | None) -> str:
+    if exitcode is None:
+        return "without an exit status"
+    if exitcode < 0:
+        try:
+            return f"killed by signal {signal.Signals(-exitcode).name}"
+        except ValueError:
+            return f"killed by signal {-exitcode}"
+    return f"with exit code {exitcode}"
+
+
+def run_in_child(
+    target: Callable[..., Any], args: tuple[Any, ...], timeout_s: float, what: str, fix: str,
+    memory_bytes: int | None = None,
+) -> Any:
+    """``target(*args)`` computed in a child process, waiting at most ``timeout_s`` seconds.
+
+    Parameters
+    ----------
+    target : a module-level function (pickled by name)
+    args : its arguments (pickled)
+    timeout_s : the longest wait for the answer, s (> 0)
+    what : names the work in messages, e.g. ``fTetWild on the body at q=0.000``
+    fix : what the user can change, ending the messages of a timeout, a crash or a failure
+    memory_bytes : the child's address space limit (``RLIMIT_AS``), bytes; None for none.  An
+        allocation beyond it fails (MemoryError, or a native ``bad_alloc`` that may abort the child)
+
+    Raises
+    ------
+    MeshError
+        The child timed out (it is killed), died without answering (a crash in
+        native code: its signal or exit code), ran out of its memory, or raised
+        (its exception's type and message).
+    """
+    if not timeout_s > 0:
+        raise ValueError(f"timeout_s must be > 0, got {timeout_s}")
+    context = multiprocessing.get_context("spawn")
+    receive, send = context.Pipe(duplex=False)
+    process = context.Process(target=_child_main, args=(send, target, args, memory_bytes), daemon=True)
+    process.start()
+    send.close()  # the child holds the only writer: its death ends the pipe, and poll() sees it at once
+    try:
+        if not receive.poll(timeout_s):
+            process.kill()
+            process.join(_REAP_S)
+            raise MeshError(f"{what} did not finish within {timeout_s:g} s and was stopped; {fix}")
+        try:
+            status, payload = receive.recv()
+        except EOFError:
+            process.join(_REAP_S)
+            raise MeshError(f"{what} crashed ({_how_it_ended(process.exitcode)}) before answering; {fix}") from None
+    finally:
+        receive.close()
+        if process.is_alive():
+            process.join(_REAP_S)
+        if process.is_alive():
+            process.kill()
+            process.join(_REAP_S)
+    if status != "ok":
+        raise MeshError(f"{what} failed: {payload}; {fix}")
+    return payload

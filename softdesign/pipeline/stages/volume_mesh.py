@@ -1,0 +1,200 @@
+"""Stage, volume_mesh: tetrahedral meshes of the body for simulators (SOFA, FEBio, Abaqus), issue 16.
+
+Runs only when the case has ``export.volume_mesh``; otherwise it writes
+nothing.  At each of its q values (by default q = 0 alone, the state the
+actuator is cast in and that a simulator deforms) the body is the export's
+own checked solid (same grid, offset, wall and port), and fTetWild fills it
+with tetrahedra of the target size (:mod:`softdesign.meshing.tetmesh`) in a
+child process with the case's time limit (:mod:`softdesign.pipeline.child`):
+a crash or a hang in its native code fails the stage with a clear message
+(exit 1), not a dead build.  The count of tetrahedra the size asks for is
+bounded before the mesher starts.  Checks (:mod:`softdesign.meshing.tet_checks`):
+every tetrahedron positive, their volume within 1 % of the body's, a hollow
+body's chamber empty.  Outputs: ``meshes/volume/q_0.000.vtu`` (ASCII XML,
+inline data: what SOFA's MeshVTKLoader reads), ``.msh`` (Gmsh 2.2, SOFA's
+MeshGmshLoader), for a hollow body ``meshes/volume/chamber_q_0.000.stl`` (the
+closed chamber, normals outwards: SOFA's SurfacePressureConstraint), and
+``volume/summary.json``; the manifest lists each file with its figures.
+
+fTetWild is not deterministic (:mod:`softdesign.meshing.tetmesh`): unlike
+every other output, these files differ from run to run of the mesher (their
+figures agree within the checks).  The build's cache keeps them while the
+inputs are unchanged.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from softdesign.config import Case
+from softdesign.config import VolumeMesh as VolumeMeshSpec
+from softdesign.errors import ConfigError
+from softdesign.io.formats import mesh_bytes
+from softdesign.io.volume_formats import VOLUME_FORMATS, volume_mesh_bytes
+from softdesign.limits_volume import MAX_VOLUME_TETS, MESHER_MEMORY_BYTES
+from softdesign.meshing.body import body_sections
+from softdesign.meshing.chamber import chamber_surface
+from softdesign.meshing.tet_checks import REGULAR_TET_FACTOR, check_tet_mesh, expected_tets
+from softdesign.meshing.tetmesh import TetSettings, tetrahedralize
+from softdesign.meshing.topology import mesh_topology
+from softdesign.pipeline import layout
+from softdesign.pipeline.child import run_in_child
+from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.export import body_spec, solid_at
+from softdesign.pipeline.stages.fit import FitResult
+from softdesign.pipeline.stages.kinematics import KinematicsResult
+from softdesign.pipeline.store import Staging
+from softdesign.types import FloatArray, IntArray
+
+VERSION = 1
+#: The function the child process runs: (vertices, faces, TetSettings) -> (points, tets).  A module attribute,
+#: so that a test can put a crashing or hanging stand-in in its place.
+MESHER = tetrahedralize
+
+
+@dataclass(frozen=True)
+class TetBody:
+    """The tetrahedra of the body at one q, and its closed chamber (hollow bodies)."""
+
+    q: float
+    points: FloatArray
+    tets: IntArray
+    chamber: tuple[FloatArray, IntArray] | None
+
+
+@dataclass(frozen=True)
+class VolumeMeshResult:
+    """The meshes (empty after a cached load, or when none is asked for) and the figures."""
+
+    meshes: tuple[TetBody, ...]
+    summary: dict[str, Any]
+
+
+def _check_count(volume_mm3: float, size_mm: float, q: float) -> None:
+    count = expected_tets(volume_mm3, size_mm)
+    if count > MAX_VOLUME_TETS:
+        least = (volume_mm3 * REGULAR_TET_FACTOR / MAX_VOLUME_TETS) ** (1.0 / 3.0)
+        raise ConfigError(
+            f"export.volume_mesh.size_mm: {size_mm:g} mm asks for about {count:.3g} tetrahedra in the body's "
+            f"{volume_mm3:.1f} mm3 at q={q:.3f}, more than the limit of {MAX_VOLUME_TETS} "
+            f"(softdesign/limits_volume.py); use size_mm >= {np.ceil(least * 1000) / 1000:g} mm"
+        )
+
+
+def mesh_body(case: Case, kinematics: KinematicsResult, fit: FitResult, q: float) -> tuple[TetBody, dict[str, Any]]:
+    """The checked tetrahedral mesh of the body at ``q`` and its figures (MeshError when a check fails)."""
+    vm = case.export.volume_mesh or VolumeMeshSpec()
+    body = solid_at(kinematics, fit, q, case)
+    volume = float(body.figures["volume_mm3"])
+    _check_count(volume, vm.size_mm, q)
+    spec = body_spec(case)
+    chamber = None
+    if spec.wall_mm > 0:
+        e = case.export
+        sections = body_sections(kinematics.chain.shape.curve_at(q), fit.field, q, e.spacing_mm, e.angular_count)
+        chamber = chamber_surface(sections, spec)
+    what = f"fTetWild on the body at q={q:.3f} ({len(body.solid.faces)} faces, size_mm {vm.size_mm:g})"
+    fix = ("raise export.volume_mesh.timeout_s, or make the mesh coarser (size_mm, envelope_mm); a crash in fTetWild "
+           f"is a bug to report with the body (`softdesign export` writes it: {layout.mesh_path(q, 'stl')})")
+    start = time.perf_counter()
+    points, tets = run_in_child(MESHER, (body.solid.vertices, body.solid.faces,
+                                         TetSettings(vm.size_mm, vm.envelope_mm)), vm.timeout_s, what, fix,
+                                  memory_bytes=MESHER_MEMORY_BYTES)
+    seconds = time.perf_counter() - start
+    figures = check_tet_mesh(points, tets, volume, chamber, f"volume mesh at q={q:.3f}")
+    figures.update({"q": q, "size_mm": vm.size_mm, "envelope_mm": vm.envelope_mm, "mesher_s": round(seconds, 3),
+                    "body_kind": body.solid.kind})
+    return TetBody(q, points, tets, chamber), figures
+
+
+def _chamber_figures(q: float, chamber: tuple[FloatArray, IntArray]) -> dict[str, Any]:
+    topology = mesh_topology(*chamber)
+    return {"q": q, "part": "chamber", "faces": topology.faces, "volume_mm3": topology.volume,
+            "area_mm2": topology.area, "watertight": topology.watertight,
+            "winding_consistent": topology.winding_consistent,
+            "normals": "outward" if topology.volume > 0 else "inward"}
+
+
+def run_volume_mesh(case: Case, kinematics: KinematicsResult, fit: FitResult) -> VolumeMeshResult:
+    """A checked tetrahedral mesh at every q of ``export.volume_mesh``, or nothing when the case asks for none."""
+    vm = case.export.volume_mesh
+    if vm is None:
+        return VolumeMeshResult((), {"requested": False})
+    meshes, files, per_q = [], {}, []
+    for q in vm.q:
+        mesh, figures = mesh_body(case, kinematics, fit, q)
+        meshes.append(mesh)
+        per_q.append(figures)
+        for suffix in VOLUME_FORMATS:
+            files[layout.volume_mesh_path(q, suffix)] = figures
+        if mesh.chamber is not None:
+            files[layout.chamber_surface_path(q)] = _chamber_figures(q, mesh.chamber)
+    mesher = {"name": "fTetWild through pytetwild, one thread", "pytetwild": metadata.version("pytetwild"),
+              "meshio": metadata.version("meshio")}
+    summary = {"requested": True, "spec": vm.model_dump(mode="json"), "mesher": mesher,
+               "deterministic": False, "per_q": per_q, "files": files}
+    return VolumeMeshResult(tuple(meshes), summary)
+
+
+def write_volume_mesh(result: VolumeMeshResult, staging: Staging) -> None:
+    """Stage every mesh in .vtu and .msh, every chamber as STL, and the figures."""
+    if not result.summary["requested"]:
+        return
+    for mesh in result.meshes:
+        for suffix in VOLUME_FORMATS:
+            data = volume_mesh_bytes(mesh.points, mesh.tets, suffix)
+            staging.write_bytes(layout.volume_mesh_path(mesh.q, suffix), data)
+        if mesh.chamber is not None:
+            staging.write_bytes(layout.chamber_surface_path(mesh.q), mesh_bytes(*mesh.chamber, "stl"))
+    staging.write_json(layout.VOLUME_SUMMARY, result.summary)
+
+
+def load_volume_mesh(build_dir: Path) -> VolumeMeshResult:
+    """The figures of kept volume meshes (the files stay on disk)."""
+    path = Path(build_dir) / layout.VOLUME_SUMMARY
+    if not path.is_file():
+        return VolumeMeshResult((), {"requested": False})
+    return VolumeMeshResult((), json.loads(path.read_text(encoding="utf-8")))
+
+
+def describe_volume_mesh(result: VolumeMeshResult) -> list[str]:
+    """One line per tetrahedral mesh and per chamber surface."""
+    s = result.summary
+    if not s["requested"]:
+        return ["no export.volume_mesh in the case file: no volume mesh"]
+    lines = []
+    for name, f in s["files"].items():
+        if name.endswith(".msh"):
+            continue
+        if f.get("part") == "chamber":
+            lines.append(f"{name}: closed chamber, {f['faces']} faces, {f['volume_mm3']:.2f} mm3, "
+                         f"normals {f['normals']}")
+            continue
+        chamber = "" if f["chamber_centroids_inside"] is None else f", {f['chamber_centroids_inside']} in the chamber"
+        lines.append(
+            f"{name} (and .msh): {f['tets']} tets, volume {f['volume_mm3']:.2f} mm3 "
+            f"({100 * f['volume_rel_error']:+.3f}% vs body){chamber}, min dihedral {f['min_dihedral_deg']:.2f} deg, "
+            f"max radius-edge {f['max_radius_edge']:.2f}, {f['mesher_s']:.1f} s")
+    return lines
+
+
+STAGE = Stage(
+    name="volume_mesh",
+    version=VERSION,
+    reads=("export.volume_mesh", "export.offset_mm", "export.wall_mm", "export.port_mm", "export.spacing_mm",
+           "export.angular_count"),
+    upstream=("kinematics", "fit"),
+    compute=lambda case, results: run_volume_mesh(case, results["kinematics"], results["fit"]),
+    write=write_volume_mesh,
+    load=lambda build_dir, results: load_volume_mesh(build_dir),
+    describe=describe_volume_mesh,
+    metrics=lambda result: {k: v for k, v in result.summary.items() if k != "files"},
+    figures=lambda result: result.summary["files"] if result.summary["requested"] else {},
+)
