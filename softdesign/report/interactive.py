@@ -196,7 +196,11 @@ def _layout(per_q: list[list[dict[str, Any]]], traces: list[Any], q_values: Floa
     axes = {name: {"range": [float(low[i] - pad), float(high[i] + pad)], "title": {"text": f"{name} (mm)"}}
             for i, name in enumerate(("x", "y", "z"))}
     animate = {"mode": "immediate", "frame": {"duration": 0, "redraw": True}, "transition": {"duration": 0}}
-    steps = [{"label": f"{q:.2f}", "method": "animate", "args": [[f"{q:.3f}"], animate]} for q in q_values]
+    # The slider queues its frames ("afterall") rather than interrupting the one being drawn: plotly.js rejects an
+    # interrupted animation's promise and nothing catches it, so every step dragged over logged "Uncaught (in
+    # promise)" in the browser's console.  Pause must interrupt play (mode "immediate"), as plotly documents.
+    queued = {**animate, "mode": "afterall"}
+    steps = [{"label": f"{q:.2f}", "method": "animate", "args": [[f"{q:.3f}"], queued]} for q in q_values]
     play = {"frame": {"duration": 120, "redraw": True}, "fromcurrent": True, "transition": {"duration": 0}}
     return {
         "template": "none", "height": HEIGHT_PX, "margin": {"l": 0, "r": 0, "t": 30, "b": 0},

@@ -88,6 +88,9 @@ def session(tmp_path_factory):
         page.mouse.down()
         page.mouse.move(rail["x"] + 1, y, steps=10)
         page.mouse.up()
+        # the slider queues a frame per step passed: wait until plotly has drawn them all, then let WebGL settle
+        page.wait_for_function(f"document.getElementById('{DIV_ID}')._transitionData._frameQueue.length === 0",
+                               timeout=LOAD_TIMEOUT_MS)
         page.wait_for_timeout(SETTLE_MS)
         record["active"] = page.evaluate(f"document.getElementById('{DIV_ID}')._fullLayout.sliders[0].active")
         record["q0"] = capture(page, "demo_q0")
