@@ -16,7 +16,7 @@ import uuid
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from softdesign.errors import ConfigError
 from softdesign.pipeline.layout import REPORT_DIR
@@ -30,6 +30,7 @@ from softdesign.report import (
     interactive,
     kinematics_figures,
     morph_figures,
+    mould_figures,
     profile_figures,
     stretch_figures,
     surface_figures,
@@ -56,6 +57,7 @@ from softdesign.report.tables import (
     output_checks,
     software_rows,
 )
+from softdesign.report.volume_mesh_tables import volume_mesh_checks, volume_mesh_table
 
 T = TypeVar("T")
 
@@ -79,6 +81,7 @@ EXPECTED_SIZES = {
     "design.png": pixel_size(design_figures.SIZE_IN),
     "morph.gif": pixel_size(animation.SIZE_IN),
     stretch_figures.NAME: pixel_size(stretch_figures.SIZE_IN),
+    mould_figures.NAME: mould_figures.PIXEL_SIZE,
     profile_figures.NAME: pixel_size(profile_figures.SIZE_IN),
 }
 
@@ -206,7 +209,32 @@ def report_sections(
     stretch = run(stretch_figures.NAME, lambda: stretch_figures.stretch_picture(data))
     if stretch is not None:
         sections.insert(4, Section("feasibility", "Skin stretch and wall", pictures=[stretch]))
+    fabrication = _fabrication_section(data, run)
+    if fabrication is not None:
+        sections.insert(-2, fabrication)
     return sections, checks, notes
+
+
+def _fabrication_section(data: BuildData, run: _Timer) -> Section | None:
+    """The casting mould (exploded view) and the volume meshes' quality, when the build has them."""
+    mould = run(mould_figures.NAME, lambda: mould_figures.mould_picture(data))
+    table = volume_mesh_table(_volume_summary(data))
+    if mould is None and table is None:
+        return None
+    section = Section("fabrication", "Fabrication: casting mould and volume meshes")
+    if mould is not None:
+        section.pictures.append(mould)
+    if table is not None:
+        section.tables.append(table)
+        section.notes.append("fTetWild is not deterministic: the volume meshes differ between runs of the mesher; "
+                             "their checks hold for every run.")
+    return section
+
+
+def _volume_summary(data: BuildData) -> dict[str, Any] | None:
+    """The volume_mesh stage's summary (manifest metrics), or None when the build has none."""
+    block = data.manifest.get("metrics", {}).get("volume_mesh")
+    return block if isinstance(block, dict) else None
 
 
 def _view_section(data: BuildData, options: ReportOptions, run: _Timer) -> Section:
@@ -248,6 +276,7 @@ def _kinematics_section(data: BuildData, options: ReportOptions, notes: list[str
 
 def _tables_section(data: BuildData) -> tuple[Section, list[Check]]:
     checks = mesh_checks(data.export_summary) + fit_checks(data.fit.summary if data.fit else None)
+    checks += volume_mesh_checks(_volume_summary(data))
     checks += output_checks(data.build_dir, data.manifest)
     stages = [(s["name"], s["status"], f"{data.manifest.get('timing_s', {}).get(s['name'], 0.0):.3f}")
               for s in data.manifest.get("stages", [])]

@@ -8,12 +8,14 @@ from pathlib import Path
 
 import pytest
 import yaml
+from PIL import Image
 from typer.testing import CliRunner
 
 from softdesign.cli import app
 from softdesign.io.formats import read_mesh
 from softdesign.meshing.checks import inspect_mesh
-from softdesign.mould_figure import mould_figure_png
+from softdesign.report.mould_figures import mould_figure_png
+from softdesign.report.writer import EXPECTED_SIZES, write_report
 from tests.helpers.paths import REPO
 
 runner = CliRunner()
@@ -86,6 +88,12 @@ def test_demo_hollow_mould_is_written_listed_and_checked(tmp_path):
     assert block["core"]["process"] == "removable"
     png = mould_figure_png(out)
     assert png is not None and png.startswith(b"\x89PNG") and png == mould_figure_png(out)  # same bytes each time
+    # the report's fabrication section shows it, with the parts' checks in its caption
+    report = write_report(out)
+    page = report.page.read_text()
+    assert 'id="fabrication"' in page and 'src="mould.png"' in page and "core: removable" in page.lower()
+    with Image.open(report.page.parent / "mould.png") as image:
+        assert image.size == EXPECTED_SIZES["mould.png"]
 
 
 @pytest.mark.slow

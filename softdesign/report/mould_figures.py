@@ -1,13 +1,12 @@
-"""An exploded view of a build's casting mould, as PNG bytes, for the report to call (issue 16).
+"""An exploded view of a build's casting mould for the report's fabrication section (issue 16).
 
-Kept outside ``softdesign/report/`` on purpose: the report can add it as a
-section (``mould_figure_png(build_dir)`` gives None when the build has no
-mould).  The parts are read from ``meshes/mould/*.stl`` and drawn in the
-mould frame (``metrics.mould.frame``): half A lifted along its pull, half B
-lowered along its own, the core between them, seen obliquely from the side of
-half A's cavity with flat shading (painter's order, back faces culled).  No
-pyplot: an Agg canvas and PNG metadata without software or time, so the same
-build gives the same bytes.
+``mould_picture(data)`` gives None when the build has no mould. The parts are
+read from ``meshes/mould/*.stl`` and drawn in the mould frame
+(``metrics.mould.frame``): half A lifted along its pull, half B lowered along
+its own, the core between them, seen obliquely from the side of half A's cavity
+with flat shading (painter's order, back faces culled). No pyplot: an Agg
+canvas and PNG metadata without software or time, so the same build gives the
+same bytes.
 """
 
 from __future__ import annotations
@@ -20,10 +19,15 @@ import numpy as np
 
 from softdesign.io.formats import read_mesh
 from softdesign.pipeline import layout
+from softdesign.report.build_folder import BuildData
+from softdesign.report.plotting import Picture
 from softdesign.types import FloatArray
 
 #: Figure size, inches, and resolution, dots per inch.
 SIZE_IN, DPI = (7.0, 5.0), 100
+NAME = "mould.png"
+#: Pixel (width, height) of the PNG.
+PIXEL_SIZE = (int(round(SIZE_IN[0] * DPI)), int(round(SIZE_IN[1] * DPI)))
 #: How far the halves are drawn apart, in heights of the box.
 EXPLODE = 0.6
 #: Viewing direction (from the eye into the scene) and light, in the mould frame (x along the body, z the pull).
@@ -94,3 +98,23 @@ def mould_figure_png(build_dir: str | Path) -> bytes | None:
     out = io.BytesIO()
     figure.savefig(out, format="png", dpi=DPI, metadata={"Software": None})
     return out.getvalue()
+
+
+def mould_picture(data: BuildData) -> Picture | None:
+    """The exploded view with a caption of the parts' checks; None when the build has no mould."""
+    png = mould_figure_png(data.build_dir)
+    if png is None:
+        return None
+    block = data.manifest["metrics"]["mould"]
+    cavity, pulls = block["cavity"], block["pull"]
+    parts = ", ".join(f"{name} {f['volume_mm3']:.0f} mm3 ({f['faces']} faces)" for name, f in block["parts"].items())
+    caption = (
+        f"Parts in meshes/mould/: {parts}. The cavity they leave differs from the q = 0 body by "
+        f"{100 * cavity['rel_difference']:.2g} % of its volume (limit {100 * cavity['tolerance']:g} %); parts "
+        f"disjoint: {'yes' if block['disjoint']['ok'] else 'NO'}; "
+        + "; ".join(f"{k} pulls off: {'yes' if p['ok'] else 'NO'} ({p['against_pull']} faces against the pull, "
+                    f"{p['blocked_rays']} rays blocked)" for k, p in pulls.items())
+        + (f". Core: {block['core']['process']}: {block['core']['note']}" if block.get("core") else "")
+        + "."
+    )
+    return Picture(NAME, png, PIXEL_SIZE, "Casting mould (exploded view)", caption)
