@@ -65,7 +65,7 @@ if TYPE_CHECKING:
 REPO = Path(__file__).resolve().parents[1]
 DEMO_CASE = REPO / "configs" / "demo.yaml"
 AORTA_DIR = REPO.parent / "shared" / "data" / "vmtk-aorta"
-STAGE_NAMES = ("ingest", "blend", "links", "kinematics", "fit", "export", "feasibility")
+STAGE_NAMES = ("ingest", "blend", "links", "kinematics", "fit", "export", "mould", "volume_mesh", "feasibility")
 
 #: Targets of the scaled case (issue 5, item 9; the build/floor ratio is issue 19's, on 2 cores).
 TARGET_FLOOR_RATIO = 2.0
