@@ -27,9 +27,11 @@ A candidate is the end's when its rim's centroid lies within
 from the axis (``e``, ``t``) is at least ``RIM_MIN_FRACTION`` of the
 inscribed radius, the rim goes all round the axis (a vertex in each of
 ``RIM_SECTORS`` equal sectors: a flat patch of the wall beside the end does
-not) and its normal is within ``MAX_TILT_DEG`` of ``t``; the nearest such
-centroid wins.
-A rounded VMTK dome has no plane: that end is reported with ``kind: none``.
+not), its vertices lie within ``MAX_FLATNESS_FRACTION`` of that radius (RMS)
+of one plane (a flat region of a finely tessellated wall that spans both
+rims is no plane) and its normal is within ``MAX_TILT_DEG`` of ``t``; the
+nearest such centroid wins.
+A rounded VMTK dome has no plane: that end is reported as None (null).
 Without inscribed radii nothing is measured (their size scale is what tells
 a cap from a patch).  Not in the papers: the seeds fit the wall only.
 """
@@ -51,6 +53,8 @@ RIM_MIN_FRACTION = 0.5
 FLAT_ANGLE_DEG = 1.0
 #: A rim must have a vertex in each of this many equal sectors around the end's axis.
 RIM_SECTORS = 8
+#: A rim farther from its least squares plane than this fraction of its radius (RMS) lies in no plane.
+MAX_FLATNESS_FRACTION = 0.05
 #: A plane tilted more than this to the end tangent is a wall facet, not an end, degrees.
 MAX_TILT_DEG = 60.0
 #: The rim past the body's square end that the build warns about, mm (a tenth of a 2.5 mm vessel's radius).
@@ -146,6 +150,8 @@ def _end_plane(
     tangent = tangent / np.linalg.norm(tangent)
     best: tuple[float, EndPlane] | None = None
     for kind, ids in rims:
+        if len(ids) < 3:  # a flat region with no boundary of its own (a closed flat shell) has no rim
+            continue
         rim = vertices[ids]
         centre = rim.mean(axis=0)
         distance = float(np.linalg.norm(centre - end))
@@ -159,9 +165,9 @@ def _end_plane(
         normal = np.linalg.svd(rim - centre, full_matrices=False)[2][-1]
         normal = normal if normal @ tangent >= 0 else -normal
         tilt = float(np.arccos(np.clip(normal @ tangent, -1.0, 1.0)))
-        if np.degrees(tilt) > MAX_TILT_DEG:
-            continue
         flatness = float(np.sqrt(np.mean(((rim - centre) @ normal) ** 2)))
+        if np.degrees(tilt) > MAX_TILT_DEG or flatness > MAX_FLATNESS_FRACTION * radius:
+            continue
         plane = EndPlane(
             kind, normal, centre, float(np.degrees(tilt)), radius, radius * float(np.tan(tilt)),
             float((centre - end) @ normal / (normal @ tangent)), flatness,

@@ -112,3 +112,26 @@ def test_the_vmtk_aorta_open_ends_are_flat_loops_and_its_rounded_caps_have_no_pl
         assert 0.5 * radius < plane.radius_mm < 2.0 * radius
     # the capped surface's caps are rounded domes: no flat region spans the vessel there
     assert end_planes(*read_surface(aorta_dir / "aorta-surface.stl", 1.0), ends, tangents, inscribed) == (None, None)
+
+
+def test_a_rounded_dome_has_no_plane():
+    import trimesh
+
+    # a capsule: hemispherical caps on a short tube, finely tessellated (neighbours 0.5 degrees apart around)
+    capsule = trimesh.creation.capsule(height=4.0, radius=RADIUS, count=[720, 16])
+    ends = np.array([[0.0, 0.0, -2.0], [0.0, 0.0, 2.0]])  # where the domes begin
+    assert end_planes(capsule.vertices, capsule.faces, ends, TANGENTS, INSCRIBED) == (None, None)
+
+
+def test_a_flat_band_of_wall_spanning_both_rims_is_not_taken_for_an_end_plane():
+    import trimesh
+
+    # an open tube 4 mm long whose wall is one flat-connected band (neighbours 0.5 degrees apart): its rim is both
+    # loops, its centroid between them, nearer the path's ends than either loop; it lies in no plane
+    tube = trimesh.creation.cylinder(radius=RADIUS, height=4.0, sections=720)
+    side = np.abs(np.abs(tube.triangles_center[:, 2]) - 2.0) > 1e-9
+    ends = np.array([[0.0, 0.0, -0.5], [0.0, 0.0, 0.5]])
+    inlet, outlet = end_planes(tube.vertices, tube.faces[side], ends, TANGENTS, INSCRIBED)
+    for plane in (inlet, outlet):
+        assert plane is not None and plane.kind == "open_end"
+        assert abs(plane.axis_offset_mm - 1.5) < COORD_TOL_MM and plane.tilt_deg < TILT_TOL_DEG
