@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from softdesign.config import Case
+from softdesign.geometry.end_planes import rim_gap_warnings
 from softdesign.geometry.network import CenterlineNetwork, Orientation, SelectedPath, all_paths, select_path
 from softdesign.geometry.plausibility import check_surface_surrounds, check_vessel_scale
 from softdesign.io.centerline import read_centerline_network
@@ -22,6 +23,7 @@ from softdesign.meshing.topology import SurfaceInfo, describe_surface
 from softdesign.pipeline import layout
 from softdesign.pipeline.auto_centerline import extract_for_case, extraction_summary, write_extracted
 from softdesign.pipeline.backbone_step import regularized_path
+from softdesign.pipeline.end_plane_step import end_plane_summary
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 from softdesign.types import UNIT_SCALE_TO_MM, FloatArray
@@ -29,7 +31,8 @@ from softdesign.types import UNIT_SCALE_TO_MM, FloatArray
 #: 2: a vessel whose size is not human in the declared units is refused (it was a warning on radii only).
 #: 3: a final path that turns tighter than the vessel is wide is regularized here (``backbone``); reads resample;
 #: the rule that chose the inlet (``centerline.inlet_rule``: the clearly widest end first).
-VERSION = 3
+#: 4: each end's flat cap or open loop, its tilt to the end tangent and the rim's gap past the body (``end_planes``).
+VERSION = 4
 
 
 @dataclass(frozen=True)
@@ -83,6 +86,8 @@ def run_ingest(case: Case) -> IngestResult:
     inlet_rule = path.notes[-1]
     path, backbone = regularized_path(case, path)
     notes += [n for n in path.notes if n not in notes]
+    ends = end_plane_summary(case, path, vertices, faces)
+    notes += [f"warning: {w}" for w in rim_gap_warnings(ends or {})]
     initial_path = None
     if case.initial.kind == "file" and case.initial.centerline is not None:
         initial_path = _one_path(case.initial.centerline, case.initial.path, scale, Orientation())
@@ -94,7 +99,7 @@ def run_ingest(case: Case) -> IngestResult:
     initial_surface = None
     if case.initial.surface is not None:
         initial_surface = read_surface(case.initial.surface, scale)
-    summary = {**_summary(case, network, path, info), "backbone": backbone}
+    summary = {**_summary(case, network, path, info), "backbone": backbone, "end_planes": ends}
     summary["centerline"]["inlet_rule"] = inlet_rule
     if extracted is not None:
         summary["centerline"]["extracted"] = extraction_summary(extracted)

@@ -1,0 +1,215 @@
+"""The plane of each end of a vessel surface (a flat cap or an open end's loop) and its tilt to the path's end.
+
+The body is cut square to the centerline's end tangent at the centerline's
+end.  A vessel whose flat cap, or clipped opening, is tilted by an angle
+theta to that tangent has its rim up to ``r tan(theta)`` past the body's
+square end on one side and as far short of it on the other (r the vessel's
+radius there): over that length the body does not follow the wall.  This
+module finds each end's plane and measures theta and ``r tan(theta)``; it
+changes nothing (the fit already drops the points past the end, see
+:mod:`softdesign.fitting.selection`).
+
+Detection, per end (the path's end point ``e`` and outward tangent ``t``):
+
+open end
+    a boundary loop (chained edges of one face each); its plane is the least
+    squares plane of the loop's vertices (the SVD's least singular vector),
+    its flatness the RMS distance of those vertices from it.
+flat cap
+    a connected region of faces whose neighbours' normals differ by less than
+    ``FLAT_ANGLE_DEG`` (a capper's flat fan: float32 STL round-off leaves its
+    triangles a fraction of a degree apart, so exact coplanarity is not
+    asked); its rim is the region's boundary, its plane the rim's least
+    squares plane as for a loop.
+
+A candidate is the end's when its rim's centroid lies within
+``END_SEARCH_RADII`` inscribed radii of ``e``, its rim's mean distance
+from the axis (``e``, ``t``) is at least ``RIM_MIN_FRACTION`` of the
+inscribed radius, the rim goes all round the axis (a vertex in each of
+``RIM_SECTORS`` equal sectors: a flat patch of the wall beside the end does
+not), its vertices lie within ``MAX_FLATNESS_FRACTION`` of that radius (RMS)
+of one plane (a flat region of a finely tessellated wall that spans both
+rims is no plane) and its normal is within ``MAX_TILT_DEG`` of ``t``; the
+nearest such centroid wins.
+A rounded VMTK dome has no plane: that end is reported as None (null).
+Without inscribed radii nothing is measured (their size scale is what tells
+a cap from a patch).  Not in the papers: the seeds fit the wall only.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from softdesign.types import FloatArray, IntArray, Points
+
+#: A rim whose centroid is farther than this many inscribed radii from the path's end is not that end's.
+END_SEARCH_RADII = 1.0
+#: A rim whose mean distance from the end's axis is below this fraction of the inscribed radius is no cap.
+RIM_MIN_FRACTION = 0.5
+#: Neighbouring faces whose normals differ by less than this belong to one flat cap, degrees.
+FLAT_ANGLE_DEG = 1.0
+#: A rim must have a vertex in each of this many equal sectors around the end's axis.
+RIM_SECTORS = 8
+#: A rim farther from its least squares plane than this fraction of its radius (RMS) lies in no plane.
+MAX_FLATNESS_FRACTION = 0.05
+#: A plane tilted more than this to the end tangent is a wall facet, not an end, degrees.
+MAX_TILT_DEG = 60.0
+#: The rim past the body's square end that the build warns about, mm (a tenth of a 2.5 mm vessel's radius).
+RIM_GAP_TOLERANCE_MM = 0.25
+
+
+@dataclass(frozen=True)
+class EndPlane:
+    """The plane found at one end of the path and how it sits against the body's square end.
+
+    Attributes
+    ----------
+    kind : "open_end" (a boundary loop) or "flat_cap" (a flat region of faces)
+    normal : (3,) unit normal of the plane, pointing out of the vessel along the end tangent
+    point : (3,) mm, the rim's centroid (a point of the plane)
+    tilt_deg : angle between the normal and the path's end tangent, degrees
+    radius_mm : mean distance of the rim's vertices from the end's axis, mm
+    rim_gap_mm : ``radius_mm * tan(tilt)``, how far the rim reaches past the body's square end, mm
+    axis_offset_mm : where the plane crosses the end's axis, along the outward tangent from the path's end, mm
+    flatness_mm : RMS distance of the rim's vertices from the plane, mm
+    """
+
+    kind: str
+    normal: FloatArray
+    point: FloatArray
+    tilt_deg: float
+    radius_mm: float
+    rim_gap_mm: float
+    axis_offset_mm: float
+    flatness_mm: float
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready figures (mm, degrees)."""
+        return {
+            "kind": self.kind,
+            "normal": [float(x) for x in self.normal],
+            "point_mm": [float(x) for x in self.point],
+            "tilt_deg": self.tilt_deg,
+            "radius_mm": self.radius_mm,
+            "rim_gap_mm": self.rim_gap_mm,
+            "axis_offset_mm": self.axis_offset_mm,
+            "flatness_mm": self.flatness_mm,
+        }
+
+
+def end_planes(
+    vertices: Points, faces: IntArray, ends: Points, tangents: Points, inscribed_mm: FloatArray
+) -> tuple[EndPlane | None, EndPlane | None]:
+    """The plane at the path's inlet and at its outlet, or None where no flat cap or open loop is found.
+
+    Parameters
+    ----------
+    vertices, faces : the vessel surface, mm
+    ends : (2, 3) mm, the path's first and last points (the body's ends)
+    tangents : (2, 3) unit tangents of the path at those points, in the path's direction
+    inscribed_mm : (2,) inscribed-sphere radius at each end, mm
+    """
+    import trimesh  # imported where used: importing the command line stays quick
+
+    vertices, faces = np.asarray(vertices, float), np.asarray(faces, np.int64)
+    mesh = trimesh.Trimesh(vertices, faces, process=False)
+    rims = [("open_end", loop) for loop in _boundary_loops(mesh)]
+    # a cap's faces lie within its rim, whose centre is within END_SEARCH_RADII inscribed radii of the end
+    reach = (END_SEARCH_RADII + 1.0 / np.cos(np.radians(MAX_TILT_DEG))) * np.asarray(inscribed_mm, float)
+    near = np.any(np.linalg.norm(mesh.triangles_center[:, None, :] - np.asarray(ends, float)[None], axis=2)
+                  <= reach, axis=1)
+    rims += [("flat_cap", np.unique(mesh.edges_sorted[_region_boundary_edges(mesh, f)]))
+             for f in _flat_regions(mesh) if near[f].any()]
+    out = []
+    for k, outward in ((0, -1.0), (1, 1.0)):
+        out.append(_end_plane(vertices, rims, np.asarray(ends[k], float),
+                              outward * np.asarray(tangents[k], float), float(inscribed_mm[k])))
+    return out[0], out[1]
+
+
+def rim_gap_warnings(planes: dict[str, dict[str, Any] | None]) -> list[str]:
+    """One line per end whose rim reaches more than ``RIM_GAP_TOLERANCE_MM`` past the body's square end."""
+    what = {"flat_cap": "flat cap", "open_end": "open end"}
+    return [
+        f"the vessel's {what[p['kind']]} at the {name} is tilted {p['tilt_deg']:.1f} deg to the centerline's end "
+        f"tangent, but the body's {name} is cut square to that tangent: the vessel's rim (radius "
+        f"{p['radius_mm']:.3f} mm) reaches {p['rim_gap_mm']:.3f} mm past the body's end on one side and stops as "
+        f"far short of it on the other (more than {RIM_GAP_TOLERANCE_MM:g} mm), and the body does not follow the "
+        "wall there; clip that end of the surface square to the centerline (e.g. vmtksurfaceclipper) and re-cap it "
+        "if the end must match"
+        for name, p in planes.items() if p is not None and p["rim_gap_mm"] > RIM_GAP_TOLERANCE_MM
+    ]
+
+
+def _end_plane(
+    vertices: Points, rims: list[tuple[str, IntArray]], end: FloatArray, tangent: FloatArray, inscribed: float
+) -> EndPlane | None:
+    tangent = tangent / np.linalg.norm(tangent)
+    best: tuple[float, EndPlane] | None = None
+    for kind, ids in rims:
+        if len(ids) < 3:  # a flat region with no boundary of its own (a closed flat shell) has no rim
+            continue
+        rim = vertices[ids]
+        centre = rim.mean(axis=0)
+        distance = float(np.linalg.norm(centre - end))
+        if distance > END_SEARCH_RADII * inscribed:
+            continue
+        offset = rim - end
+        radial = offset - np.outer(offset @ tangent, tangent)
+        radius = float(np.mean(np.linalg.norm(radial, axis=1)))
+        if radius < RIM_MIN_FRACTION * inscribed or not _all_round(radial, tangent):
+            continue
+        normal = np.linalg.svd(rim - centre, full_matrices=False)[2][-1]
+        normal = normal if normal @ tangent >= 0 else -normal
+        tilt = float(np.arccos(np.clip(normal @ tangent, -1.0, 1.0)))
+        flatness = float(np.sqrt(np.mean(((rim - centre) @ normal) ** 2)))
+        if np.degrees(tilt) > MAX_TILT_DEG or flatness > MAX_FLATNESS_FRACTION * radius:
+            continue
+        plane = EndPlane(
+            kind, normal, centre, float(np.degrees(tilt)), radius, radius * float(np.tan(tilt)),
+            float((centre - end) @ normal / (normal @ tangent)), flatness,
+        )
+        if best is None or distance < best[0]:
+            best = (distance, plane)
+    return None if best is None else best[1]
+
+
+def _boundary_loops(mesh: Any) -> list[IntArray]:
+    """Vertex ids of each chain of boundary edges (edges of one face), as connected components."""
+    import trimesh
+
+    boundary = mesh.edges_sorted[trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1)]
+    if len(boundary) == 0:
+        return []
+    return [np.asarray(c, np.int64) for c in trimesh.graph.connected_components(boundary, min_len=3)]
+
+
+def _all_round(radial: Points, tangent: FloatArray) -> bool:
+    """True when the rim's radial offsets (perpendicular to ``tangent``) have a vertex in every sector."""
+    u = np.cross(tangent, np.eye(3)[int(np.argmin(np.abs(tangent)))])
+    u /= np.linalg.norm(u)
+    angle = np.arctan2(radial @ np.cross(tangent, u), radial @ u)
+    sector = np.minimum((np.mod(angle, 2.0 * np.pi) * (RIM_SECTORS / (2.0 * np.pi))).astype(int), RIM_SECTORS - 1)
+    return len(np.unique(sector)) == RIM_SECTORS
+
+
+def _flat_regions(mesh: Any) -> list[IntArray]:
+    """Face ids of each connected region of two or more faces whose neighbours differ by < ``FLAT_ANGLE_DEG``."""
+    import trimesh
+
+    flat = mesh.face_adjacency_angles < np.radians(FLAT_ANGLE_DEG)
+    return [np.asarray(c, np.int64) for c in trimesh.graph.connected_components(mesh.face_adjacency[flat], min_len=2)]
+
+
+def _region_boundary_edges(mesh: Any, facet: IntArray) -> np.ndarray:
+    """(E,) bool over ``mesh.edges_sorted``: the edges used once by the region's faces (its boundary)."""
+    import trimesh
+
+    edges = np.zeros(len(mesh.edges_sorted), bool)
+    rows = (np.asarray(facet)[:, None] * 3 + np.arange(3)).reshape(-1)
+    once = trimesh.grouping.group_rows(mesh.edges_sorted[rows], require_count=1)
+    edges[rows[once]] = True
+    return edges
