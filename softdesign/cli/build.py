@@ -105,7 +105,7 @@ def build(
         outcome = _run(case_file, out, None, force, jobs)
         _print_runs(outcome.build_dir, outcome.runs)
         if with_report:
-            report_after_build(outcome.build_dir)
+            report_after_build(outcome.build_dir, jobs=jobs)
         feasibility = outcome.results.get("feasibility")
         return feasibility is not None and feasibility.summary.get("feasible") is False
 

@@ -24,14 +24,19 @@ def pcc_d_from_text(text: str | None) -> tuple[float, ...] | None:
     return tuple(distances_from_text(text, "--pcc-d", "chambers' distance from the backbone", item="link"))
 
 
-def report_after_build(build_dir: Path, pcc_d: str | None = None) -> None:
-    """Write the report of ``build_dir`` and print where it is (stdout) and what was left out (stderr)."""
+def report_after_build(build_dir: Path, pcc_d: str | None = None, jobs: int | None = None) -> None:
+    """Write the report of ``build_dir`` and print where it is (stdout) and what was left out (stderr).
+
+    ``jobs``: worker processes for the figures (None: the cores available); checked before any work.
+    """
+    from softdesign.pipeline.parallel import checked_jobs
     from softdesign.report.writer import ReportOptions, write_report
 
+    workers = checked_jobs(jobs)
     options = ReportOptions(pcc_d=pcc_d_from_text(pcc_d))
     start = time.perf_counter()
     with part_progress("report") as tick:  # a bar on a terminal only; logs get the one summary line below
-        result = write_report(build_dir, options, tick)
+        result = write_report(build_dir, options, tick, workers)
     seconds = time.perf_counter() - start
     for line in result.notes:
         note(f"report: {line}")
@@ -57,6 +62,12 @@ def report(
             show_default=False,
         ),
     ] = None,
+    jobs: Annotated[
+        int | None,
+        typer.Option("--jobs", "-j", help="Worker processes drawing the figures side by side [default: the cores "
+                     "available]; 1 draws everything in this process. The files are the same bytes whatever N.",
+                     show_default=False),
+    ] = None,
 ) -> None:
     """Write BUILD_DIR/report/index.html: the morph, surfaces, fit quality, kinematics, figures and checks, a GIF.
 
@@ -64,4 +75,4 @@ def report(
     bad option, 1 when drawing fails.  The page and its images replace an
     older report in one step; nothing else in the folder changes.
     """
-    run_guarded(lambda: report_after_build(build_dir, pcc_d))
+    run_guarded(lambda: report_after_build(build_dir, pcc_d, jobs))

@@ -96,13 +96,35 @@ def map_per_q(task: Callable[[float], T], q_values: Sequence[float], most: int |
     -------
     list, the results in the order of ``q_values``.  An exception raised by a task is raised here.
     """
+    return map_items(task, q_values, most)
+
+
+def map_items(
+    task: Callable[[Any], T], items: Sequence[Any], most: int | None = None,
+    on_result: Callable[[Any, T], None] | None = None,
+) -> list[T]:
+    """``[task(item) for item in items]`` on up to :func:`current_jobs` forked processes (and at most ``most``).
+
+    As :func:`map_per_q` for any picklable items and results (the report's figures by name);
+    ``on_result(item, result)`` is called in this process as each result arrives, in the order of ``items``.
+    """
     global _TASK
-    workers = min(current_jobs(), len(q_values), most if most is not None else len(q_values))
+    workers = min(current_jobs(), len(items), most if most is not None else len(items))
     if workers <= 1 or "fork" not in multiprocessing.get_all_start_methods():
-        return [task(q) for q in q_values]
+        results = []
+        for item in items:
+            results.append(task(item))
+            if on_result is not None:
+                on_result(item, results[-1])
+        return results
     _TASK = task
     try:
         with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork")) as pool:
-            return list(pool.map(_call, q_values))
+            results = []
+            for item, result in zip(items, pool.map(_call, items), strict=True):
+                results.append(result)
+                if on_result is not None:
+                    on_result(item, result)
+            return results
     finally:
         _TASK = None

@@ -22,6 +22,7 @@ from softdesign.errors import ConfigError
 from softdesign.pipeline.layout import REPORT_DIR
 from softdesign.pipeline.lock import BuildLock
 from softdesign.pipeline.out_folder import folder_errors
+from softdesign.pipeline.parallel import jobs_for_build, map_items
 from softdesign.pipeline.store import process_alive
 from softdesign.report import (
     animation,
@@ -101,19 +102,58 @@ Progress = Callable[[str, float], None]
 
 
 class _Timer:
-    """Runs each part of the report, records its time and tells ``progress``."""
+    """Runs each part of the report, records its time and tells ``progress``.
 
-    def __init__(self, progress: Progress | None) -> None:
+    :meth:`prefetch` draws independent parts on ``jobs`` forked workers
+    (:func:`softdesign.pipeline.parallel.map_items`) ahead of their turn; the
+    part's later call returns the worker's result.  Each part is drawn by the
+    same code on the same data wherever it runs, so the files do not depend on ``jobs``.
+    """
+
+    def __init__(self, progress: Progress | None, jobs: int = 1) -> None:
         self.progress = progress
+        self.jobs = jobs
         self.seconds: dict[str, float] = {}
+        self._ready: dict[str, Any] = {}
 
     def __call__(self, name: str, action: Callable[[], T]) -> T:
+        if name in self._ready:
+            ready: T = self._ready.pop(name)
+            return ready
         start = time.perf_counter()
         result = action()
-        self.seconds[name] = time.perf_counter() - start
-        if self.progress is not None:
-            self.progress(name, self.seconds[name])
+        self._record(name, time.perf_counter() - start)
         return result
+
+    def prefetch(self, parts: dict[str, Callable[[], Any]]) -> None:
+        """Draw ``parts`` (name: action; slowest first balances the workers best) on the workers now."""
+
+        def timed(name: str) -> tuple[Any, float]:
+            start = time.perf_counter()
+            return parts[name](), time.perf_counter() - start
+
+        def arrived(name: str, outcome: tuple[Any, float]) -> None:
+            self._ready[name] = outcome[0]
+            self._record(name, outcome[1])
+
+        if self.jobs > 1:
+            _import_drawing_libraries()  # once here, not once per forked worker
+        with jobs_for_build(self.jobs):
+            map_items(timed, list(parts), on_result=arrived)
+
+    def _record(self, name: str, seconds: float) -> None:
+        self.seconds[name] = seconds
+        if self.progress is not None:
+            self.progress(name, seconds)
+
+
+def _import_drawing_libraries() -> None:
+    """Import what the figures draw with (about 1 s), so that forked workers inherit it rather than each import it."""
+    import matplotlib.backends.backend_agg  # noqa: F401
+    import matplotlib.collections  # noqa: F401
+    import matplotlib.figure  # noqa: F401
+    import PIL.Image  # noqa: F401
+    import plotly.graph_objects  # noqa: F401
 
 
 @dataclass(frozen=True)
@@ -130,11 +170,13 @@ class ReportResult:
 
 
 def write_report(
-    build_dir: str | Path, options: ReportOptions = ReportOptions(), progress: Progress | None = None
+    build_dir: str | Path, options: ReportOptions = ReportOptions(), progress: Progress | None = None, jobs: int = 1
 ) -> ReportResult:
     """Draw the report of ``build_dir`` into ``build_dir/report/`` (replacing an older one).
 
     ``progress(name, seconds)`` is called after each part (loading, each figure, the page, the write).
+    ``jobs``: worker processes drawing the slow figures side by side (checked by the caller,
+    :func:`softdesign.pipeline.parallel.checked_jobs`); the files are the same bytes whatever it is.
 
     Raises
     ------
@@ -143,7 +185,7 @@ def write_report(
     SoftdesignError
         A PCC design fails (e.g. a bad ``pcc_d``).
     """
-    timer = _Timer(progress)
+    timer = _Timer(progress, jobs)
     data = timer("load the build", lambda: load_build(build_dir))
     sections, checks, notes = report_sections(data, options, timer)
     passed = sum(c.passed for c in checks)
@@ -171,6 +213,7 @@ def report_sections(
 ) -> tuple[list[Section], list[Check], list[str]]:
     """The sections of the page, every check, and the notes on what was left out."""
     run = timer or _Timer(None)
+    run.prefetch(_slow_parts(data, options))
     notes: list[str] = []
     view = _view_section(data, options, run)
     morph = Section("morph", "The morph", pictures=[
@@ -188,9 +231,8 @@ def report_sections(
         profile = run(profile_figures.NAME, lambda: profile_figures.profile_picture(data))
         if profile is not None:
             surfaces.pictures.append(profile)
-        distances = run("fit distances", lambda: fit_figures.true_distances(data))
         fit.pictures.extend([run("fit_residuals.png", lambda: fit_figures.residual_picture(data)),
-                             run("fit_distances.png", lambda: fit_figures.distance_picture(data, distances))])
+                             run("fit_distances.png", lambda: _distance_picture(data))])
     kinematics = _kinematics_section(data, options, notes, run)
     field = data.fit.field if data.fit is not None else None
     gif = run("morph.gif", lambda: animation.morph_gif(data.kinematics.chain, field, options.gif_frames))
@@ -213,6 +255,38 @@ def report_sections(
     if fabrication is not None:
         sections.insert(-2, fabrication)
     return sections, checks, notes
+
+
+def _slow_parts(data: BuildData, options: ReportOptions) -> dict[str, Callable[[], Any]]:
+    """The parts that take seconds and need only ``data``, slowest first (as measured on the demo)."""
+    field = data.fit.field if data.fit is not None else None
+    parts: dict[str, Callable[[], Any]] = {
+        "morph.gif": lambda: animation.morph_gif(data.kinematics.chain, field, options.gif_frames),
+        stretch_figures.NAME: lambda: stretch_figures.stretch_picture(data),
+        "3D view": lambda: interactive.morph_html(data, options.view_frames),
+        "morph.png": lambda: morph_figures.morph_picture(data.kinematics.chain, data.export_q),
+    }
+    if data.fit is not None:
+        parts["surfaces.png"] = lambda: surface_figures.surface_picture(data)
+    parts["kinematics.png"] = lambda: _kinematics_picture(data, options)
+    if data.fit is not None:
+        parts["fit_distances.png"] = lambda: _distance_picture(data)
+        parts["fit_residuals.png"] = lambda: fit_figures.residual_picture(data)
+        parts[profile_figures.NAME] = lambda: profile_figures.profile_picture(data)
+    parts["design.png"] = lambda: design_figures.design_picture(data.kinematics.chain)
+    parts[mould_figures.NAME] = lambda: mould_figures.mould_picture(data)
+    return parts
+
+
+def _distance_picture(data: BuildData) -> Any:
+    """The true distances' figure (a build with a fit)."""
+    return fit_figures.distance_picture(data, fit_figures.true_distances(data))
+
+
+def _kinematics_picture(data: BuildData, options: ReportOptions) -> Any:
+    """The kinematics over q figure."""
+    series = kinematics_figures.kinematics_series(data.kinematics.chain, data.export_q, options.q_samples)
+    return kinematics_figures.kinematics_picture(series)
 
 
 def _fabrication_section(data: BuildData, run: _Timer) -> Section | None:
@@ -248,9 +322,8 @@ def _view_section(data: BuildData, options: ReportOptions, run: _Timer) -> Secti
 
 
 def _kinematics_section(data: BuildData, options: ReportOptions, notes: list[str], run: _Timer) -> Section:
-    series = kinematics_figures.kinematics_series(data.kinematics.chain, data.export_q, options.q_samples)
     section = Section("kinematics", "Kinematics over q",
-                      pictures=[run("kinematics.png", lambda: kinematics_figures.kinematics_picture(series))])
+                      pictures=[run("kinematics.png", lambda: _kinematics_picture(data, options))])
     if options.pcc_d is None:
         section.notes.append("PCC chamber lengths: not drawn; give --pcc-d D (mm, one or one per link) to add them.")
         return section
@@ -267,6 +340,7 @@ def _kinematics_section(data: BuildData, options: ReportOptions, notes: list[str
             f"give one value for every link or {data.link_count}, one per link"
         )
     d = options.pcc_d[0] if len(options.pcc_d) == 1 else list(options.pcc_d)
+    series = kinematics_figures.kinematics_series(data.kinematics.chain, data.export_q, options.q_samples)
     picture, design_notes = run("pcc_chambers.png", lambda: kinematics_figures.pcc_picture(data.kinematics.chain,
                                                                                       series, d))
     section.pictures.append(picture)

@@ -1,0 +1,39 @@
+"""`softdesign report --jobs N`: the figures drawn on worker processes give the same files, byte for byte."""
+
+from __future__ import annotations
+
+import pytest
+from typer.testing import CliRunner
+
+from softdesign.cli import app
+from softdesign.pipeline.api import build_through
+from softdesign.pipeline.layout import REPORT_DIR
+from softdesign.pipeline.parallel import MAX_JOBS
+from tests.helpers.paths import REPO
+
+runner = CliRunner()
+
+
+@pytest.mark.parametrize("jobs", ["0", "-1", str(MAX_JOBS + 1)])
+def test_jobs_outside_the_bound_is_refused_before_any_work(tmp_path, jobs):
+    folder = tmp_path / "not-built"  # the bound is checked before the folder is even read
+    result = runner.invoke(app, ["report", str(folder), "--jobs", jobs])
+    assert result.exit_code == 2, result.output
+    assert f"--jobs must be 1 to {MAX_JOBS} worker processes, got {jobs}" in result.output
+    assert "Traceback" not in result.output and not folder.exists()
+
+
+@pytest.mark.slow
+def test_a_report_is_the_same_bytes_with_one_and_two_jobs(tmp_path):
+    build_dir = tmp_path / "build"
+    build_through(REPO / "configs" / "demo.yaml", build_dir)
+    drawn = {}
+    for jobs in ("1", "2"):
+        result = runner.invoke(app, ["report", str(build_dir), "--jobs", jobs])
+        assert result.exit_code == 0, result.output
+        report = build_dir / REPORT_DIR
+        drawn[jobs] = {p.name: p.read_bytes() for p in sorted(report.iterdir())}
+    one, two = drawn["1"], drawn["2"]
+    assert sorted(one) == sorted(two)
+    assert {"index.html", "morph.gif", "stretch.png", "surfaces.png", "morph.png"} <= set(one)
+    assert [name for name in one if one[name] != two[name]] == []
