@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import shutil
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,14 +17,6 @@ from tests.helpers.attacks import demo_case
 from tests.helpers.folders import snapshot
 
 runner = CliRunner()
-
-
-@pytest.fixture(scope="module")
-def prior_build(tmp_path_factory) -> Path:
-    folder = tmp_path_factory.mktemp("prior")
-    result = runner.invoke(app, ["build", str(demo_case(folder)), "--out", str(folder / "build")])
-    assert result.exit_code == 0, result.output
-    return folder / "build"
 
 
 def test_check_names_the_reference_file_when_the_reference_is_broken(prior_build, tmp_path):

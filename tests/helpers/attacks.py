@@ -15,6 +15,8 @@ from tests.helpers.paths import DEMO
 
 #: A refusal must come this fast, s: python start-up and imports, ingest of the demo (about 3 s), the check.
 REFUSAL_TIMEOUT_S = 60
+#: A whole coarse build of the demo, s (a few seconds on an idle machine; generous for a loaded CI).
+BUILD_TIMEOUT_S = 300
 
 
 def _limit_memory() -> None:

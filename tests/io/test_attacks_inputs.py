@@ -16,23 +16,6 @@ import pytest
 from tests.helpers.attacks import assert_refused, demo_case, run_limited
 from tests.helpers.folders import snapshot
 
-BUILD_TIMEOUT_S = 300
-
-
-@pytest.fixture(scope="module")
-def prior_build(tmp_path_factory) -> Path:
-    folder = tmp_path_factory.mktemp("prior")
-    result = run_limited("build", str(demo_case(folder)), "--out", str(folder / "build"), timeout=BUILD_TIMEOUT_S)
-    assert result.returncode == 0, result.stderr
-    return folder / "build"
-
-
-@pytest.fixture
-def out(prior_build, tmp_path) -> Path:
-    target = tmp_path / "build"
-    shutil.copytree(prior_build, target)
-    return target
-
 
 def refused_build(tmp_path: Path, out: Path, *needles: str, **sections) -> str:
     """Build the demo with ``sections`` over ``out``: exit 2 with every needle, ``out`` unchanged; also validate."""

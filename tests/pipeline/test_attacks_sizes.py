@@ -15,30 +15,11 @@ import numpy as np
 import pytest
 
 from softdesign.limits import MAX_CURVE_SAMPLES, MAX_EXPORT_VERTICES, MAX_FIT_COEFFICIENTS, MAX_LINKS, MAX_MESH_VERTICES
-from tests.helpers.attacks import assert_refused, demo_case, run_limited
+from tests.helpers.attacks import BUILD_TIMEOUT_S, assert_refused, demo_case, run_limited
 from tests.helpers.folders import snapshot
 
-#: A full demo build (python start-up, imports, six stages at the coarse export) takes about 12 s.
-BUILD_TIMEOUT_S = 300
 #: How far the vertex estimate of softdesign.pipeline.bounds may fall short of a mesh's vertices (caps, joint rings).
 ESTIMATE_RTOL = 0.01
-
-
-@pytest.fixture(scope="module")
-def prior_build(tmp_path_factory) -> Path:
-    folder = tmp_path_factory.mktemp("prior")
-    case = demo_case(folder)
-    result = run_limited("build", str(case), "--out", str(folder / "build"), timeout=BUILD_TIMEOUT_S)
-    assert result.returncode == 0, result.stderr
-    return folder / "build"
-
-
-@pytest.fixture
-def out(prior_build, tmp_path) -> Path:
-    """A copy of the prior build for one attack."""
-    target = tmp_path / "build"
-    shutil.copytree(prior_build, target)
-    return target
 
 
 def demo_length_mm(build: Path) -> float:

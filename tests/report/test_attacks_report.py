@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import errno
 import os
-import shutil
 from pathlib import Path
 
 import pytest
@@ -12,25 +11,10 @@ from typer.testing import CliRunner
 
 from softdesign.cli import app
 from softdesign.pipeline.lock import BuildLock
-from tests.helpers.attacks import assert_refused, demo_case
+from tests.helpers.attacks import assert_refused
 from tests.helpers.folders import snapshot
 
 runner = CliRunner()
-
-
-@pytest.fixture(scope="module")
-def prior_build(tmp_path_factory) -> Path:
-    folder = tmp_path_factory.mktemp("prior")
-    result = runner.invoke(app, ["build", str(demo_case(folder)), "--out", str(folder / "build")])
-    assert result.exit_code == 0, result.output
-    return folder / "build"
-
-
-@pytest.fixture
-def out(prior_build, tmp_path) -> Path:
-    target = tmp_path / "build"
-    shutil.copytree(prior_build, target)
-    return target
 
 
 @pytest.mark.parametrize("kept", ["blend/curves.npz", "ingest/surface.npz"])
