@@ -59,6 +59,17 @@ def run_guarded(action: Callable[[], T]) -> T:
         raise typer.Exit(code=err.exit_code) from None
 
 
+def finite_number(text: str, what: str, fix: str) -> float:
+    """``text`` as a finite float, or a ConfigError naming ``what`` and giving ``fix``."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise ConfigError(f"{what}: '{text.strip()}' is not a number; {fix}") from None
+    if not math.isfinite(value):
+        raise ConfigError(f"{what}: got {text.strip()}, expected a finite number; {fix}")
+    return value
+
+
 def q_values_from_text(text: str) -> list[float]:
     """Parse ``--q`` into a list of q values, each finite and in [0, 1].
 
@@ -101,12 +112,7 @@ def distances_from_text(
     fix = f'give the {what} in mm: one value ("15") or {per}'
     values = []
     for i, part in enumerate(text.split(","), start=1):
-        try:
-            value = float(part)
-        except ValueError:
-            raise ConfigError(f"{option} value {i}: '{part.strip()}' is not a number; {fix}") from None
-        if not math.isfinite(value):
-            raise ConfigError(f"{option} value {i}: got {part.strip()}, expected a finite number; {fix}")
+        value = finite_number(part, f"{option} value {i}", fix)
         if value <= 0:
             raise ConfigError(f"{option} value {i}: {value:g} mm, expected > 0; {fix}")
         values.append(value)

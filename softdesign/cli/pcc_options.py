@@ -5,12 +5,11 @@ Parsing raises :class:`~softdesign.errors.ConfigError` naming the option and the
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from softdesign.cli.common import distances_from_text
+from softdesign.cli.common import distances_from_text, finite_number
 from softdesign.errors import ConfigError
 
 if TYPE_CHECKING:  # numpy is imported where it is used: `softdesign --help` starts without it
@@ -33,17 +32,6 @@ DOpt = Annotated[
 ]
 
 
-def _number(text: str, what: str, fix: str) -> float:
-    """``text`` as a finite float, or a ConfigError naming ``what``."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise ConfigError(f"{what}: '{text.strip()}' is not a number; {fix}") from None
-    if not math.isfinite(value):
-        raise ConfigError(f"{what}: got {text.strip()}, expected a finite number; {fix}")
-    return value
-
-
 def lengths_from_text(text: str) -> np.ndarray:
     """Parse ``--lengths`` ("l11,l12,l13;l21,l22,l23") into a (k, 3) array, mm, each > 0."""
     import numpy as np
@@ -59,7 +47,7 @@ def lengths_from_text(text: str) -> np.ndarray:
             raise ConfigError(
                 f"--lengths: section {i} has {len(values)} length(s) ('{part.strip()}'), expected 3; {fix}"
             )
-        row = [_number(v, f"--lengths: section {i} cable {j}", fix) for j, v in enumerate(values, start=1)]
+        row = [finite_number(v, f"--lengths: section {i} cable {j}", fix) for j, v in enumerate(values, start=1)]
         for j, value in enumerate(row, start=1):
             if value <= 0:
                 raise ConfigError(f"--lengths: section {i} cable {j} is {value:g} mm, expected > 0; {fix}")
