@@ -14,6 +14,7 @@ from __future__ import annotations
 import io
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -59,14 +60,18 @@ def _shaded(vertices: FloatArray, faces: np.ndarray, colour: str) -> tuple[Float
 
 def mould_figure_png(build_dir: str | Path) -> bytes | None:
     """The exploded view of ``build_dir``'s mould as PNG bytes; None when the build has no mould."""
+    build_dir = Path(build_dir)
+    manifest = json.loads((build_dir / layout.MANIFEST).read_text(encoding="utf-8"))
+    return _exploded_png(build_dir, manifest.get("metrics", {}).get("mould"))
+
+
+def _exploded_png(build_dir: Path, block: dict[str, Any] | None) -> bytes | None:
+    """The picture of the mould the manifest's ``metrics.mould`` ``block`` describes; None without a mould."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.collections import PolyCollection
     from matplotlib.figure import Figure
     from matplotlib.patches import Patch
 
-    build_dir = Path(build_dir)
-    manifest = json.loads((build_dir / layout.MANIFEST).read_text(encoding="utf-8"))
-    block = manifest.get("metrics", {}).get("mould")
     if not block or not block.get("requested"):
         return None
     origin, axes = np.asarray(block["frame"]["origin"]), np.asarray(block["frame"]["axes"])
@@ -102,10 +107,10 @@ def mould_figure_png(build_dir: str | Path) -> bytes | None:
 
 def mould_picture(data: BuildData) -> Picture | None:
     """The exploded view with a caption of the parts' checks; None when the build has no mould."""
-    png = mould_figure_png(data.build_dir)
-    if png is None:
+    block = data.manifest.get("metrics", {}).get("mould")
+    png = _exploded_png(data.build_dir, block)
+    if png is None or block is None:
         return None
-    block = data.manifest["metrics"]["mould"]
     cavity, pulls = block["cavity"], block["pull"]
     parts = ", ".join(f"{name} {f['volume_mm3']:.0f} mm3 ({f['faces']} faces)" for name, f in block["parts"].items())
     caption = (
