@@ -18,23 +18,30 @@ import typer
 from softdesign.cli.build import blend, build, export, fit, ingest, kinematics, links, mould, validate
 from softdesign.cli.centerline import centerline
 from softdesign.cli.check import check
+from softdesign.cli.common import list_whole_first_paragraphs
 from softdesign.cli.design import design
-from softdesign.cli.pcc import pcc_app
+from softdesign.cli.pcc import PCC_SHORT_HELP, pcc_app
 from softdesign.cli.pose import pose
 from softdesign.cli.report import report
 from softdesign.cli.sample import sample
 
+#: Help is click's plain text, not typer's rich panels: rich markup ate every ``[default: ...]`` in the option
+#: help (``--out`` read "Build folder .") and importing rich for it doubled the time of ``softdesign --help``
+#: (issue 19).  The command list shows each command's whole first paragraph, as the panels did.
 app = typer.Typer(
     add_completion=False,
     no_args_is_help=True,
     help="Patient-specific soft actuators from VMTK vessel exports.",
+    rich_markup_mode=None,
 )
-app.add_typer(pcc_app, name="pcc")
+app.add_typer(pcc_app, name="pcc", short_help=PCC_SHORT_HELP)
 for command in (
     validate, build, ingest, blend, links, kinematics, fit, export, mould, pose, check, report, sample, centerline,
     design,
 ):
     app.command()(command)
+for group in (app, pcc_app):
+    list_whole_first_paragraphs(group)
 
 
 def main() -> None:

@@ -9,6 +9,7 @@ the distance lists ``--d``/``--pcc-d``) are the only ones; they raise
 
 from __future__ import annotations
 
+import inspect
 import json
 import math
 import sys
@@ -33,6 +34,17 @@ QOpt = Annotated[
 ]
 
 Q_FIX = "give one q for every link (e.g. 0.5) or one per link separated by commas (e.g. 0.2,0.8,1), each in [0, 1]"
+
+
+def list_whole_first_paragraphs(group: typer.Typer) -> None:
+    """Let ``--help`` list each command of ``group`` with the whole first paragraph of its docstring.
+
+    Click's plain help cuts a command's line at about 60 characters ("...") unless it has a short help;
+    the first paragraph is written to be that line.
+    """
+    for info in group.registered_commands:
+        if info.short_help is None and info.callback is not None and info.callback.__doc__:
+            info.short_help = " ".join(inspect.cleandoc(info.callback.__doc__).split("\n\n")[0].split())
 
 
 def note(message: str) -> None:

@@ -32,10 +32,10 @@ CONVENTION = (
     "each section's frame continues from the previous section's tip without twist."
 )
 
-pcc_app = typer.Typer(
-    no_args_is_help=True,
-    help="Piecewise constant curvature from three cable-encoder lengths per section (seed 003). " + CONVENTION,
-)
+#: The group's line in ``softdesign --help`` (its own --help adds the convention).
+PCC_SHORT_HELP = "Piecewise constant curvature from three cable-encoder lengths per section (seed 003)."
+
+pcc_app = typer.Typer(no_args_is_help=True, help=f"{PCC_SHORT_HELP} {CONVENTION}", rich_markup_mode=None)
 
 
 def forward_payload(lengths: np.ndarray, d: np.ndarray) -> dict:

@@ -38,7 +38,8 @@ from softdesign.meshing.solids import Solid, build_solid
 from softdesign.meshing.volume import BodySpec, integrate_body
 from softdesign.pipeline import layout
 from softdesign.pipeline.bounds import export_workers
-from softdesign.pipeline.parallel import map_per_q
+from softdesign.pipeline.item_progress import item_counter
+from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
@@ -146,11 +147,18 @@ def centerline_arrays(kinematics: KinematicsResult, q: float) -> dict[str, np.nd
     }
 
 
+def _mesh_label(q: float) -> str:
+    """How the progress bar names the mesh of ``q``."""
+    return f"mesh q = {q:g}"
+
+
 def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult) -> ExportResult:
     """A checked solid at every export q (on the build's worker processes: as many as fit in memory, and worth it)."""
     longest = max(key.length for key in kinematics.chain.shape.keys)
-    meshes = tuple(map_per_q(lambda q: _solid_naming_blend(kinematics, fit, q, case), case.export.q_values(),
-                             most=export_workers(case, longest)))
+    q_values = case.export.q_values()
+    counted = item_counter("export", q_values, _mesh_label)  # the command line's per-mesh bar, when it listens
+    meshes = tuple(map_items(lambda q: _solid_naming_blend(kinematics, fit, q, case), q_values,
+                             most=export_workers(case, longest), on_result=counted))
     morph = None
     if "glb" in case.export.formats and len(meshes) >= 2:
         e = case.export
