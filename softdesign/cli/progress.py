@@ -3,6 +3,9 @@
 Shown only on a terminal: a log, a pipe or ``--json`` output gets nothing from
 here (the command's own summary line says what was done).  The bar is
 transient: it disappears when the work ends, leaving the terminal as before.
+It is redrawn at each part rather than by rich's refresh thread: ``report --jobs``
+forks its workers while the bar is up, and a fork must not copy a thread that
+may hold stderr's lock.
 """
 
 from __future__ import annotations
@@ -36,10 +39,11 @@ def part_progress(label: str, enabled: bool | None = None, console: Any = None) 
 
     columns = (SpinnerColumn(), TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed} done"),
                TimeElapsedColumn())
-    with Progress(*columns, console=console or Console(stderr=True), transient=True) as bar:
+    with Progress(*columns, console=console or Console(stderr=True), transient=True,
+                  auto_refresh=False, redirect_stdout=False, redirect_stderr=False) as bar:
         task = bar.add_task(label, total=None)
 
         def tick(name: str, seconds: float) -> None:
-            bar.update(task, advance=1, description=f"{label}: {name} ({seconds:.1f} s)")
+            bar.update(task, advance=1, description=f"{label}: {name} ({seconds:.1f} s)", refresh=True)
 
         yield tick
