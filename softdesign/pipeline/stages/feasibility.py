@@ -38,6 +38,7 @@ from softdesign.meshing.skin_stretch import (
     converged_extremes,
     extremes_on,
     make_grid,
+    morph_samples,
     search_morph,
 )
 from softdesign.meshing.tessellate import ring_points
@@ -179,16 +180,26 @@ def _at_q(body: _Body, q: float, case: Case) -> dict[str, Any]:
     return row
 
 
-def _morph_search(body: _Body) -> tuple[MorphExtreme, MorphExtreme]:
-    """Where over q in [0, 1] the skin's stretches are extreme: searched on the first grid (the outer skin)."""
+def _morph_search(body: _Body, most: int | None) -> tuple[MorphExtreme, MorphExtreme]:
+    """Where over q in [0, 1] the skin's stretches are extreme: searched on the first grid (the outer skin).
+
+    The search's first samples are independent and run on the build's worker processes; the bounded
+    search that follows asks for one q at a time.
+    """
     g = make_grid(body.length, body.field.breaks, START_SPACING_MM,
                   START_ANGLES_PER_INTERVAL * body.field.final[0].angular_intervals)
     rest = body.rest(0.0)
-    cache: dict[float, StretchExtremes] = {}
+    rest(g.l, g.a)  # once, before the workers start: they inherit it
+
+    def on_grid(q: float) -> StretchExtremes:
+        return extremes_on(g, rest, body.surface(q, 0.0), body.field.breaks)
+
+    samples = morph_samples()
+    cache: dict[float, StretchExtremes] = dict(zip(samples, map_items(on_grid, samples, most=most), strict=True))
 
     def at(q: float) -> StretchExtremes:
         if q not in cache:
-            cache[q] = extremes_on(g, rest, body.surface(q, 0.0), body.field.breaks)
+            cache[q] = on_grid(q)
         return cache[q]
 
     return search_morph(at)
@@ -250,7 +261,7 @@ def run_feasibility(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
     """Every figure, then the verdict against the case's material (if any)."""
     body = _Body(kinematics.chain.shape, fit.field, body_spec(case), case.frames)
     most = meshes_at_once(case, max(key.length for key in body.shape.keys))  # a wall map is one mesh's rings
-    found = _morph_search(body)  # cheap (first grid only), so its two converged polishes join the per-q work
+    found = _morph_search(body, most)  # first grid only, so its two converged polishes join the per-q work
     work: list[tuple[str, float]] = [("q", q) for q in case.export.q_values()] + [("morph", m.q) for m in found]
 
     def task(item: tuple[str, float]) -> Any:
