@@ -23,7 +23,8 @@ I/O floor
     row compares with the read, the export row with the writes, the total
     with both.
 Workers
-    A build runs its per-q work (export's meshes, feasibility's figures) on
+    A build runs its parallel work (export's meshes, feasibility's figures
+    and morph samples, the fit's hold-out folds) on
     ``--jobs`` forked worker processes (default: the cores available, as
     ``softdesign build``); their CPU time is in the stage's cpu s, and the
     largest worker's peak RSS is printed apart (a worker shares the build
