@@ -23,7 +23,8 @@ I/O floor
     row compares with the read, the export row with the writes, the total
     with both.
 Workers
-    A build runs its per-q work (export's meshes, feasibility's figures) on
+    A build runs its parallel work (export's meshes, feasibility's figures
+    and morph samples, the fit's hold-out folds) on
     ``--jobs`` forked worker processes (default: the cores available, as
     ``softdesign build``); their CPU time is in the stage's cpu s, and the
     largest worker's peak RSS is printed apart (a worker shares the build
@@ -422,7 +423,8 @@ def stage_table(result: dict[str, Any]) -> list[str]:
         f"RSS after imports {result['baseline_mib']:.0f} MiB; --jobs {result['jobs']}, largest worker's peak "
         f"{result['worker_peak_mib']:.0f} MiB (pages shared with the build's; the whole is at most "
         f"{result['total']['peak_mib'] + result['jobs'] * result['worker_peak_mib']:.0f} MiB)",
-        f"  {'stage':<11}{'wall s':>9}{'cpu s':>9}{'peak MiB':>10}{'floor s':>9}{'build/floor':>13}",
+        f"  {'stage':<11}{'wall s':>9}{'cpu s':>9}{'peak MiB':>10}{'floor s':>9}{'build/floor':>13}"
+        f"{'wall/whole floor':>18}",
     ]
     rows = [(name, result["stages"][name]) for name in STAGE_NAMES] + [("total", result["total"])]
     for name, row in rows:
@@ -430,8 +432,10 @@ def stage_table(result: dict[str, Any]) -> list[str]:
         floor_text = "-" if f is None else f"{f:.3f}"
         lines.append(
             f"  {name:<11}{row['wall_s']:>9.2f}{row['cpu_s']:>9.2f}{row['peak_mib']:>10.0f}"
-            f"{floor_text:>9}{ratio_text(row['wall_s'], f):>13}"
+            f"{floor_text:>9}{ratio_text(row['wall_s'], f):>13}{ratio_text(row['wall_s'], floors['total']):>18}"
         )
+    lines.append("  (build/floor: against the stage's own I/O floor; wall/whole floor: against the build's, read + "
+                 "writes, so the stages' shares add up to the total's ratio)")
     return lines
 
 

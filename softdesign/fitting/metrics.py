@@ -21,8 +21,9 @@ fold is measured against the fit on the other k - 1 folds.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -129,6 +130,16 @@ def surface_points(curve: FramedCurve, spline: RadiusSpline, l: FloatArray, angl
     rho = spline.evaluate(l, angle)
     direction = np.cos(angle)[:, None] * frames[:, :, 0] + np.sin(angle)[:, None] * frames[:, :, 1]
     return curve.points(l) + rho[:, None] * direction
+
+
+#: ``mapper(task, items)`` is ``[task(item) for item in items]``, perhaps on other processes (the build's
+#: :func:`softdesign.pipeline.parallel.map_items`); the results in the order of ``items``.
+Mapper = Callable[[Callable[[Any], Any], Sequence[Any]], list[Any]]
+
+
+def serial_map(task: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
+    """The :data:`Mapper` that runs every item here, in turn."""
+    return [task(item) for item in items]
 
 
 class RadiusSurface(Protocol):
@@ -326,6 +337,7 @@ def holdout_rms(
     rng: np.random.Generator,
     holdout: HoldoutSettings = HoldoutSettings(),
     start: tuple[FloatArray, FloatArray] | None = None,
+    mapper: Mapper = serial_map,
 ) -> HoldoutReport:
     """k-fold hold-out: fit on k - 1 folds, true distances of the held-out fold, pooled RMS (mm).
 
@@ -340,21 +352,27 @@ def holdout_rms(
     holdout : folds and the most points used
     start : (l (n,), angle (n,)) of each point's closest point on the fit to all points, where its
         Gauss-Newton starts (fewer steps than from the projection); default the projection
+    mapper : runs the held-out folds' distances (independent of each other); the same figures for any
     """
     sample = holdout_sample(len(polar), holdout.max_points, rng)
     labels = fold_labels(len(sample), holdout.folds, rng)
     begin = None if start is None else (np.asarray(start[0])[sample], np.asarray(start[1])[sample])
-    return _holdout(curve, polar.subset(sample), settings, labels, begin)
+    return _holdout(curve, polar.subset(sample), settings, labels, begin, mapper)
 
 
 def _holdout(
-    curve: FramedCurve, polar: PolarPoints, settings: FitSettings, labels: np.ndarray, start=None
+    curve: FramedCurve, polar: PolarPoints, settings: FitSettings, labels: np.ndarray, start=None,
+    mapper: Mapper = serial_map,
 ) -> HoldoutReport:
-    squares, fold_rms = [], []
-    for k, spline in enumerate(fold_fits(polar, curve.length, settings, labels)):
+    splines = fold_fits(polar, curve.length, settings, labels)
+
+    def held_out(k: int) -> FloatArray:
         test = labels == k
         begin = None if start is None else (start[0][test], start[1][test])
-        d = closest_surface_points(curve, spline, polar.subset(test), begin)[0]
+        return closest_surface_points(curve, splines[k], polar.subset(test), begin)[0]
+
+    squares, fold_rms = [], []
+    for d in mapper(held_out, range(len(splines))):
         squares.append(d**2)
         fold_rms.append(np.sqrt(np.mean(d**2)))
     return HoldoutReport(float(np.sqrt(np.mean(np.concatenate(squares)))), np.array(fold_rms), len(polar))

@@ -22,9 +22,11 @@ from softdesign.fitting.metrics import (
     FitMetrics,
     HoldoutReport,
     HoldoutSettings,
+    Mapper,
     choose_knot_spacing,
     holdout_rms,
     measure_distances,
+    serial_map,
 )
 from softdesign.fitting.projection import PolarPoints, project_points
 from softdesign.fitting.radius_field import FOLD_SPACING_MM, FoldReport, RadiusField, check_self_folding, fold_margin
@@ -45,6 +47,7 @@ class WallFitOptions:
     initial_radius_mm : constant rho0; None for the axially symmetric mean of the fit
     fold_limit : the largest rho * kappa allowed at q = 1
     end_margin_mm : kept points within this arc length of either end are left out of the fit, mm
+    mapper : runs independent pieces (the hold-out's folds), perhaps on other processes; same figures for any
     """
 
     fit: FitSettings = field(default_factory=FitSettings)
@@ -54,6 +57,7 @@ class WallFitOptions:
     initial_radius_mm: float | None = None
     fold_limit: float = 1.0
     end_margin_mm: float = 0.0
+    mapper: Mapper = serial_map
 
 
 @dataclass(frozen=True)
@@ -136,7 +140,7 @@ def fit_wall(
     measured = measure_distances(curve, surface.whole, kept, rng)
     # the hold-out folds are dealt from the measured points, each starting from its closest point
     holdout = holdout_rms(curve, kept.subset(measured.sample), settings, rng, options.holdout,
-                          start=(measured.l, measured.angle))
+                          start=(measured.l, measured.angle), mapper=options.mapper)
     metrics = measured.metrics
     radius = RadiusField.from_links(settings.breaks, surface.links, options.initial_radius_mm)
     try:

@@ -121,8 +121,7 @@ def end_planes(
     reach = (END_SEARCH_RADII + 1.0 / np.cos(np.radians(MAX_TILT_DEG))) * np.asarray(inscribed_mm, float)
     near = np.any(np.linalg.norm(mesh.triangles_center[:, None, :] - np.asarray(ends, float)[None], axis=2)
                   <= reach, axis=1)
-    rims += [("flat_cap", np.unique(mesh.edges_sorted[_region_boundary_edges(mesh, f)]))
-             for f in _flat_regions(mesh) if near[f].any()]
+    rims += [("flat_cap", _region_rim(mesh, f)) for f in _flat_regions(mesh, near)]
     out = []
     for k, outward in ((0, -1.0), (1, 1.0)):
         out.append(_end_plane(vertices, rims, np.asarray(ends[k], float),
@@ -196,20 +195,34 @@ def _all_round(radial: Points, tangent: FloatArray) -> bool:
     return len(np.unique(sector)) == RIM_SECTORS
 
 
-def _flat_regions(mesh: Any) -> list[IntArray]:
-    """Face ids of each connected region of two or more faces whose neighbours differ by < ``FLAT_ANGLE_DEG``."""
+def _flat_regions(mesh: Any, near: np.ndarray) -> list[IntArray]:
+    """Face ids of each connected region of two or more faces whose neighbours differ by < ``FLAT_ANGLE_DEG``.
+
+    Only the regions holding a face of ``near`` (bool per face), in the order of their smallest face id.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    pairs = mesh.face_adjacency[mesh.face_adjacency_angles < np.radians(FLAT_ANGLE_DEG)]
+    count = len(mesh.faces)
+    graph = coo_matrix((np.ones(len(pairs), np.int8), (pairs[:, 0], pairs[:, 1])), shape=(count, count))
+    labels = connected_components(graph, directed=False)[1]  # numbered in the order of their smallest face id
+    sizes = np.bincount(labels)
+    wanted = np.unique(labels[near])
+    wanted = wanted[sizes[wanted] >= 2]
+    by_label = np.argsort(labels, kind="stable")
+    starts = np.concatenate(([0], np.cumsum(sizes)))
+    return [by_label[starts[k]:starts[k + 1]].astype(np.int64) for k in wanted]
+
+
+def _region_rim(mesh: Any, facet: IntArray) -> IntArray:
+    """Sorted vertex ids of the edges used once by the region's faces (its boundary).
+
+    Only the region's own 3 F edges are grouped (not a mask over the whole mesh's edges): the cost
+    follows the region's size, which matters on a million-triangle wall with hundreds of flat pairs.
+    """
     import trimesh
 
-    flat = mesh.face_adjacency_angles < np.radians(FLAT_ANGLE_DEG)
-    return [np.asarray(c, np.int64) for c in trimesh.graph.connected_components(mesh.face_adjacency[flat], min_len=2)]
-
-
-def _region_boundary_edges(mesh: Any, facet: IntArray) -> np.ndarray:
-    """(E,) bool over ``mesh.edges_sorted``: the edges used once by the region's faces (its boundary)."""
-    import trimesh
-
-    edges = np.zeros(len(mesh.edges_sorted), bool)
     rows = (np.asarray(facet)[:, None] * 3 + np.arange(3)).reshape(-1)
-    once = trimesh.grouping.group_rows(mesh.edges_sorted[rows], require_count=1)
-    edges[rows[once]] = True
-    return edges
+    edges = mesh.edges_sorted[rows]
+    return np.unique(edges[trimesh.grouping.group_rows(edges, require_count=1)])

@@ -151,6 +151,11 @@ class MorphExtreme:
     where: Extreme
 
 
+def morph_samples() -> list[float]:
+    """The q values :func:`search_morph` samples first (a caller may compute them ahead, e.g. in parallel)."""
+    return [float(q) for q in np.linspace(0.0, 1.0, Q_SAMPLES)]
+
+
 def search_morph(extremes_at: Callable[[float], StretchExtremes]) -> tuple[MorphExtreme, MorphExtreme]:
     """Largest lambda1 and smallest lambda2 over q in [0, 1]: samples, then a bounded search near the best.
 
@@ -158,7 +163,7 @@ def search_morph(extremes_at: Callable[[float], StretchExtremes]) -> tuple[Morph
     q, bracketed by the neighbours of the best of ``Q_SAMPLES`` samples; a
     second, narrower optimum between samples can be missed.
     """
-    qs = np.linspace(0.0, 1.0, Q_SAMPLES)
+    qs = np.array(morph_samples())
     found = [extremes_at(float(q)) for q in qs]
     out = []
     for sign, pick in ((-1.0, lambda e: e.maximum), (1.0, lambda e: e.minimum)):

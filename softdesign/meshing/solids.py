@@ -192,14 +192,16 @@ def build_solid(sections: TubeSections, spec: BodySpec = BodySpec()) -> Solid:
     MeshError
         Naming q and l: a surface that folds (rho * kappa >= 1), an inward
         offset or wall the local radius cannot take, a port wider than the
-        chamber, or a mesh manifold3d refuses.
+        chamber, or a mesh manifold3d refuses (hollow and ported solids; a
+        plain solid is checked by :func:`~softdesign.meshing.checks.check_solid`).
     """
     _check_spec(spec, sections)
     label = f"q={sections.q:.3f}"
     outer = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
     body = tessellate(outer)
     if spec.wall_mm == 0:
-        manifold_from_mesh(body.vertices, body.faces, f"{label}: body")
+        # no boolean, so no manifold3d: check_solid (which export runs on every solid) tests the same oriented
+        # 2-manifold property and more; building the Manifold only to check it was half of export's time
         return Solid(body.vertices, body.faces, body.regions, 2, "solid", outer.max_rho_kappa)
     chamber = _chamber(sections, outer, spec)
     return carve_chamber(body, tessellate(chamber), outer, chamber, spec, label)

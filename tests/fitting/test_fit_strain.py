@@ -8,7 +8,13 @@ import pytest
 from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import RadiusSpline
 from softdesign.fitting.radius_field import RadiusField
-from softdesign.fitting.strain import principal_stretches, skin_metric
+from softdesign.fitting.strain import (
+    metric_from_sections,
+    principal_stretches,
+    skin_metric,
+    tube_metric,
+    tube_sections,
+)
 from softdesign.geometry.blend import blend_shapes
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
 from softdesign.geometry.initial import straight_initial_shape
@@ -185,3 +191,13 @@ def test_the_metric_is_that_of_the_surface_points_by_finite_differences(mode):
                          np.einsum("...i,...i", x_a, x_a)], axis=-1)
     # central differences: ~h^2 x third derivatives (E ~ 1e3 mm^2 here) plus rounding ~1e-16 x 1e3 / h
     np.testing.assert_allclose(metric, expected, rtol=1e-7, atol=1e-6)
+
+
+@pytest.mark.parametrize(("p", "m"), [(7, 5), (120, 96), (33, 1)])
+def test_the_tube_metric_is_the_metric_of_the_tube_sections_to_the_last_bit(p, m):
+    """The fused metric skin_metric uses performs the sections' operations in their order: the same bits."""
+    rng = np.random.default_rng(p * m)
+    args = (rng.uniform(10.0, 300.0, p), rng.normal(0.0, 0.1, (p, 2)), rng.normal(0.0, 0.01, p),
+            np.sort(rng.uniform(0.0, 2.0 * np.pi, m)), rng.uniform(1.0, 5.0, (p, m)), rng.normal(0.0, 30.0, (p, m)),
+            rng.normal(0.0, 1.0, (p, m)))
+    assert tube_metric(*args).tobytes() == metric_from_sections(tube_sections(*args)).tobytes()

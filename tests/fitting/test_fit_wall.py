@@ -91,3 +91,34 @@ def test_fit_wall_stops_when_the_tube_would_fold():
     expected = r"folds through itself: rho \* kappa = 0\.750 \(expected < 0\.5\) at l = 1\.0000"
     with pytest.raises(FitError, match=expected):
         fit_wall(curve, vertices, network, options, np.random.default_rng(0))
+
+
+def test_the_holdout_folds_on_worker_processes_give_the_same_figures():
+    """The folds' distances are independent: run by the build's forked workers, every figure is the same bits."""
+    import os
+
+    from softdesign.pipeline.parallel import jobs_for_build, map_items
+
+    curve = Arc(40.0, 1.2)
+    rng = np.random.default_rng(5)
+    vertices, wall_count = _capped_torus(curve, rng)
+    vertices[:wall_count] += rng.normal(0.0, 0.02, (wall_count, 3))  # a wall off the spline space: rms > 0
+    path = curve.points(np.linspace(0.0, 1.0, 49))
+    network = NetworkContext(path, (), np.linspace(0.0, 1.0, 49), 2.5 + 0.5 * np.linspace(0.0, 1.0, 49))
+    pids: set[int] = set()
+
+    def forked(task, items):
+        done = map_items(lambda item: (os.getpid(), task(item)), items)
+        pids.update(pid for pid, _ in done)
+        return [result for _, result in done]
+
+    summaries = []
+    for mapper in (None, forked):
+        options = WallFitOptions(fit=FitSettings(breaks=(0.0, 0.5, 1.0)), initial_radius_mm=2.0,
+                                 **({} if mapper is None else {"mapper": mapper}))
+        with jobs_for_build(2):
+            result = fit_wall(curve, vertices, network, options, np.random.default_rng(0))
+        summaries.append(json.dumps(result.summary(), sort_keys=True))
+    assert pids - {os.getpid()}, "no fold ran in a worker process"
+    assert result.holdout.rms_mm > 0.01 and len(result.holdout.fold_rms_mm) == HoldoutSettings().folds
+    assert summaries[0] == summaries[1]

@@ -214,3 +214,29 @@ def test_manifold3d_status_is_checked():
     solid = build_solid(Body(straight_line(5.0), 1.0).sections(3, 8))
     with pytest.raises(MeshError, match="status NotManifold"):
         manifold_from_mesh(solid.vertices, solid.faces[:-1], "q=0.000: body")
+
+
+def _open(solid):
+    return solid.vertices, solid.faces[:-1]
+
+
+def _flipped(solid):
+    faces = solid.faces.copy()
+    faces[0] = faces[0, ::-1]
+    return solid.vertices, faces
+
+
+def _not_finite(solid):
+    vertices = solid.vertices.copy()
+    vertices[0, 0] = np.nan
+    return vertices, solid.faces
+
+
+@pytest.mark.parametrize("fault", [_open, _flipped, _not_finite])
+def test_a_plain_solid_that_manifold3d_refuses_is_refused_by_check_solid_too(fault):
+    """A plain solid skips manifold3d (no boolean needs it): check_solid, run on every exported solid, refuses it."""
+    vertices, faces = fault(build_solid(Body(straight_line(5.0), 1.0).sections(3, 8)))
+    with pytest.raises(MeshError, match="manifold3d refused"):
+        manifold_from_mesh(vertices, faces, "q=0.000: body")
+    with pytest.raises(MeshError, match="not a valid solid"):
+        check_solid(vertices, faces)

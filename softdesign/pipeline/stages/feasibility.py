@@ -14,6 +14,7 @@ Output: ``feasibility/summary.json``; the manifest's ``metrics.feasibility``.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,17 +33,19 @@ from softdesign.meshing.skin_stretch import (
     START_SPACING_MM,
     STRETCH_TOL,
     MetricAt,
+    MorphExtreme,
     StretchExtremes,
     converged_extremes,
     extremes_on,
     make_grid,
+    morph_samples,
     search_morph,
 )
 from softdesign.meshing.tessellate import ring_points
 from softdesign.meshing.volume import BodySpec
 from softdesign.meshing.wall import FD_STEP_MM, offset_sections, port_wall_mm, thinnest, wall_map
 from softdesign.pipeline.bounds import meshes_at_once
-from softdesign.pipeline.parallel import map_per_q
+from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.export import body_spec
 from softdesign.pipeline.stages.fit import FitResult
@@ -52,6 +55,9 @@ from softdesign.types import FramedCurve
 
 VERSION = 1
 SUMMARY = "feasibility/summary.json"
+#: Memory for the rest state's metrics a body keeps (:meth:`_Body.rest`), bytes: the finest grid's
+#: (E, F, G) of the 1M-triangle benchmark case is 18 MB (729,600 points), and every q asks for the same grids.
+REST_CACHE_BYTES = 64 * 2**20
 
 
 @dataclass(frozen=True)
@@ -69,6 +75,9 @@ class _Body:
     field: RadiusField
     spec: BodySpec
     frames: str
+    #: the rest state's metrics by (offset, grid), least recently used first; per process (a worker fills its own)
+    _rest: dict[tuple[float, bytes, bytes], np.ndarray] = dataclasses.field(
+        default_factory=dict, compare=False, repr=False)
 
     @property
     def length(self) -> float:
@@ -80,6 +89,26 @@ class _Body:
             return lambda l, a: skin_metric(curve, self.field, q, l, a, self.frames)
         return lambda l, a: metric_from_sections(offset_sections(curve, self.field, q, l, len(a), offset_mm,
                                                                  self.frames))
+
+    def rest(self, offset_mm: float) -> MetricAt:
+        """``surface(0.0, offset_mm)``, each grid's metric computed once: the rest state is the same for every q.
+
+        The same numbers as computing it afresh (the same call on the same grid); read-only.
+        """
+        at = self.surface(0.0, offset_mm)
+
+        def cached(l: np.ndarray, a: np.ndarray) -> np.ndarray:
+            key = (offset_mm, np.ascontiguousarray(l, float).tobytes(), np.ascontiguousarray(a, float).tobytes())
+            metric = self._rest.pop(key, None)  # put back last: the dict runs from least to most recently used
+            if metric is None:
+                metric = at(l, a)
+                metric.setflags(write=False)
+            self._rest[key] = metric
+            while len(self._rest) > 1 and sum(m.nbytes for m in self._rest.values()) > REST_CACHE_BYTES:
+                self._rest.pop(next(iter(self._rest)))
+            return metric
+
+        return cached
 
     def span(self, q: float, margin_mm: float) -> tuple[float, float]:
         """The l range at least ``margin_mm`` of arc from both ends at q = 0 and at q."""
@@ -94,7 +123,7 @@ class _Body:
 
 
 def _extremes(body: _Body, q: float, offset_mm: float, span: tuple[float, float]) -> StretchExtremes:
-    return converged_extremes(body.surface(0.0, offset_mm), body.surface(q, offset_mm), body.length,
+    return converged_extremes(body.rest(offset_mm), body.surface(q, offset_mm), body.length,
                               body.field.breaks, body.field.final[0].angular_intervals, span)
 
 
@@ -151,24 +180,41 @@ def _at_q(body: _Body, q: float, case: Case) -> dict[str, Any]:
     return row
 
 
-def _morph(body: _Body) -> dict[str, Any]:
-    """Extremes of the skin's stretches over q in [0, 1]: searched on the first grid, then converged at that q."""
+def _morph_search(body: _Body, most: int | None) -> tuple[MorphExtreme, MorphExtreme]:
+    """Where over q in [0, 1] the skin's stretches are extreme: searched on the first grid (the outer skin).
+
+    The search's first samples are independent and run on the build's worker processes; the bounded
+    search that follows asks for one q at a time.
+    """
     g = make_grid(body.length, body.field.breaks, START_SPACING_MM,
                   START_ANGLES_PER_INTERVAL * body.field.final[0].angular_intervals)
-    rest = body.surface(0.0, 0.0)
-    cache: dict[float, StretchExtremes] = {}
+    rest = body.rest(0.0)
+    rest(g.l, g.a)  # once, before the workers start: they inherit it
+
+    def on_grid(q: float) -> StretchExtremes:
+        return extremes_on(g, rest, body.surface(q, 0.0), body.field.breaks)
+
+    samples = morph_samples()
+    cache: dict[float, StretchExtremes] = dict(zip(samples, map_items(on_grid, samples, most=most), strict=True))
 
     def at(q: float) -> StretchExtremes:
         if q not in cache:
-            cache[q] = extremes_on(g, rest, body.surface(q, 0.0), body.field.breaks)
+            cache[q] = on_grid(q)
         return cache[q]
 
-    high, low = search_morph(at)
+    return search_morph(at)
+
+
+def _morph(found: tuple[MorphExtreme, MorphExtreme], polished: tuple[StretchExtremes, StretchExtremes]
+           ) -> dict[str, Any]:
+    """Extremes of the skin's stretches over q in [0, 1]: the q found by the search, the value on a converged grid.
+
+    ``polished`` holds the converged extremes of the outer skin without offset at each q found.
+    """
     out: dict[str, Any] = {}
-    for key, found in (("stretch_max", high), ("stretch_min", low)):
-        polished = _extremes(body, found.q, 0.0, (0.0, 1.0))
-        e = polished.maximum if key == "stretch_max" else polished.minimum
-        out[key] = {"value": e.value, "q": found.q, "where": _where(e)}
+    for key, hit, at in zip(("stretch_max", "stretch_min"), found, polished, strict=True):
+        e = at.maximum if key == "stretch_max" else at.minimum
+        out[key] = {"value": e.value, "q": hit.q, "where": _where(e)}
     out["method"] = (f"{Q_SAMPLES} q samples, then a bounded search to {Q_XTOL:g} in q near the best, on the first "
                      "grid; the value at the q found on a converged grid; the outer skin without offset")
     return out
@@ -215,7 +261,15 @@ def run_feasibility(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
     """Every figure, then the verdict against the case's material (if any)."""
     body = _Body(kinematics.chain.shape, fit.field, body_spec(case), case.frames)
     most = meshes_at_once(case, max(key.length for key in body.shape.keys))  # a wall map is one mesh's rings
-    rows = map_per_q(lambda q: _at_q(body, q, case), case.export.q_values(), most=most)
+    found = _morph_search(body, most)  # first grid only, so its two converged polishes join the per-q work
+    work: list[tuple[str, float]] = [("q", q) for q in case.export.q_values()] + [("morph", m.q) for m in found]
+
+    def task(item: tuple[str, float]) -> Any:
+        kind, q = item
+        return _at_q(body, q, case) if kind == "q" else _extremes(body, q, 0.0, (0.0, 1.0))
+
+    done = map_items(task, work, most=most)
+    rows, polished = done[:-2], (done[-2], done[-1])
     per_link = []
     for j in range(len(fit.field.final)):
         links = [r["per_link"][j] for r in rows]
@@ -227,7 +281,7 @@ def run_feasibility(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
     summary: dict[str, Any] = {
         "per_q": rows,
         "per_link": per_link,
-        "morph": _morph(body),
+        "morph": _morph(found, polished),
         "material": limits,
         "tolerance": {"stretch": STRETCH_TOL, "q": Q_XTOL},
     }

@@ -29,6 +29,7 @@ from softdesign.geometry.curves import SmoothCurve, measure_deviation
 from softdesign.geometry.network import SelectedPath
 from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import describe_backbone_fit, stretch_fit_errors
+from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.ingest import IngestResult
 from softdesign.pipeline.stages.links import LinksResult
@@ -78,6 +79,7 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
         holdout=HoldoutSettings(folds=fit.holdout_folds),
         initial_radius_mm=case.initial.radius_mm,
         end_margin_mm=case.fit.end_margin_mm,
+        mapper=map_items,  # the hold-out's folds on the build's worker processes
     )
     try:
         wall = fit_wall(curve, ingest.vertices, network, options, np.random.default_rng(HOLDOUT_SEED))
