@@ -59,6 +59,20 @@ MAX_REFINEMENTS = 2
 #: Centerline samples per link and frame.
 CURVE_SAMPLES = 40
 VESSEL_OPACITY = 0.25
+#: Runs the play and pause buttons' animations.  Pause interrupts play, and plotly.js rejects the interrupted
+#: animation's promise with no reason; a button that calls plotly itself logs "API call to Plotly.animate
+#: rejected" and leaves the rejection uncaught (an "Uncaught (in promise)" error in the console).  The buttons
+#: only emit plotly_buttonclicked ("execute": false) and this handler animates, dropping that one rejection and
+#: re-raising any other.  ``{plot_id}`` is plotly's placeholder for the figure's element id.  The page does not
+#: play on load (plotly's ``auto_play``, whose animation's promise nothing catches either: pausing it, or dragging
+#: the slider while it plays, logged the same error); it opens on q = 1.
+BUTTON_SCRIPT = """var gd = document.getElementById('{plot_id}');
+gd.on('plotly_buttonclicked', function (event) {
+  if (event.button.method !== 'animate') { return; }
+  Plotly.animate(gd, event.button.args[0], event.button.args[1]).catch(function (reason) {
+    if (reason !== undefined) { throw reason; }
+  });
+});"""
 HEIGHT_PX = 720
 
 
@@ -225,7 +239,9 @@ def _layout(per_q: list[list[dict[str, Any]]], traces: list[Any], q_values: Floa
     animate = {"mode": "immediate", "frame": {"duration": 0, "redraw": True}, "transition": {"duration": 0}}
     # The slider queues its frames ("afterall") rather than interrupting the one being drawn: plotly.js rejects an
     # interrupted animation's promise and nothing catches it, so every step dragged over logged "Uncaught (in
-    # promise)" in the browser's console.  Pause must interrupt play (mode "immediate"), as plotly documents.
+    # promise)" in the browser's console.  Pause must interrupt play (mode "immediate"), as plotly documents, which
+    # rejects play's promise: the buttons do not call plotly themselves ("execute": False) but :data:`BUTTON_SCRIPT`
+    # does, catching that rejection.
     queued = {**animate, "mode": "afterall"}
     steps = [{"label": f"{q:.2f}", "method": "animate", "args": [[f"{q:.3f}"], queued]} for q in q_values]
     play = {"frame": {"duration": 120, "redraw": True}, "fromcurrent": True, "transition": {"duration": 0}}
@@ -238,8 +254,9 @@ def _layout(per_q: list[list[dict[str, Any]]], traces: list[Any], q_values: Floa
                      "pad": {"t": 20}, "x": 0.1, "len": 0.9}],
         "updatemenus": [{"type": "buttons", "showactive": False, "x": 0.0, "y": 0.0, "xanchor": "left",
                          "yanchor": "top", "pad": {"t": 20},
-                         "buttons": [{"label": "play", "method": "animate", "args": [None, play]},
-                                     {"label": "pause", "method": "animate", "args": [[None], animate]}]}],
+                         "buttons": [{"label": "play", "method": "animate", "args": [None, play], "execute": False},
+                                     {"label": "pause", "method": "animate", "args": [[None], animate],
+                                      "execute": False}]}],
     }
 
 
@@ -247,7 +264,8 @@ def morph_html(data: BuildData, frames: int = FRAMES) -> tuple[str, list[str]]:
     """The figure's HTML fragment (a div and its script; plotly.js is :data:`JS_NAME`) and the display notes."""
     figure, notes = morph_figure(data, frames)
     html = figure.to_html(include_plotlyjs=False, full_html=False, div_id=DIV_ID,
-                          config={"displaylogo": False, "responsive": True})
+                          config={"displaylogo": False, "responsive": True}, post_script=BUTTON_SCRIPT,
+                          auto_play=False)
     return f'<script src="{JS_NAME}" charset="utf-8"></script>\n{html}', notes
 
 

@@ -9,8 +9,6 @@ has neither trace (an arc, so that its length changes with q).
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -20,17 +18,10 @@ from softdesign.pipeline.api import build_through
 from softdesign.report.build_folder import load_build
 from softdesign.report.interactive import DISPLAY_TOLERANCE_MM, max_distance_to_mesh, morph_figure, morph_html
 from softdesign.report.interactive_parts import CHAMBER_NAME, MOULD_PREFIX
-from tests.helpers.cases import straight_tube, write_case
-from tests.helpers.vessels import straight_tube as tube_vertices_faces
-from tests.helpers.vessels import torus_section
+from tests.helpers.parts_cases import LENGTH_MM, WALL_MM, bent_solid_case, hollow_tube_case
 
 pytestmark = pytest.mark.slow
 
-RADIUS_MM, LENGTH_MM, WALL_MM = 3.0, 40.0, 1.0
-#: Edge length of the vessel's open tube surface (its vertices lie on the cylinder), mm.
-EDGE_MM = 0.5
-#: The solid build's vessel: an arc of this radius (mm) and angle (rad).
-BEND_MM, BEND_ANGLE = 30.0, 1.5
 FRAMES = 5
 #: The fit of points on the cylinder gives rho = 3 mm to its own error: the chamber's radius is rho less the wall,
 #: within this.
@@ -41,36 +32,11 @@ CHAMBER_END_ATOL_MM = 1e-3
 
 @pytest.fixture(scope="module")
 def builds(tmp_path_factory):
-    """A hollow straight tube with a mould, and the same tube solid without one."""
+    """A hollow straight tube with a mould, and a solid bent tube without one."""
     folder = tmp_path_factory.mktemp("parts")
-    import trimesh
-
-    centerline, surface = straight_tube(folder, RADIUS_MM, LENGTH_MM)
-    trimesh.Trimesh(*tube_vertices_faces(RADIUS_MM, LENGTH_MM, EDGE_MM), process=False).export(surface)
-    final = {"centerline": str(centerline), "surface": str(surface)}
-    common = {"q": [0, 1], "angular_count": 48, "spacing_mm": 1.0}
-    hollow = write_case(folder, "hollow", final=final, links={"count": 2},
-                        export={**common, "wall_mm": WALL_MM, "port_mm": 1.0, "mould": {"margin_mm": 8}})
-    solid = write_case(folder, "solid", final=bent_vessel(folder), links={"count": 2}, export=common)
-    build_through(hollow, folder / "hollow")
-    build_through(solid, folder / "solid")
+    build_through(hollow_tube_case(folder), folder / "hollow")
+    build_through(bent_solid_case(folder), folder / "solid")
     return load_build(folder / "hollow"), load_build(folder / "solid")
-
-
-def bent_vessel(folder: Path) -> dict[str, str]:
-    """An open tube about a circular arc, as a case's ``final``: the straight q = 0 shape blends into it through
-    shorter curves, so the tube's length changes over q."""
-    import trimesh
-
-    from softdesign.io.polylines_vtp import write_polylines_vtp
-
-    t = np.linspace(0.0, BEND_ANGLE, 121)
-    points = BEND_MM * np.column_stack([np.cos(t), np.sin(t), np.zeros_like(t)])
-    (folder / "bent").mkdir()
-    centerline, surface = folder / "bent" / "centerline.vtp", folder / "bent" / "surface.stl"
-    write_polylines_vtp(centerline, [points], {"MaximumInscribedSphereRadius": [np.full(len(t), RADIUS_MM)]})
-    trimesh.Trimesh(*torus_section(BEND_MM, RADIUS_MM, BEND_ANGLE, EDGE_MM), process=False).export(surface)
-    return {"centerline": str(centerline), "surface": str(surface)}
 
 
 def named(figure, prefix: str) -> list:
