@@ -3,9 +3,11 @@
 Each frame is the actuator's tube S(q) tessellated from the radius field,
 shaded and coloured by link, seen along the final centerline's direction of
 least spread (as the surface figure), at one scale for every frame.  Without
-a fit the frames show the centerline alone.  One matplotlib figure is redrawn
-for every frame; the frames are quantized without dithering, so the file is
-small and the same build gives the same bytes.
+a fit the frames show the centerline alone.  One matplotlib figure is drawn
+once without the actuator and the title; each frame restores that canvas and
+draws only them over it (blitting: the axes, ticks and labels are not laid out
+and drawn again 26 times, most of a frame's cost).  The frames are quantized
+without dithering, so the file is small and the same build gives the same bytes.
 """
 
 from __future__ import annotations
@@ -68,16 +70,12 @@ def morph_frames(chain: LinkChain, field: RadiusField | None, frames: int = FRAM
         artist = ax.plot([], [], color="k", lw=2.0)[0] if field is None else ax.add_collection(
             PolyCollection([], linewidths=0.0, antialiaseds=False)  # aliased faces leave no seams to hide
         )
-        return [_draw_frame(figure, ax, artist, frame) for frame in geometry]
+        background = _background(figure, ax, artist, geometry[0])
+        return [_draw_frame(figure, ax, artist, background, frame) for frame in geometry]
 
 
-def _draw_frame(figure, ax, artist, frame) -> object:
-    """Update the one artist to this frame's geometry and grab the canvas as an RGB image.
-
-    The layout is solved for the first frame and then frozen: every frame has the same axes.
-    """
-    from PIL import Image
-
+def _set_frame(ax, artist, frame) -> None:
+    """Put this frame's geometry in the one artist and its q in the title."""
     q, shape, colours = frame
     if colours is None:
         artist.set_data(shape[:, 0], shape[:, 1])
@@ -85,8 +83,33 @@ def _draw_frame(figure, ax, artist, frame) -> object:
         artist.set_verts(shape)
         artist.set_facecolor(colours)
     ax.set_title(f"q = {q:.2f}")
+
+
+def _background(figure, ax, artist, first) -> object:
+    """The canvas without the moving artist and the title, drawn once for every frame.
+
+    The layout is solved with the first frame in place (title included) and then frozen: every frame has the
+    same axes, ticks and labels, so only the artist and the title are drawn per frame.
+    """
+    _set_frame(ax, artist, first)
     figure.canvas.draw()
     figure.set_layout_engine("none")
+    artist.set_visible(False)
+    ax.title.set_visible(False)
+    figure.canvas.draw()
+    artist.set_visible(True)
+    ax.title.set_visible(True)
+    return figure.canvas.copy_from_bbox(figure.bbox)
+
+
+def _draw_frame(figure, ax, artist, background, frame) -> object:
+    """Restore the drawn axes, draw this frame's artist and title over them, grab the canvas as an RGB image."""
+    from PIL import Image
+
+    _set_frame(ax, artist, frame)
+    figure.canvas.restore_region(background)
+    ax.draw_artist(artist)
+    ax.draw_artist(ax.title)
     return Image.fromarray(np.asarray(figure.canvas.buffer_rgba())[:, :, :3].copy())
 
 

@@ -4,7 +4,11 @@ One plotly figure: the actuator's tube S(q) tessellated from the radius field
 (faces coloured by link), the centerline c(q) per link (in the legend), and the
 patient's vessel surface, semi-transparent, around the q = 1 body.  The frames
 (one per q) change only the actuator and the centerline; the scene's ranges are
-fixed over every frame so the camera does not jump.
+fixed over every frame so the camera does not jump.  A frame changes only the
+vertices of a mesh, so the tube has the same ring count at every q (rings
+:data:`SPACING_MM` apart, or closer, on the longest c(q)).  A build with a
+casting mould or a hollow body adds them, hidden until clicked in the legend
+(:mod:`softdesign.report.interactive_parts`); the ranges include the mould.
 
 For display only, the tube is tessellated coarser than the export
 (:data:`SPACING_MM`, :data:`ANGLES`) and the vessel surface is decimated by
@@ -28,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from softdesign.report import interactive_parts
 from softdesign.report.build_folder import BuildData
 from softdesign.report.plotting import link_colours
 from softdesign.report.surface_figures import VESSEL_RGB, tube_mesh
@@ -54,6 +59,20 @@ MAX_REFINEMENTS = 2
 #: Centerline samples per link and frame.
 CURVE_SAMPLES = 40
 VESSEL_OPACITY = 0.25
+#: Runs the play and pause buttons' animations.  Pause interrupts play, and plotly.js rejects the interrupted
+#: animation's promise with no reason; a button that calls plotly itself logs "API call to Plotly.animate
+#: rejected" and leaves the rejection uncaught (an "Uncaught (in promise)" error in the console).  The buttons
+#: only emit plotly_buttonclicked ("execute": false) and this handler animates, dropping that one rejection and
+#: re-raising any other.  ``{plot_id}`` is plotly's placeholder for the figure's element id.  The page does not
+#: play on load (plotly's ``auto_play``, whose animation's promise nothing catches either: pausing it, or dragging
+#: the slider while it plays, logged the same error); it opens on q = 1.
+BUTTON_SCRIPT = """var gd = document.getElementById('{plot_id}');
+gd.on('plotly_buttonclicked', function (event) {
+  if (event.button.method !== 'animate') { return; }
+  Plotly.animate(gd, event.button.args[0], event.button.args[1]).catch(function (reason) {
+    if (reason !== undefined) { throw reason; }
+  });
+});"""
 HEIGHT_PX = 720
 
 
@@ -129,14 +148,23 @@ def _rgb(colour) -> str:
     return "rgb({:d},{:d},{:d})".format(*(int(round(255 * c)) for c in colour[:3]))
 
 
-def _frame_traces(data: BuildData, q: float, spacing_mm: float = SPACING_MM, angles: int = ANGLES
-                  ) -> list[dict[str, Any]]:
-    """The traces that change with q: the tube (when fitted), then one centerline trace per link."""
+def tube_rings(data: BuildData, q_values: FloatArray, spacing_mm: float) -> int:
+    """Rings of the displayed tube at every q: ``spacing_mm`` apart (or closer) on the longest c(q) of ``q_values``.
+
+    One count for every frame, so that every frame has the faces of the trace it updates.
+    """
+    longest = max(data.kinematics.chain.shape.curve_at(float(q)).length for q in q_values)
+    return max(int(np.ceil(longest / spacing_mm)), 8) + 1
+
+
+def _frame_traces(data: BuildData, q: float, spacing_mm: float = SPACING_MM, angles: int = ANGLES,
+                  rings: int | None = None) -> list[dict[str, Any]]:
+    """The traces that change with q: the tube (when fitted, ``rings`` rings), then one centerline trace per link."""
     chain = data.kinematics.chain
     curve = chain.shape.curve_at(q)
     traces: list[dict[str, Any]] = []
     if data.fit is not None:
-        vertices, _, _ = tube_mesh(chain, data.fit.field, q, spacing_mm, angles)
+        vertices, _, _ = tube_mesh(chain, data.fit.field, q, spacing_mm, angles, rings)
         v = vertices.astype(np.float32)
         traces.append({"type": "mesh3d", "x": v[:, 0], "y": v[:, 1], "z": v[:, 2]})
     for j in range(chain.count):
@@ -153,12 +181,13 @@ def morph_figure(data: BuildData, frames: int = FRAMES):
     colours = [_rgb(c) for c in link_colours(chain.count)]
     q_values = np.linspace(0.0, 1.0, int(frames))
     spacing, angles, tube_error = display_tube(data) if data.fit is not None else (SPACING_MM, ANGLES, 0.0)
-    per_q = [_frame_traces(data, float(q), spacing, angles) for q in q_values]
+    rings = tube_rings(data, q_values, spacing)
+    per_q = [_frame_traces(data, float(q), spacing, angles, rings) for q in q_values]
     first = per_q[-1]  # the page opens on q = 1, inside the vessel
     traces: list[Any] = []
     notes: list[str] = []
     if data.fit is not None:
-        _, faces, face_l = tube_mesh(chain, data.fit.field, 1.0, spacing, angles)
+        _, faces, face_l = tube_mesh(chain, data.fit.field, 1.0, spacing, angles, rings)
         face_colours = np.array(colours, dtype=object)[data.fit.field.link_of(face_l)]
         traces.append(go.Mesh3d(**{k: first[0][k] for k in "xyz"}, i=faces[:, 0], j=faces[:, 1], k=faces[:, 2],
                                 facecolor=face_colours, flatshading=False, name="actuator", showlegend=True,
@@ -168,6 +197,12 @@ def morph_figure(data: BuildData, frames: int = FRAMES):
     for j, trace in enumerate(first[len(first) - chain.count:]):
         traces.append(go.Scatter3d(**{k: trace[k] for k in "xyz"}, mode="lines", line={"color": colours[j], "width": 6},
                                    name=f"link {j} (centerline)", hoverinfo="name"))
+    chamber = interactive_parts.chamber_frames(data, q_values, FINE_FACTOR, DISPLAY_TOLERANCE_MM)
+    if chamber is not None and chamber.frames:
+        for frame, trace in zip(per_q, chamber.frames, strict=True):
+            frame.append(trace)
+        traces.append(interactive_parts.chamber_trace(chamber))
+    notes.extend(chamber.notes if chamber is not None else [])
     moving = list(range(len(traces)))
     if len(data.ingest.faces):
         v, f, error = decimated_vessel(data.ingest.vertices, data.ingest.faces)
@@ -177,6 +212,9 @@ def morph_figure(data: BuildData, frames: int = FRAMES):
                                 showlegend=True, hoverinfo="skip"))
         notes.append(f"vessel: {len(f)} of {len(data.ingest.faces)} triangles; display error {error:.3f} mm "
                      f"(tolerance {DISPLAY_TOLERANCE_MM:g} mm)")
+    mould, mould_notes = interactive_parts.mould_traces(data, DISPLAY_TOLERANCE_MM)
+    traces.extend(mould)
+    notes.extend(mould_notes)
     figure = go.Figure(data=traces, frames=[
         go.Frame(name=f"{q:.3f}", data=per_q[k], traces=moving) for k, q in enumerate(q_values)
     ])
@@ -187,7 +225,10 @@ def morph_figure(data: BuildData, frames: int = FRAMES):
 def _layout(per_q: list[list[dict[str, Any]]], traces: list[Any], q_values: FloatArray) -> dict[str, Any]:
     """Fixed scene ranges over every frame and the vessel, a q slider and a play button."""
     points = [np.column_stack([t["x"], t["y"], t["z"]]) for frame in per_q for t in frame]
-    points += [np.column_stack([t.x, t.y, t.z]) for t in traces if t.name and t.name.startswith("patient")]
+    # the mould too (hidden at first): it encloses the q = 0 body with export.mould.margin_mm, so the box grows by
+    # about that margin on each side, and the mould is not cut by the box when shown
+    points += [np.column_stack([t.x, t.y, t.z]) for t in traces
+               if t.name and t.name.startswith(("patient", interactive_parts.MOULD_PREFIX))]
     stacked = np.concatenate(points).astype(float)
     low, high = stacked.min(axis=0), stacked.max(axis=0)
     span = np.maximum(high - low, 1e-6)
@@ -198,7 +239,9 @@ def _layout(per_q: list[list[dict[str, Any]]], traces: list[Any], q_values: Floa
     animate = {"mode": "immediate", "frame": {"duration": 0, "redraw": True}, "transition": {"duration": 0}}
     # The slider queues its frames ("afterall") rather than interrupting the one being drawn: plotly.js rejects an
     # interrupted animation's promise and nothing catches it, so every step dragged over logged "Uncaught (in
-    # promise)" in the browser's console.  Pause must interrupt play (mode "immediate"), as plotly documents.
+    # promise)" in the browser's console.  Pause must interrupt play (mode "immediate"), as plotly documents, which
+    # rejects play's promise: the buttons do not call plotly themselves ("execute": False) but :data:`BUTTON_SCRIPT`
+    # does, catching that rejection.
     queued = {**animate, "mode": "afterall"}
     steps = [{"label": f"{q:.2f}", "method": "animate", "args": [[f"{q:.3f}"], queued]} for q in q_values]
     play = {"frame": {"duration": 120, "redraw": True}, "fromcurrent": True, "transition": {"duration": 0}}
@@ -211,8 +254,9 @@ def _layout(per_q: list[list[dict[str, Any]]], traces: list[Any], q_values: Floa
                      "pad": {"t": 20}, "x": 0.1, "len": 0.9}],
         "updatemenus": [{"type": "buttons", "showactive": False, "x": 0.0, "y": 0.0, "xanchor": "left",
                          "yanchor": "top", "pad": {"t": 20},
-                         "buttons": [{"label": "play", "method": "animate", "args": [None, play]},
-                                     {"label": "pause", "method": "animate", "args": [[None], animate]}]}],
+                         "buttons": [{"label": "play", "method": "animate", "args": [None, play], "execute": False},
+                                     {"label": "pause", "method": "animate", "args": [[None], animate],
+                                      "execute": False}]}],
     }
 
 
@@ -220,7 +264,8 @@ def morph_html(data: BuildData, frames: int = FRAMES) -> tuple[str, list[str]]:
     """The figure's HTML fragment (a div and its script; plotly.js is :data:`JS_NAME`) and the display notes."""
     figure, notes = morph_figure(data, frames)
     html = figure.to_html(include_plotlyjs=False, full_html=False, div_id=DIV_ID,
-                          config={"displaylogo": False, "responsive": True})
+                          config={"displaylogo": False, "responsive": True}, post_script=BUTTON_SCRIPT,
+                          auto_play=False)
     return f'<script src="{JS_NAME}" charset="utf-8"></script>\n{html}', notes
 
 

@@ -49,16 +49,20 @@ def intermediate_q(q_values: list[float]) -> float:
 
 
 def tube_mesh(
-    chain: LinkChain, field: RadiusField, q: float, spacing_mm: float = TUBE_SPACING_MM, angles: int = TUBE_ANGLES
+    chain: LinkChain, field: RadiusField, q: float, spacing_mm: float = TUBE_SPACING_MM, angles: int = TUBE_ANGLES,
+    rings: int | None = None,
 ) -> tuple[FloatArray, np.ndarray, FloatArray]:
     """The open tube c(q, l) + rho(q, l, a) (cos a N + sin a B) on a regular (l, a) grid.
+
+    ``rings``: the number of rings (else rings about ``spacing_mm`` apart at this q): the same at every q gives
+    the same faces at every q.
 
     Returns
     -------
     vertices (V, 3) mm, faces (F, 3) int64 (two per grid cell) and the l (F,) at which each face starts.
     """
     curve = chain.shape.curve_at(q)
-    count = max(int(np.ceil(curve.length / spacing_mm)), 8) + 1
+    count = rings if rings is not None else max(int(np.ceil(curve.length / spacing_mm)), 8) + 1
     l = np.linspace(0.0, 1.0, count)
     a = np.linspace(0.0, 2.0 * np.pi, angles, endpoint=False)
     frames, centre = curve.frames(l), curve.points(l)

@@ -29,6 +29,7 @@ from softdesign.report import (
     design_figures,
     fit_figures,
     interactive,
+    interactive_parts,
     kinematics_figures,
     morph_figures,
     mould_figures,
@@ -316,7 +317,9 @@ def _view_section(data: BuildData, options: ReportOptions, run: _Timer) -> Secti
     html, display_notes = run("3D view", lambda: interactive.morph_html(data, options.view_frames))
     what = "the actuator (coloured by link)" if data.fit is not None else "the centerline (no fit in this build)"
     note = (f"{what} at {options.view_frames} q values from 0 to 1 (slider, play), its centerline per link, and the "
-            "patient's vessel surface, semi-transparent; drag to turn, scroll to zoom. Decimated for display only: "
+            "patient's vessel surface, semi-transparent; drag to turn, scroll to zoom. "
+            + interactive_parts.hidden_parts_note(data)
+            + "Decimated for display only: "
             + "; ".join(display_notes) + ". Needs JavaScript; nothing is fetched from the network.")
     return Section("view", "The morph in 3D (interactive)", notes=[note], embeds=[html])
 

@@ -5,7 +5,10 @@ is driven by playwright with ``executable_path``: playwright downloads no browse
 WebGL runs on Chromium's software renderer (SwiftShader).  The page is opened
 from its folder (file://), the slider's grip is dragged from q = 1 (where the
 page opens) to q = 0 with the mouse, and the 3D view is captured at both ends.
-The screenshots are kept as test artifacts in :data:`ARTIFACTS` (under build/,
+Then play is pressed and paused mid-animation, and the page of a hollow tube
+with a mould is opened: its mould and chamber traces start hidden and the
+chamber's legend entry shows it; every console message of all this is
+recorded.  The screenshots are kept as test artifacts in :data:`ARTIFACTS` (under build/,
 which git ignores).  The tests skip, saying why, only when no browser can run.
 """
 
@@ -20,8 +23,10 @@ import pytest
 from PIL import Image
 
 from softdesign.pipeline.api import build_through
-from softdesign.report.interactive import DIV_ID
-from softdesign.report.writer import PAGE, REPORT_DIR, write_report
+from softdesign.report.interactive import DIV_ID, FRAMES
+from softdesign.report.interactive_parts import CHAMBER_NAME, MOULD_PREFIX
+from softdesign.report.writer import PAGE, REPORT_DIR, ReportOptions, write_report
+from tests.helpers.parts_cases import hollow_tube_case
 from tests.helpers.paths import REPO
 
 pytestmark = pytest.mark.slow
@@ -44,6 +49,23 @@ DRAWN_FRACTION = 0.002
 #: channel (measured 1.5 % between q = 1 and q = 0; the same frame captured twice gives 0).
 CHANGED_FRACTION = 0.005
 PIXEL_STEP = 10
+#: After pause, the slider must stay where it stopped for this long (a play frame lasts 120 ms).
+PAUSE_SETTLE_MS = 1_000
+VIEWPORT = {"width": 1280, "height": 1000}
+#: Counts the frames plotly starts and clicks pause (as a mouse would) when the second one starts.
+PAUSE_ON_SECOND_FRAME = f"""() => {{
+  const gd = document.getElementById('{DIV_ID}');
+  window.framesDrawn = 0;
+  gd.on('plotly_animatingframe', () => {{
+    window.framesDrawn += 1;
+    if (window.framesDrawn === 2) {{
+      gd.querySelectorAll('.updatemenu-button')[1].dispatchEvent(new MouseEvent('click', {{bubbles: true}}));
+      window.pausedAt = gd._fullLayout.sliders[0].active;
+    }}
+  }});
+}}"""
+#: While plotly animates, the slider is polled at this interval (ms) rather than on animation frames.
+POLL_MS = 50
 
 
 def chromium() -> str:
@@ -70,7 +92,7 @@ def session(tmp_path_factory):
             browser = playwright.chromium.launch(executable_path=executable, args=CHROMIUM_ARGS)
         except Exception as err:  # playwright's Error: the browser cannot start here
             pytest.skip(f"{executable} cannot start headless: {err}")
-        page = browser.new_page(viewport={"width": 1280, "height": 1000})
+        page = browser.new_page(viewport=VIEWPORT)
         page.on("console", lambda m: record["messages"].append((m.type, m.text)))
         page.on("pageerror", lambda e: record["messages"].append(("pageerror", str(e))))
         page.on("request", lambda r: record["requests"].append(r.url))
@@ -94,8 +116,63 @@ def session(tmp_path_factory):
         page.wait_for_timeout(SETTLE_MS)
         record["active"] = page.evaluate(f"document.getElementById('{DIV_ID}')._fullLayout.sliders[0].active")
         record["q0"] = capture(page, "demo_q0")
+        record["names"] = trace_names(page)
+        record["play"] = play_then_pause(browser, (report_dir / PAGE).as_uri())
+        record["hollow"] = hollow_page(page, tmp_path_factory.mktemp("browser-hollow"))
         browser.close()
     return record
+
+
+def trace_names(page) -> dict[str, object]:
+    """Each trace's name and its ``visible`` as plotly holds them in the page."""
+    return page.evaluate(f"Object.fromEntries(document.getElementById('{DIV_ID}')._fullData"
+                         ".map(t => [t.name, t.visible]))")
+
+
+def slider_active(page) -> int:
+    return page.evaluate(f"document.getElementById('{DIV_ID}')._fullLayout.sliders[0].active")
+
+
+def play_then_pause(browser, url: str) -> dict[str, object]:
+    """On the page freshly opened in a new tab (as a reader finds it), press play, then pause while it plays; the
+    slider's step before, when paused, a while after, and the tab's console messages."""
+    messages: list[tuple[str, str]] = []
+    page = browser.new_page(viewport=VIEWPORT)
+    page.on("console", lambda m: messages.append((m.type, m.text)))
+    page.on("pageerror", lambda e: messages.append(("pageerror", str(e))))
+    page.goto(url)
+    page.wait_for_function(f"document.getElementById('{DIV_ID}')?._fullLayout?.sliders !== undefined",
+                           timeout=LOAD_TIMEOUT_MS)
+    page.locator(f"#{DIV_ID}").scroll_into_view_if_needed()
+    page.wait_for_timeout(SETTLE_MS)
+    before = slider_active(page)
+    # pause is pressed from the page's script as the second frame starts, so it lands mid-animation however slow
+    # the machine draws; play is a real click
+    page.evaluate(PAUSE_ON_SECOND_FRAME)
+    page.locator(f"#{DIV_ID} .updatemenu-button").nth(0).click()  # play
+    page.wait_for_function("window.pausedAt !== undefined", polling=POLL_MS, timeout=LOAD_TIMEOUT_MS)
+    page.wait_for_timeout(PAUSE_SETTLE_MS)
+    paused = slider_active(page)
+    page.wait_for_timeout(PAUSE_SETTLE_MS)
+    later = slider_active(page)
+    frames = page.evaluate("window.framesDrawn")
+    page.close()
+    return {"before": before, "paused": paused, "later": later, "frames": frames, "messages": messages}
+
+
+def hollow_page(page, folder: Path) -> dict[str, object]:
+    """The page of a hollow tube with a mould: its traces, then with the chamber's legend entry clicked."""
+    build_dir = folder / "build"
+    build_through(hollow_tube_case(folder), build_dir)
+    write_report(build_dir, ReportOptions(gif_frames=3))
+    page.goto((build_dir / REPORT_DIR / PAGE).resolve().as_uri())
+    page.wait_for_function(f"document.getElementById('{DIV_ID}')?._fullLayout?.sliders !== undefined",
+                           timeout=LOAD_TIMEOUT_MS)
+    page.locator(f"#{DIV_ID}").scroll_into_view_if_needed()
+    before = trace_names(page)
+    page.locator(f"#{DIV_ID} g.traces", has_text=CHAMBER_NAME).locator(".legendtoggle").click()
+    page.wait_for_timeout(SETTLE_MS)
+    return {"before": before, "after": trace_names(page), "report_dir": (build_dir / REPORT_DIR).resolve()}
 
 
 def capture(page, name: str) -> np.ndarray:
@@ -117,7 +194,9 @@ def test_no_console_error_and_no_request_outside_the_page_folder(session):
     for url in session["requests"]:
         parsed = urlparse(url)
         assert parsed.scheme == "file", url  # no http(s), ws or other network address
-        assert Path(unquote(parsed.path)).resolve().parent == session["report_dir"], url
+        # every request stays in the folder of one of the two pages (the demo's, the hollow tube's)
+        assert Path(unquote(parsed.path)).resolve().parent in (session["report_dir"],
+                                                                session["hollow"]["report_dir"]), url
 
 
 def test_the_3d_view_draws_the_actuator(session):
@@ -131,3 +210,24 @@ def test_dragging_the_slider_from_q_1_to_q_0_changes_the_drawing(session):
     assert before.shape == after.shape
     changed = np.abs(before - after).max(axis=2) > PIXEL_STEP
     assert float(changed.mean()) > CHANGED_FRACTION
+
+
+def test_play_then_pause_stops_the_morph_without_a_console_error(session):
+    """Pause interrupts play: the slider moved while playing and stays put after pause, and the tab logged no error
+    (plotly's rejected animation was an "Uncaught (in promise)" error)."""
+    play = session["play"]
+    assert 2 <= play["frames"] < FRAMES  # play started, and pause stopped it before its last frame
+    assert play["paused"] != play["before"]
+    assert play["later"] == play["paused"]
+    assert [m for m in play["messages"] if m[0] in ("error", "pageerror")] == []
+
+
+def test_mould_and_chamber_traces_exist_only_when_built_and_start_hidden(session):
+    assert not any(name.startswith((MOULD_PREFIX, CHAMBER_NAME)) for name in session["names"])
+    before, after = session["hollow"]["before"], session["hollow"]["after"]
+    hidden = {name: visible for name, visible in before.items() if name.startswith((MOULD_PREFIX, CHAMBER_NAME))}
+    assert hidden == {CHAMBER_NAME: "legendonly", **{MOULD_PREFIX + p: "legendonly" for p in ("half_a", "half_b",
+                                                                                             "core")}}
+    assert after[CHAMBER_NAME] is True  # shown by its legend entry; the rest unchanged
+    assert {k: v for k, v in after.items() if k != CHAMBER_NAME} == {k: v for k, v in before.items()
+                                                                     if k != CHAMBER_NAME}

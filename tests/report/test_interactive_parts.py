@@ -1,0 +1,115 @@
+"""The 3D view's mould and chamber traces (issue 17, item 2) and its frames' topology.
+
+A straight tube of radius 3 mm (open, its vertices on the cylinder) built hollow (1 mm wall) with a mould has an
+analytic chamber: a cylinder of radius rho - wall about the centerline, from
+arc length wall to length - wall.  The mould traces are the mould stage's STL
+parts, decimated within the view's tolerance.  A solid build without mould
+has neither trace (an arc, so that its length changes with q).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from softdesign.io.formats import read_mesh
+from softdesign.pipeline import layout
+from softdesign.pipeline.api import build_through
+from softdesign.report.build_folder import load_build
+from softdesign.report.interactive import DISPLAY_TOLERANCE_MM, max_distance_to_mesh, morph_figure, morph_html
+from softdesign.report.interactive_parts import CHAMBER_NAME, MOULD_PREFIX
+from tests.helpers.parts_cases import LENGTH_MM, WALL_MM, bent_solid_case, hollow_tube_case
+
+pytestmark = pytest.mark.slow
+
+FRAMES = 5
+#: The fit of points on the cylinder gives rho = 3 mm to its own error: the chamber's radius is rho less the wall,
+#: within this.
+CHAMBER_RADIUS_ATOL_MM = 0.02
+#: Ring positions along the axis come from an arc length table of 2001 samples: far below this.
+CHAMBER_END_ATOL_MM = 1e-3
+
+
+@pytest.fixture(scope="module")
+def builds(tmp_path_factory):
+    """A hollow straight tube with a mould, and a solid bent tube without one."""
+    folder = tmp_path_factory.mktemp("parts")
+    build_through(hollow_tube_case(folder), folder / "hollow")
+    build_through(bent_solid_case(folder), folder / "solid")
+    return load_build(folder / "hollow"), load_build(folder / "solid")
+
+
+def named(figure, prefix: str) -> list:
+    return [t for t in figure.data if t.name and t.name.startswith(prefix)]
+
+
+def test_every_frame_updates_its_trace_with_the_same_vertex_count(builds):
+    """Frames change only x, y, z: each must have as many vertices as the trace's faces were made for, also when
+    the body's length changes with q (the bent vessel)."""
+    lengths = [builds[1].kinematics.chain.shape.curve_at(q).length for q in (0.5, 1.0)]
+    assert lengths[1] - lengths[0] > 1.0  # mm: a ring spacing, so rings about 1 mm apart would differ in count
+    for data in builds:
+        figure, _ = morph_figure(data, FRAMES)
+        for frame in figure.frames:
+            for index, trace in zip(frame.traces, frame.data, strict=True):
+                shown = figure.data[index]
+                assert len(trace.x) == len(shown.x)
+                if shown.type == "mesh3d":
+                    assert int(np.max(shown.i)) < len(trace.x)
+
+
+def test_the_chamber_is_the_analytic_cylinder_at_every_q_and_hidden_at_first(builds):
+    hollow, _ = builds
+    figure, notes = morph_figure(hollow, FRAMES)
+    (chamber,) = named(figure, CHAMBER_NAME)
+    assert chamber.visible == "legendonly"
+    index = list(figure.data).index(chamber)
+    rho = float(hollow.fit.field.evaluate_grid(1.0, np.array([0.5]), np.linspace(0, 2 * np.pi, 48))[0].mean())
+    for frame in figure.frames:
+        (trace,) = [t for i, t in zip(frame.traces, frame.data, strict=True) if i == index]
+        points = np.column_stack([trace.x, trace.y, trace.z]).astype(float)
+        rings = points[:-2]  # the two cap centres follow the rings
+        np.testing.assert_allclose(np.hypot(rings[:, 0], rings[:, 1]), rho - WALL_MM, atol=CHAMBER_RADIUS_ATOL_MM)
+        np.testing.assert_allclose([rings[:, 2].min(), rings[:, 2].max()], [WALL_MM, LENGTH_MM - WALL_MM],
+                                   atol=CHAMBER_END_ATOL_MM)
+    assert any(n.startswith("chamber:") for n in notes)
+
+
+def test_the_chamber_lies_on_the_exported_bodys_inner_surface(builds):
+    """The displayed chamber at q = 1 against the export's own q = 1 solid (its inner surface), within tolerance."""
+    hollow, _ = builds
+    figure, _ = morph_figure(hollow, FRAMES)
+    (chamber,) = named(figure, CHAMBER_NAME)
+    rings = np.column_stack([chamber.x, chamber.y, chamber.z]).astype(float)[:-2]
+    vertices, faces = read_mesh(hollow.build_dir / layout.mesh_path(1.0, "stl"))
+    assert max_distance_to_mesh(rings, vertices, faces) <= DISPLAY_TOLERANCE_MM
+
+
+def test_the_mould_parts_are_the_stages_files_hidden_at_first_and_inside_the_scene(builds):
+    hollow, _ = builds
+    figure, notes = morph_figure(hollow, FRAMES)
+    parts = named(figure, MOULD_PREFIX)
+    assert sorted(t.name.removeprefix(MOULD_PREFIX) for t in parts) == ["core", "half_a", "half_b"]
+    scene = figure.layout.scene
+    for trace in parts:
+        assert trace.visible == "legendonly"
+        shown = np.column_stack([trace.x, trace.y, trace.z]).astype(float)
+        vertices, faces = read_mesh(hollow.build_dir / layout.mould_path(trace.name.removeprefix(MOULD_PREFIX), "stl"))
+        # decimated within the display tolerance: every vertex of the part is that close to the shown mesh
+        faces_shown = np.column_stack([trace.i, trace.j, trace.k])
+        assert max_distance_to_mesh(vertices, shown, faces_shown) <= DISPLAY_TOLERANCE_MM
+        for axis, column in zip((scene.xaxis, scene.yaxis, scene.zaxis), shown.T, strict=True):
+            assert axis.range[0] <= column.min() and column.max() <= axis.range[1]
+    assert sum(n.startswith("mould ") for n in notes) == 3
+
+
+def test_a_solid_build_without_mould_has_neither_trace(builds):
+    _, solid = builds
+    figure, notes = morph_figure(solid, FRAMES)
+    assert named(figure, CHAMBER_NAME) == [] and named(figure, MOULD_PREFIX) == []
+    assert not any(n.startswith(("chamber", "mould")) for n in notes)
+
+
+def test_the_view_with_mould_and_chamber_is_the_same_bytes_twice(builds):
+    hollow, _ = builds
+    assert morph_html(hollow, FRAMES) == morph_html(hollow, FRAMES)
