@@ -162,6 +162,9 @@ class Fit(_Section):
     # wall points within this of either end are not fitted (a tilted cap's rim, one-sided ends); the end's
     # rings are then held at the inscribed radius by the end prior (fitting/end_prior.py)
     end_margin_mm: FiniteFloat = Field(0.0, ge=0.0, le=MAX_END_MARGIN_MM)
+    # where the body ends: at each end's detected cap plane or boundary loop (auto, cap_plane) or square to the
+    # end tangent (normal); see geometry/end_cut.py
+    end_cut: Literal["auto", "cap_plane", "normal"] = "auto"
 
     @field_validator("knot_spacing_mm", mode="before")
     @classmethod
