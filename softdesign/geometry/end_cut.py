@@ -84,7 +84,7 @@ def choose_end_cuts(
 
 def _choose(mode: str, end: str, plane: dict[str, Any] | None, frame: FloatArray) -> dict[str, Any]:
     if mode == "normal":
-        record: dict[str, Any] = {"applied": False, "reason": "fit.end_cut: normal (square to the end tangent)"}
+        record: dict[str, Any] = {"applied": False, "reason": "fit.end_cut: normal"}
         return record if plane is None else {**record, **_figures(plane)}
     if plane is None:
         return {"applied": False, "reason": "no flat cap or open boundary loop found at this end (or not measured)"}
@@ -105,5 +105,7 @@ def _choose(mode: str, end: str, plane: dict[str, Any] | None, frame: FloatArray
             "normal_local": [float(x) for x in local]}
 
 
-def _figures(plane: dict[str, Any]) -> dict[str, float]:
-    return {key: float(plane[key]) for key in ("tilt_deg", "rim_gap_mm", "axis_offset_mm")}
+def _figures(plane: dict[str, Any]) -> dict[str, Any]:
+    figures: dict[str, Any] = {key: float(plane[key]) for key in ("tilt_deg", "rim_gap_mm", "radius_mm",
+                                                                   "axis_offset_mm")}
+    return {"kind": plane["kind"], **figures}

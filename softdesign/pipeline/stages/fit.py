@@ -27,6 +27,7 @@ from softdesign.fitting.selection import NetworkContext, SelectionSettings, insc
 from softdesign.fitting.wall_fit import WallFitOptions, fit_wall
 from softdesign.geometry.curves import SmoothCurve, measure_deviation
 from softdesign.geometry.end_cut import choose_end_cuts
+from softdesign.geometry.end_planes import rim_gap_warnings
 from softdesign.geometry.network import SelectedPath
 from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import describe_backbone_fit, stretch_fit_errors
@@ -218,10 +219,11 @@ def end_lines(summary: dict[str, Any]) -> list[str]:
         f"held at the inscribed radius ({e['reference_min_mm']:.3f} to {e['reference_max_mm']:.3f} mm)"
         for end, e in summary.get("end_prior", {}).items()
     ]
+    cuts = summary.get("end_cut", {})
     lines += [f"{end}: cut at the detected plane (tilt {c['tilt_deg']:.1f} deg, rim gap {c['rim_gap_mm']:.3f} mm)"
-              if c["applied"] else f"{end}: cut square to the end tangent ({c['reason']})"
-              for end, c in summary.get("end_cut", {}).items()]
-    return lines + [f"  warning: {w}" for w in thin_end_warnings(summary.get("ends", {}))]
+              if c["applied"] else f"{end}: cut square to the end tangent ({c['reason']})" for end, c in cuts.items()]
+    square = {end: c for end, c in cuts.items() if not c["applied"] and "rim_gap_mm" in c}
+    return lines + [f"  warning: {w}" for w in thin_end_warnings(summary.get("ends", {})) + rim_gap_warnings(square)]
 
 
 def _sampled_note(distance: dict[str, Any]) -> str:
