@@ -10,19 +10,21 @@ end frame moves with q, carries the plane rigidly: at q = 1 the plane has
 the detected cap's normal, at any other q it is the same plane in that q's
 end frame.
 
-The plane passes through the centerline's end point (the body's end on its
-axis) with the detected plane's normal: the body keeps its length along the
-axis.  The detected plane may cross the axis ``axis_offset_mm`` past (or
+The detected plane may cross the end's axis ``axis_offset_mm`` past (or
 short of) the centerline's end (a VMTK centerline starts about a radius
-inside an opening); that offset is recorded, not applied, since the body
-ends where the kinematic chain ends.  Not in the papers (the seeds' body
-ends in the end frames' normal planes).
+inside an opening).  Not in the papers (the seeds' body ends in the end
+frames' normal planes).
 
 Modes (``fit.end_cut``)
-    ``auto``       cut at the detected plane where one is found, its tilt is at
-                   most ``MAX_CUT_TILT_DEG`` and its rim gap at least
-                   ``MIN_CUT_GAP_MM``; square otherwise, saying why.
-    ``cap_plane``  as auto, but a tilt above ``MAX_CUT_TILT_DEG`` is refused.
+    ``auto``       the detected plane's normal through the centerline's end
+                   point (the body keeps its length along the axis; the axis
+                   offset is recorded, not applied), where a plane is found,
+                   its tilt is at most ``MAX_CUT_TILT_DEG`` and its rim gap at
+                   least ``MIN_CUT_GAP_MM``; square otherwise, saying why.
+    ``cap_plane``  the detected plane itself, axis offset included (the body
+                   is lengthened or shortened along its axis to reach it),
+                   wherever one is found; a tilt above ``MAX_CUT_TILT_DEG``
+                   is refused.
     ``normal``     square to the end tangent at both ends (the seeds' body).
 """
 
@@ -68,7 +70,8 @@ def choose_end_cuts(
     dict
         Per end: ``applied`` (bool), ``reason``, and the detected ``tilt_deg``, ``rim_gap_mm`` and
         ``axis_offset_mm`` when a plane was found; when applied, ``normal_local`` (3,): the outward unit
-        normal of the cut plane in the end frame's (N, B, T) coordinates.
+        normal of the cut plane in the end frame's (N, B, T) coordinates, and ``offset_mm``: where it crosses
+        the axis, mm along the outward tangent from the centerline's end (0 for auto).
 
     Raises
     ------
@@ -98,11 +101,14 @@ def _choose(mode: str, end: str, plane: dict[str, Any] | None, frame: FloatArray
                 "closer to square (e.g. vmtksurfaceclipper) and re-cap it"
             )
         return {"applied": False, "reason": f"tilt above {MAX_CUT_TILT_DEG:g} deg: square end kept", **figures}
-    if plane["rim_gap_mm"] < MIN_CUT_GAP_MM:
+    if mode == "auto" and plane["rim_gap_mm"] < MIN_CUT_GAP_MM:
         return {"applied": False, "reason": f"rim gap below {MIN_CUT_GAP_MM:g} mm: square end kept", **figures}
     local = end_normal_local(np.asarray(plane["normal"], float), frame)  # already outward at both ends
-    return {"applied": True, "reason": f"{plane['kind'].replace('_', ' ')} plane detected", **figures,
-            "normal_local": [float(x) for x in local]}
+    kind = plane["kind"].replace("_", " ")
+    reason = f"{kind} plane detected" + (", axis offset applied" if mode == "cap_plane" else
+                                         ", through the centerline's end (axis offset not applied)")
+    return {"applied": True, "reason": reason, **figures, "normal_local": [float(x) for x in local],
+            "offset_mm": figures["axis_offset_mm"] if mode == "cap_plane" else 0.0}
 
 
 def _figures(plane: dict[str, Any]) -> dict[str, Any]:

@@ -45,7 +45,7 @@ import numpy as np
 
 from softdesign.errors import MeshError
 from softdesign.meshing.tessellate import Sweep, TubeMesh
-from softdesign.meshing.volume import EndNormals
+from softdesign.meshing.volume import EndCuts
 from softdesign.types import FloatArray
 
 #: The zone whose rings slide to meet the plane is this many times the largest shift long.
@@ -63,23 +63,25 @@ class CutPlane:
     normal: FloatArray
 
 
-def cut_planes(outer: Sweep, normals: EndNormals, inset_mm: float = 0.0) -> tuple[CutPlane | None, CutPlane | None]:
+def cut_planes(outer: Sweep, cuts: EndCuts, inset_mm: float = 0.0) -> tuple[CutPlane | None, CutPlane | None]:
     """The base and tip cut planes of the body whose outer sweep is ``outer``, moved ``inset_mm`` inward.
 
     Parameters
     ----------
     outer : the body's outer sweep at this q (its end rings' centres and frames carry the planes)
-    normals : per end (base, tip), the outward normal in the end frame's (N, B, T) coordinates, or None
+    cuts : per end (base, tip), (n_N, n_B, n_T, offset_mm): the outward normal in the end frame's (N, B, T)
+        coordinates and where the plane crosses the axis, mm along the outward tangent; or None
     inset_mm : how far inward along each normal the plane moves (a chamber's: ``wall_mm``)
     """
     planes: list[CutPlane | None] = []
-    for k, local in ((0, normals[0]), (-1, normals[1])):
-        if local is None:
+    for k, cut, outward in ((0, cuts[0], -1.0), (-1, cuts[1], 1.0)):
+        if cut is None:
             planes.append(None)
             continue
-        normal = outer.frames[k] @ np.asarray(local, float)
+        normal = outer.frames[k] @ np.asarray(cut[:3], float)
         normal /= np.linalg.norm(normal)
-        planes.append(CutPlane(outer.centers[k] - inset_mm * normal, normal))
+        on_axis = outer.centers[k] + cut[3] * outward * outer.frames[k][:, 2]
+        planes.append(CutPlane(on_axis - inset_mm * normal, normal))
     return planes[0], planes[1]
 
 
@@ -194,13 +196,14 @@ def _wedge_volume(xy: FloatArray, centre: FloatArray, frame: FloatArray, outward
     return height / float(n @ outward)
 
 
-def end_normals(record: dict[str, Any] | None) -> EndNormals:
-    """The (base, tip) cut normals of the fit's ``end_cut`` record (see :mod:`softdesign.geometry.end_cut`).
+def end_cuts_from_record(record: dict[str, Any] | None) -> EndCuts:
+    """The (base, tip) cut planes of the fit's ``end_cut`` record (see :mod:`softdesign.geometry.end_cut`).
 
     None where an end is not cut, or when there is no record (a fit kept before end cuts existed).
     """
     if not record:
         return (None, None)
-    cuts = [record.get(end) or {} for end in ("inlet", "outlet")]
-    normals = [tuple(float(x) for x in c["normal_local"]) if c.get("applied") else None for c in cuts]
-    return (normals[0], normals[1])  # type: ignore[return-value]
+    ends = [record.get(end) or {} for end in ("inlet", "outlet")]
+    cuts = [(*(float(x) for x in c["normal_local"]), float(c["offset_mm"])) if c.get("applied") else None
+            for c in ends]
+    return (cuts[0], cuts[1])  # type: ignore[return-value]

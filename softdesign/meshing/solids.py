@@ -173,9 +173,9 @@ def _port(outer: Sweep, chamber: Sweep, spec: BodySpec) -> tuple[m3.Manifold, in
             f"not fit the chamber's base section (largest diameter about the port axis {2 * clearance:.3f} mm, "
             f"keeping a {spec.min_radius_mm:g} mm ledge); use port_mm <= {2 * (clearance - spec.min_radius_mm):.3f}"
         )
-    # a tilted base cut moves the outer and chamber caps along the port's axis by up to this much
+    # a base cut moves the outer and chamber caps along the port's axis by up to this much (tilt and offset)
     cut = spec.end_cuts[0]
-    lean = 0.0 if cut is None else radius * np.tan(np.arccos(-cut[2])) + w * (1.0 / -cut[2] - 1.0)
+    lean = 0.0 if cut is None else radius * np.tan(np.arccos(-cut[2])) + w * (1.0 / -cut[2] - 1.0) + abs(cut[3])
     outside = PORT_OUTSIDE_WALLS * w + lean
     inside = min(PORT_INSIDE_WALLS * w, 0.25 * (chamber.s[-1] - chamber.s[0])) + lean
     segments = spec.port_segments or outer.xy.shape[1]

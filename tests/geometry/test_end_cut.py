@@ -34,10 +34,10 @@ def test_auto_cuts_a_tilted_cap_and_keeps_its_normal_in_the_end_frame():
     cuts = choose_end_cuts("auto", planes, f)
     for k, end in enumerate(("inlet", "outlet")):
         c = cuts[end]
-        assert c["applied"] and c["reason"] == "flat cap plane detected"
+        assert c["applied"] and c["reason"].startswith("flat cap plane detected, through the centerline")
         # at q = 1 the end frame turns the local normal back into the detected one
         np.testing.assert_allclose(f[k] @ np.array(c["normal_local"]), planes[end]["normal"], rtol=0, atol=UNIT_TOL)
-        assert (c["tilt_deg"], c["axis_offset_mm"]) == (planes[end]["tilt_deg"], 0.2)
+        assert (c["tilt_deg"], c["axis_offset_mm"], c["offset_mm"]) == (planes[end]["tilt_deg"], 0.2, 0.0)
     # outward: against T at the inlet, along T at the outlet
     assert cuts["inlet"]["normal_local"][2] < 0 < cuts["outlet"]["normal_local"][2]
 
@@ -59,6 +59,9 @@ def test_cap_plane_refuses_a_plane_tilted_beyond_the_limit_and_normal_cuts_nothi
     with pytest.raises(ConfigError, match=r"fit.end_cut: cap_plane: the inlet's flat cap is tilted 35.0 deg.*"
                                           r"use fit.end_cut: auto or normal"):
         choose_end_cuts("cap_plane", planes, f)
+    planes["inlet"] = plane(0.1, -f[0][:, 2])  # a gap auto leaves square: cap_plane cuts it, offset applied
+    exact = choose_end_cuts("cap_plane", planes, f)
+    assert exact["inlet"]["applied"] and exact["inlet"]["offset_mm"] == 0.2 and exact["outlet"]["offset_mm"] == 0.2
     square = choose_end_cuts("normal", planes, f)
     assert not any(c["applied"] for c in square.values())
     assert square["outlet"]["rim_gap_mm"] == planes["outlet"]["rim_gap_mm"]  # still reported

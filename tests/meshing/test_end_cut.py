@@ -15,7 +15,7 @@ import pytest
 
 from softdesign.errors import MeshError
 from softdesign.meshing.checks import check_solid
-from softdesign.meshing.end_cut import cut_ends, cut_planes, end_normals
+from softdesign.meshing.end_cut import cut_ends, cut_planes, end_cuts_from_record
 from softdesign.meshing.solids import build_solid
 from softdesign.meshing.tessellate import Region, TubeSections, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec, integrate_body
@@ -28,10 +28,12 @@ PLANE_TOL_MM = 1e-9
 VOLUME_RTOL = 5e-3
 
 
-def tilted(theta_deg: float, toward: float, outward_t: float) -> tuple[float, float, float]:
-    """Outward unit normal in the end frame, leaning ``theta_deg`` from +-T towards angle ``toward`` in (N, B)."""
+def tilted(theta_deg: float, toward: float, outward_t: float, offset_mm: float = 0.0) -> tuple[float, ...]:
+    """A cut: the outward unit normal in the end frame, leaning ``theta_deg`` from +-T towards angle ``toward``
+    in (N, B), crossing the axis ``offset_mm`` past the end."""
     t = np.radians(theta_deg)
-    return (float(np.sin(t) * np.cos(toward)), float(np.sin(t) * np.sin(toward)), float(outward_t * np.cos(t)))
+    return (float(np.sin(t) * np.cos(toward)), float(np.sin(t) * np.sin(toward)), float(outward_t * np.cos(t)),
+            offset_mm)
 
 
 def cap_vertices(solid, region: Region) -> np.ndarray:
@@ -53,7 +55,7 @@ def test_a_straight_tube_cut_at_tilted_planes_through_its_ends_is_the_exact_cut_
     np.testing.assert_allclose(report.volume, polygon_area(r, na) * length, rtol=0,
                                atol=ROUNDOFF_RTOL * report.volume)
     for region, normal, point in ((Region.BASE_CAP, base, [0, 0, 0]), (Region.TIP_CAP, tip, [0, 0, length])):
-        assert np.abs((cap_vertices(solid, region) - point) @ np.array(normal)).max() < PLANE_TOL_MM
+        assert np.abs((cap_vertices(solid, region) - point) @ np.array(normal[:3])).max() < PLANE_TOL_MM
         np.testing.assert_allclose(cap_area(solid, region), polygon_area(r, na) / np.cos(np.radians(theta_deg)),
                                    rtol=ROUNDOFF_RTOL)
 
@@ -66,7 +68,21 @@ def test_without_cuts_the_mesh_is_the_square_tessellation_bit_for_bit():
     assert same is mesh and added == 0.0
     plain = build_solid(sections, BodySpec())
     assert np.array_equal(plain.vertices, mesh.vertices) and np.array_equal(plain.faces, mesh.faces)
-    assert end_normals(None) == (None, None) and end_normals({}) == (None, None)
+    assert end_cuts_from_record(None) == (None, None) and end_cuts_from_record({}) == (None, None)
+
+
+@pytest.mark.parametrize("offsets", [(1.5, -0.8), (-0.6, 2.0)])
+def test_a_plane_crossing_the_axis_past_or_short_of_the_end_lengthens_or_shortens_the_prism(offsets):
+    # tilted planes crossing the axis offset mm outward from each end: the prism between them is A (L + sum)
+    r, length, na, theta = 3.0, 40.0, 64, 10.0
+    base, tip = tilted(theta, 1.0, -1.0, offsets[0]), tilted(theta, -0.5, 1.0, offsets[1])
+    solid = build_solid(Body(straight_line(length), r).sections(81, na), BodySpec(end_cuts=(base, tip)))
+    expected = polygon_area(r, na) * (length + sum(offsets))
+    report = check_solid(solid.vertices, solid.faces, solid.expectation(polygon_area(r, na) * length))
+    np.testing.assert_allclose(report.volume, expected, rtol=0, atol=ROUNDOFF_RTOL * expected)
+    for region, cut, point in ((Region.BASE_CAP, base, [0, 0, -offsets[0]]),
+                               (Region.TIP_CAP, tip, [0, 0, length + offsets[1]])):
+        assert np.abs((cap_vertices(solid, region) - point) @ np.array(cut[:3])).max() < PLANE_TOL_MM
 
 
 def test_the_cut_plane_moves_rigidly_with_the_end_frame():
@@ -103,7 +119,7 @@ def test_a_hollow_body_keeps_its_wall_at_tilted_ends(port_mm):
     assert report.watertight and report.bodies == 1 and report.euler == (2 if port_mm else 4)
     chamber_caps = cap_vertices(solid, Region.CHAMBER_CAP)
     # each chamber cap lies in its outer cap's plane moved wall_mm inward (the nearer of the two planes)
-    per_vertex = np.maximum(chamber_caps @ np.array(base), (chamber_caps - [0, 0, length]) @ np.array(tip))
+    per_vertex = np.maximum(chamber_caps @ np.array(base[:3]), (chamber_caps - [0, 0, length]) @ np.array(tip[:3]))
     np.testing.assert_allclose(per_vertex, -wall, rtol=0, atol=PLANE_TOL_MM)
     assert report.volume > 0
     # the side wall is the prism's: the chamber is the (r - wall) prism, nothing nearer the outside

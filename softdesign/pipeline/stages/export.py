@@ -32,7 +32,7 @@ from softdesign.io.polylines_vtp import write_polylines_vtp
 from softdesign.io.pvd import pvd_bytes
 from softdesign.meshing.body import body_breaks, body_sections, body_stations
 from softdesign.meshing.checks import check_solid
-from softdesign.meshing.end_cut import end_normals
+from softdesign.meshing.end_cut import end_cuts_from_record
 from softdesign.meshing.morph_body import MorphSurfaces, morph_surfaces
 from softdesign.meshing.regions import RegionPiece, split_by_region
 from softdesign.meshing.solids import Solid, build_solid
@@ -82,7 +82,7 @@ def body_spec(case: Case, fit: FitResult | None = None) -> BodySpec:
     """The case's export keys as a solid specification, with the fit's end cuts when ``fit`` is given."""
     e = case.export
     spec = BodySpec(offset_mm=e.offset_mm, wall_mm=e.wall_mm or 0.0, port_mm=e.port_mm or 0.0)
-    return spec if fit is None else replace(spec, end_cuts=end_normals(fit.summary.get("end_cut")))
+    return spec if fit is None else replace(spec, end_cuts=end_cuts_from_record(fit.summary.get("end_cut")))
 
 
 def solid_at(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case) -> ExportedMesh:
