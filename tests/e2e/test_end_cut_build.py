@@ -4,7 +4,8 @@ The tilted-cap vessel (tests/helpers/robust_vessels.py: radius r, straight, its 
 to the end tangent, through the centerline's first point) leaves ``r tan(theta)`` of wall beyond a square body
 end.  Built at default settings the q = 1 body's base cap lies in the detected cap plane, the wall near the cap
 is covered, the plane sits in the end frame at every q, the meshes are valid solids; a hollow body keeps its
-wall; ``fit.end_cut: normal`` gives the square body, and auto leaves a square-capped vessel's bytes alone.
+wall; morph.glb ends in the plane too; ``fit.end_cut: normal`` gives the square body, and auto leaves a
+square-capped vessel's bytes alone; on the VMTK aorta's open ends cap_plane ends the body in the clipping planes.
 """
 
 from __future__ import annotations
@@ -130,3 +131,36 @@ def test_auto_leaves_a_square_capped_vessel_byte_for_byte_as_normal(tmp_path):
     assert not any(c["applied"] for c in auto["metrics"]["fit"]["end_cut"].values())
     for mesh in sorted((tmp_path / "auto" / "meshes").glob("*.stl")):
         assert mesh.read_bytes() == (tmp_path / "normal" / "meshes" / mesh.name).read_bytes()
+
+
+def test_the_vmtk_aorta_open_ends_are_cut_at_their_clipping_planes_with_cap_plane(tmp_path, aorta_dir):
+    # vmtksurfaceclipper opened each end with a plane; cap_plane ends the body in those planes (the inlet's
+    # crosses the axis 2.1 mm past the centerline's end: the body is lengthened to it), auto at their tilt
+    final = {"centerline": str(aorta_dir / "aorta-centerline.vtp"),
+             "surface": str(aorta_dir / "aorta-surface-open-ends.stl"), "path": 0}
+    export = {"q": [0, 1], "formats": ["vtp"]}
+    manifest = build(write_case(tmp_path, "aorta", final=final, export=export, fit={"end_cut": "cap_plane"}),
+                     tmp_path / "out")
+    cuts, planes = manifest["metrics"]["fit"]["end_cut"], manifest["metrics"]["ingest"]["end_planes"]
+    points, faces, arrays = read_vtp(tmp_path / "out" / "meshes" / "q_1.000.vtp")
+    for end, region in (("inlet", Region.BASE_CAP), ("outlet", Region.TIP_CAP)):
+        assert cuts[end]["applied"] and cuts[end]["offset_mm"] == planes[end]["axis_offset_mm"]
+        cap = points[np.unique(faces[arrays["Region"] == region])]
+        point, normal = np.array(planes[end]["point_mm"]), np.array(planes[end]["normal"])
+        assert np.abs((cap - point) @ normal).max() < CAP_PLANE_TOL_MM
+    assert all(o["watertight"] for o in manifest["outputs"] if o["path"].startswith("meshes/"))
+
+
+def test_the_morphing_mesh_ends_in_the_cut_plane_at_q_1(tmp_path):
+    from softdesign.pipeline.api import build_through
+
+    centerline, surface = write_tilted_cap_vessel(tmp_path / "tilted", RADIUS, LENGTH, 14.0)
+    case = write_case(tmp_path, "morph", final={"centerline": str(centerline), "surface": str(surface)},
+                      export={"q": [0, 1], "formats": ["glb"], "angular_count": 48})
+    outcome = build_through(case, tmp_path / "out", target="export")
+    morph = outcome.results["export"].morph
+    plane = outcome.results["ingest"].summary["end_planes"]["inlet"]
+    point, normal = np.array(plane["point_mm"]), np.array(plane["normal"])
+    base = np.concatenate([morph.vertices[-1][:48], morph.vertices[-1][-2:-1]])  # first ring and its hub
+    assert morph.q[-1] == 1.0 and np.abs((base - point) @ normal).max() < CAP_PLANE_TOL_MM
+    assert (tmp_path / "out" / "morph.glb").is_file()
