@@ -43,6 +43,11 @@ MAX_CUT_TILT_DEG = 30.0
 #: A rim gap below this is left square, mm: the detection's own scatter (a 64-gon's sagitta on a 3 mm
 #: radius is 0.004 mm; float32 STL caps tilt by hundredths of a degree) and well under a fit's RMS.
 MIN_CUT_GAP_MM = 0.05
+#: The body's end zone, whose rings slide along the wall to meet the plane, is this many times the largest
+#: shift long (each ring step scales by at most 1 +- 1/3) ...
+ZONE_FACTOR = 3.0
+#: ... and at most this fraction of the body's length (the two ends' zones never meet).
+MAX_ZONE_FRACTION = 0.25
 #: The ends in path order.
 ENDS = ("inlet", "outlet")
 
@@ -54,7 +59,7 @@ def end_normal_local(normal: FloatArray, frame: FloatArray) -> FloatArray:
 
 
 def choose_end_cuts(
-    mode: str, planes: dict[str, dict[str, Any] | None] | None, frames: FloatArray
+    mode: str, planes: dict[str, dict[str, Any] | None] | None, frames: FloatArray, length_mm: float
 ) -> dict[str, dict[str, Any]]:
     """Per end ("inlet", "outlet"): whether the body is cut at the detected plane, why, and the plane.
 
@@ -64,6 +69,8 @@ def choose_end_cuts(
     planes : the ingest's ``end_planes`` (:meth:`EndPlane.as_dict` per end, None where none was found),
         or None when nothing was measured
     frames : (2, 3, 3) end frames (columns N, B, T) of the final shape at l = 0 and l = 1
+    length_mm : the final path's length, mm: auto keeps an end square whose plane lies farther from it
+        (rim gap plus applied offset) than a zone of ``MAX_ZONE_FRACTION`` of it can take
 
     Returns
     -------
@@ -81,11 +88,11 @@ def choose_end_cuts(
     out: dict[str, dict[str, Any]] = {}
     for k, end in enumerate(ENDS):
         plane = None if planes is None else planes.get(end)
-        out[end] = _choose(mode, end, plane, np.asarray(frames[k], float))
+        out[end] = _choose(mode, end, plane, np.asarray(frames[k], float), length_mm)
     return out
 
 
-def _choose(mode: str, end: str, plane: dict[str, Any] | None, frame: FloatArray) -> dict[str, Any]:
+def _choose(mode: str, end: str, plane: dict[str, Any] | None, frame: FloatArray, length_mm: float) -> dict[str, Any]:
     if mode == "normal":
         record: dict[str, Any] = {"applied": False, "reason": "fit.end_cut: normal"}
         return record if plane is None else {**record, **_figures(plane)}
@@ -103,6 +110,9 @@ def _choose(mode: str, end: str, plane: dict[str, Any] | None, frame: FloatArray
         return {"applied": False, "reason": f"tilt above {MAX_CUT_TILT_DEG:g} deg: square end kept", **figures}
     if mode == "auto" and plane["rim_gap_mm"] < MIN_CUT_GAP_MM:
         return {"applied": False, "reason": f"rim gap below {MIN_CUT_GAP_MM:g} mm: square end kept", **figures}
+    if mode == "auto" and ZONE_FACTOR * plane["rim_gap_mm"] > MAX_ZONE_FRACTION * length_mm:
+        return {"applied": False, "reason": f"rim gap too long for a {length_mm:.1f} mm path: square end kept",
+                **figures}
     local = end_normal_local(np.asarray(plane["normal"], float), frame)  # already outward at both ends
     kind = plane["kind"].replace("_", " ")
     reason = f"{kind} plane detected" + (", axis offset applied" if mode == "cap_plane" else

@@ -44,15 +44,10 @@ from typing import Any
 import numpy as np
 
 from softdesign.errors import MeshError
+from softdesign.geometry.end_cut import MAX_ZONE_FRACTION, ZONE_FACTOR
 from softdesign.meshing.tessellate import Sweep, TubeMesh
 from softdesign.meshing.volume import EndCuts
 from softdesign.types import FloatArray
-
-#: The zone whose rings slide to meet the plane is this many times the largest shift long.
-ZONE_FACTOR = 3.0
-#: ... and at most this fraction of the body's length (the two ends' zones never meet).
-MAX_ZONE_FRACTION = 0.25
-
 
 
 @dataclass(frozen=True)

@@ -28,10 +28,13 @@ def frames() -> np.ndarray:
     return np.stack([np.eye(3), rotation])
 
 
+LENGTH_MM = 100.0
+
+
 def test_auto_cuts_a_tilted_cap_and_keeps_its_normal_in_the_end_frame():
     f = frames()
     planes = {"inlet": plane(8.0, -f[0][:, 2]), "outlet": plane(12.0, f[1][:, 2])}
-    cuts = choose_end_cuts("auto", planes, f)
+    cuts = choose_end_cuts("auto", planes, f, LENGTH_MM)
     for k, end in enumerate(("inlet", "outlet")):
         c = cuts[end]
         assert c["applied"] and c["reason"].startswith("flat cap plane detected, through the centerline")
@@ -45,12 +48,16 @@ def test_auto_cuts_a_tilted_cap_and_keeps_its_normal_in_the_end_frame():
 def test_auto_keeps_square_ends_where_nothing_is_found_the_gap_is_noise_or_the_tilt_too_large():
     f = frames()
     small = np.degrees(np.arctan(0.5 * MIN_CUT_GAP_MM / 3.0))
-    cuts = choose_end_cuts("auto", {"inlet": None, "outlet": plane(small, f[1][:, 2])}, f)
+    cuts = choose_end_cuts("auto", {"inlet": None, "outlet": plane(small, f[1][:, 2])}, f, LENGTH_MM)
     assert not cuts["inlet"]["applied"] and "no flat cap or open boundary loop" in cuts["inlet"]["reason"]
     assert not cuts["outlet"]["applied"] and cuts["outlet"]["reason"].startswith("rim gap below")
-    steep = choose_end_cuts("auto", {"inlet": plane(MAX_CUT_TILT_DEG + 5, -f[0][:, 2]), "outlet": None}, f)
+    steep = choose_end_cuts("auto", {"inlet": plane(MAX_CUT_TILT_DEG + 5, -f[0][:, 2]), "outlet": None}, f,
+                            LENGTH_MM)
     assert not steep["inlet"]["applied"] and steep["inlet"]["reason"].startswith(f"tilt above {MAX_CUT_TILT_DEG:g}")
-    assert choose_end_cuts("auto", None, f)["outlet"]["applied"] is False
+    assert choose_end_cuts("auto", None, f, LENGTH_MM)["outlet"]["applied"] is False
+    # a 3 mm vessel's 14 deg cap (gap 0.75 mm) on a 8 mm path: its end zone would take more than a quarter
+    short = choose_end_cuts("auto", {"inlet": plane(14.0, -f[0][:, 2]), "outlet": None}, f, 8.0)
+    assert not short["inlet"]["applied"] and short["inlet"]["reason"].startswith("rim gap too long for a 8.0 mm")
 
 
 def test_cap_plane_refuses_a_plane_tilted_beyond_the_limit_and_normal_cuts_nothing():
@@ -58,10 +65,10 @@ def test_cap_plane_refuses_a_plane_tilted_beyond_the_limit_and_normal_cuts_nothi
     planes = {"inlet": plane(MAX_CUT_TILT_DEG + 5, -f[0][:, 2]), "outlet": plane(10.0, f[1][:, 2])}
     with pytest.raises(ConfigError, match=r"fit.end_cut: cap_plane: the inlet's flat cap is tilted 35.0 deg.*"
                                           r"use fit.end_cut: auto or normal"):
-        choose_end_cuts("cap_plane", planes, f)
+        choose_end_cuts("cap_plane", planes, f, LENGTH_MM)
     planes["inlet"] = plane(0.1, -f[0][:, 2])  # a gap auto leaves square: cap_plane cuts it, offset applied
-    exact = choose_end_cuts("cap_plane", planes, f)
+    exact = choose_end_cuts("cap_plane", planes, f, LENGTH_MM)
     assert exact["inlet"]["applied"] and exact["inlet"]["offset_mm"] == 0.2 and exact["outlet"]["offset_mm"] == 0.2
-    square = choose_end_cuts("normal", planes, f)
+    square = choose_end_cuts("normal", planes, f, LENGTH_MM)
     assert not any(c["applied"] for c in square.values())
     assert square["outlet"]["rim_gap_mm"] == planes["outlet"]["rim_gap_mm"]  # still reported

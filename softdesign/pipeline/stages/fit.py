@@ -95,7 +95,7 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     summary = {**wall.summary(), "initial_radius": _initial_kind(case),
                "backbone": stretch_fit_errors(ingest.summary.get("backbone"), wall, curve),
                "end_cut": choose_end_cuts(fit.end_cut, ingest.summary.get("end_planes"),
-                                          curve.frames(np.array([0.0, 1.0])))}
+                                          curve.frames(np.array([0.0, 1.0])), chain.shape.keys[-1].length)}
     # the end prior can hold the ends a straying centerline leaves one-sided: the fit then succeeds, so say it
     stray = centerline_stray(case, curve.curve, path)
     if stray is not None:
