@@ -103,7 +103,6 @@ def cut_ends(mesh: TubeMesh, sweep: Sweep, planes: tuple[CutPlane | None, CutPla
         return mesh, 0.0
     points = mesh.vertices[: n * na].reshape(n, na, 3).copy()
     hubs = mesh.vertices[n * na:].copy()
-    added = 0.0
     for end, plane in enumerate(planes):
         if plane is None:
             continue
@@ -113,9 +112,19 @@ def cut_ends(mesh: TubeMesh, sweep: Sweep, planes: tuple[CutPlane | None, CutPla
         outward = sweep.frames[k][:, 2] * (-1.0 if end == 0 else 1.0)
         name = f"{label}: the {'base' if end == 0 else 'tip'} end's cut plane"
         points[order], hubs[end] = _cut_last_end(points[order], s, sweep.centers[k], outward, plane, name)
-        added += _wedge_volume(sweep.xy[k], sweep.centers[k], sweep.frames[k], outward, plane)
     vertices = np.concatenate([points.reshape(-1, 3), hubs])
-    return TubeMesh(vertices, mesh.faces, mesh.regions), float(added)
+    return TubeMesh(vertices, mesh.faces, mesh.regions), end_cut_volume(sweep, planes)
+
+
+def end_cut_volume(sweep: Sweep, planes: tuple[CutPlane | None, CutPlane | None]) -> float:
+    """The volume the cuts at ``planes`` add to the body of ``sweep`` (what :func:`cut_ends` returns), mm3."""
+    added = 0.0
+    for end, plane in enumerate(planes):
+        if plane is not None:
+            k = 0 if end == 0 else -1
+            outward = sweep.frames[k][:, 2] * (-1.0 if end == 0 else 1.0)
+            added += _wedge_volume(sweep.xy[k], sweep.centers[k], sweep.frames[k], outward, plane)
+    return float(added)
 
 
 def _cut_last_end(points: FloatArray, s: FloatArray, centre: FloatArray, outward: FloatArray, plane: CutPlane,

@@ -164,3 +164,23 @@ def test_the_morphing_mesh_ends_in_the_cut_plane_at_q_1(tmp_path):
     base = np.concatenate([morph.vertices[-1][:48], morph.vertices[-1][-2:-1]])  # first ring and its hub
     assert morph.q[-1] == 1.0 and np.abs((base - point) @ normal).max() < CAP_PLANE_TOL_MM
     assert (tmp_path / "out" / "morph.glb").is_file()
+
+
+def test_a_pose_with_one_q_per_link_is_cut_like_the_export(tmp_path):
+    import trimesh
+
+    centerline, surface = write_tilted_cap_vessel(tmp_path / "tilted", RADIUS, LENGTH, 14.0)
+    case = write_case(tmp_path, "pose", final={"centerline": str(centerline), "surface": str(surface)},
+                      links={"count": 3}, export={"q": [1], "wall_mm": 1.0, "port_mm": 1.5})
+    out, output = tmp_path / "out", tmp_path / "pose.stl"
+    result = runner.invoke(app, ["pose", str(case), "--q", "1", "--output", str(output), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    # every q equal: the export's hollow mesh, cut ends and all
+    from softdesign.meshing.compare import compare_meshes
+
+    mine, built = trimesh.load(output), trimesh.load(out / "meshes" / "q_1.000.stl")
+    assert compare_meshes(mine.vertices, mine.faces, built.vertices, built.faces).distance_max_mm < 1e-6
+    result = runner.invoke(app, ["pose", str(case), "--q", "0,1,0.5", "--output", str(output), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    # the pose's own check of the solid it built (watertight, one body, the volume with the cuts' wedges)
+    assert "NOT watertight" not in result.output and "watertight" in result.output
