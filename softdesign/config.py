@@ -162,6 +162,9 @@ class Fit(_Section):
     # wall points within this of either end are not fitted (a tilted cap's rim, one-sided ends); the end's
     # rings are then held at the inscribed radius by the end prior (fitting/end_prior.py)
     end_margin_mm: FiniteFloat = Field(0.0, ge=0.0, le=MAX_END_MARGIN_MM)
+    # where the body ends: at each end's detected cap plane or boundary loop (auto, cap_plane) or square to the
+    # end tangent (normal); see geometry/end_cut.py
+    end_cut: Literal["auto", "cap_plane", "normal"] = "auto"
 
     @field_validator("knot_spacing_mm", mode="before")
     @classmethod
@@ -350,6 +353,24 @@ class Case(_Section):
             "undefined where the curvature is zero. Use frames: rmf (defined on straight parts) or set "
             + " and ".join(fixes)
         )
+
+    @field_validator("export")
+    @classmethod
+    def _mould_casts_square_ends(cls, export: Export, info: ValidationInfo) -> Export:
+        """Refuse ``fit.end_cut: cap_plane`` with ``export.mould``: the mould casts square-ended bodies only.
+
+        A mould of the square-ended body around a body cut at a tilted plane would cast
+        something other than the exported actuator; ``auto`` keeps the ends square when a
+        mould is asked for (and says so), ``cap_plane`` asks for the cut outright.
+        """
+        fit = info.data.get("fit")
+        if export.mould is not None and isinstance(fit, Fit) and fit.end_cut == "cap_plane":
+            raise ValueError(
+                "export.mould casts the body with square ends (cutting the mould at a tilted cap plane is not built "
+                "yet), but fit.end_cut: cap_plane cuts the exported body at the cap plane, so the mould would cast "
+                "another body; use fit.end_cut: auto or normal (square ends) with a mould, or drop export.mould"
+            )
+        return export
 
     @field_validator("name")
     @classmethod

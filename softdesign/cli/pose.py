@@ -120,6 +120,7 @@ def _print_pose(payload: dict[str, Any], seconds: float) -> None:
 
 def _make_pose(case_file: Path, q: list[float], out: Path | None, force: bool) -> Any:
     """Build (cached) through every stage, then the pose body; errors name the case file."""
+    from softdesign.meshing.end_cut import end_cuts_from_record
     from softdesign.meshing.pose_body import PoseSpec, pose_body
     from softdesign.pipeline.api import build_through
 
@@ -130,7 +131,7 @@ def _make_pose(case_file: Path, q: list[float], out: Path | None, force: bool) -
     export = outcome.case.export
     with errors_named_for(case_file):
         spec = PoseSpec(export.spacing_mm, export.angular_count, export.offset_mm, export.wall_mm or 0.0,
-                        export.port_mm or 0.0)
+                        export.port_mm or 0.0, end_cuts_from_record(outcome.results["fit"].summary.get("end_cut")))
         return pose_body(chain, field, q, spec)
 
 

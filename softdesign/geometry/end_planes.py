@@ -7,7 +7,8 @@ square end on one side and as far short of it on the other (r the vessel's
 radius there): over that length the body does not follow the wall.  This
 module finds each end's plane and measures theta and ``r tan(theta)``; it
 changes nothing (the fit already drops the points past the end, see
-:mod:`softdesign.fitting.selection`).
+:mod:`softdesign.fitting.selection`); :mod:`softdesign.geometry.end_cut`
+decides whether the body's end is cut at this plane instead (``fit.end_cut``).
 
 Detection, per end (the path's end point ``e`` and outward tangent ``t``):
 
@@ -43,6 +44,7 @@ from typing import Any
 
 import numpy as np
 
+from softdesign.geometry.end_cut import MAX_CUT_TILT_DEG
 from softdesign.types import FloatArray, IntArray, Points
 
 #: A rim whose centroid is farther than this many inscribed radii from the path's end is not that end's.
@@ -138,7 +140,7 @@ def rim_gap_warnings(planes: dict[str, dict[str, Any] | None]) -> list[str]:
         f"{p['radius_mm']:.3f} mm) reaches {p['rim_gap_mm']:.3f} mm past the body's end on one side and stops as "
         f"far short of it on the other (more than {RIM_GAP_TOLERANCE_MM:g} mm), and the body does not follow the "
         "wall there; clip that end of the surface square to the centerline (e.g. vmtksurfaceclipper) and re-cap it "
-        "if the end must match"
+        f"if the end must match (fit.end_cut: auto cuts the body at a plane tilted up to {MAX_CUT_TILT_DEG:g} deg)"
         for name, p in planes.items() if p is not None and p["rim_gap_mm"] > RIM_GAP_TOLERANCE_MM
     ]
 

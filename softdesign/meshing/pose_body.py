@@ -46,11 +46,13 @@ from softdesign.geometry.se3 import inverse_pose
 from softdesign.kinematics.links import LinkChain
 from softdesign.meshing.body import body_breaks, body_stations, export_l_grid, sections_on_grid
 from softdesign.meshing.checks import Expectation, MeshReport, check_solid
+from softdesign.meshing.end_cut import CutPlane, cut_planes, end_cut_volume
 from softdesign.meshing.pose_stitch import JointStep, JointStitch, assemble, placed, resampled_joints
 from softdesign.meshing.solids import carve_chamber, manifold_from_mesh
 from softdesign.meshing.tessellate import Sweep, TubeMesh, TubeSections, sweep_from_sections, trim_sweep
 from softdesign.meshing.volume import (
     BodySpec,
+    EndCuts,
     angle_grid,
     arclength_at,
     integrate_body,
@@ -69,10 +71,11 @@ class PoseSpec:
     offset_mm: float = 0.0
     wall_mm: float = 0.0
     port_mm: float = 0.0
+    end_cuts: EndCuts = (None, None)
 
     def body(self) -> BodySpec:
-        """The solid's offset, wall and port."""
-        return BodySpec(offset_mm=self.offset_mm, wall_mm=self.wall_mm, port_mm=self.port_mm)
+        """The solid's offset, wall, port and end cuts."""
+        return BodySpec(offset_mm=self.offset_mm, wall_mm=self.wall_mm, port_mm=self.port_mm, end_cuts=self.end_cuts)
 
 
 @dataclass(frozen=True)
@@ -194,17 +197,20 @@ def pose_body(chain: LinkChain, field: RadiusField, q: float | npt.ArrayLike, sp
         l_range = (float(field.breaks[j]), float(field.breaks[j + 1]))
         links.append(PoseLink(j, qj, *l_range, length, start2world, sweep, volumes[j]))
         start2world = start2world @ transform
-    vertices, faces, regions = assemble([link.sweep for link in links], stitches)
+    planes = _end_planes(links[0].sweep, links[-1].sweep, spec.end_cuts, 0.0)
+    vertices, faces, regions = assemble([link.sweep for link in links], stitches, planes, label="pose")
     label = "pose q=[" + ", ".join(f"{v:.3f}" for v in q) + "]"
     joints = [s.figures(j, float(field.breaks[j + 1])) for j, s in enumerate(stitches)]
     reach = max(s.max_rho_kappa for s in sweeps)
-    expected, euler, kind = float(sum(volumes)), 2, "solid"
+    expected, euler, kind = float(sum(volumes)) + _cut_volume(links[0].sweep, links[-1].sweep, planes), 2, "solid"
     if spec.wall_mm > 0:
         chamber, chamber_stitches = _chamber(sections, spec, label)
         joints = [replace(step, min_wall_mm=_joint_wall(outer, inner, step, spec))
                   for outer, inner, step in zip(stitches, chamber_stitches, joints, strict=True)]
         chamber = [placed(sweep, move) for sweep, move in zip(chamber, moves, strict=True)]
-        cavity = TubeMesh(*assemble(chamber, chamber_stitches))
+        inner = _end_planes(links[0].sweep, links[-1].sweep, spec.end_cuts, spec.wall_mm)
+        cavity = TubeMesh(*assemble(chamber, chamber_stitches, inner, label="pose chamber"))
+        expected -= _cut_volume(chamber[0], chamber[-1], inner)
         body = TubeMesh(vertices, faces, regions)
         solid = carve_chamber(body, cavity, links[0].sweep, chamber[0], spec.body(), label)
         vertices, faces, regions, euler, kind = solid.vertices, solid.faces, solid.regions, solid.euler, solid.kind
@@ -213,6 +219,16 @@ def pose_body(chain: LinkChain, field: RadiusField, q: float | npt.ArrayLike, sp
     if kind == "solid":
         manifold_from_mesh(vertices, faces, label)
     return PoseBody(q, tuple(links), tuple(joints), vertices, faces, regions, expected, report, reach, kind)
+
+
+def _end_planes(first: Sweep, last: Sweep, cuts: EndCuts, inset_mm: float) -> tuple[CutPlane | None, CutPlane | None]:
+    """The cut planes at the base of the placed ``first`` link and the tip of the placed ``last``."""
+    return cut_planes(first, (cuts[0], None), inset_mm)[0], cut_planes(last, (None, cuts[1]), inset_mm)[1]
+
+
+def _cut_volume(first: Sweep, last: Sweep, planes: tuple[CutPlane | None, CutPlane | None]) -> float:
+    """What the end cuts add to the volume between the end frames' planes, mm3 (the export's wedges)."""
+    return end_cut_volume(first, (planes[0], None)) + end_cut_volume(last, (None, planes[1]))
 
 
 def _chamber(sections: list[TubeSections], spec: PoseSpec, label: str) -> tuple[list[Sweep], list[JointStitch]]:

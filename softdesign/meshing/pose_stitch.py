@@ -21,6 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import MeshError
+from softdesign.meshing.end_cut import CutPlane, cut_ends
 from softdesign.meshing.tessellate import Region, Sweep, TubeMesh, tessellate
 from softdesign.meshing.topology import drop_unused_vertices
 from softdesign.meshing.volume import angle_grid
@@ -155,9 +156,13 @@ def stitch_joint(
     )
 
 
-def _link_mesh(sweep: Sweep, base: bool, tip: bool) -> TubeMesh:
-    """The link's wall, with the base cap only on the first link and the tip cap only on the last."""
+def _link_mesh(sweep: Sweep, base: bool, tip: bool, planes: tuple[CutPlane | None, CutPlane | None],
+               label: str) -> TubeMesh:
+    """The link's wall, with the base cap only on the first link and the tip cap only on the last (cut at
+    ``planes``)."""
     mesh = tessellate(sweep, caps=base or tip)
+    if base or tip:
+        mesh, _ = cut_ends(mesh, sweep, planes, label)
     if base == tip:
         return mesh
     hub = sweep.xy.shape[0] * sweep.xy.shape[1] + (1 if base else 0)  # the hub of the cap to drop
@@ -206,9 +211,16 @@ def resampled_joints(sweeps: list[Sweep]) -> tuple[list[Sweep], list[JointStitch
     return sweeps, stitches
 
 
-def assemble(sweeps: list[Sweep], stitches: list[JointStitch]) -> tuple[FloatArray, IntArray, npt.NDArray[np.int8]]:
-    """One mesh of the placed link sweeps, joined at every joint by shared vertices and annuli."""
-    meshes = [_link_mesh(sweep, j == 0, j == len(sweeps) - 1) for j, sweep in enumerate(sweeps)]
+def assemble(sweeps: list[Sweep], stitches: list[JointStitch],
+             planes: tuple[CutPlane | None, CutPlane | None] = (None, None),
+             label: str = "pose") -> tuple[FloatArray, IntArray, npt.NDArray[np.int8]]:
+    """One mesh of the placed link sweeps, joined at every joint by shared vertices and annuli.
+
+    ``planes`` cut the first link's base and the last link's tip (:mod:`softdesign.meshing.end_cut`).
+    """
+    last = len(sweeps) - 1
+    meshes = [_link_mesh(sweep, j == 0, j == last, (planes[0] if j == 0 else None, planes[1] if j == last else None),
+                         label) for j, sweep in enumerate(sweeps)]
     offsets = np.cumsum([0] + [m.vertices.shape[0] for m in meshes])
     vertices = [m.vertices for m in meshes]
     faces = np.concatenate([m.faces + off for m, off in zip(meshes, offsets[:-1], strict=True)])

@@ -15,7 +15,7 @@ every Manifold made here is checked and a bad one raises MeshError.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import manifold3d as m3
 import numpy as np
@@ -23,6 +23,7 @@ import numpy.typing as npt
 
 from softdesign.errors import MeshError
 from softdesign.meshing.checks import Expectation
+from softdesign.meshing.end_cut import cut_ends, cut_planes
 from softdesign.meshing.tessellate import (
     Region,
     Sweep,
@@ -56,6 +57,9 @@ class Solid:
         ``solid``, ``hollow`` or ``ported``.
     max_rho_kappa : float
         Largest rho * kappa of the outer surface (offset included); it folds at 1.
+    volume_offset_mm3 : float
+        What the end cuts add to the volume of the body between its end frames' planes, mm3
+        (:mod:`softdesign.meshing.end_cut`; 0 for square ends).
     """
 
     vertices: FloatArray
@@ -64,10 +68,13 @@ class Solid:
     euler: int
     kind: str
     max_rho_kappa: float
+    volume_offset_mm3: float = 0.0
 
     def expectation(self, volume: float | None) -> Expectation:
-        """What :func:`~softdesign.meshing.checks.check_solid` must find for this solid."""
-        return Expectation(volume=volume, euler=self.euler, bodies=1)
+        """What :func:`~softdesign.meshing.checks.check_solid` must find for this solid (``volume`` between the
+        end frames' planes, to which the end cuts' volume is added)."""
+        return Expectation(volume=None if volume is None else volume + self.volume_offset_mm3, euler=self.euler,
+                           bodies=1)
 
 
 def manifold_from_mesh(vertices: npt.ArrayLike, faces: npt.ArrayLike, label: str) -> tuple[m3.Manifold, int]:
@@ -166,8 +173,11 @@ def _port(outer: Sweep, chamber: Sweep, spec: BodySpec) -> tuple[m3.Manifold, in
             f"not fit the chamber's base section (largest diameter about the port axis {2 * clearance:.3f} mm, "
             f"keeping a {spec.min_radius_mm:g} mm ledge); use port_mm <= {2 * (clearance - spec.min_radius_mm):.3f}"
         )
-    outside = PORT_OUTSIDE_WALLS * w
-    inside = min(PORT_INSIDE_WALLS * w, 0.25 * (chamber.s[-1] - chamber.s[0]))
+    # a base cut moves the outer and chamber caps along the port's axis by up to this much (tilt and offset)
+    cut = spec.end_cuts[0]
+    lean = 0.0 if cut is None else radius * np.tan(np.arccos(-cut[2])) + w * (1.0 / -cut[2] - 1.0) + abs(cut[3])
+    outside = PORT_OUTSIDE_WALLS * w + lean
+    inside = min(PORT_INSIDE_WALLS * w, 0.25 * (chamber.s[-1] - chamber.s[0])) + lean
     segments = spec.port_segments or outer.xy.shape[1]
     cylinder = m3.Manifold.cylinder(outside + w + inside, radius, radius, segments, False)
     pose = np.column_stack([outer.frames[0], base - outside * axis])
@@ -198,13 +208,15 @@ def build_solid(sections: TubeSections, spec: BodySpec = BodySpec()) -> Solid:
     _check_spec(spec, sections)
     label = f"q={sections.q:.3f}"
     outer = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
-    body = tessellate(outer)
+    body, added = cut_ends(tessellate(outer), outer, cut_planes(outer, spec.end_cuts), label)
     if spec.wall_mm == 0:
         # no boolean, so no manifold3d: check_solid (which export runs on every solid) tests the same oriented
         # 2-manifold property and more; building the Manifold only to check it was half of export's time
-        return Solid(body.vertices, body.faces, body.regions, 2, "solid", outer.max_rho_kappa)
+        return Solid(body.vertices, body.faces, body.regions, 2, "solid", outer.max_rho_kappa, added)
     chamber = _chamber(sections, outer, spec)
-    return carve_chamber(body, tessellate(chamber), outer, chamber, spec, label)
+    cavity, removed = cut_ends(tessellate(chamber), chamber, cut_planes(outer, spec.end_cuts, spec.wall_mm),
+                               f"{label}: chamber")
+    return replace(carve_chamber(body, cavity, outer, chamber, spec, label), volume_offset_mm3=added - removed)
 
 
 def carve_chamber(body: TubeMesh, cavity: TubeMesh, outer: Sweep, chamber: Sweep, spec: BodySpec, label: str) -> Solid:

@@ -44,6 +44,10 @@ MIN_RADIUS_MM = 0.2
 GAUSS_ORDER = 8
 #: Newton iterations allowed to invert s(l), and their tolerance relative to the length.
 NEWTON_STEPS, NEWTON_RTOL = 30, 1e-12
+#: Per end (base, tip): the end's cut plane as (n_N, n_B, n_T, offset_mm): its outward unit normal in the end
+#: frame's (N, B, T) coordinates and where it crosses the axis, mm along the outward tangent from the end ring's
+#: centre; or None for a square end (:mod:`softdesign.meshing.end_cut`).
+EndCuts = tuple[tuple[float, float, float, float] | None, tuple[float, float, float, float] | None]
 
 
 @dataclass(frozen=True)
@@ -64,6 +68,8 @@ class BodySpec:
         least chamber length and the least ledge left around the port.
     port_segments : int
         Polygon sides of the port channel; 0 takes the body's angular count.
+    end_cuts : EndCuts
+        Per end, the cut plane in the end frame, or None: square to the end tangent.
     """
 
     offset_mm: float = 0.0
@@ -71,6 +77,7 @@ class BodySpec:
     port_mm: float = 0.0
     min_radius_mm: float = MIN_RADIUS_MM
     port_segments: int = 0
+    end_cuts: EndCuts = (None, None)
 
 
 @dataclass(frozen=True)

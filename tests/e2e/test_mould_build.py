@@ -23,11 +23,13 @@ runner = CliRunner()
 STL_VOLUME_RTOL = 1e-5
 
 
-def demo_case(folder: Path, **export) -> Path:
+def demo_case(folder: Path, fit: dict | None = None, **export) -> Path:
     case = yaml.safe_load((REPO / "configs" / "demo.yaml").read_text())
     for key in ("centerline", "surface"):
         case["final"][key] = str((REPO / "configs" / case["final"][key]).resolve())
     case["export"] = {"q": [0, 1], "angular_count": 48, "spacing_mm": 1.0, **export}
+    if fit is not None:
+        case["fit"] = {**case.get("fit", {}), **fit}
     path = folder / "demo.yaml"
     path.write_text(yaml.safe_dump(case, sort_keys=False))
     return path
@@ -98,16 +100,29 @@ def test_demo_hollow_mould_is_written_listed_and_checked(tmp_path):
 
 @pytest.mark.slow
 def test_a_mould_leaves_every_other_output_byte_for_byte(tmp_path):
+    # the mould casts square ends, so with a mould fit.end_cut: auto keeps the demo's tilted-cap ends square: the
+    # meshes equal those of a plain build with square ends (normal)
     plain, moulded = tmp_path / "plain", tmp_path / "moulded"
     (tmp_path / "a").mkdir()
     (tmp_path / "b").mkdir()
-    run("build", str(demo_case(tmp_path / "a")), "--out", str(plain))
+    run("build", str(demo_case(tmp_path / "a", fit={"end_cut": "normal"})), "--out", str(plain))
     run("build", str(demo_case(tmp_path / "b", mould={"up": "tip"})), "--out", str(moulded))
     before, after = files(plain), files(moulded)
     assert set(after) - set(before) == {"mould/summary.json", "meshes/mould/half_a.stl", "meshes/mould/half_b.stl"}
-    # only the manifest (it holds the case) and the mould stage's own record differ
-    assert {k for k in before if before[k] != after[k]} == {"manifest.json", "mould/stage.json"}
+    # the case differs (the manifest holds it; the fit reads export.mould, so the fit's and its followers' cache
+    # keys differ) and the fit's record says why each end stayed square; every mesh and figure is the same
+    changed = {k for k in before if before[k] != after[k]}
+    assert {k for k in changed if not k.endswith("stage.json")} == {"manifest.json", "fit/summary.json"}
+    assert not any(k.startswith("meshes/") for k in changed)
+    cuts = json.loads((moulded / "fit" / "summary.json").read_text())["end_cut"]
+    assert all(not c["applied"] and c["reason"].startswith("export.mould casts square ends") for c in cuts.values())
     assert mould_figure_png(plain) is None
+
+
+def test_a_mould_with_cap_plane_cuts_is_refused_before_building(tmp_path):
+    case = demo_case(tmp_path, mould={}, fit={"end_cut": "cap_plane"})
+    result = runner.invoke(app, ["validate", str(case)])
+    assert result.exit_code == 2 and "fit.end_cut: auto or normal" in result.output, result.output
 
 
 @pytest.mark.slow

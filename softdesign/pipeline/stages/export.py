@@ -18,7 +18,7 @@ and an animation over q (see :mod:`softdesign.meshing.morph_body`).
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -32,6 +32,7 @@ from softdesign.io.polylines_vtp import write_polylines_vtp
 from softdesign.io.pvd import pvd_bytes
 from softdesign.meshing.body import body_breaks, body_sections, body_stations
 from softdesign.meshing.checks import check_solid
+from softdesign.meshing.end_cut import end_cuts_from_record
 from softdesign.meshing.morph_body import MorphSurfaces, morph_surfaces
 from softdesign.meshing.regions import RegionPiece, split_by_region
 from softdesign.meshing.solids import Solid, build_solid
@@ -78,10 +79,11 @@ def region_name(q: float, piece: RegionPiece) -> str:
     return layout.region_path(q, piece.name)
 
 
-def body_spec(case: Case) -> BodySpec:
-    """The case's export keys as a solid specification."""
+def body_spec(case: Case, fit: FitResult | None = None) -> BodySpec:
+    """The case's export keys as a solid specification, with the fit's end cuts when ``fit`` is given."""
     e = case.export
-    return BodySpec(offset_mm=e.offset_mm, wall_mm=e.wall_mm or 0.0, port_mm=e.port_mm or 0.0)
+    spec = BodySpec(offset_mm=e.offset_mm, wall_mm=e.wall_mm or 0.0, port_mm=e.port_mm or 0.0)
+    return spec if fit is None else replace(spec, end_cuts=end_cuts_from_record(fit.summary.get("end_cut")))
 
 
 def solid_at(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case) -> ExportedMesh:
@@ -94,7 +96,7 @@ def solid_at(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case)
     """
     curve = kinematics.chain.shape.curve_at(q)
     e = case.export
-    spec = body_spec(case)
+    spec = body_spec(case, fit)
     solid = build_solid(body_sections(curve, fit.field, q, e.spacing_mm, e.angular_count), spec)
     integral = integrate_body(body_stations(curve, fit.field, q, e.angular_count), body_breaks(fit.field), spec)
     report = check_solid(solid.vertices, solid.faces, solid.expectation(integral.volume), label=f"q={q:.3f}")
@@ -162,7 +164,7 @@ def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Expo
     morph = None
     if "glb" in case.export.formats and len(meshes) >= 2:
         e = case.export
-        morph = morph_surfaces(kinematics.chain.shape, fit.field, np.array([m.q for m in meshes]), body_spec(case),
+        morph = morph_surfaces(kinematics.chain.shape, fit.field, np.array([m.q for m in meshes]), body_spec(case, fit),
                                e.spacing_mm, e.angular_count)
     summary = {
         "formats": list(case.export.formats),

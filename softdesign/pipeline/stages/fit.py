@@ -26,6 +26,8 @@ from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.selection import NetworkContext, SelectionSettings, inscribed_profile
 from softdesign.fitting.wall_fit import WallFitOptions, fit_wall
 from softdesign.geometry.curves import SmoothCurve, measure_deviation
+from softdesign.geometry.end_cut import choose_end_cuts
+from softdesign.geometry.end_planes import rim_gap_warnings
 from softdesign.geometry.network import SelectedPath
 from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import describe_backbone_fit, stretch_fit_errors
@@ -35,9 +37,10 @@ from softdesign.pipeline.stages.ingest import IngestResult
 from softdesign.pipeline.stages.links import LinksResult
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 
-VERSION = 4  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
+VERSION = 5  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
 # 3: points fitted in path order; distances sampled above 200k points (max still over all)
 # 4: end prior and end radii (issue 20); true distances on the regularized backbone's stretches (``backbone``)
+# 5: each end's cut plane in the end frame (``end_cut``, issue 20)
 #: Seed of the hold-out folds: the same case always gets the same folds.
 HOLDOUT_SEED = 4
 #: A failed fit is blamed on the centerline when the smoothed one strays from the input by this fraction of the
@@ -92,7 +95,10 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     if ingest.initial_surface is not None:
         field = _with_fitted_initial(chain, wall.settings, ingest.initial_surface[0], wall.field)
     summary = {**wall.summary(), "initial_radius": _initial_kind(case),
-               "backbone": stretch_fit_errors(ingest.summary.get("backbone"), wall, curve)}
+               "backbone": stretch_fit_errors(ingest.summary.get("backbone"), wall, curve),
+               "end_cut": choose_end_cuts(fit.end_cut, ingest.summary.get("end_planes"),
+                                          curve.frames(np.array([0.0, 1.0])), chain.shape.keys[-1].length,
+                                          mould=case.export.mould is not None)}
     # the end prior can hold the ends a straying centerline leaves one-sided: the fit then succeeds, so say it
     stray = centerline_stray(case, curve.curve, path)
     if stray is not None:
@@ -181,6 +187,7 @@ def fit_metrics(result: FitResult) -> dict[str, Any]:
         "backbone": s.get("backbone", []),
         "ends": s.get("ends", {}),
         "end_prior": s.get("end_prior", {}),
+        "end_cut": s.get("end_cut", {}),
     }
 
 
@@ -215,7 +222,11 @@ def end_lines(summary: dict[str, Any]) -> list[str]:
         f"held at the inscribed radius ({e['reference_min_mm']:.3f} to {e['reference_max_mm']:.3f} mm)"
         for end, e in summary.get("end_prior", {}).items()
     ]
-    return lines + [f"  warning: {w}" for w in thin_end_warnings(summary.get("ends", {}))]
+    cuts = summary.get("end_cut", {})
+    lines += [f"{end}: cut at the detected plane (tilt {c['tilt_deg']:.1f} deg, rim gap {c['rim_gap_mm']:.3f} mm)"
+              if c["applied"] else f"{end}: cut square to the end tangent ({c['reason']})" for end, c in cuts.items()]
+    square = {end: c for end, c in cuts.items() if not c["applied"] and "rim_gap_mm" in c}
+    return lines + [f"  warning: {w}" for w in thin_end_warnings(summary.get("ends", {})) + rim_gap_warnings(square)]
 
 
 def _sampled_note(distance: dict[str, Any]) -> str:
@@ -229,7 +240,7 @@ def _sampled_note(distance: dict[str, Any]) -> str:
 STAGE = Stage(
     name="fit",
     version=VERSION,
-    reads=("fit", "initial.radius_mm", "initial.surface"),
+    reads=("fit", "initial.radius_mm", "initial.surface", "export.mould"),  # a mould keeps auto's ends square
     upstream=("ingest", "links"),
     compute=lambda case, results: run_fit(case, results["ingest"], results["links"]),
     write=write_fit,

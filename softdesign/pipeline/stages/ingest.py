@@ -14,7 +14,6 @@ from typing import Any
 import numpy as np
 
 from softdesign.config import Case
-from softdesign.geometry.end_planes import rim_gap_warnings
 from softdesign.geometry.network import CenterlineNetwork, Orientation, SelectedPath, all_paths, select_path
 from softdesign.geometry.plausibility import check_surface_surrounds, check_vessel_scale
 from softdesign.io.centerline import read_centerline_network
@@ -32,7 +31,8 @@ from softdesign.types import UNIT_SCALE_TO_MM, FloatArray
 #: 3: a final path that turns tighter than the vessel is wide is regularized here (``backbone``); reads resample;
 #: the rule that chose the inlet (``centerline.inlet_rule``: the clearly widest end first).
 #: 4: each end's flat cap or open loop, its tilt to the end tangent and the rim's gap past the body (``end_planes``).
-VERSION = 4
+#: 5: the rim-gap warning moved to the fit, which decides whether the body is cut at the plane (``fit.end_cut``).
+VERSION = 5
 
 
 @dataclass(frozen=True)
@@ -87,7 +87,6 @@ def run_ingest(case: Case) -> IngestResult:
     path, backbone = regularized_path(case, path)
     notes += [n for n in path.notes if n not in notes]
     ends = end_plane_summary(case, path, vertices, faces)
-    notes += [f"warning: {w}" for w in rim_gap_warnings(ends or {})]
     initial_path = None
     if case.initial.kind == "file" and case.initial.centerline is not None:
         initial_path = _one_path(case.initial.centerline, case.initial.path, scale, Orientation())

@@ -94,7 +94,7 @@ def mesh_body(case: Case, kinematics: KinematicsResult, fit: FitResult, q: float
     body = solid_at(kinematics, fit, q, case)
     volume = float(body.figures["volume_mm3"])
     _check_count(volume, vm.size_mm, q)
-    spec = body_spec(case)
+    spec = body_spec(case, fit)
     chamber = None
     if spec.wall_mm > 0:
         e = case.export
