@@ -170,9 +170,9 @@ def _channel_points(body: m3.Manifold, up: FloatArray, spec: MouldSpec,
     """Vent at the parting line's highest point; pour at the highest point far enough from the vent.
 
     ``print_line`` (a point and unit direction in the parting plane, and the print's radius, mm): a core print
-    running up beside the channels; a channel is kept ``MIN_MOULD_WALL_MM`` off it.  A square end's face is
-    level, so its highest points include its rim; a cut end's face leans, and the highest point far enough from
-    the vent is next to the print, on the face's middle.
+    running up beside the channels; a channel is kept off it (the build still checks that none meets the core).
+    A square end's face is level, so its highest points include its rim; a cut end's face leans, and the
+    highest point far enough from the vent is next to the print, on the face's middle.
     """
     pts = _slice_points(body)
     height = pts @ up[:2]
@@ -184,14 +184,13 @@ def _channel_points(body: m3.Manifold, up: FloatArray, spec: MouldSpec,
         point, direction, print_radius = print_line
         off = pts - point
         distance = np.abs(off[:, 0] * direction[1] - off[:, 1] * direction[0])
-        return distance >= radius + print_radius + MIN_MOULD_WALL_MM
+        return distance >= radius + print_radius
 
     vent_ok, pour_ok = clear(0.5 * spec.vent_mm), clear(0.5 * spec.pour_mm)
     if not np.any(vent_ok):
         raise MouldRefused(
-            f"export.mould: the vent (vent_mm={spec.vent_mm:g}) needs {MIN_MOULD_WALL_MM:g} mm of mould between it "
-            "and the core print, and the body's top end is narrower; lower vent_mm or cast the other end up "
-            "(up: tip or base)"
+            f"export.mould: the vent (vent_mm={spec.vent_mm:g}) must run beside the core print, and the body's top "
+            "end is narrower; lower vent_mm or cast the other end up (up: tip or base)"
         )
     vent = pts[vent_ok][int(np.argmax(height[vent_ok]))]
     apart = 0.5 * (spec.pour_mm + spec.vent_mm) + MIN_MOULD_WALL_MM
@@ -199,8 +198,8 @@ def _channel_points(body: m3.Manifold, up: FloatArray, spec: MouldSpec,
     if not np.any(far):
         raise MouldRefused(
             f"export.mould: the pour channel (pour_mm={spec.pour_mm:g}) and the vent (vent_mm={spec.vent_mm:g}) "
-            f"need {apart:g} mm between their axes on the parting line (and {MIN_MOULD_WALL_MM:g} mm of mould "
-            "between each and a core print), and the body is narrower; lower them"
+            f"need {apart:g} mm between their axes on the parting line (each beside a core print), and the body is "
+            "narrower; lower them"
         )
     # the highest of them; among equally high ones (a flat end face) the one farthest from the vent
     top = far & (height >= np.max(height[far]) - PEAK_TOL_MM)
