@@ -357,18 +357,19 @@ class Case(_Section):
     @field_validator("export")
     @classmethod
     def _mould_casts_square_ends(cls, export: Export, info: ValidationInfo) -> Export:
-        """Refuse ``fit.end_cut: cap_plane`` with ``export.mould``: the mould casts square-ended bodies only.
+        """Refuse ``fit.end_cut: cap_plane`` with ``export.mould``: a two-part mould cannot release a cap plane
+        leaning out of its parting plane.
 
-        A mould of the square-ended body around a body cut at a tilted plane would cast
-        something other than the exported actuator; ``auto`` keeps the ends square when a
-        mould is asked for (and says so), ``cap_plane`` asks for the cut outright.
+        ``auto`` turns each cut into the parting plane when a mould is asked for (and says by how much);
+        ``cap_plane`` asks for the detected plane itself.
         """
         fit = info.data.get("fit")
         if export.mould is not None and isinstance(fit, Fit) and fit.end_cut == "cap_plane":
             raise ValueError(
-                "export.mould casts the body with square ends (cutting the mould at a tilted cap plane is not built "
-                "yet), but fit.end_cut: cap_plane cuts the exported body at the cap plane, so the mould would cast "
-                "another body; use fit.end_cut: auto or normal (square ends) with a mould, or drop export.mould"
+                "export.mould's two halves cannot be drawn off a cap plane that leans out of their parting plane, "
+                "and fit.end_cut: cap_plane cuts the exported body at the detected cap plane itself; use "
+                "fit.end_cut: auto (each cut turned into the parting plane) or normal (square ends) with a mould, "
+                "or drop export.mould"
             )
         return export
 

@@ -20,7 +20,10 @@ Modes (``fit.end_cut``)
                    point (the body keeps its length along the axis; the axis
                    offset is recorded, not applied), where a plane is found,
                    its tilt is at most ``MAX_CUT_TILT_DEG`` and its rim gap at
-                   least ``MIN_CUT_GAP_MM``; square otherwise, saying why.
+                   least ``MIN_CUT_GAP_MM``; square otherwise, saying why.  With
+                   ``export.mould`` each cut is turned into the mould's parting
+                   plane (a lean out of it would lock one half), or kept square
+                   on a curved q = 0 body.
     ``cap_plane``  the detected plane itself, axis offset included (the body
                    is lengthened or shortened along its axis to reach it),
                    wherever one is found; a tilt above ``MAX_CUT_TILT_DEG``
@@ -60,7 +63,7 @@ def end_normal_local(normal: FloatArray, frame: FloatArray) -> FloatArray:
 
 def choose_end_cuts(
     mode: str, planes: dict[str, dict[str, Any] | None] | None, frames: FloatArray, length_mm: float,
-    mould: bool = False,
+    mould: bool = False, parting_local: FloatArray | None = None,
 ) -> dict[str, dict[str, Any]]:
     """Per end ("inlet", "outlet"): whether the body is cut at the detected plane, why, and the plane.
 
@@ -72,8 +75,13 @@ def choose_end_cuts(
     frames : (2, 3, 3) end frames (columns N, B, T) of the final shape at l = 0 and l = 1
     length_mm : the final path's length, mm: auto keeps an end square whose plane lies farther from it
         (rim gap plus applied offset) than a zone of ``MAX_ZONE_FRACTION`` of it can take
-    mould : the case asks for a casting mould; the mould casts square ends only, so auto keeps them square
-        (the case file refuses ``cap_plane`` with a mould)
+    mould : the case asks for a two-part casting mould.  A cut leaning out of the mould's parting plane is an
+        undercut for one half (a rigid half cannot be drawn off along the plane's normal), so auto turns each
+        cut normal into the parting plane (drops its component along the plane's normal, recorded as
+        ``parting_lean_deg``); without ``parting_local`` (a curved q = 0 body) the ends stay square.  The case
+        file refuses ``cap_plane`` with a mould.
+    parting_local : (2, 3) the parting plane's unit normal in each end frame's (N, B, T) coordinates at q = 0
+        (:func:`~softdesign.meshing.mould_frame.parting_frame` of a straight q = 0 body), or None
 
     Returns
     -------
@@ -93,11 +101,27 @@ def choose_end_cuts(
         plane = None if planes is None else planes.get(end)
         out[end] = _choose(mode, end, plane, np.asarray(frames[k], float), length_mm)
         if mould and out[end]["applied"]:
-            kept = {key: value for key, value in out[end].items() if key not in ("normal_local", "offset_mm")}
-            out[end] = {**kept, "applied": False,
-                        "reason": "export.mould casts square ends only: square end kept so the mould casts the "
-                                  "exported body"}
+            out[end] = _into_parting_plane(out[end], None if parting_local is None else parting_local[k])
     return out
+
+
+def _into_parting_plane(record: dict[str, Any], parting: FloatArray | None) -> dict[str, Any]:
+    """An applied cut turned into the mould's parting plane (normal ``parting``, end-frame coordinates), or
+    left square when there is none (a curved q = 0 body)."""
+    if parting is None:
+        kept = {key: value for key, value in record.items() if key not in ("normal_local", "offset_mm")}
+        return {**kept, "applied": False,
+                "reason": "export.mould on a curved q = 0 body casts square ends only: square end kept so the mould "
+                          "casts the exported body"}
+    z = np.asarray(parting, float) / np.linalg.norm(parting)
+    normal = np.asarray(record["normal_local"], float)
+    along = float(normal @ z)
+    turned = normal - along * z
+    turned /= np.linalg.norm(turned)
+    lean = float(np.degrees(np.arcsin(min(1.0, abs(along)))))
+    return {**record, "normal_local": [float(x) for x in turned], "parting_lean_deg": lean,
+            "reason": f"{record['reason']}; turned into the mould's parting plane (its {lean:.2f} deg lean out of "
+                      "it dropped: a two-part mould cannot release a cap leaning out of its parting plane)"}
 
 
 def _choose(mode: str, end: str, plane: dict[str, Any] | None, frame: FloatArray, length_mm: float) -> dict[str, Any]:

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import manifold3d as m3
 import numpy as np
+import numpy.typing as npt
 
 from softdesign.errors import InputDataError, MeshError
 from softdesign.meshing.mould_frame import PartingFrame
@@ -164,18 +165,41 @@ def _slice_points(body: m3.Manifold) -> FloatArray:
     return np.concatenate(points)
 
 
-def _channel_points(body: m3.Manifold, up: FloatArray, spec: MouldSpec) -> tuple[FloatArray, FloatArray]:
-    """Vent at the parting line's highest point; pour at the highest point far enough from the vent."""
+def _channel_points(body: m3.Manifold, up: FloatArray, spec: MouldSpec,
+                    print_line: tuple[FloatArray, FloatArray, float] | None = None) -> tuple[FloatArray, FloatArray]:
+    """Vent at the parting line's highest point; pour at the highest point far enough from the vent.
+
+    ``print_line`` (a point and unit direction in the parting plane, and the print's radius, mm): a core print
+    running up beside the channels; a channel is kept off it (the build still checks that none meets the core).
+    A square end's face is level, so its highest points include its rim; a cut end's face leans, and the
+    highest point far enough from the vent is next to the print, on the face's middle.
+    """
     pts = _slice_points(body)
     height = pts @ up[:2]
-    vent = pts[int(np.argmax(height))]
     across = np.array([-up[1], up[0]])
+
+    def clear(radius: float) -> npt.NDArray[np.bool_]:
+        if print_line is None:
+            return np.ones(len(pts), bool)
+        point, direction, print_radius = print_line
+        off = pts - point
+        distance = np.abs(off[:, 0] * direction[1] - off[:, 1] * direction[0])
+        return distance >= radius + print_radius
+
+    vent_ok, pour_ok = clear(0.5 * spec.vent_mm), clear(0.5 * spec.pour_mm)
+    if not np.any(vent_ok):
+        raise MouldRefused(
+            f"export.mould: the vent (vent_mm={spec.vent_mm:g}) must run beside the core print, and the body's top "
+            "end is narrower; lower vent_mm or cast the other end up (up: tip or base)"
+        )
+    vent = pts[vent_ok][int(np.argmax(height[vent_ok]))]
     apart = 0.5 * (spec.pour_mm + spec.vent_mm) + MIN_MOULD_WALL_MM
-    far = np.abs((pts - vent) @ across) >= apart
+    far = (np.abs((pts - vent) @ across) >= apart) & pour_ok
     if not np.any(far):
         raise MouldRefused(
             f"export.mould: the pour channel (pour_mm={spec.pour_mm:g}) and the vent (vent_mm={spec.vent_mm:g}) "
-            f"need {apart:g} mm between their axes on the parting line, and the body is narrower; lower them"
+            f"need {apart:g} mm between their axes on the parting line (each beside a core print), and the body is "
+            "narrower; lower them"
         )
     # the highest of them; among equally high ones (a flat end face) the one farthest from the vent
     top = far & (height >= np.max(height[far]) - PEAK_TOL_MM)
@@ -215,7 +239,12 @@ def build_mould(body: m3.Manifold, casting: m3.Manifold, core: Core | None, fram
                         for z in (box_lo[2], box_hi[2])])
     top = float(np.max(corners @ up))
     core_f = None if core is None else _core(core, frame, box_lo, box_hi, spec).as_original()
-    pour_at, vent_at = _channel_points(body_f, up, spec)
+    print_line = None
+    if core is not None:
+        base, axis = frame.to_frame(core.base), frame.direction_to_frame(core.axis)
+        if -axis @ up > 0:  # the core print runs up, beside the channels: keep them off it
+            print_line = (base[:2], -axis[:2] / np.linalg.norm(axis[:2]), core.port_radius_mm)
+    pour_at, vent_at = _channel_points(body_f, up, spec, print_line)
     channels = _union([_channel(pour_at, up, 0.5 * spec.pour_mm, top, spec),
                        _channel(vent_at, up, 0.5 * spec.vent_mm, top, spec)]).as_original()
     if core_f is not None and (channels ^ core_f).volume() > 0:

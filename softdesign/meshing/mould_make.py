@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from softdesign.errors import MeshError
+from softdesign.meshing.end_cut import cut_ends, cut_planes
 from softdesign.meshing.mould import Core, MouldParts, MouldRefused, MouldSpec, build_mould, inside_mm
 from softdesign.meshing.mould_checks import (
     CAVITY_RTOL,
@@ -29,7 +30,7 @@ from softdesign.meshing.mould_checks import (
     shared_volume,
 )
 from softdesign.meshing.mould_frame import PartingFrame, parting_frame
-from softdesign.meshing.solids import _chamber, build_solid, manifold_from_mesh
+from softdesign.meshing.solids import _chamber, build_solid, manifold_from_mesh, port_lean_mm
 from softdesign.meshing.tessellate import Region, TubeSections, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec
 from softdesign.types import FloatArray, IntArray
@@ -78,11 +79,14 @@ def _core(sections: TubeSections, spec: BodySpec) -> tuple[Core | None, dict[str
                            "set export.port_mm")
     outer = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
     chamber = _chamber(sections, outer, spec)
-    cavity = tessellate(chamber)
+    # the chamber cut as the export's solid cuts it (its planes wall_mm inside the body's), the port as long
+    cavity, _ = cut_ends(tessellate(chamber), chamber, cut_planes(outer, spec.end_cuts, spec.wall_mm),
+                         "mould core: chamber")
     manifold, _ = manifold_from_mesh(cavity.vertices, cavity.faces, "mould core: chamber")
     length = float(chamber.s[-1] - chamber.s[0])
     core = Core(manifold, outer.centers[0], outer.frames[0][:, 2], 0.5 * spec.port_mm,
-                inside_mm(spec.wall_mm, length), spec.wall_mm, spec.port_segments or outer.xy.shape[1])
+                inside_mm(spec.wall_mm, length) + port_lean_mm(spec), spec.wall_mm,
+                spec.port_segments or outer.xy.shape[1])
     widest = float(2.0 * np.max(np.linalg.norm(chamber.xy, axis=-1)))
     return core, {"chamber_length_mm": length, "chamber_widest_mm": widest,
                   "port_stretch_to_release": widest / spec.port_mm}
@@ -109,7 +113,7 @@ def make_mould(sections: TubeSections, body_spec: BodySpec, spec: MouldSpec,
     Parameters
     ----------
     sections : the body at q = 0 on its (l, a) grid (the export's grid)
-    body_spec : the export's solid (offset, wall, port)
+    body_spec : the export's solid (offset, wall, port, end cuts)
     spec : the mould keys
     link_of : normalized l -> link index, for the messages
 
@@ -121,7 +125,8 @@ def make_mould(sections: TubeSections, body_spec: BodySpec, spec: MouldSpec,
         A check failed that construction should guarantee (a bug).
     """
     outer = sweep_from_sections(sections, body_spec.offset_mm, body_spec.min_radius_mm)
-    body_mesh = tessellate(outer)
+    # the body's ends cut as the export's solid's are (same faces and regions, moved vertices)
+    body_mesh, _ = cut_ends(tessellate(outer), outer, cut_planes(outer, body_spec.end_cuts), "mould: body")
     body, body_id = manifold_from_mesh(body_mesh.vertices, body_mesh.faces, "mould: body")
     solid = build_solid(sections, body_spec)
     casting, _ = manifold_from_mesh(solid.vertices, solid.faces, "mould: cast part")

@@ -173,15 +173,23 @@ def _port(outer: Sweep, chamber: Sweep, spec: BodySpec) -> tuple[m3.Manifold, in
             f"not fit the chamber's base section (largest diameter about the port axis {2 * clearance:.3f} mm, "
             f"keeping a {spec.min_radius_mm:g} mm ledge); use port_mm <= {2 * (clearance - spec.min_radius_mm):.3f}"
         )
-    # a base cut moves the outer and chamber caps along the port's axis by up to this much (tilt and offset)
-    cut = spec.end_cuts[0]
-    lean = 0.0 if cut is None else radius * np.tan(np.arccos(-cut[2])) + w * (1.0 / -cut[2] - 1.0) + abs(cut[3])
+    lean = port_lean_mm(spec)
     outside = PORT_OUTSIDE_WALLS * w + lean
     inside = min(PORT_INSIDE_WALLS * w, 0.25 * (chamber.s[-1] - chamber.s[0])) + lean
     segments = spec.port_segments or outer.xy.shape[1]
     cylinder = m3.Manifold.cylinder(outside + w + inside, radius, radius, segments, False)
     pose = np.column_stack([outer.frames[0], base - outside * axis])
     return checked(cylinder.transform(pose), f"q={outer.q:.3f}: port"), cylinder.original_id()
+
+
+def port_lean_mm(spec: BodySpec) -> float:
+    """How far a base cut moves the outer and chamber caps along the port's axis within its radius, mm (tilt
+    and offset; 0 for a square base): the port reaches this much farther out and in."""
+    cut = spec.end_cuts[0]
+    if cut is None or spec.port_mm == 0:
+        return 0.0
+    return float(0.5 * spec.port_mm * np.tan(np.arccos(-cut[2])) + spec.wall_mm * (1.0 / -cut[2] - 1.0)
+                 + abs(cut[3]))
 
 
 def build_solid(sections: TubeSections, spec: BodySpec = BodySpec()) -> Solid:

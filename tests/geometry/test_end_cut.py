@@ -74,13 +74,25 @@ def test_cap_plane_refuses_a_plane_tilted_beyond_the_limit_and_normal_cuts_nothi
     assert square["outlet"]["rim_gap_mm"] == planes["outlet"]["rim_gap_mm"]  # still reported
 
 
-def test_auto_keeps_square_ends_when_a_mould_is_asked_for_and_says_why():
-    # the mould casts square-ended bodies only: a cut body would not be what the mould casts
+def test_with_a_mould_auto_turns_each_cut_into_the_parting_plane_and_says_by_how_much():
+    # a two-part mould's halves are drawn off along the parting plane's normal: a cap leaning out of that plane
+    # would be an undercut, so the cut keeps only its lean within the plane; known answer: the normal with its
+    # component along the plane's normal z removed, and that lean arcsin(|n.z|)
     f = frames()
     planes = {"inlet": plane(8.0, -f[0][:, 2]), "outlet": plane(12.0, f[1][:, 2])}
+    parting = np.array([[0.0, 1.0, 0.0], [0.0, 1.0, 0.0]])  # B in both end frames, as for a straight q = 0 body
     cut = choose_end_cuts("auto", planes, f, LENGTH_MM)
+    turned = choose_end_cuts("auto", planes, f, LENGTH_MM, mould=True, parting_local=parting)
+    for end in ("inlet", "outlet"):
+        n, m = np.array(cut[end]["normal_local"]), np.array(turned[end]["normal_local"])
+        expected = n - n[1] * np.array([0.0, 1.0, 0.0])
+        assert turned[end]["applied"] and abs(m[1]) <= UNIT_TOL
+        assert np.allclose(m, expected / np.linalg.norm(expected), atol=UNIT_TOL)
+        assert turned[end]["parting_lean_deg"] == pytest.approx(np.degrees(np.arcsin(abs(n[1]))), abs=1e-9)
+        assert turned[end]["parting_lean_deg"] > 0 and "turned into the mould's parting plane" in turned[end]["reason"]
+        assert abs(m[2]) >= abs(n[2])  # the cut leans no more than the detected plane
+    # a curved q = 0 body (no parting plane given): square ends, saying why
     kept = choose_end_cuts("auto", planes, f, LENGTH_MM, mould=True)
     for end in ("inlet", "outlet"):
-        assert cut[end]["applied"] and not kept[end]["applied"]
-        assert kept[end]["reason"].startswith("export.mould casts square ends only")
+        assert not kept[end]["applied"] and kept[end]["reason"].startswith("export.mould on a curved q = 0 body")
         assert "normal_local" not in kept[end] and kept[end]["tilt_deg"] == planes[end]["tilt_deg"]

@@ -29,6 +29,8 @@ from softdesign.geometry.curves import SmoothCurve, measure_deviation
 from softdesign.geometry.end_cut import choose_end_cuts
 from softdesign.geometry.end_planes import rim_gap_warnings
 from softdesign.geometry.network import SelectedPath
+from softdesign.kinematics.links import LinkChain
+from softdesign.meshing.mould_frame import parting_frame
 from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import describe_backbone_fit, stretch_fit_errors
 from softdesign.pipeline.parallel import map_items
@@ -36,6 +38,7 @@ from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.ingest import IngestResult
 from softdesign.pipeline.stages.links import LinksResult
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
+from softdesign.types import FloatArray
 
 VERSION = 5  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
 # 3: points fitted in path order; distances sampled above 200k points (max still over all)
@@ -46,6 +49,9 @@ HOLDOUT_SEED = 4
 #: A failed fit is blamed on the centerline when the smoothed one strays from the input by this fraction of the
 #: smallest radius: on the demo the default smoothing strays 3% and fits, resample.smoothing_mm 2 strays 91% and fails.
 STRAY_FRACTION = 0.25
+#: Points of the q = 0 centerline the mould's parting plane is found from (a straight one needs two; a curved
+#: one keeps its ends square with a mould, see :func:`_parting_local`).
+PARTING_SAMPLES = 65
 
 
 @dataclass(frozen=True)
@@ -55,6 +61,17 @@ class FitResult:
     field: RadiusField
     summary: dict[str, Any]
     points: dict[str, np.ndarray]
+
+
+def _parting_local(chain: LinkChain) -> FloatArray | None:
+    """The mould's parting-plane normal in the q = 0 end frames' (N, B, T) coordinates, (2, 3); None for a
+    curved q = 0 body (see :func:`~softdesign.geometry.end_cut.choose_end_cuts`)."""
+    start = chain.shape.curve_at(0.0)
+    frames = start.frames(np.array([0.0, 1.0]))
+    frame = parting_frame(start.points(np.linspace(0.0, 1.0, PARTING_SAMPLES)), frames[0])
+    if not frame.straight:
+        return None
+    return np.einsum("kji,j->ki", frames, frame.axes[2])
 
 
 def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
@@ -98,7 +115,8 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
                "backbone": stretch_fit_errors(ingest.summary.get("backbone"), wall, curve),
                "end_cut": choose_end_cuts(fit.end_cut, ingest.summary.get("end_planes"),
                                           curve.frames(np.array([0.0, 1.0])), chain.shape.keys[-1].length,
-                                          mould=case.export.mould is not None)}
+                                          mould=case.export.mould is not None,
+                                          parting_local=_parting_local(chain) if case.export.mould else None)}
     # the end prior can hold the ends a straying centerline leaves one-sided: the fit then succeeds, so say it
     stray = centerline_stray(case, curve.curve, path)
     if stray is not None:
@@ -240,7 +258,7 @@ def _sampled_note(distance: dict[str, Any]) -> str:
 STAGE = Stage(
     name="fit",
     version=VERSION,
-    reads=("fit", "initial.radius_mm", "initial.surface", "export.mould"),  # a mould keeps auto's ends square
+    reads=("fit", "initial.radius_mm", "initial.surface", "export.mould"),  # a mould turns auto's cuts
     upstream=("ingest", "links"),
     compute=lambda case, results: run_fit(case, results["ingest"], results["links"]),
     write=write_fit,

@@ -61,7 +61,7 @@ def run_mould(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Mould
         return MouldResult((), {"requested": False})
     e = case.export
     sections = body_sections(kinematics.chain.shape.curve_at(0.0), fit.field, 0.0, e.spacing_mm, e.angular_count)
-    mould = make_mould(sections, body_spec(case), spec, fit.field.link_of)
+    mould = make_mould(sections, body_spec(case, fit), spec, fit.field.link_of)
     files: dict[str, Any] = {}
     for part in mould.parts:
         report = check_solid(part.vertices, part.faces, Expectation(euler=2, bodies=1), label=f"mould {part.name}")
