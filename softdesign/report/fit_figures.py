@@ -21,12 +21,15 @@ from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.selection import REASONS
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.report.build_folder import BuildData
-from softdesign.report.plotting import Picture, new_figure, panels, picture, styled
+from softdesign.report.plotting import Picture, fixed_figure, new_figure, panels, picture, styled
 from softdesign.report.projection import principal_view
 from softdesign.types import FloatArray
 
 RESIDUAL_SIZE_IN = (12.0, 6.0)
 DISTANCE_SIZE_IN = (12.0, 4.2)
+#: Fixed layout of the distance figure's three panels, inches: margins (left, right, bottom, top) and the gap
+#: between panels, room for tick labels up to 6 characters wide, the axis labels and one line of title.
+DISTANCE_MARGINS_IN, DISTANCE_GAP_IN = (0.7, 0.2, 0.5, 0.35), 0.8
 #: Percentile of |bin mean| setting the residual maps' colour scale (one wild bin must not wash out the rest).
 RESIDUAL_SCALE_PERCENTILE = 99.0
 #: Background of residual bins that hold no kept point.
@@ -169,7 +172,7 @@ def distance_picture(data: BuildData, distances: FloatArray) -> Picture:
     """The distance histogram and the excluded points, side by side."""
     metrics = data.manifest.get("metrics", {}).get("fit", {})
     with styled():
-        figure = new_figure(DISTANCE_SIZE_IN)
+        figure = fixed_figure(DISTANCE_SIZE_IN, DISTANCE_MARGINS_IN, (DISTANCE_GAP_IN, 0.0), (1, 3))
         grid = figure.add_gridspec(1, 3, width_ratios=(1.2, 1.4, 0.8))
         distance_histogram(figure.add_subplot(grid[0]), distances, metrics)
         exclusion_views(figure.add_subplot(grid[1]), figure.add_subplot(grid[2]), data)
