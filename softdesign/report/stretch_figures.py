@@ -117,7 +117,9 @@ def _body(figure, ax, data: BuildData, grid) -> None:
     values = lam1[cell // MAP_ANGLES, cell % MAP_ANGLES]
     norm = matplotlib.colors.Normalize(1.0, max(float(lam1.max()), 1.0))
     colours = matplotlib.colormaps["magma"](norm(values))[:, :3] * shaded.brightness[:, None]
-    ax.add_collection(PolyCollection(list(shaded.triangles), facecolors=colours, edgecolors=colours, linewidths=0.15))
+    # an (n, 3, 2) array is a documented verts argument (matplotlib's fast path); the stubs accept only a Sequence
+    ax.add_collection(PolyCollection(shaded.triangles, facecolors=colours, edgecolors=colours,  # type: ignore[arg-type]
+                                     linewidths=0.15))
     ax.set_aspect("equal", adjustable="datalim")
     ax.autoscale_view()
     ax.set_title("lambda1 at q = 1 on the body")
