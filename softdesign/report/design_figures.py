@@ -16,11 +16,14 @@ from softdesign.kinematics import pcc
 from softdesign.kinematics.arc_check import ARC_TOLERANCE_MM, SNAP_L
 from softdesign.kinematics.arc_design import distances_to_arcs
 from softdesign.kinematics.links import LinkChain
-from softdesign.report.plotting import Picture, link_colours, new_figure, picture, styled
+from softdesign.report.plotting import Picture, fixed_figure, link_colours, picture, styled
 from softdesign.report.projection import principal_view
 from softdesign.types import FloatArray
 
 SIZE_IN = (12.0, 4.8)
+#: Fixed layout of the two panels, inches: margins (left, right, bottom, top) and the gap between them,
+#: room for tick labels up to 6 characters wide, the axis labels and one line of title.
+MARGINS_IN, GAP_IN = (0.7, 0.2, 0.5, 0.3), 0.85
 #: Samples drawn along each arc.
 ARC_SAMPLES = 60
 
@@ -63,7 +66,7 @@ def design_picture(chain: LinkChain) -> Picture:
     centerline = series["centerline"][0]
     view = principal_view(centerline, centerline[-1] - centerline[0])
     with styled():
-        figure = new_figure(SIZE_IN)
+        figure = fixed_figure(SIZE_IN, MARGINS_IN, (GAP_IN, 0.0), (1, 2))
         left, right = figure.subplots(1, 2, width_ratios=[1.3, 1.0])
         xy = view.project(centerline)
         left.plot(xy[:, 0], xy[:, 1], color="0.6", lw=3.0, label="centerline, q = 1")

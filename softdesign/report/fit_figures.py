@@ -21,12 +21,17 @@ from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.selection import REASONS
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.report.build_folder import BuildData
-from softdesign.report.plotting import Picture, new_figure, panels, picture, styled
+from softdesign.report.plotting import Picture, fixed_figure, grid_shape, panels, picture, styled
 from softdesign.report.projection import principal_view
 from softdesign.types import FloatArray
 
 RESIDUAL_SIZE_IN = (12.0, 6.0)
 DISTANCE_SIZE_IN = (12.0, 4.2)
+#: Fixed layout of the distance figure's three panels, inches: margins (left, right, bottom, top) and the gap
+#: between panels, room for tick labels up to 6 characters wide, the axis labels and one line of title.
+DISTANCE_MARGINS_IN, DISTANCE_GAP_IN = (0.7, 0.2, 0.5, 0.35), 0.8
+#: The same for the residual maps (two per row); the right margin holds the colour bar's ticks and label.
+RESIDUAL_MARGINS_IN, RESIDUAL_GAPS_IN = (0.75, 1.0, 0.45, 0.3), (0.8, 0.7)
 #: Percentile of |bin mean| setting the residual maps' colour scale (one wild bin must not wash out the rest).
 RESIDUAL_SCALE_PERCENTILE = 99.0
 #: Background of residual bins that hold no kept point.
@@ -110,7 +115,7 @@ def residual_picture(data: BuildData) -> Picture:
     values = np.concatenate([np.abs(m[2][np.isfinite(m[2])]) for m in maps] + [np.zeros(1)])
     scale = max(float(np.percentile(values, RESIDUAL_SCALE_PERCENTILE)), 1e-6)
     with styled():
-        figure = new_figure(RESIDUAL_SIZE_IN)
+        figure = fixed_figure(RESIDUAL_SIZE_IN, RESIDUAL_MARGINS_IN, RESIDUAL_GAPS_IN, grid_shape(len(maps), 2))
         mesh = None
         for j, ax in enumerate(panels(figure, len(maps), max_columns=2)):
             l_edges, a_edges, mean = maps[j]
@@ -169,7 +174,7 @@ def distance_picture(data: BuildData, distances: FloatArray) -> Picture:
     """The distance histogram and the excluded points, side by side."""
     metrics = data.manifest.get("metrics", {}).get("fit", {})
     with styled():
-        figure = new_figure(DISTANCE_SIZE_IN)
+        figure = fixed_figure(DISTANCE_SIZE_IN, DISTANCE_MARGINS_IN, (DISTANCE_GAP_IN, 0.0), (1, 3))
         grid = figure.add_gridspec(1, 3, width_ratios=(1.2, 1.4, 0.8))
         distance_histogram(figure.add_subplot(grid[0]), distances, metrics)
         exclusion_views(figure.add_subplot(grid[1]), figure.add_subplot(grid[2]), data)

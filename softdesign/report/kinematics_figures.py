@@ -13,11 +13,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from softdesign.kinematics.links import LinkChain
-from softdesign.report.plotting import Picture, link_colours, new_figure, panels, picture, styled
+from softdesign.report.plotting import Picture, fixed_figure, link_colours, new_figure, panels, picture, styled
 from softdesign.types import FloatArray
 
 SIZE_IN = (12.0, 7.0)
 PCC_SIZE_IN = (12.0, 4.2)
+#: Fixed layout of the 2 x 3 panels, inches: margins (left, right, bottom, top) and gaps (columns, rows),
+#: room for tick labels up to 7 characters wide, the axis labels and one line of title.
+MARGINS_IN, GAPS_IN = (0.75, 0.25, 0.45, 0.28), (0.85, 0.75)
 #: Evenly spaced q of the series (0 and 1 included); the export q are added.
 Q_SAMPLES = 41
 #: Backbone samples per link of the PCC arc fit (pcc design's default is 201; the curves do not change visibly).
@@ -86,7 +89,7 @@ def kinematics_picture(series: KinematicsSeries) -> Picture:
     """Five per-link panels over q and the chain's base-to-tip distance."""
     colours = link_colours(series.theta1.shape[1])
     with styled():
-        figure = new_figure(SIZE_IN)
+        figure = fixed_figure(SIZE_IN, MARGINS_IN, GAPS_IN, (2, 3))
         for k, (name, title, label) in enumerate(PANELS):
             ax = figure.add_subplot(2, 3, k + 1)
             for j, colour in enumerate(colours):

@@ -12,11 +12,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from softdesign.kinematics.links import LinkChain
-from softdesign.report.plotting import TRIAD_COLOURS, Picture, link_colours, new_figure, picture, styled
+from softdesign.report.plotting import TRIAD_COLOURS, Picture, fixed_figure, link_colours, picture, styled
 from softdesign.report.projection import View, axis_views
 from softdesign.types import FloatArray
 
 SIZE_IN = (12.0, 9.0)
+#: Fixed layout of the 2 x 2 views, inches: margins (left, right, bottom, top) and gaps (columns, rows); the
+#: bottom margin holds the x labels and the legend's row under them.
+MARGINS_IN, GAPS_IN = (0.75, 0.2, 0.75, 0.3), (0.85, 0.75)
 #: Samples per link along each drawn centerline.
 SAMPLES_PER_LINK = 60
 #: Triad arm length as a fraction of the largest extent of all drawn centerlines.
@@ -112,7 +115,7 @@ def morph_figure(chain: LinkChain, q_values: list[float]):
     colours = link_colours(chain.count)
     arm = TRIAD_FRACTION * _extent(curves)
     with styled():
-        figure = new_figure(SIZE_IN)
+        figure = fixed_figure(SIZE_IN, MARGINS_IN, GAPS_IN, (2, 2))
         for k, view in enumerate(axis_views()):
             ax = figure.add_subplot(2, 2, k + 1)
             draw_view(ax, curves, view, colours, arm)
@@ -121,7 +124,7 @@ def morph_figure(chain: LinkChain, q_values: list[float]):
         handles = [figure.axes[0].plot([], [], color=c, lw=2)[0] for c in colours]
         handles += [figure.axes[0].plot([], [], color=c, lw=1)[0] for c in TRIAD_COLOURS]
         labels = [f"link {j}" for j in range(chain.count)] + ["N", "B", "T"]
-        figure.legend(handles, labels, loc="outside lower center", ncol=min(len(labels), 10), frameon=False)
+        figure.legend(handles, labels, loc="lower center", ncol=min(len(labels), 10), frameon=False)
     return figure
 
 

@@ -35,6 +35,8 @@ STYLE: dict[RcKeyType, Any] = {
     "path.simplify": True,
     "figure.dpi": DPI,
 }
+#: zlib level of the PNGs: 3 encodes about twice as fast as Pillow's default 6 for about 5 % more bytes.
+PNG_COMPRESS_LEVEL = 3
 #: Colours of the frame axes in triads: N, B, T as red, green, blue (x, y, z by habit).
 TRIAD_COLOURS = ("#d62728", "#2ca02c", "#1f77b4")
 #: Link colours (up to six links; more take evenly spaced colours of "plasma"): kept apart from the triads'.
@@ -60,15 +62,37 @@ class Picture:
     caption: str
 
 
-def new_figure(size_in: tuple[float, float]):
-    """An empty Agg figure of ``size_in`` inches (width, height) with :data:`STYLE` applied."""
+def new_figure(size_in: tuple[float, float], fixed: bool = False):
+    """An empty Agg figure of ``size_in`` inches (width, height) with :data:`STYLE` applied.
+
+    Its layout is matplotlib's constrained one, or none when ``fixed`` (see :func:`fixed_figure`).
+    """
     import matplotlib
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     with matplotlib.rc_context(STYLE):
-        figure = Figure(figsize=size_in, dpi=DPI, layout="constrained")
+        figure = Figure(figsize=size_in, dpi=DPI, layout=None if fixed else "constrained")
     FigureCanvasAgg(figure)
+    return figure
+
+
+def fixed_figure(size_in: tuple[float, float], margins_in: tuple[float, float, float, float],
+                 gaps_in: tuple[float, float], grid: tuple[int, int]):
+    """An Agg figure like :func:`new_figure` but with a fixed layout instead of matplotlib's constrained one.
+
+    For a plain grid of ``grid`` (rows, columns) axes: ``margins_in`` (left, right, bottom, top) and ``gaps_in``
+    (between columns, between rows) in inches, sized for the tick labels, axis labels and titles the figure
+    draws.  Solving the constrained layout measures every tick label twice (about half of a plain figure's
+    drawing time); a fixed grid costs nothing.
+    """
+    figure = new_figure(size_in, fixed=True)
+    (width, height), (rows, columns) = size_in, grid
+    left, right, bottom, top = margins_in
+    axes_w = (width - left - right - gaps_in[0] * (columns - 1)) / columns
+    axes_h = (height - bottom - top - gaps_in[1] * (rows - 1)) / rows
+    figure.subplots_adjust(left=left / width, right=1.0 - right / width, bottom=bottom / height, top=1.0 - top / height,
+                           wspace=gaps_in[0] / axes_w, hspace=gaps_in[1] / axes_h)
     return figure
 
 
@@ -88,7 +112,8 @@ def png_bytes(figure) -> bytes:
     """The figure as PNG bytes, without software or time metadata (reproducible)."""
     buffer = io.BytesIO()
     with styled():
-        figure.savefig(buffer, format="png", dpi=DPI, metadata={"Software": None})
+        figure.savefig(buffer, format="png", dpi=DPI, metadata={"Software": None},
+                       pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
     return buffer.getvalue()
 
 

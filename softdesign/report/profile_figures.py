@@ -16,11 +16,13 @@ import numpy as np
 
 from softdesign.io.surface import read_surface
 from softdesign.report.build_folder import BuildData
-from softdesign.report.plotting import Picture, link_colours, new_figure, picture, styled
+from softdesign.report.plotting import Picture, fixed_figure, link_colours, picture, styled
 from softdesign.types import FloatArray
 
 NAME = "profile.png"
 SIZE_IN = (13.0, 4.4)
+#: Fixed layout of the profile and the cuts, inches: margins (left, right, bottom, top) and the gap between panels.
+MARGINS_IN, GAP_IN = (0.7, 0.2, 0.5, 0.3), 0.75
 #: Where the q = 1 body is cut, as distances from the base in mm (the first, near the base cap, crosses a port)
 #: and fractions of the length.
 SECTION_BASE_MM = 1.0
@@ -59,7 +61,7 @@ def profile_picture(data: BuildData) -> Picture | None:
     length = data.kinematics.chain.shape.curve_at(1.0).length
     cuts = [min(SECTION_BASE_MM / length, 0.5), *SECTION_L]
     with styled():
-        figure = new_figure(SIZE_IN)
+        figure = fixed_figure(SIZE_IN, MARGINS_IN, (GAP_IN, 0.0), (1, 1 + len(cuts)))
         grid = figure.add_gridspec(1, 1 + len(cuts), width_ratios=[2.2] + [1.0] * len(cuts))
         ax = figure.add_subplot(grid[0, 0])
         for q, colour, style in ((1.0, "#d62728", "-"), (0.0, "#1f77b4", ":")):  # q = 0 on top: often the same mean

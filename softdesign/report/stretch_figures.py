@@ -17,12 +17,15 @@ from softdesign.fitting.strain import principal_stretches, skin_metric
 from softdesign.meshing.volume import BodySpec
 from softdesign.meshing.wall import wall_map
 from softdesign.report.build_folder import BuildData
-from softdesign.report.plotting import Picture, new_figure, picture, styled
+from softdesign.report.plotting import Picture, fixed_figure, picture, styled
 from softdesign.report.projection import principal_view, shaded_triangles
 from softdesign.report.surface_figures import tube_mesh
 from softdesign.types import FloatArray
 
 SIZE_IN = (13.0, 8.0)
+#: Fixed layout of the 2 x 3 panels, inches: margins (left, right, bottom, top) and gaps (columns, rows); each
+#: panel's colour bar is taken from its own cell, so the gaps hold the bar's ticks and the next panel's labels.
+MARGINS_IN, GAPS_IN = (0.75, 0.5, 0.45, 0.3), (1.2, 0.75)
 #: Drawing grid: spacing along the centerline (mm) and angles around.
 MAP_SPACING_MM = 0.5
 MAP_ANGLES = 96
@@ -77,7 +80,7 @@ def stretch_picture(data: BuildData) -> Picture | None:
     low = min(float(g[3].min()) for g in grids.values())
     spec = _spec(data)
     with styled():
-        figure = new_figure(SIZE_IN)
+        figure = fixed_figure(SIZE_IN, MARGINS_IN, GAPS_IN, (2, 3))
         axes = figure.subplots(2, 3)
         for row, q in enumerate((1.0, q_worst)):
             l, a, lam1, lam2 = grids[q]
@@ -114,7 +117,9 @@ def _body(figure, ax, data: BuildData, grid) -> None:
     values = lam1[cell // MAP_ANGLES, cell % MAP_ANGLES]
     norm = matplotlib.colors.Normalize(1.0, max(float(lam1.max()), 1.0))
     colours = matplotlib.colormaps["magma"](norm(values))[:, :3] * shaded.brightness[:, None]
-    ax.add_collection(PolyCollection(list(shaded.triangles), facecolors=colours, edgecolors=colours, linewidths=0.15))
+    # an (n, 3, 2) array is a documented verts argument (matplotlib's fast path); the stubs accept only a Sequence
+    ax.add_collection(PolyCollection(shaded.triangles, facecolors=colours, edgecolors=colours,  # type: ignore[arg-type]
+                                     linewidths=0.15))
     ax.set_aspect("equal", adjustable="datalim")
     ax.autoscale_view()
     ax.set_title("lambda1 at q = 1 on the body")

@@ -17,11 +17,14 @@ from softdesign.fitting.radius_field import RadiusField
 from softdesign.io.surface import read_surface
 from softdesign.kinematics.links import LinkChain
 from softdesign.report.build_folder import BuildData
-from softdesign.report.plotting import Picture, new_figure, picture, styled
+from softdesign.report.plotting import Picture, fixed_figure, picture, styled
 from softdesign.report.projection import View, principal_view, shaded_triangles
 from softdesign.types import FloatArray
 
 SIZE_IN = (12.0, 7.0)
+#: Fixed layout of the 2 x 2 views, inches: margins (left, right, bottom, top) and gaps (columns, rows),
+#: room for tick labels up to 6 characters wide, the axis labels and one line of title.
+MARGINS_IN, GAPS_IN = (0.7, 0.2, 0.45, 0.3), (0.8, 0.75)
 #: Tube tessellation when a q has no exported mesh: spacing along the centerline (mm) and angles around.
 TUBE_SPACING_MM = 0.5
 TUBE_ANGLES = 48
@@ -130,7 +133,7 @@ def surface_picture(data: BuildData) -> Picture | None:
     samples = curve.points(np.linspace(0.0, 1.0, 101))
     view = principal_view(samples, samples[-1] - samples[0])
     with styled():
-        figure = new_figure(SIZE_IN)
+        figure = fixed_figure(SIZE_IN, MARGINS_IN, GAPS_IN, (2, 2))
         for k, body in enumerate(bodies):
             draw_shaded(figure.add_subplot(2, 2, k + 1), body, view)
     sources = "; ".join(f"{b.title}: {b.source}" for b in bodies)
