@@ -11,9 +11,8 @@ pressurised volume but for the channel's own.
 
 from __future__ import annotations
 
-from softdesign.meshing.end_cut import cut_ends, cut_planes
-from softdesign.meshing.solids import _chamber
-from softdesign.meshing.tessellate import TubeSections, sweep_from_sections, tessellate
+from softdesign.meshing.solids import cut_chamber
+from softdesign.meshing.tessellate import TubeSections, sweep_from_sections
 from softdesign.meshing.volume import BodySpec
 from softdesign.types import FloatArray, IntArray
 
@@ -31,7 +30,5 @@ def chamber_surface(sections: TubeSections, spec: BodySpec) -> tuple[FloatArray,
     if spec.wall_mm <= 0:
         raise ValueError(f"a chamber needs wall_mm > 0, got {spec.wall_mm}")
     outer = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
-    chamber = _chamber(sections, outer, spec)
-    planes = cut_planes(outer, spec.end_cuts, spec.wall_mm)
-    mesh, _ = cut_ends(tessellate(chamber), chamber, planes, f"q={sections.q:.3f}: chamber")
+    _, mesh, _ = cut_chamber(sections, outer, spec, f"q={sections.q:.3f}: chamber")
     return mesh.vertices, mesh.faces

@@ -20,8 +20,8 @@ from softdesign.errors import MeshError
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.geometry.blend import BlendedShape
 from softdesign.meshing.body import export_l_grid, sections_on_grid
-from softdesign.meshing.end_cut import cut_ends, cut_planes
-from softdesign.meshing.tessellate import sweep_from_sections, tessellate
+from softdesign.meshing.solids import cut_body
+from softdesign.meshing.tessellate import sweep_from_sections
 from softdesign.meshing.volume import BodySpec, angle_grid
 from softdesign.types import FloatArray, IntArray
 
@@ -64,7 +64,7 @@ def morph_surfaces(shape: BlendedShape, field: RadiusField, q_values: FloatArray
         sections = sections_on_grid(shape.curve_at(q), q, l, field.evaluate_grid(q, l, a),
                                     field.evaluate_grid(q, l, a, dl=1))
         sweep = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
-        mesh, _ = cut_ends(tessellate(sweep), sweep, cut_planes(sweep, spec.end_cuts), f"morph q={q:.3f}")
+        mesh, _ = cut_body(sweep, spec, f"morph q={q:.3f}")
         if faces is not None and not np.array_equal(faces, mesh.faces):
             raise MeshError(f"morph: the tessellation at q={q:.3f} differs from the one at q={q_values[0]:.3f}")
         faces = mesh.faces

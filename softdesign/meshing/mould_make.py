@@ -18,7 +18,6 @@ from typing import Any
 import numpy as np
 
 from softdesign.errors import MeshError
-from softdesign.meshing.end_cut import cut_ends, cut_planes
 from softdesign.meshing.mould import Core, MouldParts, MouldRefused, MouldSpec, build_mould, inside_mm
 from softdesign.meshing.mould_checks import (
     CAVITY_RTOL,
@@ -30,8 +29,8 @@ from softdesign.meshing.mould_checks import (
     shared_volume,
 )
 from softdesign.meshing.mould_frame import PartingFrame, parting_frame
-from softdesign.meshing.solids import _chamber, build_solid, manifold_from_mesh, port_lean_mm
-from softdesign.meshing.tessellate import Region, TubeSections, sweep_from_sections, tessellate
+from softdesign.meshing.solids import build_solid, cut_body, cut_chamber, manifold_from_mesh, port_lean_mm
+from softdesign.meshing.tessellate import Region, TubeSections, sweep_from_sections
 from softdesign.meshing.volume import BodySpec
 from softdesign.types import FloatArray, IntArray
 
@@ -78,10 +77,8 @@ def _core(sections: TubeSections, spec: BodySpec) -> tuple[Core | None, dict[str
                            "which no core can form: the core needs an opening to be held and removed; "
                            "set export.port_mm")
     outer = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
-    chamber = _chamber(sections, outer, spec)
     # the chamber cut as the export's solid cuts it (its planes wall_mm inside the body's), the port as long
-    cavity, _ = cut_ends(tessellate(chamber), chamber, cut_planes(outer, spec.end_cuts, spec.wall_mm),
-                         "mould core: chamber")
+    chamber, cavity, _ = cut_chamber(sections, outer, spec, "mould core: chamber")
     manifold, _ = manifold_from_mesh(cavity.vertices, cavity.faces, "mould core: chamber")
     length = float(chamber.s[-1] - chamber.s[0])
     core = Core(manifold, outer.centers[0], outer.frames[0][:, 2], 0.5 * spec.port_mm,
@@ -126,7 +123,7 @@ def make_mould(sections: TubeSections, body_spec: BodySpec, spec: MouldSpec,
     """
     outer = sweep_from_sections(sections, body_spec.offset_mm, body_spec.min_radius_mm)
     # the body's ends cut as the export's solid's are (same faces and regions, moved vertices)
-    body_mesh, _ = cut_ends(tessellate(outer), outer, cut_planes(outer, body_spec.end_cuts), "mould: body")
+    body_mesh, _ = cut_body(outer, body_spec, "mould: body")
     body, body_id = manifold_from_mesh(body_mesh.vertices, body_mesh.faces, "mould: body")
     solid = build_solid(sections, body_spec)
     casting, _ = manifold_from_mesh(solid.vertices, solid.faces, "mould: cast part")

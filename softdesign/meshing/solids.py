@@ -155,6 +155,19 @@ def _chamber(sections: TubeSections, outer: Sweep, spec: BodySpec) -> Sweep:
     return trim_sweep(inner, w, length - w)
 
 
+def cut_body(outer: Sweep, spec: BodySpec, label: str) -> tuple[TubeMesh, float]:
+    """``outer`` tessellated, its ends cut at ``spec.end_cuts``' planes; and the volume the cuts add, mm3."""
+    return cut_ends(tessellate(outer), outer, cut_planes(outer, spec.end_cuts), label)
+
+
+def cut_chamber(sections: TubeSections, outer: Sweep, spec: BodySpec, label: str) -> tuple[Sweep, TubeMesh, float]:
+    """The chamber (:func:`_chamber`), tessellated with its ends cut at the body's planes moved ``wall_mm``
+    inward (so the sealed ends stay ``wall_mm`` thick), and the volume the cuts add, mm3."""
+    chamber = _chamber(sections, outer, spec)
+    mesh, added = cut_ends(tessellate(chamber), chamber, cut_planes(outer, spec.end_cuts, spec.wall_mm), label)
+    return chamber, mesh, added
+
+
 def _port(outer: Sweep, chamber: Sweep, spec: BodySpec) -> tuple[m3.Manifold, int]:
     """The inlet channel along the base tangent, refused unless it fits inside the chamber's base section."""
     radius, w = 0.5 * spec.port_mm, spec.wall_mm
@@ -216,14 +229,12 @@ def build_solid(sections: TubeSections, spec: BodySpec = BodySpec()) -> Solid:
     _check_spec(spec, sections)
     label = f"q={sections.q:.3f}"
     outer = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
-    body, added = cut_ends(tessellate(outer), outer, cut_planes(outer, spec.end_cuts), label)
+    body, added = cut_body(outer, spec, label)
     if spec.wall_mm == 0:
         # no boolean, so no manifold3d: check_solid (which export runs on every solid) tests the same oriented
         # 2-manifold property and more; building the Manifold only to check it was half of export's time
         return Solid(body.vertices, body.faces, body.regions, 2, "solid", outer.max_rho_kappa, added)
-    chamber = _chamber(sections, outer, spec)
-    cavity, removed = cut_ends(tessellate(chamber), chamber, cut_planes(outer, spec.end_cuts, spec.wall_mm),
-                               f"{label}: chamber")
+    chamber, cavity, removed = cut_chamber(sections, outer, spec, f"{label}: chamber")
     return replace(carve_chamber(body, cavity, outer, chamber, spec, label), volume_offset_mm3=added - removed)
 
 
