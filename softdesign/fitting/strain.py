@@ -73,16 +73,24 @@ class SectionDerivatives:
 
 def metric_from_sections(d: SectionDerivatives) -> FloatArray:
     """First fundamental form (E, F, G) in (l, a), (p, m, 3): mm^2 per unit l^2, per unit l rad, per rad^2."""
-    x, y = d.xy[..., 0], d.xy[..., 1]
-    v = d.speed[:, None]
-    vt = (d.speed * d.twist)[:, None]
-    axial = v * (1.0 - x * d.curvature[:, :1] - y * d.curvature[:, 1:])
-    along_n = d.xy_l[..., 0] - vt * y
-    along_b = d.xy_l[..., 1] + vt * x
-    e = axial**2 + along_n**2 + along_b**2
-    f = along_n * d.xy_a[..., 0] + along_b * d.xy_a[..., 1]
-    g = d.xy_a[..., 0] ** 2 + d.xy_a[..., 1] ** 2
-    return np.stack([e, f, g], axis=-1)
+    return _metric(d.speed, d.curvature, d.twist, d.xy[..., 0], d.xy[..., 1], d.xy_l[..., 0], d.xy_l[..., 1],
+                   d.xy_a[..., 0], d.xy_a[..., 1])
+
+
+def _metric(speed: FloatArray, curvature: FloatArray, twist: FloatArray, x: FloatArray, y: FloatArray,
+            x_l: FloatArray, y_l: FloatArray, x_a: FloatArray, y_a: FloatArray) -> FloatArray:
+    """(E, F, G) (p, m, 3) of the surface ``c + x N + y B`` from its section coordinates and their l and a
+    derivatives (p, m) and the centerline's speed (p,), curvature (p, 2) and twist (p,)."""
+    v = speed[:, None]
+    vt = (speed * twist)[:, None]
+    axial = v * (1.0 - x * curvature[:, :1] - y * curvature[:, 1:])
+    along_n = x_l - vt * y
+    along_b = y_l + vt * x
+    out = np.empty(x.shape + (3,))
+    out[..., 0] = axial**2 + along_n**2 + along_b**2
+    out[..., 1] = along_n * x_a + along_b * y_a
+    out[..., 2] = x_a**2 + y_a**2
+    return out
 
 
 def tube_sections(
@@ -114,17 +122,8 @@ def tube_metric(
     rho, rho_l, rho_a = (np.asarray(v, float) for v in (rho, rho_l, rho_a))
     x, y = rho * cos, rho * sin
     x_a, y_a = rho_a * cos + rho * -sin, rho_a * sin + rho * cos
-    speed, curvature, twist = (np.asarray(v, float) for v in (speed, curvature, twist))
-    v = speed[:, None]
-    vt = (speed * twist)[:, None]
-    axial = v * (1.0 - x * curvature[:, :1] - y * curvature[:, 1:])
-    along_n = rho_l * cos - vt * y
-    along_b = rho_l * sin + vt * x
-    out = np.empty(x.shape + (3,))
-    out[..., 0] = axial**2 + along_n**2 + along_b**2
-    out[..., 1] = along_n * x_a + along_b * y_a
-    out[..., 2] = x_a**2 + y_a**2
-    return out
+    return _metric(np.asarray(speed, float), np.asarray(curvature, float), np.asarray(twist, float), x, y,
+                   rho_l * cos, rho_l * sin, x_a, y_a)
 
 
 def principal_stretches(rest: npt.ArrayLike, deformed: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
