@@ -197,7 +197,9 @@ def import_heavy_libraries() -> float:
     import scipy.sparse.linalg  # noqa: F401
     import scipy.spatial  # noqa: F401
     import trimesh  # noqa: F401
-    import vtk  # noqa: F401
+    import vtkmodules.vtkCommonDataModel  # noqa: F401  (VTK's modules the stages use, not all of `import vtk`)
+    import vtkmodules.vtkFiltersCore  # noqa: F401
+    import vtkmodules.vtkIOXML  # noqa: F401
 
     from softdesign.pipeline import stages  # noqa: F401
 

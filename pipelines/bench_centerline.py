@@ -44,7 +44,9 @@ def run_worker(surface: Path) -> dict[str, Any]:
     import scipy.sparse.csgraph  # noqa: F401
     import scipy.spatial  # noqa: F401
     import trimesh  # noqa: F401
-    import vtk  # noqa: F401
+    import vtkmodules.vtkCommonDataModel  # noqa: F401  (VTK's modules the stages use, not all of `import vtk`)
+    import vtkmodules.vtkFiltersCore  # noqa: F401
+    import vtkmodules.vtkIOXML  # noqa: F401
 
     from softdesign.centerline.extract import extract_centerlines
     from softdesign.io.centerline_vtp import write_centerlines_vtp

@@ -53,15 +53,15 @@ DECIMATION = (
 
 def decimate(vertices: np.ndarray, faces: np.ndarray, reduction: float) -> tuple[np.ndarray, np.ndarray]:
     """The mesh with about ``reduction`` of its faces removed by quadric error decimation."""
-    import vtk
-    from vtk.util.numpy_support import vtk_to_numpy
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkFiltersCore import vtkQuadricDecimation
 
     from softdesign.io.vtk_polydata import polydata_from_triangles
 
     if reduction <= 0.0:
         return vertices, faces
     poly = polydata_from_triangles(vertices, faces)
-    decimation = vtk.vtkQuadricDecimation()
+    decimation = vtkQuadricDecimation()
     decimation.SetInputData(poly)
     decimation.SetTargetReduction(reduction)
     decimation.VolumePreservationOn()

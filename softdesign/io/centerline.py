@@ -80,7 +80,7 @@ def _read_vtk_lines(path: Path) -> list[Polyline]:
 
 def _line_cells(poly) -> list[np.ndarray]:
     """Point ids of each line/polyline cell, in cell order (other cell types skipped)."""
-    from vtk.util.numpy_support import vtk_to_numpy
+    from vtkmodules.util.numpy_support import vtk_to_numpy
 
     if poly.GetNumberOfLines() == 0:
         return []

@@ -39,15 +39,15 @@ def read_face_regions(path: str | Path) -> np.ndarray | None:
 
     Only .vtp and .vtk files carry labels (``REGION_KEYS``); other formats, and files without them, give None.
     """
-    import vtk
-    from vtk.util.numpy_support import vtk_to_numpy
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkFiltersCore import vtkTriangleFilter
 
     from softdesign.io.vtk_polydata import read_polydata
 
     path = Path(path)
     if path.suffix.lower() not in (".vtp", ".vtk"):
         return None
-    triangles = vtk.vtkTriangleFilter()  # as triangles_from_polydata does, so labels follow the faces
+    triangles = vtkTriangleFilter()  # as triangles_from_polydata does, so labels follow the faces
     triangles.SetInputData(read_polydata(path))
     triangles.PassLinesOff()
     triangles.PassVertsOff()

@@ -130,8 +130,8 @@ def _glb_bytes(vertices: np.ndarray, faces: np.ndarray, regions: np.ndarray | No
 
 def _vtp_bytes(vertices: np.ndarray, faces: np.ndarray, regions: np.ndarray | None) -> bytes:
     """VTK XML PolyData of the triangles, binary (base64) and zlib-compressed, as VMTK writes it."""
-    import vtk
-    from vtk.util.numpy_support import numpy_to_vtk
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    from vtkmodules.vtkCommonCore import vtkStringArray
 
     from softdesign.io.vtk_polydata import polydata_from_triangles, polydata_writer
     from softdesign.meshing.tessellate import Region
@@ -141,7 +141,7 @@ def _vtp_bytes(vertices: np.ndarray, faces: np.ndarray, regions: np.ndarray | No
         labels = numpy_to_vtk(np.ascontiguousarray(regions, dtype=np.int32), deep=True)
         labels.SetName("Region")
         poly.GetCellData().AddArray(labels)
-        names = vtk.vtkStringArray()
+        names = vtkStringArray()
         names.SetName("RegionNames")
         for region in Region:  # value i is names[i]
             names.InsertNextValue(region.name.lower())

@@ -107,17 +107,18 @@ def _check_cell_array(name: str, values: npt.ArrayLike, count: int) -> np.ndarra
 
 def _polydata(points: np.ndarray, sizes: list[int], per_point: dict, per_cell: dict):
     """A ``vtkPolyData`` with one polyline cell per run of ``sizes`` points."""
-    import vtk
-    from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+    from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+    from vtkmodules.vtkCommonCore import vtkPoints
+    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
 
-    poly = vtk.vtkPolyData()
-    vtk_points = vtk.vtkPoints()
+    poly = vtkPolyData()
+    vtk_points = vtkPoints()
     vtk_points.SetDataTypeToDouble()
     if len(points):
         vtk_points.SetData(numpy_to_vtk(np.ascontiguousarray(points), deep=True))
     poly.SetPoints(vtk_points)
     offsets = np.concatenate([[0], np.cumsum(sizes, dtype=np.int64)]).astype(np.int64)
-    cells = vtk.vtkCellArray()
+    cells = vtkCellArray()
     cells.SetData(
         numpy_to_vtkIdTypeArray(offsets, deep=True),
         numpy_to_vtkIdTypeArray(np.arange(offsets[-1], dtype=np.int64), deep=True),

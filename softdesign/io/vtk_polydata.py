@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -22,15 +23,17 @@ def read_polydata(path: Path):
     InputDataError
         The file is missing, not PolyData, or vtk reports a read error.
     """
-    import vtk
+    from vtkmodules.vtkIOLegacy import vtkPolyDataReader
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
 
     if not path.is_file():
         raise InputDataError(f"{path}: file not found; check the path in the case file")
     _silence_vtk_log()
+    reader: Any  # VTK's stubs type AddObserver's event as an int id; vtk takes the event's name too
     if path.suffix.lower() == ".vtp":
-        reader = vtk.vtkXMLPolyDataReader()
+        reader = vtkXMLPolyDataReader()
     else:
-        reader = vtk.vtkPolyDataReader()
+        reader = vtkPolyDataReader()
     errors = _ErrorCatcher()
     reader.AddObserver("ErrorEvent", errors.catch)
     reader.SetFileName(str(path))
@@ -44,9 +47,9 @@ def read_polydata(path: Path):
 
 def _silence_vtk_log() -> None:
     """vtk prints parser errors to stderr itself; we report them as one clear message."""
-    import vtk
+    from vtkmodules.vtkCommonCore import vtkLogger
 
-    vtk.vtkLogger.SetStderrVerbosity(vtk.vtkLogger.VERBOSITY_OFF)
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
 
 
 class _ErrorCatcher:
@@ -67,7 +70,7 @@ class _ErrorCatcher:
 
 def polydata_arrays(poly) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
     """Points (n, 3) float64 and the point and cell data arrays by name."""
-    from vtk.util.numpy_support import vtk_to_numpy
+    from vtkmodules.util.numpy_support import vtk_to_numpy
 
     if poly.GetPoints() is None or poly.GetNumberOfPoints() == 0:
         return np.zeros((0, 3)), {}, {}
@@ -86,10 +89,10 @@ def polydata_arrays(poly) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, 
 
 def triangles_from_polydata(poly) -> tuple[np.ndarray, np.ndarray]:
     """Vertices (V, 3) float64 and triangles (F, 3) int64 of a surface, polygons triangulated."""
-    import vtk
-    from vtk.util.numpy_support import vtk_to_numpy
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkFiltersCore import vtkTriangleFilter
 
-    tri = vtk.vtkTriangleFilter()
+    tri = vtkTriangleFilter()
     tri.SetInputData(poly)
     tri.PassLinesOff()
     tri.PassVertsOff()
@@ -109,14 +112,15 @@ def triangles_from_polydata(poly) -> tuple[np.ndarray, np.ndarray]:
 
 def polydata_from_triangles(vertices: np.ndarray, faces: np.ndarray):
     """A ``vtkPolyData`` of a triangle mesh: vertices (V, 3) float, faces (F, 3) int."""
-    import vtk
-    from vtk.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+    from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+    from vtkmodules.vtkCommonCore import vtkPoints
+    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
 
-    poly = vtk.vtkPolyData()
-    points = vtk.vtkPoints()
+    poly = vtkPolyData()
+    points = vtkPoints()
     points.SetData(numpy_to_vtk(np.ascontiguousarray(vertices, dtype=np.float64), deep=True))
     poly.SetPoints(points)
-    cells = vtk.vtkCellArray()
+    cells = vtkCellArray()
     offsets = np.arange(0, 3 * len(faces) + 1, 3, dtype=np.int64)
     connectivity = np.ascontiguousarray(np.asarray(faces).reshape(-1), dtype=np.int64)
     cells.SetData(numpy_to_vtkIdTypeArray(offsets, deep=True), numpy_to_vtkIdTypeArray(connectivity, deep=True))
@@ -126,9 +130,9 @@ def polydata_from_triangles(vertices: np.ndarray, faces: np.ndarray):
 
 def polydata_writer(poly):
     """A ``vtkXMLPolyDataWriter`` of ``poly``: binary, zlib-compressed, as VMTK writes its files."""
-    import vtk
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter
 
-    writer = vtk.vtkXMLPolyDataWriter()
+    writer = vtkXMLPolyDataWriter()
     writer.SetInputData(poly)
     writer.SetDataModeToBinary()
     writer.SetCompressorTypeToZLib()

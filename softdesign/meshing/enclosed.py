@@ -35,8 +35,10 @@ def points_inside(points: npt.ArrayLike, vertices: npt.ArrayLike, faces: npt.Arr
     MeshError
         The surface is not closed (not watertight).
     """
-    import vtk
-    from vtk.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+    from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+    from vtkmodules.vtkCommonCore import vtkPoints
+    from vtkmodules.vtkCommonDataModel import vtkPolyData
+    from vtkmodules.vtkFiltersModeling import vtkSelectEnclosedPoints
 
     from softdesign.io.vtk_polydata import polydata_from_triangles
 
@@ -46,11 +48,11 @@ def points_inside(points: npt.ArrayLike, vertices: npt.ArrayLike, faces: npt.Arr
         raise MeshError(f"{label}: the surface is not closed, so inside and outside are undefined")
     if len(p) == 0:
         return np.zeros(0, bool)
-    cloud = vtk.vtkPolyData()
-    cloud_points = vtk.vtkPoints()
+    cloud = vtkPolyData()
+    cloud_points = vtkPoints()
     cloud_points.SetData(numpy_to_vtk(p, deep=True))
     cloud.SetPoints(cloud_points)
-    select = vtk.vtkSelectEnclosedPoints()
+    select = vtkSelectEnclosedPoints()
     select.SetInputData(cloud)
     select.SetSurfaceData(polydata_from_triangles(np.asarray(vertices, float), np.asarray(faces)))
     select.SetTolerance(_RAY_TOLERANCE)

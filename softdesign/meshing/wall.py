@@ -33,7 +33,7 @@ from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.strain import SectionDerivatives, curve_terms
 from softdesign.geometry.frames import FramedSpline
 from softdesign.meshing.body import body_sections
-from softdesign.meshing.compare import _squared_distances
+from softdesign.meshing.compare import squared_distances
 from softdesign.meshing.tessellate import Sweep, ring_points, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec, angle_grid, angular_derivative, section_curves
 from softdesign.types import FloatArray
@@ -81,7 +81,7 @@ def wall_distances(
     """True distance (mm) from each inner point (..., 3) to the outer triangle mesh, same leading shape."""
     points = np.asarray(inner_points, float)
     flat = points.reshape(-1, 3)
-    squared = _squared_distances(flat, np.asarray(outer_vertices, float), np.asarray(outer_faces, np.int64))
+    squared = squared_distances(flat, np.asarray(outer_vertices, float), np.asarray(outer_faces, np.int64))
     return np.sqrt(squared).reshape(points.shape[:-1])
 
 

@@ -77,24 +77,10 @@ HEIGHT_PX = 720
 
 
 def max_distance_to_mesh(points: FloatArray, vertices: FloatArray, faces: np.ndarray) -> float:
-    """Largest true distance (mm) from ``points`` (n, 3) to the triangle mesh (vertices, faces).
+    """Largest true distance (mm) from ``points`` (n, 3) to the triangle mesh (vertices, faces)."""
+    from softdesign.meshing.compare import squared_distances
 
-    VTK's static cell locator finds each point's closest point on the triangles (vtkImplicitPolyDataDistance
-    gives the same figures some twenty times slower).
-    """
-    import vtk
-
-    from softdesign.io.vtk_polydata import polydata_from_triangles
-
-    locator = vtk.vtkStaticCellLocator()
-    locator.SetDataSet(polydata_from_triangles(np.asarray(vertices, float), np.asarray(faces, np.int64)))
-    locator.BuildLocator()
-    closest, cell, sub, squared = [0.0, 0.0, 0.0], vtk.reference(0), vtk.reference(0), vtk.reference(0.0)
-    largest = 0.0
-    for point in np.asarray(points, float):
-        locator.FindClosestPoint(point, closest, cell, sub, squared)
-        largest = max(largest, float(squared))
-    return float(np.sqrt(largest))
+    return float(np.sqrt(squared_distances(np.asarray(points, float), vertices, faces).max(initial=0.0)))
 
 
 def decimated_vessel(vertices: FloatArray, faces: np.ndarray, target: int = VESSEL_FACES,
@@ -104,12 +90,12 @@ def decimated_vessel(vertices: FloatArray, faces: np.ndarray, target: int = VESS
     The error is the largest distance from an original vertex to the decimated surface (0 when kept whole);
     while it exceeds ``tolerance_mm`` the target doubles (up to the whole surface).
     """
-    import vtk
+    from vtkmodules.vtkFiltersCore import vtkQuadricDecimation
 
     from softdesign.io.vtk_polydata import polydata_from_triangles, triangles_from_polydata
 
     while len(faces) > target:
-        decimate = vtk.vtkQuadricDecimation()
+        decimate = vtkQuadricDecimation()
         decimate.SetInputData(polydata_from_triangles(np.asarray(vertices, float), np.asarray(faces, np.int64)))
         decimate.SetTargetReduction(1.0 - target / len(faces))
         decimate.Update()

@@ -18,7 +18,7 @@ from softdesign.io.formats import FORMATS
 from tests.helpers.paths import DEMO, REPO
 
 #: Slow to import (about 0.2 to 1 s each with what they pull in); none is needed to parse, validate or print help.
-HEAVY = ("vtk", "scipy", "trimesh", "manifold3d", "matplotlib")
+HEAVY = ("vtk", "vtkmodules", "scipy", "trimesh", "manifold3d", "matplotlib")
 #: Not needed to print help or check a case either: numpy (about 0.1 s), and rich with markdown_it (typer's rich
 #: help panels, about 0.13 s of the 0.26 s `--help` took with them; the help is click's plain text).
 LIGHT_BUT_UNNEEDED = ("numpy", "rich", "markdown_it", "pygments")

@@ -122,9 +122,9 @@ def write_elbow_vessel(folder: Path, radius: float, stub_mm: float, turn_deg: fl
 
 def wall_to_body_mm(wall: np.ndarray, body: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
     """Exact distance, mm, from each wall point (n, 3) to the body mesh (vertices, faces)."""
-    from softdesign.meshing.compare import _squared_distances
+    from softdesign.meshing.compare import squared_distances
 
-    return np.sqrt(_squared_distances(np.asarray(wall, float), *body))
+    return np.sqrt(squared_distances(np.asarray(wall, float), *body))
 
 
 def write_outlet_seeded_sample(folder: Path) -> tuple[Path, Path, np.ndarray]:
