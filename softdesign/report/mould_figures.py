@@ -90,7 +90,7 @@ def _exploded_png(build_dir: Path, block: dict[str, Any] | None) -> bytes | None
     figure = Figure(figsize=SIZE_IN, dpi=DPI)
     FigureCanvasAgg(figure)
     ax = figure.add_axes((0.02, 0.02, 0.96, 0.9))
-    ax.add_collection(PolyCollection(list(screen[order]), facecolors=rgba[order], edgecolors="none"))
+    ax.add_collection(PolyCollection(list(screen[order]), facecolors=rgba[order], edgecolors="none"), autolim=False)
     ax.set_xlim(screen[..., 0].min(), screen[..., 0].max())
     ax.set_ylim(screen[..., 1].min(), screen[..., 1].max())
     ax.set_aspect("equal")

@@ -27,6 +27,10 @@ STYLE: dict[RcKeyType, Any] = {
     "font.family": "DejaVu Sans",
     "font.size": 8.5,
     "axes.titlesize": 9.5,
+    # titles sit at the axes' top (plus axes.titlepad) instead of being moved above whatever the axes draw there:
+    # no figure puts ticks, labels or an offset text above its axes, and measuring them for every title took a
+    # third of some figures' drawing time
+    "axes.titley": 1.0,
     "axes.labelsize": 8.5,
     "legend.fontsize": 7.5,
     "xtick.labelsize": 7.5,
@@ -122,6 +126,16 @@ def picture(name: str, figure, size_in: tuple[float, float], title: str, caption
     data = png_bytes(figure)
     figure.clear()
     return Picture(name, data, pixel_size(size_in), title, caption)
+
+
+def add_polygons(ax, collection, points) -> None:
+    """Add a polygon ``collection`` to ``ax``, its data limits from its ``points`` (..., 2) (mm on screen).
+
+    The limits are the points' bounds, which matplotlib's own ``autolim`` finds too but by building every
+    polygon's path extents (about 0.2 s for the tens of thousands of triangles of a shaded body).
+    """
+    ax.add_collection(collection, autolim=False)
+    ax.update_datalim(np.asarray(points, float).reshape(-1, 2))
 
 
 def link_colours(count: int) -> list[tuple[float, float, float, float]]:

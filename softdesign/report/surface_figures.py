@@ -17,7 +17,7 @@ from softdesign.fitting.radius_field import RadiusField
 from softdesign.io.surface import read_surface
 from softdesign.kinematics.links import LinkChain
 from softdesign.report.build_folder import BuildData
-from softdesign.report.plotting import Picture, fixed_figure, picture, styled
+from softdesign.report.plotting import Picture, add_polygons, fixed_figure, picture, styled
 from softdesign.report.projection import View, principal_view, shaded_triangles
 from softdesign.types import FloatArray
 
@@ -101,7 +101,7 @@ def draw_shaded(ax, body: Body, view: View) -> None:
     # edges in the face colour close the hairline gaps antialiasing leaves between neighbours
     # an (n, 3, 2) array is a documented verts argument (and matplotlib's fast path); the stubs accept only a Sequence
     shaded = PolyCollection(triangles, facecolors=colours, edgecolors=colours, linewidths=0.15)  # type: ignore[arg-type]
-    ax.add_collection(shaded)
+    add_polygons(ax, shaded, triangles)
     ax.set_aspect("equal", adjustable="datalim")
     ax.autoscale_view()
     ax.set_title(body.title)
