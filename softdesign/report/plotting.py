@@ -122,9 +122,12 @@ def png_bytes(figure) -> bytes:
 
 
 def picture(name: str, figure, size_in: tuple[float, float], title: str, caption: str) -> Picture:
-    """Render ``figure`` to a :class:`Picture` (and release the figure's memory)."""
+    """Render ``figure`` to a :class:`Picture`.
+
+    The figure is left to the garbage collector: ``Figure.clear`` would rebuild every axes (ticks included) only to
+    drop them, a tenth of a figure's drawing time.
+    """
     data = png_bytes(figure)
-    figure.clear()
     return Picture(name, data, pixel_size(size_in), title, caption)
 
 
