@@ -37,3 +37,18 @@ def test_a_report_is_the_same_bytes_with_one_and_two_jobs(tmp_path):
     assert sorted(one) == sorted(two)
     assert {"index.html", "morph.gif", "stretch.png", "surfaces.png", "morph.png"} <= set(one)
     assert [name for name in one if one[name] != two[name]] == []
+
+
+def test_the_garbage_collector_is_given_back_as_it_was_even_when_drawing_fails():
+    """The report freezes what is loaded and raises the collector's threshold while it draws (process-wide
+    settings): both are restored afterwards, also when a figure raises."""
+    import gc
+
+    from softdesign.report.writer import GC_THRESHOLD, _collector_for_figures
+
+    before = gc.get_threshold()
+    assert before[0] != GC_THRESHOLD
+    with pytest.raises(ZeroDivisionError), _collector_for_figures():
+        assert gc.get_threshold()[0] == GC_THRESHOLD and gc.get_freeze_count() > 0
+        _ = 1 / 0
+    assert gc.get_threshold() == before and gc.get_freeze_count() == 0
