@@ -20,6 +20,14 @@ most :data:`MAX_REFINEMENTS` times) and the vessel keeps twice the triangles.
 The caption states both measured errors.  Coordinates are written as
 float32 (0.01 um at 100 mm, far below those errors).
 
+The figure is a plain dict of plotly trace dicts (``{"type": "mesh3d", ...}``),
+written by :func:`plotly.io.to_html` unvalidated: plotly's figure classes
+(``plotly.graph_objects``) would check every property of every trace and
+frame, about half the view's time, for a figure this module writes whole.  Its
+numpy arrays are written as plotly writes a figure's arrays (base64 typed
+arrays, :func:`_plotly_utils.utils.convert_to_base64`), and layout.template is
+:data:`TEMPLATE_NONE`, the JSON of plotly's template ``"none"``.
+
 plotly (MIT licence) ships plotly.js; the report writes it once as the file
 :data:`JS_NAME` beside the page, so the view needs no network.  The figure's
 div has a fixed id and plotly writes no time or random id: the same build gives
@@ -74,6 +82,9 @@ gd.on('plotly_buttonclicked', function (event) {
   });
 });"""
 HEIGHT_PX = 720
+#: plotly's template ``"none"`` (no styling: plotly.js's own defaults) as plotly's figure classes wrote it in the
+#: layout: plotly's Python side keeps one empty scatter style in it, as it takes an empty template for none given.
+TEMPLATE_NONE: dict[str, Any] = {"data": {"scatter": [{"type": "scatter"}]}}
 
 
 def max_distance_to_mesh(points: FloatArray, vertices: FloatArray, faces: np.ndarray) -> float:
@@ -152,17 +163,15 @@ def _frame_traces(data: BuildData, q: float, spacing_mm: float = SPACING_MM, ang
     if data.fit is not None:
         vertices, _, _ = tube_mesh(chain, data.fit.field, q, spacing_mm, angles, rings)
         v = vertices.astype(np.float32)
-        traces.append({"type": "mesh3d", "x": v[:, 0], "y": v[:, 1], "z": v[:, 2]})
+        traces.append({"x": v[:, 0], "y": v[:, 1], "z": v[:, 2], "type": "mesh3d"})
     for j in range(chain.count):
         p = curve.points(np.linspace(chain.breaks[j], chain.breaks[j + 1], CURVE_SAMPLES)).astype(np.float32)
-        traces.append({"type": "scatter3d", "x": p[:, 0], "y": p[:, 1], "z": p[:, 2]})
+        traces.append({"x": p[:, 0], "y": p[:, 1], "z": p[:, 2], "type": "scatter3d"})
     return traces
 
 
-def morph_figure(data: BuildData, frames: int = FRAMES):
-    """The plotly figure and the notes on what was decimated (display errors, mm)."""
-    import plotly.graph_objects as go
-
+def morph_figure(data: BuildData, frames: int = FRAMES) -> tuple[dict[str, Any], list[str]]:
+    """The plotly figure as a dict (data, layout, frames) and the notes on what was decimated (display errors, mm)."""
     chain = data.kinematics.chain
     colours = [_rgb(c) for c in link_colours(chain.count)]
     q_values = np.linspace(0.0, 1.0, int(frames))
@@ -170,19 +179,19 @@ def morph_figure(data: BuildData, frames: int = FRAMES):
     rings = tube_rings(data, q_values, spacing)
     per_q = [_frame_traces(data, float(q), spacing, angles, rings) for q in q_values]
     first = per_q[-1]  # the page opens on q = 1, inside the vessel
-    traces: list[Any] = []
+    traces: list[dict[str, Any]] = []
     notes: list[str] = []
     if data.fit is not None:
         _, faces, face_l = tube_mesh(chain, data.fit.field, 1.0, spacing, angles, rings)
         face_colours = np.array(colours, dtype=object)[data.fit.field.link_of(face_l)]
-        traces.append(go.Mesh3d(**{k: first[0][k] for k in "xyz"}, i=faces[:, 0], j=faces[:, 1], k=faces[:, 2],
-                                facecolor=face_colours, flatshading=False, name="actuator", showlegend=True,
-                                hoverinfo="skip"))
+        traces.append({"facecolor": face_colours, "flatshading": False, "hoverinfo": "skip", "i": faces[:, 0],
+                       "j": faces[:, 1], "k": faces[:, 2], "name": "actuator", "showlegend": True,
+                       **{k: first[0][k] for k in "xyz"}, "type": "mesh3d"})
         notes.append(f"actuator: {spacing:g} mm rings, {angles} vertices around; display error at q = 1 "
                      f"{tube_error:.3f} mm (against {FINE_FACTOR}x finer; tolerance {DISPLAY_TOLERANCE_MM:g} mm)")
     for j, trace in enumerate(first[len(first) - chain.count:]):
-        traces.append(go.Scatter3d(**{k: trace[k] for k in "xyz"}, mode="lines", line={"color": colours[j], "width": 6},
-                                   name=f"link {j} (centerline)", hoverinfo="name"))
+        traces.append({"hoverinfo": "name", "line": {"color": colours[j], "width": 6}, "mode": "lines",
+                       "name": f"link {j} (centerline)", **{k: trace[k] for k in "xyz"}, "type": "scatter3d"})
     chamber = interactive_parts.chamber_frames(data, q_values, FINE_FACTOR, DISPLAY_TOLERANCE_MM)
     if chamber is not None and chamber.frames:
         for frame, trace in zip(per_q, chamber.frames, strict=True):
@@ -193,34 +202,34 @@ def morph_figure(data: BuildData, frames: int = FRAMES):
     if len(data.ingest.faces):
         v, f, error = decimated_vessel(data.ingest.vertices, data.ingest.faces)
         v = v.astype(np.float32)
-        traces.append(go.Mesh3d(x=v[:, 0], y=v[:, 1], z=v[:, 2], i=f[:, 0], j=f[:, 1], k=f[:, 2],
-                                color=_rgb(VESSEL_RGB), opacity=VESSEL_OPACITY, name="patient's vessel (input)",
-                                showlegend=True, hoverinfo="skip"))
+        traces.append({"color": _rgb(VESSEL_RGB), "hoverinfo": "skip", "i": f[:, 0], "j": f[:, 1], "k": f[:, 2],
+                       "name": "patient's vessel (input)", "opacity": VESSEL_OPACITY, "showlegend": True,
+                       "x": v[:, 0], "y": v[:, 1], "z": v[:, 2], "type": "mesh3d"})
         notes.append(f"vessel: {len(f)} of {len(data.ingest.faces)} triangles; display error {error:.3f} mm "
                      f"(tolerance {DISPLAY_TOLERANCE_MM:g} mm)")
     mould, mould_notes = interactive_parts.mould_traces(data, DISPLAY_TOLERANCE_MM)
     traces.extend(mould)
     notes.extend(mould_notes)
-    figure = go.Figure(data=traces, frames=[
-        go.Frame(name=f"{q:.3f}", data=per_q[k], traces=moving) for k, q in enumerate(q_values)
-    ])
-    figure.update_layout(**_layout(per_q, traces, q_values))
+    figure = {"data": traces, "layout": _layout(per_q, traces, q_values), "frames": [
+        {"data": per_q[k], "name": f"{q:.3f}", "traces": moving} for k, q in enumerate(q_values)
+    ]}
     return figure, notes
 
 
-def _layout(per_q: list[list[dict[str, Any]]], traces: list[Any], q_values: FloatArray) -> dict[str, Any]:
+def _layout(per_q: list[list[dict[str, Any]]], traces: list[dict[str, Any]], q_values: FloatArray
+            ) -> dict[str, Any]:
     """Fixed scene ranges over every frame and the vessel, a q slider and a play button."""
     points = [np.column_stack([t["x"], t["y"], t["z"]]) for frame in per_q for t in frame]
     # the mould too (hidden at first): it encloses the q = 0 body with export.mould.margin_mm, so the box grows by
     # about that margin on each side, and the mould is not cut by the box when shown
-    points += [np.column_stack([t.x, t.y, t.z]) for t in traces
-               if t.name and t.name.startswith(("patient", interactive_parts.MOULD_PREFIX))]
+    points += [np.column_stack([t["x"], t["y"], t["z"]]) for t in traces
+               if t.get("name", "").startswith(("patient", interactive_parts.MOULD_PREFIX))]
     stacked = np.concatenate(points).astype(float)
     low, high = stacked.min(axis=0), stacked.max(axis=0)
     span = np.maximum(high - low, 1e-6)
     pad = 0.03 * span.max()
     ratio = (span + 2 * pad) / (span + 2 * pad).max()
-    axes = {name: {"range": [float(low[i] - pad), float(high[i] + pad)], "title": {"text": f"{name} (mm)"}}
+    axes = {name: {"title": {"text": f"{name} (mm)"}, "range": [float(low[i] - pad), float(high[i] + pad)]}
             for i, name in enumerate(("x", "y", "z"))}
     animate = {"mode": "immediate", "frame": {"duration": 0, "redraw": True}, "transition": {"duration": 0}}
     # The slider queues its frames ("afterall") rather than interrupting the one being drawn: plotly.js rejects an
@@ -229,29 +238,33 @@ def _layout(per_q: list[list[dict[str, Any]]], traces: list[Any], q_values: Floa
     # rejects play's promise: the buttons do not call plotly themselves ("execute": False) but :data:`BUTTON_SCRIPT`
     # does, catching that rejection.
     queued = {**animate, "mode": "afterall"}
-    steps = [{"label": f"{q:.2f}", "method": "animate", "args": [[f"{q:.3f}"], queued]} for q in q_values]
+    steps = [{"args": [[f"{q:.3f}"], queued], "label": f"{q:.2f}", "method": "animate"} for q in q_values]
     play = {"frame": {"duration": 120, "redraw": True}, "fromcurrent": True, "transition": {"duration": 0}}
+    # keys in the order plotly's figure classes wrote them, so that the page's bytes did not change with them
     return {
-        "template": "none", "height": HEIGHT_PX, "margin": {"l": 0, "r": 0, "t": 30, "b": 0},
-        "legend": {"x": 0.0, "y": 1.0},
-        "scene": {**{f"{k}axis": v for k, v in axes.items()}, "aspectmode": "manual",
-                  "aspectratio": {k: float(r) for k, r in zip("xyz", ratio, strict=True)}},
-        "sliders": [{"active": len(q_values) - 1, "steps": steps, "currentvalue": {"prefix": "q = "},
-                     "pad": {"t": 20}, "x": 0.1, "len": 0.9}],
-        "updatemenus": [{"type": "buttons", "showactive": False, "x": 0.0, "y": 0.0, "xanchor": "left",
-                         "yanchor": "top", "pad": {"t": 20},
-                         "buttons": [{"label": "play", "method": "animate", "args": [None, play], "execute": False},
-                                     {"label": "pause", "method": "animate", "args": [[None], animate],
-                                      "execute": False}]}],
+        "template": TEMPLATE_NONE, "margin": {"l": 0, "r": 0, "t": 30, "b": 0}, "legend": {"x": 0.0, "y": 1.0},
+        "scene": {**{f"{k}axis": v for k, v in axes.items()},
+                  "aspectratio": {k: float(r) for k, r in zip("xyz", ratio, strict=True)}, "aspectmode": "manual"},
+        "height": HEIGHT_PX,
+        "sliders": [{"active": len(q_values) - 1, "currentvalue": {"prefix": "q = "}, "len": 0.9, "pad": {"t": 20},
+                     "steps": steps, "x": 0.1}],
+        "updatemenus": [{"buttons": [{"args": [None, play], "execute": False, "label": "play", "method": "animate"},
+                                     {"args": [[None], animate], "execute": False, "label": "pause",
+                                      "method": "animate"}],
+                         "pad": {"t": 20}, "showactive": False, "type": "buttons", "x": 0.0, "xanchor": "left",
+                         "y": 0.0, "yanchor": "top"}],
     }
 
 
 def morph_html(data: BuildData, frames: int = FRAMES) -> tuple[str, list[str]]:
     """The figure's HTML fragment (a div and its script; plotly.js is :data:`JS_NAME`) and the display notes."""
+    from _plotly_utils.utils import convert_to_base64
+    from plotly.io import to_html
+
     figure, notes = morph_figure(data, frames)
-    html = figure.to_html(include_plotlyjs=False, full_html=False, div_id=DIV_ID,
-                          config={"displaylogo": False, "responsive": True}, post_script=BUTTON_SCRIPT,
-                          auto_play=False)
+    convert_to_base64(figure)  # numpy arrays as plotly writes a figure's: base64 typed arrays
+    html = to_html(figure, validate=False, include_plotlyjs=False, full_html=False, div_id=DIV_ID,
+                   config={"displaylogo": False, "responsive": True}, post_script=BUTTON_SCRIPT, auto_play=False)
     return f'<script src="{JS_NAME}" charset="utf-8"></script>\n{html}', notes
 
 

@@ -57,24 +57,23 @@ def mould_block(data: BuildData) -> dict[str, Any] | None:
     return block if isinstance(block, dict) and block.get("requested") else None
 
 
-def mould_traces(data: BuildData, tolerance_mm: float) -> tuple[list[Any], list[str]]:
-    """The mould's parts as hidden plotly meshes (none without a mould) and notes on their display error."""
-    import plotly.graph_objects as go
-
+def mould_traces(data: BuildData, tolerance_mm: float) -> tuple[list[dict[str, Any]], list[str]]:
+    """The mould's parts as hidden plotly mesh3d trace dicts (none without a mould) and notes on their display error."""
     from softdesign.report.interactive import decimated_vessel
 
     block = mould_block(data)
     if block is None:
         return [], []
-    traces: list[Any] = []
+    traces: list[dict[str, Any]] = []
     notes: list[str] = []
     for part in sorted(block["parts"], key=list(MOULD_COLOURS).index):
         vertices, faces = read_mesh(data.build_dir / layout.mould_path(part, "stl"))
         v, f, error = decimated_vessel(vertices, faces, MOULD_FACES, tolerance_mm)
         v = v.astype(np.float32)
-        traces.append(go.Mesh3d(x=v[:, 0], y=v[:, 1], z=v[:, 2], i=f[:, 0], j=f[:, 1], k=f[:, 2],
-                                color=MOULD_COLOURS[part], opacity=MOULD_OPACITY, name=MOULD_PREFIX + part,
-                                showlegend=True, visible="legendonly", hoverinfo="name", flatshading=True))
+        traces.append({"color": MOULD_COLOURS[part], "flatshading": True, "hoverinfo": "name", "i": f[:, 0],
+                       "j": f[:, 1], "k": f[:, 2], "name": MOULD_PREFIX + part, "opacity": MOULD_OPACITY,
+                       "showlegend": True, "visible": "legendonly", "x": v[:, 0], "y": v[:, 1], "z": v[:, 2],
+                       "type": "mesh3d"})
         notes.append(f"mould {part}: {len(f)} of {len(faces)} triangles, display error {error:.3f} mm")
     return traces, notes
 
@@ -178,7 +177,7 @@ def chamber_frames(data: BuildData, q_values: FloatArray, fine_factor: int, tole
             vertices = np.full((rings * angles + 2, 3), np.nan)
             missing.append(f"{q:.2f}")
         v = vertices.astype(np.float32)
-        frames.append({"type": "mesh3d", "x": v[:, 0], "y": v[:, 1], "z": v[:, 2]})
+        frames.append({"x": v[:, 0], "y": v[:, 1], "z": v[:, 2], "type": "mesh3d"})
     notes = [f"chamber: {rings} rings, {angles} vertices around; display error at q = 1 {error:.3f} mm (against "
              f"{fine_factor}x finer; tolerance {tolerance_mm:g} mm)"]
     if missing:
@@ -186,13 +185,12 @@ def chamber_frames(data: BuildData, q_values: FloatArray, fine_factor: int, tole
     return ChamberFrames(frames, faces, notes)
 
 
-def chamber_trace(chamber: ChamberFrames) -> Any:
-    """The hidden chamber trace the page opens on (the last frame's, q = 1)."""
-    import plotly.graph_objects as go
-
+def chamber_trace(chamber: ChamberFrames) -> dict[str, Any]:
+    """The hidden chamber trace the page opens on (the last frame's, q = 1), a plotly mesh3d trace dict."""
     first, f = chamber.frames[-1], chamber.faces
-    return go.Mesh3d(**{k: first[k] for k in "xyz"}, i=f[:, 0], j=f[:, 1], k=f[:, 2], color=CHAMBER_RGB,
-                     name=CHAMBER_NAME, showlegend=True, visible="legendonly", hoverinfo="name")
+    return {"color": CHAMBER_RGB, "hoverinfo": "name", "i": f[:, 0], "j": f[:, 1], "k": f[:, 2],
+            "name": CHAMBER_NAME, "showlegend": True, "visible": "legendonly", **{k: first[k] for k in "xyz"},
+            "type": "mesh3d"}
 
 
 def hidden_parts_note(data: BuildData) -> str:
