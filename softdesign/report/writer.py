@@ -175,12 +175,12 @@ def _collector_for_figures() -> Iterator[None]:
 
 
 def _import_drawing_libraries() -> None:
-    """Import what the figures draw with (about half a second), so that forked workers inherit it rather than each import it."""
+    """Import what the figures draw with (about half a second): forked workers inherit it, none imports it again."""
     import matplotlib.backends.backend_agg  # noqa: F401
     import matplotlib.collections  # noqa: F401
     import matplotlib.figure  # noqa: F401
     import PIL.Image  # noqa: F401
-    import plotly.graph_objects  # noqa: F401
+    import plotly.io  # noqa: F401
 
 
 @dataclass(frozen=True)
