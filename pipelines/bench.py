@@ -201,7 +201,7 @@ def import_heavy_libraries() -> float:
     import vtkmodules.vtkFiltersCore  # noqa: F401
     import vtkmodules.vtkIOXML  # noqa: F401
 
-    from softdesign.pipeline import stages  # noqa: F401
+    from softdesign.pipeline import stage_order  # noqa: F401  (every stage module)
 
     return time.perf_counter() - start
 
@@ -242,7 +242,7 @@ def run_worker(case_file: Path, out_dir: Path, profile_dir: Path | None, jobs: i
     import_s = import_heavy_libraries()
     from softdesign.config import load_case
     from softdesign.pipeline.runner import RunOptions, run_stages
-    from softdesign.pipeline.stages import STAGES, input_files
+    from softdesign.pipeline.stage_order import STAGES, input_files
 
     case = load_case(case_file)
     memory = PeakMemory()

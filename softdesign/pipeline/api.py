@@ -12,7 +12,7 @@ from softdesign.errors import errors_named_for
 from softdesign.io.input_checks import input_os_errors
 from softdesign.pipeline.runner import RunOptions, run_stages
 from softdesign.pipeline.stage import StageRun
-from softdesign.pipeline.stages import STAGES, input_files, stages_through
+from softdesign.pipeline.stage_order import STAGES, input_files, stages_through
 
 
 @dataclass(frozen=True)

@@ -9,16 +9,18 @@ in a later case), is an output of the ingest stage like any other.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from softdesign.centerline.extract import CenterlineOptions, Centerlines, extract_centerlines
-from softdesign.config import Case
 from softdesign.geometry.network import CenterlineNetwork, Polyline
 from softdesign.pipeline import layout
 from softdesign.pipeline.store import Staging
 from softdesign.types import UNIT_SCALE_TO_MM
+
+if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
+    from softdesign.config import Case
 
 
 def extract_for_case(case: Case) -> tuple[CenterlineNetwork, Centerlines]:

@@ -11,11 +11,10 @@ the fixes.  Without inscribed radii nothing is checked.
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softdesign.config import Case
 from softdesign.errors import InputDataError
 from softdesign.fitting.metrics import closest_surface_points
 from softdesign.fitting.wall_fit import WallFit
@@ -24,6 +23,9 @@ from softdesign.geometry.curves import CurveOptions
 from softdesign.geometry.network import SelectedPath
 from softdesign.limits import MAX_CURVE_SAMPLES
 from softdesign.types import FramedCurve
+
+if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
+    from softdesign.config import Case
 
 
 def curve_options(case: Case, count: int | None = None) -> CurveOptions:

@@ -14,7 +14,6 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from softdesign.config import Case
 from softdesign.errors import ConfigError
 from softdesign.limits import (
     MAX_CURVE_SAMPLES,
@@ -24,6 +23,9 @@ from softdesign.limits import (
     MAX_MESH_VERTICES,
     MEMORY_BUDGET_TEXT,
 )
+
+if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
+    from softdesign.config import Case
 
 if TYPE_CHECKING:  # the export and feasibility stages import this module: no import of the stages here
     from softdesign.pipeline.stages.ingest import IngestResult

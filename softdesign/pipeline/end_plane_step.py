@@ -9,11 +9,10 @@ measured without a surface or without inscribed radii.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softdesign.config import Case
 from softdesign.errors import ConfigError, GeometryError
 from softdesign.geometry.curves import smooth_curve_from_polyline
 from softdesign.geometry.end_planes import end_planes
@@ -22,6 +21,9 @@ from softdesign.geometry.network import SelectedPath
 from softdesign.limits import MAX_CURVE_SAMPLES
 from softdesign.pipeline.backbone_step import curve_options
 from softdesign.types import FloatArray
+
+if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
+    from softdesign.config import Case
 
 
 def end_plane_summary(

@@ -13,10 +13,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from softdesign.config import Case
 from softdesign.pipeline.store import Staging, canonical_json, sha256_bytes
+
+if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
+    from softdesign.config import Case
 
 Results = dict[str, Any]
 

@@ -13,7 +13,7 @@ from softdesign.meshing.skin_stretch import make_grid
 from softdesign.meshing.wall import FD_STEP_MM
 from softdesign.pipeline.api import build_through
 from softdesign.pipeline.parallel import jobs_for_build
-from softdesign.pipeline.stages import STAGES
+from softdesign.pipeline.stage_order import STAGES
 from softdesign.pipeline.stages.export import body_spec
 from softdesign.pipeline.stages.feasibility import _Body, run_feasibility
 from tests.helpers.cases import write_case

@@ -6,40 +6,8 @@ kinematics: both kinematics and the fit consume them) -> mould (a casting
 mould of the q = 0 body, when the case asks for one) -> volume_mesh (tetrahedra of
 the body for simulators, when asked for) -> feasibility (skin
 stretch and wall thickness, judged against the case's material).
+
+The list of them in build order is :data:`softdesign.pipeline.stage_order.STAGES`.  This package imports
+nothing, so that importing one stage (the report loads six stages' results) does not import all nine and the
+libraries they compute with.
 """
-
-from __future__ import annotations
-
-from pathlib import Path
-
-from softdesign.config import Case
-from softdesign.pipeline import inputs
-from softdesign.pipeline.stage import Stage
-from softdesign.pipeline.stages import (
-    blend,
-    export,
-    feasibility,
-    fit,
-    ingest,
-    kinematics,
-    links,
-    mould,
-    volume_mesh,
-)
-
-#: Every stage, in build order.
-STAGES: list[Stage] = [
-    ingest.STAGE, blend.STAGE, links.STAGE, kinematics.STAGE, fit.STAGE, export.STAGE, mould.STAGE, volume_mesh.STAGE,
-    feasibility.STAGE,
-]
-
-
-def stages_through(name: str) -> list[Stage]:
-    """The stages up to and including ``name`` (its upstream, in order)."""
-    names = [s.name for s in STAGES]
-    return STAGES[: names.index(name) + 1]
-
-
-def input_files(case: Case) -> list[Path]:
-    """Files the build reads (ConfigError naming the field when one is missing)."""
-    return inputs.input_files(case)

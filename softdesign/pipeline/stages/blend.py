@@ -11,11 +11,10 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softdesign.config import Case
 from softdesign.geometry.blend import BlendedShape, Shortening, blend_shapes
 from softdesign.geometry.curves import (
     TORSION_KAPPA_FLOOR,
@@ -29,6 +28,9 @@ from softdesign.pipeline.blend_choice import choose_blend, describe_choice
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.ingest import IngestResult
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
+
+if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
+    from softdesign.config import Case
 
 #: 2: the final path's torsion only where curvature >= TORSION_KAPPA_FLOOR (null when nowhere), with the
 #: fraction of the path where it is defined and the floor.

@@ -20,11 +20,10 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softdesign.config import Case
 from softdesign.errors import MeshError
 from softdesign.io.formats import FILE_UNITS, mesh_bytes
 from softdesign.io.gltf_morph import morph_glb_bytes
@@ -45,6 +44,9 @@ from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
+
+if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
+    from softdesign.config import Case
 
 VERSION = 3  # 2: .glb in metres (glTF's unit), metrics.export.units; 3: .pvd time series, morph.glb
 

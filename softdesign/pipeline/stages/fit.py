@@ -12,11 +12,10 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softdesign.config import Case
 from softdesign.errors import ConfigError, FitError
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
 from softdesign.fitting.end_checks import thin_end_warnings
@@ -39,6 +38,9 @@ from softdesign.pipeline.stages.ingest import IngestResult
 from softdesign.pipeline.stages.links import LinksResult
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 from softdesign.types import FloatArray
+
+if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
+    from softdesign.config import Case
 
 VERSION = 5  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
 # 3: points fitted in path order; distances sampled above 200k points (max still over all)

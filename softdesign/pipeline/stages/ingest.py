@@ -9,11 +9,10 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softdesign.config import Case
 from softdesign.geometry.network import CenterlineNetwork, Orientation, SelectedPath, all_paths, select_path
 from softdesign.geometry.plausibility import check_surface_surrounds, check_vessel_scale
 from softdesign.io.centerline import read_centerline_network
@@ -26,6 +25,9 @@ from softdesign.pipeline.end_plane_step import end_plane_summary
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 from softdesign.types import UNIT_SCALE_TO_MM, FloatArray
+
+if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
+    from softdesign.config import Case
 
 #: 2: a vessel whose size is not human in the declared units is refused (it was a warning on radii only).
 #: 3: a final path that turns tighter than the vessel is wide is regularized here (``backbone``); reads resample;

@@ -11,11 +11,10 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softdesign.config import Case
 from softdesign.kinematics.arc_check import arc_check_metrics, arc_misses, link_arcs_at_final_shape
 from softdesign.kinematics.links import LinkChain, LinkReport
 from softdesign.kinematics.poe import PoeSplit
@@ -23,6 +22,9 @@ from softdesign.pipeline import layout
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.links import LinksResult
 from softdesign.pipeline.store import Staging
+
+if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
+    from softdesign.config import Case
 
 VERSION = 1
 CONVENTION = (

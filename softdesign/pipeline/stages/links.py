@@ -11,16 +11,18 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softdesign.config import Case
 from softdesign.kinematics.links import LinkChain, link_breaks
 from softdesign.pipeline import layout
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.blend import BlendResult
 from softdesign.pipeline.store import Staging
+
+if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
+    from softdesign.config import Case
 
 VERSION = 1
 
