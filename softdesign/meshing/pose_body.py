@@ -29,7 +29,8 @@ Checks
     sealed hollow), and volume within 0.5 % of the sum over links of the volume integrated from
     the spline surface on each link's own segment (Gauss-Legendre in l between the link's joints
     and spline knots, trapezoid rule in the angle; an annulus is flat and encloses nothing), less
-    the chamber's and the port's; then manifold3d's status.
+    the chamber's and the port's; that no two vertices become one in float32 coordinates (a mesh
+    file's: one read back would no longer be closed); then manifold3d's status.
 """
 
 from __future__ import annotations
@@ -216,9 +217,22 @@ def pose_body(chain: LinkChain, field: RadiusField, q: float | npt.ArrayLike, sp
         vertices, faces, regions, euler, kind = solid.vertices, solid.faces, solid.regions, solid.euler, solid.kind
         expected -= _chamber_volume(curves, field, q.tolist(), spec)
     report = check_solid(vertices, faces, Expectation(volume=expected, euler=euler, bodies=1), label=label)
+    check_distinct_when_written(vertices, label)
     if kind == "solid":
         manifold_from_mesh(vertices, faces, label)
     return PoseBody(q, tuple(links), tuple(joints), vertices, faces, regions, expected, report, reach, kind)
+
+
+def check_distinct_when_written(vertices: FloatArray, label: str) -> None:
+    """Raise when two vertices would become one in a mesh file (float32 coordinates), opening the written solid."""
+    lost = vertices.shape[0] - np.unique(np.asarray(vertices, np.float32), axis=0).shape[0]
+    if lost:
+        which = "1 vertex lies" if lost == 1 else f"{lost} vertices lie"
+        raise MeshError(
+            f"{label}: {which} closer to another than a mesh file's float32 coordinates can tell apart, so the "
+            "written solid would not be closed; this is a bug in the pose mesher, please report it with the case "
+            "file and the q"
+        )
 
 
 def _end_planes(first: Sweep, last: Sweep, cuts: EndCuts, inset_mm: float) -> tuple[CutPlane | None, CutPlane | None]:

@@ -2,7 +2,7 @@
 
 Joints
     Both rings sit on the rays a_k = 2 pi k / na of the joint frame.  Where they coincide (to
-    JOINT_MERGE_TOL_MM: equal q, or rho0 = rhof there) they share vertices.  Elsewhere a planar
+    JOINT_MERGE_TOL_MM, a micron: equal q, or rho0 = rhof there) they share vertices.  Elsewhere a planar
     annulus closes the step: in each angular interval the quad between the rings is split into
     two triangles; where the step changes sign inside an interval the two chords cross, and the
     crossing point becomes a vertex of both walls and of the annulus.  A triangle where link j's
@@ -25,10 +25,14 @@ from softdesign.meshing.end_cut import CutPlane, cut_ends
 from softdesign.meshing.tessellate import Region, Sweep, TubeMesh, tessellate
 from softdesign.meshing.topology import drop_unused_vertices
 from softdesign.meshing.volume import angle_grid
-from softdesign.types import POINT_TOL_MM, FloatArray, IntArray, Pose
+from softdesign.types import FloatArray, IntArray, Pose
 
-#: Joint ring vertices closer than this are shared, mm (placement round-off is ~1e-13 mm).
-JOINT_MERGE_TOL_MM = POINT_TOL_MM
+#: Joint ring vertices closer than this are shared, mm: a micron, far below any fabrication's resolution, and far
+#: above the resolution of the files the pose is written to (float32 coordinates: 3e-5 mm at 500 mm).  Two vertices
+#: closer than that resolution become one when a mesh file is read, and the edge between them with them: the
+#: written solid was no longer closed (a five-link coil with rings 3e-7 mm apart at one joint read back with two
+#: edges in four faces).  A crossing then lies at least (chord x 1 micron / the largest step) from the rings' vertices.
+JOINT_MERGE_TOL_MM = 1e-3
 
 
 @dataclass(frozen=True)
