@@ -15,12 +15,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softdesign.geometry.blend import BlendedShape, Shortening, blend_shapes
+from softdesign.geometry.blend import BlendedShape, BlendMode, Shortening, blend_shapes
 from softdesign.geometry.curves import (
     TORSION_KAPPA_FLOOR,
     smooth_curve_from_polyline,
     smooth_curve_from_samples,
 )
+from softdesign.geometry.frames import FrameMode
 from softdesign.geometry.initial import InitialSpec, build_initial_shape, initial_shape_from_polyline
 from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import curve_options
@@ -40,10 +41,11 @@ VERSION = 3
 
 @dataclass(frozen=True)
 class BlendResult:
-    """The blended shape and its figures."""
+    """The blended shape, its figures, and the key shapes' samples it was rebuilt from (what the folder keeps)."""
 
     shape: BlendedShape
     summary: dict[str, Any]
+    samples: tuple[np.ndarray, ...]
 
 
 def run_blend(case: Case, ingest: IngestResult) -> BlendResult:
@@ -65,7 +67,20 @@ def run_blend(case: Case, ingest: IngestResult) -> BlendResult:
         for q, p in ingest.keyframes
     )
     choice = choose_blend(initial, final, keyframes, case.blend, case.frames, ingest.path)
-    return BlendResult(choice.shape, {**_summary(case, choice.shape), **choice.summary()})
+    # the shape rebuilt from the samples the folder keeps, as load_blend rebuilds it: the splines through them equal
+    # the smoothed ones to round-off (1e-13 mm), not to the bit, and the stages after this one must get the same
+    # shape whether the blend ran now or was loaded, or a stage re-run on cached results writes other bytes
+    samples = tuple(curve.points(curve.l_grid) for curve in choice.shape.keys)
+    shape = _shape_from_samples(choice.shape.key_q, samples, choice.shape.mode, choice.shape.frames)
+    return BlendResult(shape, {**_summary(case, shape), **choice.summary()}, samples)
+
+
+def _shape_from_samples(
+    key_q: np.ndarray, samples: tuple[np.ndarray, ...], mode: BlendMode, frames: FrameMode
+) -> BlendedShape:
+    keys = [smooth_curve_from_samples(points) for points in samples]
+    keyframes = tuple(zip(np.asarray(key_q)[1:-1].tolist(), keys[1:-1], strict=True))
+    return blend_shapes(keys[0], keys[-1], keyframes, mode, frames)
 
 
 def _summary(case: Case, shape: BlendedShape) -> dict[str, Any]:
@@ -97,9 +112,8 @@ def _summary(case: Case, shape: BlendedShape) -> dict[str, Any]:
 
 def write_blend(result: BlendResult, staging: Staging) -> None:
     """Keep the key shapes' samples and the figures."""
-    shape = result.shape
-    samples = {f"key_{k}": curve.points(curve.l_grid) for k, curve in enumerate(shape.keys)}
-    staging.write_bytes(layout.BLEND_CURVES, npz_bytes(key_q=shape.key_q, **samples))
+    samples = {f"key_{k}": points for k, points in enumerate(result.samples)}
+    staging.write_bytes(layout.BLEND_CURVES, npz_bytes(key_q=result.shape.key_q, **samples))
     staging.write_json(layout.BLEND_SUMMARY, result.summary)
 
 
@@ -107,10 +121,9 @@ def load_blend(build_dir: Path) -> BlendResult:
     """Rebuild the blended shape from the kept samples (no smoothing is redone)."""
     data = load_npz(Path(build_dir) / layout.BLEND_CURVES)
     summary = json.loads((Path(build_dir) / layout.BLEND_SUMMARY).read_text(encoding="utf-8"))
-    keys = [smooth_curve_from_samples(data[f"key_{k}"]) for k in range(len(data["key_q"]))]
-    keyframes = tuple(zip(data["key_q"][1:-1].tolist(), keys[1:-1], strict=True))
-    shape = blend_shapes(keys[0], keys[-1], keyframes, summary["mode"], summary["frames"])
-    return BlendResult(shape, summary)
+    samples = tuple(data[f"key_{k}"] for k in range(len(data["key_q"])))
+    shape = _shape_from_samples(data["key_q"], samples, summary["mode"], summary["frames"])
+    return BlendResult(shape, summary, samples)
 
 
 def torsion_text(path: dict[str, Any]) -> str:
