@@ -114,7 +114,9 @@ def _merge_duplicate_vertices(vertices: np.ndarray, faces: np.ndarray) -> Mesh:
     if len(vertices) == 0:
         return vertices, faces
     unique, inverse = np.unique(vertices, axis=0, return_inverse=True)
-    used = np.unique(inverse[faces])
+    referenced = np.zeros(len(unique), bool)
+    referenced[inverse.reshape(-1)[faces]] = True
+    used = np.flatnonzero(referenced)  # np.unique(inverse[faces]): numpy 2.4 hashes 3 F integers, 15 times slower
     remap = np.full(len(unique), -1, np.int64)
     remap[used] = np.arange(len(used))
     return unique[used], remap[inverse.reshape(-1)[faces]]
