@@ -205,7 +205,9 @@ class _EdgeTable:
         key = np.minimum(start, end) * n_vertices + np.maximum(start, end)
         order = np.argsort(key, kind="stable")  # a tessellation's keys come in long sorted runs
         keys = key[order]
-        starts = np.flatnonzero(np.concatenate(([True], keys[1:] != keys[:-1])))
+        first = np.ones(len(keys), bool)
+        first[1:] = keys[1:] != keys[:-1]
+        starts = np.flatnonzero(first)
         return cls(n_vertices, keys, order, starts, np.diff(np.append(starts, len(keys))))
 
     def single_edges(self) -> IntArray:
