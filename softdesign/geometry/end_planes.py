@@ -122,9 +122,12 @@ def end_planes(
     reach = (END_SEARCH_RADII + 1.0 / np.cos(np.radians(MAX_TILT_DEG))) * inscribed_mm
     near = _faces_near(vertices, faces, ends, reach)
     rims += [("flat_cap", _region_rim(faces, f, len(vertices))) for f in _flat_regions(vertices, faces, edges, near)]
+    # a flat region with no boundary of its own (a closed flat shell) has no rim; each rim's centre serves both ends
+    points = [(kind, vertices[ids]) for kind, ids in rims if len(ids) >= 3]
+    candidates = [(kind, rim, rim.mean(axis=0)) for kind, rim in points]
     out = []
     for k, outward in ((0, -1.0), (1, 1.0)):
-        out.append(_end_plane(vertices, rims, np.asarray(ends[k], float),
+        out.append(_end_plane(candidates, np.asarray(ends[k], float),
                               outward * np.asarray(tangents[k], float), float(inscribed_mm[k])))
     return out[0], out[1]
 
@@ -144,15 +147,12 @@ def rim_gap_warnings(planes: dict[str, dict[str, Any] | None]) -> list[str]:
 
 
 def _end_plane(
-    vertices: Points, rims: list[tuple[str, IntArray]], end: FloatArray, tangent: FloatArray, inscribed: float
+    rims: list[tuple[str, Points, FloatArray]], end: FloatArray, tangent: FloatArray, inscribed: float
 ) -> EndPlane | None:
+    """The nearest of ``rims`` (kind, rim vertices, their centroid) that passes for this end's plane, or None."""
     tangent = tangent / np.linalg.norm(tangent)
     best: tuple[float, EndPlane] | None = None
-    for kind, ids in rims:
-        if len(ids) < 3:  # a flat region with no boundary of its own (a closed flat shell) has no rim
-            continue
-        rim = vertices[ids]
-        centre = rim.mean(axis=0)
+    for kind, rim, centre in rims:
         distance = float(np.linalg.norm(centre - end))
         if distance > END_SEARCH_RADII * inscribed:
             continue
