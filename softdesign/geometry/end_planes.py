@@ -114,19 +114,20 @@ def end_planes(
     tangents : (2, 3) unit tangents of the path at those points, in the path's direction
     inscribed_mm : (2,) inscribed-sphere radius at each end, mm
     """
-    import trimesh  # imported where used: importing the command line stays quick
-
     vertices, faces = np.asarray(vertices, float), np.asarray(faces, np.int64)
-    mesh = trimesh.Trimesh(vertices, faces, process=False)
-    rims = [("open_end", loop) for loop in _boundary_loops(mesh)]
+    ends, inscribed_mm = np.asarray(ends, float), np.asarray(inscribed_mm, float)
+    edges = _EdgeTable.of(faces, len(vertices))
+    rims = [("open_end", loop) for loop in _boundary_loops(edges)]
     # a cap's faces lie within its rim, whose centre is within END_SEARCH_RADII inscribed radii of the end
-    reach = (END_SEARCH_RADII + 1.0 / np.cos(np.radians(MAX_TILT_DEG))) * np.asarray(inscribed_mm, float)
-    near = np.any(np.linalg.norm(mesh.triangles_center[:, None, :] - np.asarray(ends, float)[None], axis=2)
-                  <= reach, axis=1)
-    rims += [("flat_cap", _region_rim(mesh, f)) for f in _flat_regions(mesh, near)]
+    reach = (END_SEARCH_RADII + 1.0 / np.cos(np.radians(MAX_TILT_DEG))) * inscribed_mm
+    near = _faces_near(vertices, faces, ends, reach)
+    rims += [("flat_cap", _region_rim(faces, f, len(vertices))) for f in _flat_regions(vertices, faces, edges, near)]
+    # a flat region with no boundary of its own (a closed flat shell) has no rim; each rim's centre serves both ends
+    points = [(kind, vertices[ids]) for kind, ids in rims if len(ids) >= 3]
+    candidates = [(kind, rim, rim.mean(axis=0)) for kind, rim in points]
     out = []
     for k, outward in ((0, -1.0), (1, 1.0)):
-        out.append(_end_plane(vertices, rims, np.asarray(ends[k], float),
+        out.append(_end_plane(candidates, np.asarray(ends[k], float),
                               outward * np.asarray(tangents[k], float), float(inscribed_mm[k])))
     return out[0], out[1]
 
@@ -146,15 +147,12 @@ def rim_gap_warnings(planes: dict[str, dict[str, Any] | None]) -> list[str]:
 
 
 def _end_plane(
-    vertices: Points, rims: list[tuple[str, IntArray]], end: FloatArray, tangent: FloatArray, inscribed: float
+    rims: list[tuple[str, Points, FloatArray]], end: FloatArray, tangent: FloatArray, inscribed: float
 ) -> EndPlane | None:
+    """The nearest of ``rims`` (kind, rim vertices, their centroid) that passes for this end's plane, or None."""
     tangent = tangent / np.linalg.norm(tangent)
     best: tuple[float, EndPlane] | None = None
-    for kind, ids in rims:
-        if len(ids) < 3:  # a flat region with no boundary of its own (a closed flat shell) has no rim
-            continue
-        rim = vertices[ids]
-        centre = rim.mean(axis=0)
+    for kind, rim, centre in rims:
         distance = float(np.linalg.norm(centre - end))
         if distance > END_SEARCH_RADII * inscribed:
             continue
@@ -178,11 +176,58 @@ def _end_plane(
     return None if best is None else best[1]
 
 
-def _boundary_loops(mesh: Any) -> list[IntArray]:
+@dataclass(frozen=True)
+class _EdgeTable:
+    """The faces' edges (``faces_to_edges`` order: f0-f1, f1-f2, f2-f0 of each face), grouped by vertex pair.
+
+    One sort of integer keys ``min V + max`` (V vertices, int64 up to V = 3e9) stands in for trimesh's row grouping
+    (``group_rows`` on ``edges_sorted``), which hashes and sorts the 3 F rows again for each question.
+
+    Attributes
+    ----------
+    n_vertices : V, the vertex count the keys are made with
+    keys : (3 F,) int64, the edges' keys, sorted
+    order : (3 F,) int64, the edge (3 f + p) at each position of ``keys``
+    starts : (G,) int64, where each group of equal keys begins in ``keys``
+    uses : (G,) int64, the group's size: how many face edges join that vertex pair
+    """
+
+    n_vertices: int
+    keys: IntArray
+    order: IntArray
+    starts: IntArray
+    uses: IntArray
+
+    @classmethod
+    def of(cls, faces: IntArray, n_vertices: int) -> _EdgeTable:
+        """The table of ``faces`` (F, 3) on ``n_vertices`` vertices."""
+        start, end = faces.ravel(), faces[:, [1, 2, 0]].ravel()
+        key = np.minimum(start, end) * n_vertices + np.maximum(start, end)
+        order = np.argsort(key, kind="stable")  # a tessellation's keys come in long sorted runs
+        keys = key[order]
+        first = np.ones(len(keys), bool)
+        first[1:] = keys[1:] != keys[:-1]
+        starts = np.flatnonzero(first)
+        return cls(n_vertices, keys, order, starts, np.diff(np.append(starts, len(keys))))
+
+    def single_edges(self) -> IntArray:
+        """(B, 2) vertex ids, smaller first, of the edges used by one face edge only, in key order."""
+        single = self.keys[self.starts[self.uses == 1]]
+        return np.column_stack((single // self.n_vertices, single % self.n_vertices))
+
+    def face_pairs(self) -> IntArray:
+        """(P, 2) the two faces on each edge that exactly two face edges use, when the faces are distinct:
+        trimesh's ``face_adjacency`` up to the order of the pairs and within them."""
+        twice = self.starts[self.uses == 2]
+        pairs = self.order[np.column_stack((twice, twice + 1))] // 3
+        return pairs[pairs[:, 0] != pairs[:, 1]]
+
+
+def _boundary_loops(edges: _EdgeTable) -> list[IntArray]:
     """Vertex ids of each chain of boundary edges (edges of one face), as connected components."""
     import trimesh
 
-    boundary = mesh.edges_sorted[trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1)]
+    boundary = edges.single_edges()
     if len(boundary) == 0:
         return []
     return [np.asarray(c, np.int64) for c in trimesh.graph.connected_components(boundary, min_len=3)]
@@ -197,34 +242,65 @@ def _all_round(radial: Points, tangent: FloatArray) -> bool:
     return len(np.unique(sector)) == RIM_SECTORS
 
 
-def _flat_regions(mesh: Any, near: np.ndarray) -> list[IntArray]:
+def _faces_near(vertices: Points, faces: IntArray, ends: Points, reach: FloatArray) -> np.ndarray:
+    """Bool per face: its centre (trimesh's ``triangles_center``) lies within ``reach[k]`` of ``ends[k]``.
+
+    Centres are computed only for faces that have no axis on which all three vertices lie more than that
+    reach (padded by a relative 1e-6, far above round-off) to one side of the end: their centres are too far.
+    """
+    near = np.zeros(len(faces), bool)
+    bits = np.array([1, 2, 4], np.uint8)
+    for end, within in zip(ends, reach, strict=True):
+        pad = within + 1e-6 * (within + np.abs(end))
+        side = ((vertices < end - pad) @ bits) | (((vertices > end + pad) @ bits) << 3)  # axis, below | above
+        candidates = np.flatnonzero(np.bitwise_and.reduce(side[faces], axis=1) == 0)
+        centres = vertices[faces[candidates]].mean(axis=1)
+        near[candidates[np.linalg.norm(centres - end, axis=1) <= within]] = True
+    return near
+
+
+def _flat_regions(vertices: Points, faces: IntArray, edges: _EdgeTable, near: np.ndarray) -> list[IntArray]:
     """Face ids of each connected region of two or more faces whose neighbours differ by < ``FLAT_ANGLE_DEG``.
 
     Only the regions holding a face of ``near`` (bool per face), in the order of their smallest face id.
     """
+    import trimesh
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    pairs = mesh.face_adjacency[mesh.face_adjacency_angles < np.radians(FLAT_ANGLE_DEG)]
-    count = len(mesh.faces)
+    pairs = edges.face_pairs()
+    pairs = pairs[trimesh.geometry.vector_angle(_face_normals(vertices, faces)[pairs]) < np.radians(FLAT_ANGLE_DEG)]
+    count = len(faces)
     graph = coo_matrix((np.ones(len(pairs), np.int8), (pairs[:, 0], pairs[:, 1])), shape=(count, count))
     labels = connected_components(graph, directed=False)[1]  # numbered in the order of their smallest face id
     sizes = np.bincount(labels)
-    wanted = np.unique(labels[near])
-    wanted = wanted[sizes[wanted] >= 2]
-    by_label = np.argsort(labels, kind="stable")
-    starts = np.concatenate(([0], np.cumsum(sizes)))
-    return [by_label[starts[k]:starts[k + 1]].astype(np.int64) for k in wanted]
+    wanted = np.zeros(len(sizes), bool)
+    wanted[labels[near]] = True
+    wanted &= sizes >= 2
+    members = np.flatnonzero(wanted[labels])  # only the wanted regions' faces are sorted by region
+    by_label = members[np.argsort(labels[members], kind="stable")]
+    starts = np.concatenate(([0], np.cumsum(sizes[wanted])))
+    return [by_label[starts[k]:starts[k + 1]] for k in range(int(np.count_nonzero(wanted)))]
 
 
-def _region_rim(mesh: Any, facet: IntArray) -> IntArray:
+def _face_normals(vertices: Points, faces: IntArray) -> FloatArray:
+    """(F, 3) unit normals as trimesh's ``face_normals`` makes them (zero for a degenerate face)."""
+    import trimesh
+
+    unit, valid = trimesh.triangles.normals(vertices[faces])
+    normals = np.zeros((len(faces), 3))
+    normals[valid] = unit
+    return normals
+
+
+def _region_rim(faces: IntArray, facet: IntArray, n_vertices: int) -> IntArray:
     """Sorted vertex ids of the edges used once by the region's faces (its boundary).
 
     Only the region's own 3 F edges are grouped (not a mask over the whole mesh's edges): the cost
     follows the region's size, which matters on a million-triangle wall with hundreds of flat pairs.
     """
-    import trimesh
-
-    rows = (np.asarray(facet)[:, None] * 3 + np.arange(3)).reshape(-1)
-    edges = mesh.edges_sorted[rows]
-    return np.unique(edges[trimesh.grouping.group_rows(edges, require_count=1)])
+    ids = np.sort(_EdgeTable.of(faces[facet], n_vertices).single_edges(), axis=None)
+    # np.unique, sorted; numpy 2.4's np.unique hashes integers first, ten times slower at these sizes
+    first = np.ones(len(ids), bool)
+    first[1:] = ids[1:] != ids[:-1]
+    return ids[first]

@@ -135,3 +135,41 @@ def test_a_flat_band_of_wall_spanning_both_rims_is_not_taken_for_an_end_plane():
     for plane in (inlet, outlet):
         assert plane is not None and plane.kind == "open_end"
         assert abs(plane.axis_offset_mm - 1.5) < COORD_TOL_MM and plane.tilt_deg < TILT_TOL_DEG
+
+
+def test_the_faces_near_an_end_are_those_whose_centres_lie_within_reach():
+    import trimesh
+
+    from softdesign.geometry.end_planes import _faces_near
+
+    # the vertex box that spares most centres must not drop one: a lumpy sphere far from the origin, reaches
+    # that end exactly on a face's centre, and none
+    rng = np.random.default_rng(3)
+    sphere = trimesh.creation.icosphere(subdivisions=4, radius=RADIUS)
+    vertices = sphere.vertices * rng.uniform(0.9, 1.1, (len(sphere.vertices), 1)) + [200.0, -50.0, 10.0]
+    centres = vertices[sphere.faces].mean(axis=1)
+    ends = vertices[rng.choice(len(vertices), 2, replace=False)]
+    exact = np.linalg.norm(centres[7] - ends[0])
+    for reach in ([0.5, 2.0], [exact, 1e-9], [0.0, 0.0], [3.0 * RADIUS, 3.0 * RADIUS]):
+        expected = np.any(np.linalg.norm(centres[:, None] - ends[None], axis=2) <= reach, axis=1)
+        assert np.array_equal(_faces_near(vertices, sphere.faces, ends, np.array(reach)), expected)
+
+
+def test_the_edge_table_pairs_faces_and_finds_boundary_edges_as_trimesh_does():
+    import trimesh
+
+    from softdesign.geometry.end_planes import _EdgeTable
+
+    # an open tube with a duplicated face (edges of 3 and 4 face edges), degenerate faces (one on an edge of the
+    # wall, one whose only edge a-c no other face has, used twice by it alone) and faces in shuffled order
+    tube = trimesh.creation.cylinder(radius=RADIUS, height=4.0, sections=24)
+    faces = np.asarray(tube.faces)[np.abs(np.abs(tube.triangles_center[:, 2]) - 2.0) > 1e-9]
+    a, b = faces[5, 0], faces[5, 1]
+    c = next(v for v in np.unique(faces) if v != a and not np.any(np.isin(faces, [a, v]).sum(axis=1) >= 2))
+    faces = np.concatenate([faces, faces[:1], [[a, b, a], [a, c, a]]])
+    faces = faces[np.random.default_rng(0).permutation(len(faces))]
+    mesh = trimesh.Trimesh(tube.vertices, faces, process=False)
+    table = _EdgeTable.of(faces, len(mesh.vertices))
+    assert {tuple(sorted(p)) for p in table.face_pairs().tolist()} == {tuple(p) for p in mesh.face_adjacency.tolist()}
+    once = mesh.edges_sorted[trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1)]
+    assert sorted(map(tuple, table.single_edges().tolist())) == sorted(map(tuple, once.tolist()))
