@@ -118,6 +118,15 @@ class RadiusField:
         ]
         return self._link_grids(blended, l, a, dl, da)[0]  # blended as link_spline blends them
 
+    def slope_rows(self, q: float, l: npt.ArrayLike, a: npt.ArrayLike) -> SlopeRows:
+        """rho(q), d rho / dl and d rho / da on the grid l (p,) x a (m,), a block of rows at a time.
+
+        The same numbers as :meth:`evaluate_grid` with (dl, da) = (0, 0), (1, 0)
+        and (0, 1); what does not depend on the rows (the blended coefficients,
+        their sums over the angular basis, the bases along l) is built once.
+        """
+        return SlopeRows(self, q, l, a)
+
     def end_grids(self, l: npt.ArrayLike, a: npt.ArrayLike, dl: int = 0, da: int = 0) -> tuple[FloatArray, FloatArray]:
         """rho0 and rhof (or their derivatives) on the grid l (p,) x a (m,), each (p, m) mm, read-only.
 
@@ -199,6 +208,68 @@ class RadiusField:
         initial = tuple(RadiusSpline.from_arrays(arrays[f"link{j}_knots"], arrays[f"link{j}_initial"])
                         for j in range(count))
         return cls(breaks, final, initial)
+
+
+class SlopeRows:
+    """rho, rho_l and rho_a of one q on a grid, evaluated for a block of its rows (:meth:`RadiusField.slope_rows`).
+
+    Each value is added up as :func:`~softdesign.fitting.bspline_surface.grid_from_local` adds it:
+    around first, then along, in ascending basis index, from zero; a block of rows small enough to
+    stay in the processor's cache costs far less than the whole grid's arrays at once.
+    """
+
+    def __init__(self, field: RadiusField, q: float, l: npt.ArrayLike, a: npt.ArrayLike) -> None:
+        l = np.asarray(l, float).reshape(-1)
+        self.shape = (len(l), int(np.size(a)))
+        owner = field.link_of(l)
+        around: dict[int, tuple[tuple[IntArray, FloatArray], tuple[IntArray, FloatArray]]] = {}
+        #: per link present: its rows (ascending), local basis indices along l, values, slopes, and the
+        #: coefficients summed over the periodic basis (n, m) and over its derivative
+        self._links: list[tuple[IntArray, IntArray, FloatArray, FloatArray, FloatArray, FloatArray]] = []
+        for j in np.unique(owner):
+            f, i = field.final[j], field.initial[j]
+            m = f.angular_intervals
+            if m not in around:
+                around[m] = (bb.periodic_local(m, a), bb.periodic_local(m, a, 1))
+            coefficients = (1.0 - q) * i.coefficients + q * f.coefficients  # as link_spline blends them
+            rows = np.flatnonzero(owner == j)
+            index, values, slopes = bb.open_local_and_slope(f.knots, l[rows])
+            self._links.append((rows, index, values, slopes, _around_sum(coefficients, around[m][0]),
+                                _around_sum(coefficients, around[m][1])))
+
+    def __call__(self, start: int, stop: int) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """rho, rho_l and rho_a (stop - start, m) on rows ``start:stop`` of the grid."""
+        shape = (max(0, min(stop, self.shape[0]) - start), self.shape[1])
+        rho, rho_l, rho_a = np.zeros(shape), np.zeros(shape), np.zeros(shape)
+        for rows, index, values, slopes, inner, inner_a in self._links:
+            lo, hi = np.searchsorted(rows, (start, stop))
+            if lo == hi:
+                continue
+            at = rows[lo:hi] - start
+            contiguous = at[-1] - at[0] == hi - lo - 1  # l ascending: add up in place, in the block's rows
+            if contiguous:
+                block = slice(int(at[0]), int(at[-1]) + 1)
+                value, value_l, value_a = rho[block], rho_l[block], rho_a[block]
+            else:
+                value, value_l, value_a = (np.zeros((hi - lo, shape[1])) for _ in range(3))
+            for r in range(index.shape[1]):
+                near = inner[index[lo:hi, r]]
+                value += values[lo:hi, r, None] * near
+                value_l += slopes[lo:hi, r, None] * near
+                value_a += values[lo:hi, r, None] * inner_a[index[lo:hi, r]]
+            if not contiguous:
+                rho[at], rho_l[at], rho_a[at] = value, value_l, value_a
+        return rho, rho_l, rho_a
+
+
+def _around_sum(coefficients: FloatArray, around: tuple[IntArray, FloatArray]) -> FloatArray:
+    """``sum_s P_s(a_m) C[:, j_ms]`` (n, m), in ascending basis index from zero (as grid_from_local)."""
+    order = np.argsort(around[0], axis=1, kind="stable")
+    rows_a, values_a = np.take_along_axis(around[0], order, axis=1), np.take_along_axis(around[1], order, axis=1)
+    inner = np.zeros((coefficients.shape[0], rows_a.shape[0]))
+    for s in range(rows_a.shape[1]):
+        inner += coefficients[:, rows_a[:, s]] * values_a[:, s]
+    return inner
 
 
 def fold_margin(curve: FramedCurve, field: RadiusField, q: float = 1.0) -> FoldReport:

@@ -172,3 +172,17 @@ def test_blend_grid_is_the_blend_of_the_end_grids_cached_or_not(monkeypatch):
     field.end_grids(l, angle)
     assert sum(g.nbytes for g in field._grid_cache.values()) <= 4 * initial.nbytes
     assert "_grid_cache" not in pickle.loads(pickle.dumps(field)).__dict__
+
+
+def test_slope_rows_give_the_bits_of_the_grid_evaluations_in_any_block_and_order():
+    """rho, rho_l and rho_a a block of rows at a time: the numbers of evaluate_grid, unsorted l included."""
+    field = RadiusField.from_links((0.0, 0.4, 1.0), _random_links())
+    rng = np.random.default_rng(5)
+    angle = rng.uniform(-7, 7, 13)
+    for l in (np.linspace(0.0, 1.0, 37), np.append(rng.uniform(0, 1, 30), [0.0, 0.4, 1.0])):
+        whole = [field.evaluate_grid(0.3, l, angle, dl, da) for dl, da in ((0, 0), (1, 0), (0, 1))]
+        rows = field.slope_rows(0.3, l, angle)
+        for step in (1, 7, len(l)):
+            blocks = [rows(start, start + step) for start in range(0, len(l), step)]
+            for k in range(3):
+                assert np.concatenate([b[k] for b in blocks]).tobytes() == whole[k].tobytes()

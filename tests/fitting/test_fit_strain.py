@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from softdesign.fitting import bspline_basis as bb
+from softdesign.fitting import strain
 from softdesign.fitting.bspline_surface import RadiusSpline
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.strain import (
@@ -201,3 +202,16 @@ def test_the_tube_metric_is_the_metric_of_the_tube_sections_to_the_last_bit(p, m
             np.sort(rng.uniform(0.0, 2.0 * np.pi, m)), rng.uniform(1.0, 5.0, (p, m)), rng.normal(0.0, 30.0, (p, m)),
             rng.normal(0.0, 1.0, (p, m)))
     assert tube_metric(*args).tobytes() == metric_from_sections(tube_sections(*args)).tobytes()
+
+
+def test_blocks_of_rows_change_no_bit_of_the_metric_or_the_stretches(bent, monkeypatch):
+    """skin_metric and principal_stretches take a few rows at a time: the bits of the whole grid at once."""
+    shape, field = bent
+    l, a = np.linspace(0.0, 1.0, 53), np.linspace(0.0, 2 * np.pi, 24, endpoint=False)
+    whole = [skin_metric(shape.curve_at(q), field, q, l, a) for q in (0.0, 0.6)]
+    stretches = principal_stretches(*whole)
+    monkeypatch.setattr(strain, "BLOCK_POINTS", 5 * len(a))
+    blocks = [skin_metric(shape.curve_at(q), field, q, l, a) for q in (0.0, 0.6)]
+    assert [m.tobytes() for m in blocks] == [m.tobytes() for m in whole]
+    assert [s.tobytes() for s in principal_stretches(*blocks)] == [s.tobytes() for s in stretches]
+    assert [s.tobytes() for s in strain._principal_stretches(*whole)] == [s.tobytes() for s in stretches]
