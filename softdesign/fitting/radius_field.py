@@ -34,6 +34,17 @@ FOLD_ANGLES_PER_INTERVAL = 8
 #: for the volume integral's rho and rho_l of a few bodies (2.6 MB on a 1M-triangle benchmark case,
 #: 1248 Gauss nodes x 64 angles), without letting a long run of one-off grids pile up.
 GRID_CACHE_BYTES = 32 * 2**20
+#: Grid points evaluated at a time by the callers of :class:`SlopeRows` (the skin's metric and
+#: stretches, the folding check): a block's dozen temporaries (16384 float64 each, 128 kB) stay in a
+#: core's cache, where a whole fine grid's (5.8 MB each on the 1M-triangle benchmark case) went to
+#: memory and back between every two operations.  Every value is computed point by point, so the
+#: blocks change no bit.
+BLOCK_POINTS = 16384
+
+
+def row_blocks(rows: int, points_per_row: int) -> range:
+    """Starts of the blocks of whole rows of about ``BLOCK_POINTS`` points (at least one row each)."""
+    return range(0, rows, max(1, BLOCK_POINTS // max(1, points_per_row)))
 
 
 def axisymmetric(spline: RadiusSpline) -> RadiusSpline:
@@ -118,14 +129,15 @@ class RadiusField:
         ]
         return self._link_grids(blended, l, a, dl, da)[0]  # blended as link_spline blends them
 
-    def slope_rows(self, q: float, l: npt.ArrayLike, a: npt.ArrayLike) -> SlopeRows:
+    def slope_rows(self, q: float, l: npt.ArrayLike, a: npt.ArrayLike, slopes: bool = True) -> SlopeRows:
         """rho(q), d rho / dl and d rho / da on the grid l (p,) x a (m,), a block of rows at a time.
 
         The same numbers as :meth:`evaluate_grid` with (dl, da) = (0, 0), (1, 0)
-        and (0, 1); what does not depend on the rows (the blended coefficients,
-        their sums over the angular basis, the bases along l) is built once.
+        and (0, 1) (only the first with ``slopes=False``); what does not depend on
+        the rows (the blended coefficients, their sums over the angular basis, the
+        bases along l) is built once.
         """
-        return SlopeRows(self, q, l, a)
+        return SlopeRows(self, q, l, a, slopes)
 
     def end_grids(self, l: npt.ArrayLike, a: npt.ArrayLike, dl: int = 0, da: int = 0) -> tuple[FloatArray, FloatArray]:
         """rho0 and rhof (or their derivatives) on the grid l (p,) x a (m,), each (p, m) mm, read-only.
@@ -215,33 +227,49 @@ class SlopeRows:
 
     Each value is added up as :func:`~softdesign.fitting.bspline_surface.grid_from_local` adds it:
     around first, then along, in ascending basis index, from zero; a block of rows small enough to
-    stay in the processor's cache costs far less than the whole grid's arrays at once.
+    stay in the processor's cache costs far less than the whole grid's arrays at once.  With
+    ``slopes=False`` only rho is prepared (:meth:`values`).
     """
 
-    def __init__(self, field: RadiusField, q: float, l: npt.ArrayLike, a: npt.ArrayLike) -> None:
+    def __init__(self, field: RadiusField, q: float, l: npt.ArrayLike, a: npt.ArrayLike, slopes: bool = True) -> None:
         l = np.asarray(l, float).reshape(-1)
         self.shape = (len(l), int(np.size(a)))
         owner = field.link_of(l)
-        around: dict[int, tuple[tuple[IntArray, FloatArray], tuple[IntArray, FloatArray]]] = {}
-        #: per link present: its rows (ascending), local basis indices along l, values, slopes, and the
-        #: coefficients summed over the periodic basis (n, m) and over its derivative
+        around: dict[tuple[int, int], tuple[IntArray, FloatArray]] = {}
+        #: per link present: its rows (ascending), local basis indices along l, values, slopes (or values),
+        #: and the coefficients summed over the periodic basis (n, m) and over its derivative (or the same)
         self._links: list[tuple[IntArray, IntArray, FloatArray, FloatArray, FloatArray, FloatArray]] = []
         for j in np.unique(owner):
             f, i = field.final[j], field.initial[j]
             m = f.angular_intervals
-            if m not in around:
-                around[m] = (bb.periodic_local(m, a), bb.periodic_local(m, a, 1))
+            for da in (0, 1) if slopes else (0,):
+                if (m, da) not in around:
+                    around[m, da] = bb.periodic_local(m, a, da)
             coefficients = (1.0 - q) * i.coefficients + q * f.coefficients  # as link_spline blends them
             rows = np.flatnonzero(owner == j)
-            index, values, slopes = bb.open_local_and_slope(f.knots, l[rows])
-            self._links.append((rows, index, values, slopes, _around_sum(coefficients, around[m][0]),
-                                _around_sum(coefficients, around[m][1])))
+            inner = _around_sum(coefficients, around[m, 0])
+            if slopes:
+                index, values, slopes_l = bb.open_local_and_slope(f.knots, l[rows])
+                self._links.append((rows, index, values, slopes_l, inner, _around_sum(coefficients, around[m, 1])))
+            else:
+                index, values = bb.open_local(f.knots, l[rows])
+                self._links.append((rows, index, values, values, inner, inner))
+        self.slopes = slopes
 
     def __call__(self, start: int, stop: int) -> tuple[FloatArray, FloatArray, FloatArray]:
         """rho, rho_l and rho_a (stop - start, m) on rows ``start:stop`` of the grid."""
+        if not self.slopes:
+            raise ValueError("SlopeRows: prepared without slopes (slopes=False); use values()")
+        return self._rows(start, stop, True)
+
+    def values(self, start: int, stop: int) -> FloatArray:
+        """rho (stop - start, m) on rows ``start:stop`` of the grid."""
+        return self._rows(start, stop, False)[0]
+
+    def _rows(self, start: int, stop: int, slopes: bool) -> tuple[FloatArray, FloatArray, FloatArray]:
         shape = (max(0, min(stop, self.shape[0]) - start), self.shape[1])
-        rho, rho_l, rho_a = np.zeros(shape), np.zeros(shape), np.zeros(shape)
-        for rows, index, values, slopes, inner, inner_a in self._links:
+        rho, rho_l, rho_a = (np.zeros(shape), np.zeros(shape), np.zeros(shape)) if slopes else (np.zeros(shape),) * 3
+        for rows, index, values, slopes_l, inner, inner_a in self._links:
             lo, hi = np.searchsorted(rows, (start, stop))
             if lo == hi:
                 continue
@@ -255,10 +283,13 @@ class SlopeRows:
             for r in range(index.shape[1]):
                 near = inner[index[lo:hi, r]]
                 value += values[lo:hi, r, None] * near
-                value_l += slopes[lo:hi, r, None] * near
-                value_a += values[lo:hi, r, None] * inner_a[index[lo:hi, r]]
+                if slopes:
+                    value_l += slopes_l[lo:hi, r, None] * near
+                    value_a += values[lo:hi, r, None] * inner_a[index[lo:hi, r]]
             if not contiguous:
-                rho[at], rho_l[at], rho_a[at] = value, value_l, value_a
+                rho[at] = value
+                if slopes:
+                    rho_l[at], rho_a[at] = value_l, value_a
         return rho, rho_l, rho_a
 
 
@@ -290,11 +321,20 @@ def fold_margin(curve: FramedCurve, field: RadiusField, q: float = 1.0) -> FoldR
     kvec = (d2 - np.einsum("ni,ni->n", d2, tangent)[:, None] * tangent) / speed2[:, None]
     k_n = np.einsum("ni,ni->n", kvec, frames[:, :, 0])
     k_b = np.einsum("ni,ni->n", kvec, frames[:, :, 1])
-    kappa = k_n[:, None] * np.cos(a)[None, :] + k_b[:, None] * np.sin(a)[None, :]
-    rho = field.evaluate_grid(q, l, a)
-    product = rho * kappa
-    i, j = np.unravel_index(int(np.argmax(product)), product.shape)
-    return FoldReport(float(product[i, j]), float(l[i]), float(l[i] * curve.length), float(a[j]), float(rho.min()))
+    cos, sin = np.cos(a)[None, :], np.sin(a)[None, :]
+    rows = field.slope_rows(q, l, a, slopes=False)
+    best, at, smallest = -np.inf, (0, 0), []
+    step = row_blocks(len(l), len(a))
+    for start in step:  # the largest first in row-major order, as np.argmax over the whole grid
+        rho = rows.values(start, start + step.step)
+        block = slice(start, start + step.step)
+        product = rho * (k_n[block, None] * cos + k_b[block, None] * sin)
+        i, j = np.unravel_index(int(np.argmax(product)), product.shape)
+        if start == 0 or (not np.isnan(best) and (np.isnan(product[i, j]) or product[i, j] > best)):
+            best, at = float(product[i, j]), (start + int(i), int(j))
+        smallest.append(rho.min())
+    row, column = at
+    return FoldReport(best, float(l[row]), float(l[row] * curve.length), float(a[column]), float(np.min(smallest)))
 
 
 def check_self_folding(curve: FramedCurve, field: RadiusField, q: float = 1.0, limit: float = 1.0) -> FoldReport:

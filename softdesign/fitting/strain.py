@@ -32,7 +32,7 @@ from typing import Protocol
 import numpy as np
 import numpy.typing as npt
 
-from softdesign.fitting.radius_field import RadiusField
+from softdesign.fitting.radius_field import RadiusField, row_blocks
 from softdesign.types import FloatArray, Frames, Points
 
 
@@ -49,16 +49,6 @@ class FramedDerivatives(Protocol):
 
 #: A rest metric whose determinant is below this fraction of (E0 G0) is degenerate (a collapsed section).
 DEGENERATE_RTOL = 1e-12
-#: Grid points a metric or a stretch is computed for at a time: a block's dozen temporaries (16384
-#: float64 each, 128 kB) stay in a core's cache, where a whole fine grid's (5.8 MB each on the 1M-triangle
-#: benchmark case) went to memory and back between every two operations.  Every value is computed
-#: point by point, so the blocks change no bit.
-BLOCK_POINTS = 16384
-
-
-def _row_blocks(rows: int, points_per_row: int) -> range:
-    """Starts of the blocks of whole rows of about ``BLOCK_POINTS`` points (at least one row each)."""
-    return range(0, rows, max(1, BLOCK_POINTS // max(1, points_per_row)))
 
 
 @dataclass(frozen=True)
@@ -151,7 +141,7 @@ def principal_stretches(rest: npt.ArrayLike, deformed: npt.ArrayLike) -> tuple[F
     if rest.shape != deformed.shape or rest.ndim < 2:
         return _principal_stretches(rest, deformed)
     lam1, lam2 = np.empty(rest.shape[:-1]), np.empty(rest.shape[:-1])
-    step = _row_blocks(len(rest), rest[0].size // 3)
+    step = row_blocks(len(rest), rest[0].size // 3)
     for start in step:
         rows = slice(start, start + step.step)
         lam1[rows], lam2[rows] = _principal_stretches(rest[rows], deformed[rows])
@@ -210,7 +200,7 @@ def skin_metric(curve: FramedDerivatives, field: RadiusField, q: float, l: npt.A
     speed, curvature, twist = curve_terms(curve, l, frames_mode)
     rows = field.slope_rows(q, l, a)
     out = np.empty((len(l), np.size(a), 3))
-    step = _row_blocks(len(l), np.size(a))
+    step = row_blocks(len(l), np.size(a))
     for start in step:
         block = slice(start, start + step.step)
         out[block] = tube_metric(speed[block], curvature[block], twist[block], a, *rows(start, start + step.step))
