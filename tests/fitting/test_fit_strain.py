@@ -20,7 +20,14 @@ from softdesign.geometry.blend import blend_shapes
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
 from softdesign.geometry.initial import straight_initial_shape
 from softdesign.meshing.body import sections_on_grid
-from softdesign.meshing.skin_stretch import STRETCH_TOL, converged_extremes
+from softdesign.meshing.skin_stretch import (
+    START_ANGLES_PER_INTERVAL,
+    START_SPACING_MM,
+    STRETCH_TOL,
+    converged_extremes,
+    extremes_on,
+    make_grid,
+)
 from softdesign.meshing.tessellate import sweep_from_sections, tessellate
 
 #: The issue's bound for the known answers.
@@ -84,6 +91,21 @@ def test_bent_tube_extremes_are_one_plus_and_minus_r_kappa(bent):
     grid_error = rk * (1 - np.cos(np.pi / found.grid.angles))
     assert abs(found.maximum.value - (1 + rk)) <= grid_error + KNOWN_TOL
     assert abs(found.minimum.value - (1 - rk)) <= grid_error + KNOWN_TOL
+    # the first grid's extremes computed ahead (as the morph search does) are taken, and the answer is the same;
+    # on another grid they are ignored
+    first = extremes_on(make_grid(LENGTH_MM, field.breaks, START_SPACING_MM, START_ANGLES_PER_INTERVAL * 16),
+                        rest, bent_metric, field.breaks)
+    calls = []
+    counted = lambda l, a: calls.append(len(l)) or bent_metric(l, a)  # noqa: E731
+    again = converged_extremes(rest, counted, LENGTH_MM, field.breaks, 16, first=first)
+    assert _figures(again) == _figures(found) and len(calls) == len(found.history) - 1
+    inner = (0.1, 0.9)
+    assert _figures(converged_extremes(rest, bent_metric, LENGTH_MM, field.breaks, 16, inner, first=first)) == (
+        _figures(converged_extremes(rest, bent_metric, LENGTH_MM, field.breaks, 16, inner)))
+
+
+def _figures(e):
+    return e.maximum, e.minimum, e.per_link, e.grid.points, e.change, e.converged, e.history
 
 
 def test_a_straight_tube_growing_in_radius_stretches_only_around():
