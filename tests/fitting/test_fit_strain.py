@@ -237,3 +237,40 @@ def test_blocks_of_rows_change_no_bit_of_the_metric_or_the_stretches(bent, monke
     assert [m.tobytes() for m in blocks] == [m.tobytes() for m in whole]
     assert [s.tobytes() for s in principal_stretches(*blocks)] == [s.tobytes() for s in stretches]
     assert [s.tobytes() for s in strain._principal_stretches(*whole)] == [s.tobytes() for s in stretches]
+
+
+def _plain_metric(speed, curvature, twist, x, y, x_l, y_l, x_a, y_a):
+    v, vt = speed[:, None], (speed * twist)[:, None]
+    axial = v * (1.0 - x * curvature[:, :1] - y * curvature[:, 1:])
+    along_n, along_b = x_l - vt * y, y_l + vt * x
+    return np.stack([axial**2 + along_n**2 + along_b**2, along_n * x_a + along_b * y_a, x_a**2 + y_a**2], axis=-1)
+
+
+def _plain_stretches(rest, deformed):
+    e0, f0, g0 = np.moveaxis(rest, -1, 0)
+    e, f, g = np.moveaxis(deformed, -1, 0)
+    det0 = e0 * g0 - f0 * f0
+    half_trace = 0.5 * (e0 * g + g0 * e - 2.0 * f0 * f) / det0
+    det_ratio = (e * g - f * f) / det0
+    mu1 = half_trace + np.sqrt(np.maximum(half_trace**2 - det_ratio, 0.0))
+    mu2 = np.where(mu1 > 0.0, det_ratio / np.where(mu1 > 0.0, mu1, 1.0), 0.0)
+    return np.sqrt(mu1), np.sqrt(np.maximum(mu2, 0.0))
+
+
+def test_the_metric_and_the_stretches_in_place_are_the_plain_formulas_to_the_last_bit():
+    """Written into few temporaries, the metric and the stretches keep the formulas' operations and order."""
+    rng = np.random.default_rng(8)
+    p, m = 40, 24
+    sections = [rng.normal(0.0, 3.0, (p, m)) for _ in range(6)]
+    centerline = (rng.uniform(10.0, 300.0, p), rng.normal(0.0, 0.1, (p, 2)), rng.normal(0.0, 0.01, p))
+    metric = strain._metric(*centerline, *sections)
+    assert metric.tobytes() == _plain_metric(*centerline, *sections).tobytes()
+    rest = strain._metric(*centerline, *[0.9 * s for s in sections])
+    degenerate = metric.copy()
+    degenerate[3, 4] = [1.0, 1.0, 1.0]  # E G = F^2: a collapsed rest section
+    with pytest.raises(ValueError, match="degenerate"):
+        principal_stretches(degenerate, metric)
+    for pair in ((rest, metric), (metric, rest), (metric, -rest)):  # -rest: negative roots, NaN and 0 as before
+        with np.errstate(invalid="ignore"):
+            expected, found = _plain_stretches(*pair), principal_stretches(*pair)
+        assert [s.tobytes() for s in found] == [s.tobytes() for s in expected]
