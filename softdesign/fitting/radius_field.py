@@ -40,6 +40,9 @@ GRID_CACHE_BYTES = 32 * 2**20
 #: memory and back between every two operations.  Every value is computed point by point, so the
 #: blocks change no bit.
 BLOCK_POINTS = 16384
+#: Memory for the bases along l a field keeps (:meth:`RadiusField.along_bases`), bytes: the finest
+#: stretch grid of the 1M-triangle benchmark case needs 0.2 MB (1900 rows).
+BASIS_CACHE_BYTES = 8 * 2**20
 
 
 def row_blocks(rows: int, points_per_row: int) -> range:
@@ -139,6 +142,42 @@ class RadiusField:
         """
         return SlopeRows(self, q, l, a, slopes)
 
+    def along_bases(self, l: npt.ArrayLike, slopes: bool = True
+                    ) -> tuple[tuple[int, IntArray, IntArray, FloatArray, FloatArray], ...]:
+        """Per link present in l (n,): its rows of l (ascending), and the open basis along l at them.
+
+        Each item is ``(link, rows, indices (r, DEGREE + 1), values, slopes)`` (``slopes`` the values
+        again with ``slopes=False``), read-only.  The field keeps the last ones it was asked for (keyed
+        on the values of l; least recently used out past ``BASIS_CACHE_BYTES``): the grids of every q
+        are the same, and so are their bases.
+        """
+        l = np.ascontiguousarray(l, float).reshape(-1)
+        key = (l.tobytes(), bool(slopes))
+        cache = self.__dict__.get("_basis_cache")
+        if cache is None:
+            cache = {}
+            object.__setattr__(self, "_basis_cache", cache)  # frozen: the cache is not part of the value
+        bases = cache.pop(key, None)  # put back last: the dict runs from least to most recently used
+        if bases is None:
+            owner = self.link_of(l)
+            found = []
+            for j in np.unique(owner):
+                rows = np.flatnonzero(owner == j)
+                if slopes:
+                    index, values, slopes_l = bb.open_local_and_slope(self.final[j].knots, l[rows])
+                else:
+                    index, values = bb.open_local(self.final[j].knots, l[rows])
+                    slopes_l = values
+                for array in (rows, index, values, slopes_l):
+                    array.setflags(write=False)
+                found.append((int(j), rows, index, values, slopes_l))
+            bases = tuple(found)
+        cache[key] = bases
+        while len(cache) > 1 and sum(a.nbytes for b in cache.values() for item in b for a in item[1:]) > (
+                BASIS_CACHE_BYTES):
+            cache.pop(next(iter(cache)))
+        return bases
+
     def end_grids(self, l: npt.ArrayLike, a: npt.ArrayLike, dl: int = 0, da: int = 0) -> tuple[FloatArray, FloatArray]:
         """rho0 and rhof (or their derivatives) on the grid l (p,) x a (m,), each (p, m) mm, read-only.
 
@@ -189,7 +228,7 @@ class RadiusField:
 
     def __getstate__(self) -> dict[str, object]:
         # pickles carry the field, not the grids cached from it
-        return {k: v for k, v in self.__dict__.items() if k != "_grid_cache"}
+        return {k: v for k, v in self.__dict__.items() if k not in ("_grid_cache", "_basis_cache")}
 
     def evaluate_pairs(self, q: float, l: npt.ArrayLike, a: npt.ArrayLike) -> FloatArray:
         """rho(q) at paired points (l_i, a_i), (n,) mm; each l in its own link."""
@@ -234,26 +273,20 @@ class SlopeRows:
     def __init__(self, field: RadiusField, q: float, l: npt.ArrayLike, a: npt.ArrayLike, slopes: bool = True) -> None:
         l = np.asarray(l, float).reshape(-1)
         self.shape = (len(l), int(np.size(a)))
-        owner = field.link_of(l)
         around: dict[tuple[int, int], tuple[IntArray, FloatArray]] = {}
         #: per link present: its rows (ascending), local basis indices along l, values, slopes (or values),
         #: and the coefficients summed over the periodic basis (n, m) and over its derivative (or the same)
         self._links: list[tuple[IntArray, IntArray, FloatArray, FloatArray, FloatArray, FloatArray]] = []
-        for j in np.unique(owner):
+        for j, rows, index, values, slopes_l in field.along_bases(l, slopes):
             f, i = field.final[j], field.initial[j]
             m = f.angular_intervals
             for da in (0, 1) if slopes else (0,):
                 if (m, da) not in around:
                     around[m, da] = bb.periodic_local(m, a, da)
             coefficients = (1.0 - q) * i.coefficients + q * f.coefficients  # as link_spline blends them
-            rows = np.flatnonzero(owner == j)
             inner = _around_sum(coefficients, around[m, 0])
-            if slopes:
-                index, values, slopes_l = bb.open_local_and_slope(f.knots, l[rows])
-                self._links.append((rows, index, values, slopes_l, inner, _around_sum(coefficients, around[m, 1])))
-            else:
-                index, values = bb.open_local(f.knots, l[rows])
-                self._links.append((rows, index, values, values, inner, inner))
+            inner_a = _around_sum(coefficients, around[m, 1]) if slopes else inner
+            self._links.append((rows, index, values, slopes_l, inner, inner_a))
         self.slopes = slopes
 
     def __call__(self, start: int, stop: int) -> tuple[FloatArray, FloatArray, FloatArray]:

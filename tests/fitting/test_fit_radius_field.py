@@ -175,7 +175,7 @@ def test_blend_grid_is_the_blend_of_the_end_grids_cached_or_not(monkeypatch):
     assert "_grid_cache" not in pickle.loads(pickle.dumps(field)).__dict__
 
 
-def test_slope_rows_give_the_bits_of_the_grid_evaluations_in_any_block_and_order():
+def test_slope_rows_give_the_bits_of_the_grid_evaluations_in_any_block_and_order(monkeypatch):
     """rho, rho_l and rho_a a block of rows at a time: the numbers of evaluate_grid, unsorted l included."""
     field = RadiusField.from_links((0.0, 0.4, 1.0), _random_links())
     rng = np.random.default_rng(5)
@@ -191,6 +191,14 @@ def test_slope_rows_give_the_bits_of_the_grid_evaluations_in_any_block_and_order
         assert np.concatenate([values.values(s, s + 5) for s in range(0, len(l), 5)]).tobytes() == whole[0].tobytes()
         with pytest.raises(ValueError, match="slopes=False"):
             values(0, 5)
+    # the bases along l are kept per l (read-only, within their budget, out of pickles)
+    l = np.linspace(0.0, 1.0, 37)
+    assert field.along_bases(l) is field.along_bases(l.copy())
+    assert not field.along_bases(l)[0][3].flags.writeable
+    monkeypatch.setattr(radius_field, "BASIS_CACHE_BYTES", 1)
+    field.along_bases(np.linspace(0.0, 1.0, 5))
+    assert len(field._basis_cache) == 1
+    assert "_basis_cache" not in pickle.loads(pickle.dumps(field)).__dict__
 
 
 def test_fold_margin_in_blocks_of_rows_is_the_whole_grid_s(monkeypatch):
