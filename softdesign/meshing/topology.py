@@ -144,6 +144,8 @@ def mesh_topology(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> MeshTopology
     manifold = consistent and twin is not None and _vertex_manifold(twin, used.size)  # twin: None unless consistent
     corners = np.take(vertices, faces, axis=0)  # (F, 3, 3); take gathers rows faster than vertices[faces]
     centroid = (vertices if used.size == n else vertices[used]).mean(axis=0)
+    # corners about the centroid: each vertex moved once, then gathered (the same differences, F / V times fewer)
+    centered = np.take(vertices - centroid, faces, axis=0)
     return MeshTopology(
         vertices=int(used.size),
         faces=int(faces.shape[0]),
@@ -151,7 +153,7 @@ def mesh_topology(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> MeshTopology
         watertight=watertight,
         winding_consistent=consistent,
         vertex_manifold=bool(manifold),
-        shell_volumes=_shell_volumes(faces, corners - centroid, n, used),
+        shell_volumes=_shell_volumes(faces, centered, n, used),
         face_areas=0.5 * _double_areas(corners),
     )
 
