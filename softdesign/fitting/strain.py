@@ -32,7 +32,8 @@ from typing import Protocol
 import numpy as np
 import numpy.typing as npt
 
-from softdesign.fitting.radius_field import RadiusField, row_blocks
+from softdesign.fitting.radius_field import RadiusField
+from softdesign.fitting.radius_rows import SlopeRows, row_blocks
 from softdesign.types import FloatArray, Frames, Points
 
 
@@ -237,7 +238,7 @@ def skin_metric(curve: FramedDerivatives, field: RadiusField, q: float, l: npt.A
     """
     l = np.asarray(l, float).reshape(-1)
     speed, curvature, twist = curve_terms(curve, l, frames_mode)
-    rows = field.slope_rows(q, l, a)
+    rows = SlopeRows(field, q, l, a)
     planes = np.empty((3, len(l), np.size(a)))
     step = row_blocks(len(l), np.size(a))
     for start in step:

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from softdesign.fitting import bspline_basis as bb
-from softdesign.fitting import radius_field, strain
+from softdesign.fitting import radius_rows, strain
 from softdesign.fitting.bspline_surface import RadiusSpline
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.strain import (
@@ -232,7 +232,7 @@ def test_blocks_of_rows_change_no_bit_of_the_metric_or_the_stretches(bent, monke
     l, a = np.linspace(0.0, 1.0, 53), np.linspace(0.0, 2 * np.pi, 24, endpoint=False)
     whole = [skin_metric(shape.curve_at(q), field, q, l, a) for q in (0.0, 0.6)]
     stretches = principal_stretches(*whole)
-    monkeypatch.setattr(radius_field, "BLOCK_POINTS", 5 * len(a))
+    monkeypatch.setattr(radius_rows, "BLOCK_POINTS", 5 * len(a))
     blocks = [skin_metric(shape.curve_at(q), field, q, l, a) for q in (0.0, 0.6)]
     assert [m.tobytes() for m in blocks] == [m.tobytes() for m in whole]
     assert [s.tobytes() for s in principal_stretches(*blocks)] == [s.tobytes() for s in stretches]
