@@ -24,6 +24,7 @@ import numpy.typing as npt
 from softdesign.errors import FitError
 from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import RadiusSpline, grid_from_local
+from softdesign.fitting.radius_rows import SlopeRows, row_blocks
 from softdesign.types import FloatArray, FramedCurve, IntArray
 
 #: Grid spacing along the centerline for the folding check, mm.
@@ -34,6 +35,10 @@ FOLD_ANGLES_PER_INTERVAL = 8
 #: for the volume integral's rho and rho_l of a few bodies (2.6 MB on a 1M-triangle benchmark case,
 #: 1248 Gauss nodes x 64 angles), without letting a long run of one-off grids pile up.
 GRID_CACHE_BYTES = 32 * 2**20
+#: Memory for the bases along l a field keeps (:meth:`RadiusField.along_bases`), bytes: the finest
+#: stretch grid of the 1M-triangle benchmark case needs 0.2 MB (1900 rows).
+BASIS_CACHE_BYTES = 8 * 2**20
+
 
 
 def axisymmetric(spline: RadiusSpline) -> RadiusSpline:
@@ -118,6 +123,42 @@ class RadiusField:
         ]
         return self._link_grids(blended, l, a, dl, da)[0]  # blended as link_spline blends them
 
+    def along_bases(self, l: npt.ArrayLike, slopes: bool = True
+                    ) -> tuple[tuple[int, IntArray, IntArray, FloatArray, FloatArray], ...]:
+        """Per link present in l (n,): its rows of l (ascending), and the open basis along l at them.
+
+        Each item is ``(link, rows, indices (r, DEGREE + 1), values, slopes)`` (``slopes`` the values
+        again with ``slopes=False``), read-only.  The field keeps the last ones it was asked for (keyed
+        on the values of l; least recently used out past ``BASIS_CACHE_BYTES``): the grids of every q
+        are the same, and so are their bases.
+        """
+        l = np.ascontiguousarray(l, float).reshape(-1)
+        key = (l.tobytes(), bool(slopes))
+        cache = self.__dict__.get("_basis_cache")
+        if cache is None:
+            cache = {}
+            object.__setattr__(self, "_basis_cache", cache)  # frozen: the cache is not part of the value
+        bases = cache.pop(key, None)  # put back last: the dict runs from least to most recently used
+        if bases is None:
+            owner = self.link_of(l)
+            found = []
+            for j in np.unique(owner):
+                rows = np.flatnonzero(owner == j)
+                if slopes:
+                    index, values, slopes_l = bb.open_local_and_slope(self.final[j].knots, l[rows])
+                else:
+                    index, values = bb.open_local(self.final[j].knots, l[rows])
+                    slopes_l = values
+                for array in (rows, index, values, slopes_l):
+                    array.setflags(write=False)
+                found.append((int(j), rows, index, values, slopes_l))
+            bases = tuple(found)
+        cache[key] = bases
+        while len(cache) > 1 and sum(a.nbytes for b in cache.values() for item in b for a in item[1:]) > (
+                BASIS_CACHE_BYTES):
+            cache.pop(next(iter(cache)))
+        return bases
+
     def end_grids(self, l: npt.ArrayLike, a: npt.ArrayLike, dl: int = 0, da: int = 0) -> tuple[FloatArray, FloatArray]:
         """rho0 and rhof (or their derivatives) on the grid l (p,) x a (m,), each (p, m) mm, read-only.
 
@@ -168,7 +209,7 @@ class RadiusField:
 
     def __getstate__(self) -> dict[str, object]:
         # pickles carry the field, not the grids cached from it
-        return {k: v for k, v in self.__dict__.items() if k != "_grid_cache"}
+        return {k: v for k, v in self.__dict__.items() if k not in ("_grid_cache", "_basis_cache")}
 
     def evaluate_pairs(self, q: float, l: npt.ArrayLike, a: npt.ArrayLike) -> FloatArray:
         """rho(q) at paired points (l_i, a_i), (n,) mm; each l in its own link."""
@@ -219,11 +260,20 @@ def fold_margin(curve: FramedCurve, field: RadiusField, q: float = 1.0) -> FoldR
     kvec = (d2 - np.einsum("ni,ni->n", d2, tangent)[:, None] * tangent) / speed2[:, None]
     k_n = np.einsum("ni,ni->n", kvec, frames[:, :, 0])
     k_b = np.einsum("ni,ni->n", kvec, frames[:, :, 1])
-    kappa = k_n[:, None] * np.cos(a)[None, :] + k_b[:, None] * np.sin(a)[None, :]
-    rho = field.evaluate_grid(q, l, a)
-    product = rho * kappa
-    i, j = np.unravel_index(int(np.argmax(product)), product.shape)
-    return FoldReport(float(product[i, j]), float(l[i]), float(l[i] * curve.length), float(a[j]), float(rho.min()))
+    cos, sin = np.cos(a)[None, :], np.sin(a)[None, :]
+    rows = SlopeRows(field, q, l, a, slopes=False)
+    best, at, smallest = -np.inf, (0, 0), []
+    step = row_blocks(len(l), len(a))
+    for start in step:  # the largest first in row-major order, as np.argmax over the whole grid
+        rho = rows.values(start, start + step.step)
+        block = slice(start, start + step.step)
+        product = rho * (k_n[block, None] * cos + k_b[block, None] * sin)
+        i, j = np.unravel_index(int(np.argmax(product)), product.shape)
+        if start == 0 or (not np.isnan(best) and (np.isnan(product[i, j]) or product[i, j] > best)):
+            best, at = float(product[i, j]), (start + int(i), int(j))
+        smallest.append(rho.min())
+    row, column = at
+    return FoldReport(best, float(l[row]), float(l[row] * curve.length), float(a[column]), float(np.min(smallest)))
 
 
 def check_self_folding(curve: FramedCurve, field: RadiusField, q: float = 1.0, limit: float = 1.0) -> FoldReport:

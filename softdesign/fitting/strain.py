@@ -33,6 +33,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.fitting.radius_field import RadiusField
+from softdesign.fitting.radius_rows import SlopeRows, row_blocks
 from softdesign.types import FloatArray, Frames, Points
 
 
@@ -78,19 +79,35 @@ def metric_from_sections(d: SectionDerivatives) -> FloatArray:
 
 
 def _metric(speed: FloatArray, curvature: FloatArray, twist: FloatArray, x: FloatArray, y: FloatArray,
-            x_l: FloatArray, y_l: FloatArray, x_a: FloatArray, y_a: FloatArray) -> FloatArray:
+            x_l: FloatArray, y_l: FloatArray, x_a: FloatArray, y_a: FloatArray,
+            out: FloatArray | None = None) -> FloatArray:
     """(E, F, G) (p, m, 3) of the surface ``c + x N + y B`` from its section coordinates and their l and a
-    derivatives (p, m) and the centerline's speed (p,), curvature (p, 2) and twist (p,)."""
+    derivatives (p, m) and the centerline's speed (p,), curvature (p, 2) and twist (p,).
+
+    Returned as a view of (3, p, m) planes (``out`` when given), so that E, F and G are each contiguous
+    for :func:`principal_stretches`; the operations are those of the plain expressions, in their order.
+    """
     v = speed[:, None]
     vt = (speed * twist)[:, None]
-    axial = v * (1.0 - x * curvature[:, :1] - y * curvature[:, 1:])
-    along_n = x_l - vt * y
-    along_b = y_l + vt * x
-    out = np.empty(x.shape + (3,))
-    out[..., 0] = axial**2 + along_n**2 + along_b**2
-    out[..., 1] = along_n * x_a + along_b * y_a
-    out[..., 2] = x_a**2 + y_a**2
-    return out
+    axial = x * curvature[:, :1]  # v (1 - x k1 - y k2)
+    np.subtract(1.0, axial, out=axial)
+    axial -= y * curvature[:, 1:]
+    axial *= v
+    along_n = vt * y  # x_l - vt y
+    np.subtract(x_l, along_n, out=along_n)
+    along_b = vt * x  # y_l + vt x
+    np.add(y_l, along_b, out=along_b)
+    planes = np.empty((3,) + x.shape) if out is None else out
+    e, f, g = planes
+    term = np.empty(x.shape)
+    np.square(axial, out=e)  # E = axial^2 + along_n^2 + along_b^2
+    e += np.square(along_n, out=term)
+    e += np.square(along_b, out=term)
+    np.multiply(along_n, x_a, out=f)  # F = along_n x_a + along_b y_a
+    f += np.multiply(along_b, y_a, out=term)
+    np.square(x_a, out=g)  # G = x_a^2 + y_a^2
+    g += np.square(y_a, out=term)
+    return np.moveaxis(planes, 0, -1)
 
 
 def tube_sections(
@@ -111,11 +128,13 @@ def tube_sections(
 def tube_metric(
     speed: npt.ArrayLike, curvature: npt.ArrayLike, twist: npt.ArrayLike,
     angles: npt.ArrayLike, rho: npt.ArrayLike, rho_l: npt.ArrayLike, rho_a: npt.ArrayLike,
+    out: FloatArray | None = None,
 ) -> FloatArray:
     """``metric_from_sections(tube_sections(...))`` without the (p, m, 2) section arrays, (p, m, 3).
 
     The same operations on the same numbers in the same order, so the same bits; it skips stacking
     x and y into arrays only to slice them apart again (most of a metric's time on large grids).
+    ``out`` (3, p, m), when given, receives E, F and G (the result is its view).
     """
     a = np.asarray(angles, float)
     cos, sin = np.cos(a), np.sin(a)
@@ -123,31 +142,66 @@ def tube_metric(
     x, y = rho * cos, rho * sin
     x_a, y_a = rho_a * cos + rho * -sin, rho_a * sin + rho * cos
     return _metric(np.asarray(speed, float), np.asarray(curvature, float), np.asarray(twist, float), x, y,
-                   rho_l * cos, rho_l * sin, x_a, y_a)
+                   rho_l * cos, rho_l * sin, x_a, y_a, out)
 
 
 def principal_stretches(rest: npt.ArrayLike, deformed: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
     """lambda1 >= lambda2 (dimensionless) from metrics (..., 3) = (E, F, G) at rest and deformed.
 
     The squares are the roots of ``det G0 mu^2 - (E0 G + G0 E - 2 F0 F) mu + det G = 0``.
+    Metrics of the same shape are taken a block of rows (first axis) at a time.
 
     Raises
     ------
     ValueError
         A rest metric is degenerate (det G0 <= DEGENERATE_RTOL E0 G0): no stretch is defined there.
     """
-    e0, f0, g0 = np.moveaxis(np.asarray(rest, float), -1, 0)
-    e, f, g = np.moveaxis(np.asarray(deformed, float), -1, 0)
-    det0 = e0 * g0 - f0 * f0
-    if np.any(~(det0 > DEGENERATE_RTOL * np.abs(e0 * g0))):
+    rest, deformed = np.asarray(rest, float), np.asarray(deformed, float)
+    if rest.shape != deformed.shape or rest.ndim < 2:
+        return _principal_stretches(rest, deformed)
+    lam1, lam2 = np.empty(rest.shape[:-1]), np.empty(rest.shape[:-1])
+    step = row_blocks(len(rest), rest[0].size // 3)
+    for start in step:
+        rows = slice(start, start + step.step)
+        lam1[rows], lam2[rows] = _principal_stretches(rest[rows], deformed[rows])
+    return lam1, lam2
+
+
+def _principal_stretches(rest: FloatArray, deformed: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """:func:`principal_stretches` on arrays at once: the operations of the formulas in the comments, in their
+    order, into few temporaries."""
+    e0, f0, g0 = np.moveaxis(rest, -1, 0)
+    e, f, g = np.moveaxis(deformed, -1, 0)
+    scale = e0 * g0  # det0 = e0 g0 - f0 f0, degenerate unless det0 > DEGENERATE_RTOL |e0 g0|
+    det0 = f0 * f0
+    np.subtract(scale, det0, out=det0)
+    np.abs(scale, out=scale)
+    scale *= DEGENERATE_RTOL
+    if not np.all(det0 > scale):
         raise ValueError("principal_stretches: a rest metric is degenerate (collapsed or folded rest surface)")
-    half_trace = 0.5 * (e0 * g + g0 * e - 2.0 * f0 * f) / det0
-    det_ratio = (e * g - f * f) / det0
-    root = np.sqrt(np.maximum(half_trace**2 - det_ratio, 0.0))
-    mu1 = half_trace + root
+    term = scale
+    half_trace = e0 * g  # 0.5 (e0 g + g0 e - 2 f0 f) / det0
+    half_trace += np.multiply(g0, e, out=term)
+    np.multiply(2.0, f0, out=term)
+    term *= f
+    half_trace -= term
+    half_trace *= 0.5
+    half_trace /= det0
+    det_ratio = e * g  # (e g - f f) / det0
+    det_ratio -= np.multiply(f, f, out=term)
+    det_ratio /= det0
+    mu1 = np.square(half_trace, out=term)  # half_trace + sqrt(max(half_trace^2 - det_ratio, 0))
+    mu1 -= det_ratio
+    np.maximum(mu1, 0.0, out=mu1)
+    np.sqrt(mu1, out=mu1)
+    mu1 += half_trace
     # the smaller root as det / mu1 keeps its digits when mu2 << mu1
-    mu2 = np.where(mu1 > 0.0, det_ratio / np.where(mu1 > 0.0, mu1, 1.0), 0.0)
-    return np.sqrt(mu1), np.sqrt(np.maximum(mu2, 0.0))
+    positive = mu1 > 0.0
+    mu2 = np.where(positive, mu1, 1.0)
+    np.divide(det_ratio, mu2, out=mu2)
+    mu2[~positive] = 0.0
+    np.maximum(mu2, 0.0, out=mu2)
+    return np.sqrt(mu1, out=mu1), np.sqrt(mu2, out=mu2)
 
 
 def frame_twist(curve: FramedDerivatives, l: npt.ArrayLike, frames_mode: str) -> FloatArray:
@@ -182,9 +236,13 @@ def skin_metric(curve: FramedDerivatives, field: RadiusField, q: float, l: npt.A
     ``curve`` is c(q, .) with its frames; rho, rho_l and rho_a come from the
     radius field's own basis derivatives (no finite differences).
     """
-    l = np.asarray(l, float)
+    l = np.asarray(l, float).reshape(-1)
     speed, curvature, twist = curve_terms(curve, l, frames_mode)
-    rho = field.evaluate_grid(q, l, a)
-    rho_l = field.evaluate_grid(q, l, a, dl=1)
-    rho_a = field.evaluate_grid(q, l, a, da=1)
-    return tube_metric(speed, curvature, twist, a, rho, rho_l, rho_a)
+    rows = SlopeRows(field, q, l, a)
+    planes = np.empty((3, len(l), np.size(a)))
+    step = row_blocks(len(l), np.size(a))
+    for start in step:
+        block = slice(start, start + step.step)
+        tube_metric(speed[block], curvature[block], twist[block], a, *rows(start, start + step.step),
+                    out=planes[:, block])
+    return np.moveaxis(planes, 0, -1)

@@ -106,10 +106,12 @@ def extremes_on(grid: Grid, rest: MetricAt, deformed: MetricAt, breaks: npt.Arra
     owner = np.clip(np.searchsorted(b, grid.l, side="right") - 1, 0, len(b) - 2)
     i, k = np.unravel_index(int(np.argmax(lam1)), lam1.shape)
     j, m = np.unravel_index(int(np.argmin(lam2)), lam2.shape)
-    per_link = tuple(
-        (float(lam1[owner == n].max()), float(lam2[owner == n].min())) if np.any(owner == n) else (1.0, 1.0)
-        for n in range(len(b) - 1)
-    )
+    if np.all(owner[1:] >= owner[:-1]):  # l ascending (as make_grid makes it): each link's rows are one slice
+        ends = np.searchsorted(owner, np.arange(len(b)))
+        rows = [slice(int(lo), int(hi)) if hi > lo else None for lo, hi in zip(ends[:-1], ends[1:], strict=True)]
+    else:
+        rows = [owner == n if np.any(owner == n) else None for n in range(len(b) - 1)]
+    per_link = tuple((float(lam1[r].max()), float(lam2[r].min())) if r is not None else (1.0, 1.0) for r in rows)
     return StretchExtremes(
         Extreme(float(lam1[i, k]), int(owner[i]), float(grid.l[i]), float(grid.a[k])),
         Extreme(float(lam2[j, m]), int(owner[j]), float(grid.l[j]), float(grid.a[m])),
@@ -119,13 +121,20 @@ def extremes_on(grid: Grid, rest: MetricAt, deformed: MetricAt, breaks: npt.Arra
 
 def converged_extremes(rest: MetricAt, deformed: MetricAt, length_mm: float, breaks: npt.ArrayLike,
                        angular_intervals: int, span: tuple[float, float] = (0.0, 1.0),
-                       start: tuple[float, int] | None = None) -> StretchExtremes:
+                       start: tuple[float, int] | None = None, first: StretchExtremes | None = None
+                       ) -> StretchExtremes:
     """:func:`extremes_on` on grids halved until the extremes move by less than ``STRETCH_TOL``.
 
     ``start`` (spacing_mm, angles) replaces the first grid (e.g. one already found converged at another q).
+    ``first``: :func:`extremes_on` of the same metrics already computed, used when on the first grid
+    (e.g. the morph search's sample at this q); on another grid it is ignored.
     """
     spacing, angles = start or (START_SPACING_MM, START_ANGLES_PER_INTERVAL * angular_intervals)
-    current = extremes_on(make_grid(length_mm, breaks, spacing, angles, span), rest, deformed, breaks)
+    grid = make_grid(length_mm, breaks, spacing, angles, span)
+    if first is not None and _same_grid(first.grid, grid):
+        current = first
+    else:
+        current = extremes_on(grid, rest, deformed, breaks)
     history = [(current.grid.points, current.maximum.value, current.minimum.value)]
     change = math.inf
     for _ in range(MAX_REFINEMENTS):
@@ -140,6 +149,11 @@ def converged_extremes(rest: MetricAt, deformed: MetricAt, length_mm: float, bre
             break
     return StretchExtremes(current.maximum, current.minimum, current.per_link, current.grid, float(change),
                            bool(change < STRETCH_TOL), tuple(history))
+
+
+def _same_grid(a: Grid, b: Grid) -> bool:
+    return a.spacing_mm == b.spacing_mm and a.angles == b.angles and np.array_equal(a.l, b.l) and np.array_equal(
+        a.a, b.a)
 
 
 @dataclass(frozen=True)

@@ -10,6 +10,7 @@ import pytest
 
 from softdesign.errors import FitError
 from softdesign.fitting import bspline_basis as bb
+from softdesign.fitting import radius_field, radius_rows
 from softdesign.fitting.bspline_surface import RadiusSpline, split_at_breaks
 from softdesign.fitting.radius_field import (
     FOLD_ANGLES_PER_INTERVAL,
@@ -19,6 +20,7 @@ from softdesign.fitting.radius_field import (
     constant_like,
     fold_margin,
 )
+from softdesign.fitting.radius_rows import SlopeRows
 from tests.helpers.analytic import Arc, Helix
 
 #: Spline evaluations of O(5 mm) values.
@@ -172,3 +174,39 @@ def test_blend_grid_is_the_blend_of_the_end_grids_cached_or_not(monkeypatch):
     field.end_grids(l, angle)
     assert sum(g.nbytes for g in field._grid_cache.values()) <= 4 * initial.nbytes
     assert "_grid_cache" not in pickle.loads(pickle.dumps(field)).__dict__
+
+
+def test_slope_rows_give_the_bits_of_the_grid_evaluations_in_any_block_and_order(monkeypatch):
+    """rho, rho_l and rho_a a block of rows at a time: the numbers of evaluate_grid, unsorted l included."""
+    field = RadiusField.from_links((0.0, 0.4, 1.0), _random_links())
+    rng = np.random.default_rng(5)
+    angle = rng.uniform(-7, 7, 13)
+    for l in (np.linspace(0.0, 1.0, 37), np.append(rng.uniform(0, 1, 30), [0.0, 0.4, 1.0])):
+        whole = [field.evaluate_grid(0.3, l, angle, dl, da) for dl, da in ((0, 0), (1, 0), (0, 1))]
+        rows = SlopeRows(field, 0.3, l, angle)
+        for step in (1, 7, len(l)):
+            blocks = [rows(start, start + step) for start in range(0, len(l), step)]
+            for k in range(3):
+                assert np.concatenate([b[k] for b in blocks]).tobytes() == whole[k].tobytes()
+        values = SlopeRows(field, 0.3, l, angle, slopes=False)
+        assert np.concatenate([values.values(s, s + 5) for s in range(0, len(l), 5)]).tobytes() == whole[0].tobytes()
+        with pytest.raises(ValueError, match="slopes=False"):
+            values(0, 5)
+    # the bases along l are kept per l (read-only, within their budget, out of pickles)
+    l = np.linspace(0.0, 1.0, 37)
+    assert field.along_bases(l) is field.along_bases(l.copy())
+    assert not field.along_bases(l)[0][3].flags.writeable
+    monkeypatch.setattr(radius_field, "BASIS_CACHE_BYTES", 1)
+    field.along_bases(np.linspace(0.0, 1.0, 5))
+    assert len(field._basis_cache) == 1
+    assert "_basis_cache" not in pickle.loads(pickle.dumps(field)).__dict__
+
+
+def test_fold_margin_in_blocks_of_rows_is_the_whole_grid_s(monkeypatch):
+    """The folding check scans a few rows at a time: the same maximum, place and smallest radius."""
+    field = RadiusField.from_links((0.0, 0.4, 1.0), _random_links())
+    curve = Helix(8.0, 3.0, 1.2)
+    monkeypatch.setattr(radius_rows, "BLOCK_POINTS", 10**9)
+    whole = fold_margin(curve, field, 0.6)
+    monkeypatch.setattr(radius_rows, "BLOCK_POINTS", 7 * FOLD_ANGLES_PER_INTERVAL * 12)
+    assert fold_margin(curve, field, 0.6) == whole

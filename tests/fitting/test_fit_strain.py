@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from softdesign.fitting import bspline_basis as bb
+from softdesign.fitting import radius_rows, strain
 from softdesign.fitting.bspline_surface import RadiusSpline
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.strain import (
@@ -19,7 +20,14 @@ from softdesign.geometry.blend import blend_shapes
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
 from softdesign.geometry.initial import straight_initial_shape
 from softdesign.meshing.body import sections_on_grid
-from softdesign.meshing.skin_stretch import STRETCH_TOL, converged_extremes
+from softdesign.meshing.skin_stretch import (
+    START_ANGLES_PER_INTERVAL,
+    START_SPACING_MM,
+    STRETCH_TOL,
+    converged_extremes,
+    extremes_on,
+    make_grid,
+)
 from softdesign.meshing.tessellate import sweep_from_sections, tessellate
 
 #: The issue's bound for the known answers.
@@ -83,6 +91,21 @@ def test_bent_tube_extremes_are_one_plus_and_minus_r_kappa(bent):
     grid_error = rk * (1 - np.cos(np.pi / found.grid.angles))
     assert abs(found.maximum.value - (1 + rk)) <= grid_error + KNOWN_TOL
     assert abs(found.minimum.value - (1 - rk)) <= grid_error + KNOWN_TOL
+    # the first grid's extremes computed ahead (as the morph search does) are taken, and the answer is the same;
+    # on another grid they are ignored
+    first = extremes_on(make_grid(LENGTH_MM, field.breaks, START_SPACING_MM, START_ANGLES_PER_INTERVAL * 16),
+                        rest, bent_metric, field.breaks)
+    calls = []
+    counted = lambda l, a: calls.append(len(l)) or bent_metric(l, a)  # noqa: E731
+    again = converged_extremes(rest, counted, LENGTH_MM, field.breaks, 16, first=first)
+    assert _figures(again) == _figures(found) and len(calls) == len(found.history) - 1
+    inner = (0.1, 0.9)
+    assert _figures(converged_extremes(rest, bent_metric, LENGTH_MM, field.breaks, 16, inner, first=first)) == (
+        _figures(converged_extremes(rest, bent_metric, LENGTH_MM, field.breaks, 16, inner)))
+
+
+def _figures(e):
+    return e.maximum, e.minimum, e.per_link, e.grid.points, e.change, e.converged, e.history
 
 
 def test_a_straight_tube_growing_in_radius_stretches_only_around():
@@ -201,3 +224,53 @@ def test_the_tube_metric_is_the_metric_of_the_tube_sections_to_the_last_bit(p, m
             np.sort(rng.uniform(0.0, 2.0 * np.pi, m)), rng.uniform(1.0, 5.0, (p, m)), rng.normal(0.0, 30.0, (p, m)),
             rng.normal(0.0, 1.0, (p, m)))
     assert tube_metric(*args).tobytes() == metric_from_sections(tube_sections(*args)).tobytes()
+
+
+def test_blocks_of_rows_change_no_bit_of_the_metric_or_the_stretches(bent, monkeypatch):
+    """skin_metric and principal_stretches take a few rows at a time: the bits of the whole grid at once."""
+    shape, field = bent
+    l, a = np.linspace(0.0, 1.0, 53), np.linspace(0.0, 2 * np.pi, 24, endpoint=False)
+    whole = [skin_metric(shape.curve_at(q), field, q, l, a) for q in (0.0, 0.6)]
+    stretches = principal_stretches(*whole)
+    monkeypatch.setattr(radius_rows, "BLOCK_POINTS", 5 * len(a))
+    blocks = [skin_metric(shape.curve_at(q), field, q, l, a) for q in (0.0, 0.6)]
+    assert [m.tobytes() for m in blocks] == [m.tobytes() for m in whole]
+    assert [s.tobytes() for s in principal_stretches(*blocks)] == [s.tobytes() for s in stretches]
+    assert [s.tobytes() for s in strain._principal_stretches(*whole)] == [s.tobytes() for s in stretches]
+
+
+def _plain_metric(speed, curvature, twist, x, y, x_l, y_l, x_a, y_a):
+    v, vt = speed[:, None], (speed * twist)[:, None]
+    axial = v * (1.0 - x * curvature[:, :1] - y * curvature[:, 1:])
+    along_n, along_b = x_l - vt * y, y_l + vt * x
+    return np.stack([axial**2 + along_n**2 + along_b**2, along_n * x_a + along_b * y_a, x_a**2 + y_a**2], axis=-1)
+
+
+def _plain_stretches(rest, deformed):
+    e0, f0, g0 = np.moveaxis(rest, -1, 0)
+    e, f, g = np.moveaxis(deformed, -1, 0)
+    det0 = e0 * g0 - f0 * f0
+    half_trace = 0.5 * (e0 * g + g0 * e - 2.0 * f0 * f) / det0
+    det_ratio = (e * g - f * f) / det0
+    mu1 = half_trace + np.sqrt(np.maximum(half_trace**2 - det_ratio, 0.0))
+    mu2 = np.where(mu1 > 0.0, det_ratio / np.where(mu1 > 0.0, mu1, 1.0), 0.0)
+    return np.sqrt(mu1), np.sqrt(np.maximum(mu2, 0.0))
+
+
+def test_the_metric_and_the_stretches_in_place_are_the_plain_formulas_to_the_last_bit():
+    """Written into few temporaries, the metric and the stretches keep the formulas' operations and order."""
+    rng = np.random.default_rng(8)
+    p, m = 40, 24
+    sections = [rng.normal(0.0, 3.0, (p, m)) for _ in range(6)]
+    centerline = (rng.uniform(10.0, 300.0, p), rng.normal(0.0, 0.1, (p, 2)), rng.normal(0.0, 0.01, p))
+    metric = strain._metric(*centerline, *sections)
+    assert metric.tobytes() == _plain_metric(*centerline, *sections).tobytes()
+    rest = strain._metric(*centerline, *[0.9 * s for s in sections])
+    degenerate = metric.copy()
+    degenerate[3, 4] = [1.0, 1.0, 1.0]  # E G = F^2: a collapsed rest section
+    with pytest.raises(ValueError, match="degenerate"):
+        principal_stretches(degenerate, metric)
+    for pair in ((rest, metric), (metric, rest), (metric, -rest)):  # -rest: negative roots, NaN and 0 as before
+        with np.errstate(invalid="ignore"):
+            expected, found = _plain_stretches(*pair), principal_stretches(*pair)
+        assert [s.tobytes() for s in found] == [s.tobytes() for s in expected]

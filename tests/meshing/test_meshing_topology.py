@@ -150,3 +150,27 @@ def test_dropping_unused_vertices_keeps_the_faces_on_the_same_points():
     kept, faces = drop_unused_vertices(padded, renumbered)
     np.testing.assert_array_equal(kept, v)
     np.testing.assert_array_equal(faces, f)
+
+
+def _row_cross(u, v):
+    """The (F, 3) cross product the figures were first computed with: np.cross's products in its order."""
+    return np.stack([u[:, j] * v[:, k] - u[:, k] * v[:, j] for j, k in ((1, 2), (2, 0), (0, 1))], axis=-1)
+
+
+def test_volume_area_and_edge_scale_keep_the_bits_of_the_row_wise_formulas():
+    """On (3, F) coordinate rows, the figures are those of (F, 3, 3) corners and np.einsum, to the last bit."""
+    from softdesign.meshing.checks import _mean_squared_edge
+    from softdesign.meshing.topology import corner_planes
+
+    rng = np.random.default_rng(11)
+    vertices, faces = joined(*[cube(rng.uniform(0.5, 3.0), rng.normal(0.0, 40.0, 3)) for _ in range(40)])
+    vertices = vertices + rng.normal(0.0, 0.01, vertices.shape)  # rounding in every term
+    found = mesh_topology(vertices, faces)
+    corners = vertices[faces]
+    centered = (vertices - vertices.mean(axis=0))[faces]
+    tet = np.einsum("ij,ij->i", centered[:, 0], _row_cross(centered[:, 1], centered[:, 2])) / 6.0
+    assert found.shell_volumes.tobytes() == np.bincount(np.repeat(np.arange(40), 12), weights=tet).tobytes()
+    normal = _row_cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    assert found.face_areas.tobytes() == (0.5 * np.sqrt(np.sum(normal * normal, axis=-1))).tobytes()
+    edges = np.stack([np.sum((corners[:, b] - corners[:, a]) ** 2, axis=-1) for a, b in ((0, 1), (1, 2), (2, 0))], -1)
+    assert _mean_squared_edge(*corner_planes(vertices, faces)) == float(np.mean(edges))

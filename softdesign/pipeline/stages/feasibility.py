@@ -78,6 +78,9 @@ class _Body:
     #: the rest state's metrics by (offset, grid), least recently used first; per process (a worker fills its own)
     _rest: dict[tuple[float, bytes, bytes], np.ndarray] = dataclasses.field(
         default_factory=dict, compare=False, repr=False)
+    #: the outer skin's (no offset) extremes on the first grid by q, from the morph search (:func:`_morph_search`);
+    #: filled before the per-q work forks, so its workers start their grids from them
+    _first: dict[float, StretchExtremes] = dataclasses.field(default_factory=dict, compare=False, repr=False)
 
     @property
     def length(self) -> float:
@@ -123,8 +126,9 @@ class _Body:
 
 
 def _extremes(body: _Body, q: float, offset_mm: float, span: tuple[float, float]) -> StretchExtremes:
+    first = body._first.get(q) if offset_mm == 0.0 else None  # the same metrics; used when on the same grid
     return converged_extremes(body.rest(offset_mm), body.surface(q, offset_mm), body.length,
-                              body.field.breaks, body.field.final[0].angular_intervals, span)
+                              body.field.breaks, body.field.final[0].angular_intervals, span, first=first)
 
 
 def _where(e) -> dict[str, Any]:
@@ -184,7 +188,8 @@ def _morph_search(body: _Body, most: int | None) -> tuple[MorphExtreme, MorphExt
     """Where over q in [0, 1] the skin's stretches are extreme: searched on the first grid (the outer skin).
 
     The search's first samples are independent and run on the build's worker processes; the bounded
-    search that follows asks for one q at a time.
+    search that follows asks for one q at a time.  Every q's extremes stay in ``body._first``: the
+    converged extremes of the outer skin at a q searched here start from them (:func:`_extremes`).
     """
     g = make_grid(body.length, body.field.breaks, START_SPACING_MM,
                   START_ANGLES_PER_INTERVAL * body.field.final[0].angular_intervals)
@@ -195,7 +200,8 @@ def _morph_search(body: _Body, most: int | None) -> tuple[MorphExtreme, MorphExt
         return extremes_on(g, rest, body.surface(q, 0.0), body.field.breaks)
 
     samples = morph_samples()
-    cache: dict[float, StretchExtremes] = dict(zip(samples, map_items(on_grid, samples, most=most), strict=True))
+    cache = body._first
+    cache.update(zip(samples, map_items(on_grid, samples, most=most), strict=True))
 
     def at(q: float) -> StretchExtremes:
         if q not in cache:
