@@ -362,7 +362,10 @@ def check_surrounds(polar: PolarPoints, length_mm: float, settings: FitSettings)
             f"(4 per angular interval); check final.surface and final.path, or lower fit.angular_intervals"
         )
     bins = np.minimum((polar.l * intervals).astype(int), intervals - 1)
-    gaps = np.array([_largest_gap(polar.angle[bins == k]) for k in range(intervals)])
+    # each bin's angles as one slice of the points sorted by bin (a mask per bin read every point once per bin)
+    order = np.argsort(bins, kind="stable")
+    edges = np.searchsorted(bins[order], np.arange(intervals + 1))
+    gaps = np.array([_largest_gap(polar.angle[order[edges[k] : edges[k + 1]]]) for k in range(intervals)])
     surrounded = gaps <= SURROUND_GAP_RAD
     if surrounded.mean() < MIN_SURROUNDED_FRACTION:
         first = int(np.flatnonzero(~surrounded)[0])
