@@ -40,6 +40,8 @@ from softdesign.types import FloatArray, FramedCurve, Points
 CLOSEST_TOL_MM = 1e-5
 #: Hard stop on Gauss-Newton steps (from the projection, 2-3 for most points, ~10 for the slowest).
 CLOSEST_MAX_STEPS = 30
+#: Points searched together (their arrays, a few MB, stay in cache): 200k points in one go took ~20 % longer.
+CLOSEST_CHUNK = 1 << 15
 #: Step in normalized l of the central differences that measure the frames' twist (not in the protocol).
 FRAME_DIFF_STEP = 1e-6
 #: Spacing of the samples of the frames' twist, interpolated linearly in between, mm.
@@ -153,8 +155,8 @@ class CurvePart:
         """The fields in order (the arrays themselves, not copies)."""
         return (self.points, self.d1, self.normal, self.binormal, self.normal_change, self.binormal_change)
 
-    def subset(self, index: np.ndarray) -> CurvePart:
-        """The rows ``index`` (a boolean mask or indices), copies."""
+    def subset(self, index: np.ndarray | slice) -> CurvePart:
+        """The rows ``index`` (a boolean mask, indices, or a slice: then views)."""
         return CurvePart(*(v[index] for v in self.arrays()))
 
 
@@ -170,8 +172,8 @@ class SearchStart:
     angle: FloatArray
     curve_part: CurvePart | None = None
 
-    def subset(self, index: np.ndarray) -> SearchStart:
-        """The points ``index`` (a boolean mask or indices), copies."""
+    def subset(self, index: np.ndarray | slice) -> SearchStart:
+        """The points ``index`` (a boolean mask, indices, or a slice: then views)."""
         part = None if self.curve_part is None else self.curve_part.subset(index)
         return SearchStart(np.asarray(self.l)[index], np.asarray(self.angle)[index], part)
 
@@ -233,9 +235,26 @@ def _search_start(polar: PolarPoints, start: tuple[FloatArray, FloatArray] | Sea
 def _closest(
     curve: FramedCurve, spline: RadiusSurface, p: Points, start: SearchStart
 ) -> tuple[FloatArray, FloatArray, FloatArray, CurvePart]:
-    """:func:`closest_surface_points` on the points p (n, 3) mm, also returning the curve's part at the result."""
-    l, a = np.array(start.l, float), np.array(start.angle, float)
+    """:func:`closest_surface_points` on the points p (n, 3) mm, also returning the curve's part at the result.
+
+    Every point's search is its own: they run ``CLOSEST_CHUNK`` points at a time, whose arrays stay in
+    the processor's caches (the same numbers as all at once, in less time).
+    """
     twist = frame_twist_table(curve)
+    rows = [slice(lo, lo + CLOSEST_CHUNK) for lo in range(0, max(len(p), 1), CLOSEST_CHUNK)]
+    pieces = [_closest_piece(curve, spline, twist, p[r], start.subset(r)) for r in rows]
+    if len(pieces) == 1:
+        return pieces[0]
+    dist, l, a = (np.concatenate([piece[k] for piece in pieces]) for k in range(3))
+    part = CurvePart(*(np.concatenate(arrays) for arrays in zip(*(piece[3].arrays() for piece in pieces), strict=True)))
+    return dist, l, a, part
+
+
+def _closest_piece(
+    curve: FramedCurve, spline: RadiusSurface, twist, p: Points, start: SearchStart
+) -> tuple[FloatArray, FloatArray, FloatArray, CurvePart]:
+    """Damped Gauss-Newton from ``start`` to the closest surface point of each point p (n, 3) mm."""
+    l, a = np.array(start.l, float), np.array(start.angle, float)
     part = _curve_part(curve, twist, l) if start.curve_part is None else start.curve_part
     part = CurvePart(*(np.array(v, float) for v in part.arrays()))  # updated in place below
     surface, du, dv = _surface_and_tangents(part, spline, l, a)

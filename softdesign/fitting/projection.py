@@ -31,6 +31,8 @@ SEED_SPACING_MM = 0.5
 NEWTON_TOL_MM = 1e-10
 #: Safeguarded Newton converges in 4-6 steps from a bracket one sample wide; this is a hard stop.
 NEWTON_MAX_STEPS = 60
+#: Feet refined together (500k in one go took ~25 % longer: their arrays no longer stay in cache).
+FOOT_CHUNK = 1 << 15
 
 
 @dataclass(frozen=True)
@@ -113,7 +115,10 @@ def foot_parameters(curve: FramedCurve, points: Points) -> FloatArray:
     # solved in order along the curve (each evaluation then reads its polynomial pieces in turn)
     order = np.argsort(nearest, kind="stable")
     l = np.empty(len(points))
-    l[order] = _refined_feet(curve, points[order], grid, nearest[order])
+    # each foot is its own search: FOOT_CHUNK points at a time keep the arrays in cache
+    for lo in range(0, len(points), FOOT_CHUNK):
+        part = order[lo : lo + FOOT_CHUNK]
+        l[part] = _refined_feet(curve, points[part], grid, nearest[part])
     return l
 
 

@@ -39,6 +39,9 @@ FLIP_LIMIT_RAD = 0.5
 PARALLEL_TOL = 1e-6
 #: Squared reflection-vector length below which a reflection is the identity (coincident inputs).
 REFLECTION_EPS = 1e-30
+#: Frames found together: each l's frame is its own, and the (n, 3, 3) temporaries of this many stay in
+#: cache (500k frames in one go took ~1.6 times as long).
+FRAME_CHUNK = 1 << 14
 
 
 def base_normal_from_tangent(tangent: npt.ArrayLike) -> FloatArray:
@@ -197,6 +200,11 @@ class FramedSpline:
         l = checked_l(l)
         if self.mode == "frenet":
             return frenet_frames(self.curve, l, self.label)
+        if len(l) > FRAME_CHUNK:
+            return np.concatenate([self._rmf_frames(l[lo : lo + FRAME_CHUNK]) for lo in range(0, len(l), FRAME_CHUNK)])
+        return self._rmf_frames(l)
+
+    def _rmf_frames(self, l: FloatArray) -> Frames:
         # one double-reflection step from the dense sample at or before l
         start = np.clip(np.searchsorted(self.dense_l, l, side="right") - 1, 0, len(self.dense_l) - 2)
         dense_tangents, dense_derivatives = self.dense_jets
