@@ -111,10 +111,16 @@ class RadiusSpline:
     def evaluate(self, l: npt.ArrayLike, a: npt.ArrayLike, dl: int = 0, da: int = 0) -> FloatArray:
         """``d^(dl+da) rho / dl^dl da^da`` at paired (l, a); l, a broadcast together; mm (per unit l, rad)."""
         l, a = np.broadcast_arrays(np.asarray(l, float), np.asarray(a, float))
+        flat_l, flat_a = l.reshape(-1), a.reshape(-1)
+        # each point's value is its own: cache-sized pieces, the same numbers
+        pieces = [self._evaluate_flat(flat_l[r], flat_a[r], dl, da) for r in bb.chunks(len(flat_l), bb.BASIS_CHUNK)]
+        return (pieces[0] if len(pieces) == 1 else np.concatenate(pieces)).reshape(l.shape)
+
+    def _evaluate_flat(self, l: FloatArray, a: FloatArray, dl: int, da: int) -> FloatArray:
         il, vl = bb.open_local(self.knots, l, dl)
         ia, va = bb.periodic_local(self.angular_intervals, a, da)
         local = self.coefficients[il[:, :, None], ia[:, None, :]]
-        return np.einsum("nr,ns,nrs->n", vl, va, local).reshape(l.shape)
+        return np.einsum("nr,ns,nrs->n", vl, va, local)
 
     def evaluate_with_slopes(self, l: npt.ArrayLike, a: npt.ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """rho, d rho / dl and d rho / da at paired (l, a) (n,), in one pass over the coefficients."""
