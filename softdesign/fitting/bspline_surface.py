@@ -25,7 +25,9 @@ in value and derivatives up to rounding.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -308,6 +310,20 @@ def roughness_matrix(knots: FloatArray, intervals: int, ratio: float) -> sp.csr_
 
     ``ratio`` = r / L turns l derivatives into s derivatives at the penalty's scale r.
     """
+    ll, la, aa = _roughness_terms(np.asarray(knots, float).tobytes(), int(intervals))
+    energy = ratio**4 * ll + 2.0 * ratio**2 * la + aa
+    return (energy / (2.0 * np.pi)).tocsr()
+
+
+@functools.lru_cache(maxsize=2)
+def _roughness_terms(knot_bytes: bytes, intervals: int) -> tuple[Any, Any, Any]:
+    """The penalty's three Kronecker terms (ll, la, aa; sparse, as sp.kron gives them) for knots (float64 bytes) and M.
+
+    Keyed on the knots' content: the hold-out's folds solve on one knot vector with different r
+    (each training set's median rho), so the terms are built once, and only scaled per fold.
+    The returned matrices are shared: callers combine them into new ones and never change them.
+    """
+    knots = np.frombuffer(knot_bytes, dtype=np.float64)
     breakpoints_l = np.unique(knots)
     breakpoints_a = np.linspace(0.0, 2.0 * np.pi, intervals + 1)
 
@@ -319,8 +335,7 @@ def roughness_matrix(knots: FloatArray, intervals: int, ratio: float) -> sp.csr_
 
     gl = [bb.gram_matrix(along, breakpoints_l, d) for d in range(3)]
     ga = [bb.gram_matrix(around, breakpoints_a, d) for d in range(3)]
-    energy = ratio**4 * sp.kron(gl[2], ga[0]) + 2.0 * ratio**2 * sp.kron(gl[1], ga[1]) + sp.kron(gl[0], ga[2])
-    return (energy / (2.0 * np.pi)).tocsr()
+    return sp.kron(gl[2], ga[0]), sp.kron(gl[1], ga[1]), sp.kron(gl[0], ga[2])
 
 
 def split_at_breaks(whole: RadiusSpline, breaks: tuple[float, ...]) -> tuple[RadiusSpline, ...]:
