@@ -131,7 +131,7 @@ def _raise_degree(left: FloatArray, right: FloatArray, values: FloatArray, j: in
 
 def _divided(values: FloatArray, denom: FloatArray) -> FloatArray:
     """``values / denom``, 0 where denom is not > 0 (a repeated knot); the plain division when none is."""
-    if denom.min() > 0:  # a NaN fails this too, and then gets the masked division's 0
+    if denom.min(initial=np.inf) > 0:  # a NaN fails this too, and then gets the masked division's 0
         return values / denom
     return np.divide(values, denom, out=np.zeros(len(denom)), where=denom > 0)
 
