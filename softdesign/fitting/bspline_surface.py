@@ -225,11 +225,11 @@ def fit_radius_surface(polar: PolarPoints, length_mm: float, settings: FitSettin
     """
     check_surrounds(polar, length_mm, settings)
     knots = path_knots(length_mm, settings)
-    design = design_matrix(knots, settings.angular_intervals, polar.l, polar.angle)
+    design, gram = design_and_gram(knots, settings.angular_intervals, polar.l, polar.angle)
     if settings.smoothing == 0:
         _check_supported(design, knots, settings.angular_intervals, length_mm)
     scale = float(np.median(polar.rho))
-    coef = _solve(design.T @ design, design.T @ polar.rho, len(polar), knots, scale, length_mm, settings)
+    coef = _solve(gram, design.T @ polar.rho, len(polar), knots, scale, length_mm, settings)
     whole = RadiusSpline(knots, coef.reshape(-1, settings.angular_intervals))
     links = split_at_breaks(whole, settings.breaks)
     value_jump, slope_jump = joint_jumps(links, length_mm)
@@ -294,15 +294,53 @@ def _solve(gram, moment, count: int, knots: FloatArray, scale: float, length_mm:
 
 def design_matrix(knots: FloatArray, intervals: int, l: FloatArray, angle: FloatArray) -> sp.csr_matrix:
     """Sparse (n, n_l * M) matrix of ``B_i(l_k) P_j(a_k)``, column ``i * M + j``; 16 nonzeros a row."""
+    return _design_csr(*_design_rows(knots, intervals, l, angle), len(knots) - bb.DEGREE - 1, intervals)
+
+
+def design_and_gram(
+    knots: FloatArray, intervals: int, l: FloatArray, angle: FloatArray
+) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """:func:`design_matrix` A and ``A^T A``, the latter summed as dense (DEGREE + 1)^2-square blocks.
+
+    The rows of points in the same knot span along l and around share all their columns, listed in
+    the same order (the first names them), so each such group adds one dense block ``V^T V`` to the
+    Gram matrix.  The sparse product's sums in another order (entries within 4e-15 of their size on the
+    1M case), in a third of its time on the case's 500k points.  The blocks are summed by einsum, not
+    BLAS: a threaded BLAS call for a large group stalls on a busy machine.
+    """
+    columns, values = _design_rows(knots, intervals, l, angle)
+    count, width = values.shape
+    order = np.argsort(columns[:, 0], kind="stable")
+    first = columns[order, 0]
+    starts = np.flatnonzero(np.diff(first, prepend=-1))  # columns are >= 0: the first row starts a group
+    blocks = np.empty((len(starts), width, width))
+    bounds = np.append(starts, count)
+    for g, (lo, hi) in enumerate(zip(bounds[:-1], bounds[1:], strict=True)):
+        group = values[order[lo:hi]]
+        np.einsum("ki,kj->ij", group, group, out=blocks[g])
+    names = columns[order[starts]]
+    rows = np.broadcast_to(names[:, :, None], blocks.shape).ravel()
+    cols = np.broadcast_to(names[:, None, :], blocks.shape).ravel()
+    size = (len(knots) - bb.DEGREE - 1) * intervals
+    gram = sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(size, size))
+    return _design_csr(columns, values, len(knots) - bb.DEGREE - 1, intervals), gram
+
+
+def _design_rows(knots: FloatArray, intervals: int, l: FloatArray, angle: FloatArray) -> tuple[IntArray, FloatArray]:
+    """Columns and values (n, (DEGREE + 1)^2) of each row of the design matrix, the open basis' index major."""
     il, vl = bb.open_local(knots, l)
     ia, va = bb.periodic_local(intervals, angle)
     k = bb.DEGREE + 1
-    cols = (il[:, :, None] * intervals + ia[:, None, :]).ravel()
-    vals = (vl[:, :, None] * va[:, None, :]).ravel()
-    n_basis = len(knots) - bb.DEGREE - 1
-    # Every row holds k * k distinct columns (M >= 4), so the CSR arrays are written out directly.
-    indptr = np.arange(0, k * k * len(il) + 1, k * k, dtype=np.int64)
-    return sp.csr_matrix((vals, cols, indptr), shape=(len(il), n_basis * intervals))
+    cols = (il[:, :, None] * intervals + ia[:, None, :]).reshape(-1, k * k)
+    vals = (vl[:, :, None] * va[:, None, :]).reshape(-1, k * k)
+    return cols, vals
+
+
+def _design_csr(columns: IntArray, values: FloatArray, n_basis: int, intervals: int) -> sp.csr_matrix:
+    count, width = values.shape
+    # Every row holds width distinct columns (M >= 4), so the CSR arrays are written out directly.
+    indptr = np.arange(0, width * count + 1, width, dtype=np.int64)
+    return sp.csr_matrix((values.ravel(), columns.ravel(), indptr), shape=(count, n_basis * intervals))
 
 
 def roughness_matrix(knots: FloatArray, intervals: int, ratio: float) -> sp.csr_matrix:
