@@ -31,6 +31,8 @@ SEED_SPACING_MM = 0.5
 NEWTON_TOL_MM = 1e-10
 #: Safeguarded Newton converges in 4-6 steps from a bracket one sample wide; this is a hard stop.
 NEWTON_MAX_STEPS = 60
+#: Feet refined together (500k in one go took ~25 % longer: their arrays no longer stay in cache).
+FOOT_CHUNK = 1 << 15
 
 
 @dataclass(frozen=True)
@@ -109,29 +111,46 @@ def foot_parameters(curve: FramedCurve, points: Points) -> FloatArray:
     """
     count = max(int(np.ceil(curve.length / SEED_SPACING_MM)), 8) + 1
     grid = np.linspace(0.0, 1.0, count)
-    nearest = np.asarray(cKDTree(curve.points(grid)).query(points)[1])
+    # c, c' and c'' at the samples: every search starts at one and brackets itself by its neighbours
+    samples = (curve.points(grid), curve.derivative(grid, 1), curve.derivative(grid, 2))
+    nearest = np.asarray(cKDTree(samples[0]).query(points)[1])
     # solved in order along the curve (each evaluation then reads its polynomial pieces in turn)
     order = np.argsort(nearest, kind="stable")
     l = np.empty(len(points))
-    l[order] = _refined_feet(curve, points[order], grid, nearest[order])
+    # each foot is its own search: FOOT_CHUNK points at a time keep the arrays in cache
+    for lo in range(0, len(points), FOOT_CHUNK):
+        part = order[lo : lo + FOOT_CHUNK]
+        l[part] = _refined_feet(curve, points[part], grid, nearest[part], samples)
     return l
 
 
-def _refined_feet(curve: FramedCurve, points: Points, grid: FloatArray, nearest: np.ndarray) -> FloatArray:
-    """Safeguarded Newton from the nearest samples ``grid[nearest]`` to each point's foot, clamped to [0, 1]."""
+def _refined_feet(
+    curve: FramedCurve, points: Points, grid: FloatArray, nearest: np.ndarray, samples: tuple[Points, Points, Points]
+) -> FloatArray:
+    """Safeguarded Newton from the nearest samples ``grid[nearest]`` to each point's foot, clamped to [0, 1].
+
+    ``samples`` holds c, c' and c'' at ``grid`` (each (count, 3)): the bracket's slopes and the first
+    step read them there instead of evaluating the curve at those same l again.
+    """
     count = len(grid)
-    lo = grid[np.maximum(nearest - 1, 0)]
-    hi = grid[np.minimum(nearest + 1, count - 1)]
-    slope_lo, slope_hi = _slope(curve, points, lo), _slope(curve, points, hi)
+    c, d1, d2 = samples
+    below, above = np.maximum(nearest - 1, 0), np.minimum(nearest + 1, count - 1)
+    lo, hi = grid[below], grid[above]
+    slope_lo = -np.einsum("ni,ni->n", points - c[below], d1[below])
+    slope_hi = -np.einsum("ni,ni->n", points - c[above], d1[above])
     x = grid[nearest].copy()
     at_lo, at_hi = slope_lo >= 0.0, slope_hi <= 0.0
     active = ~(at_lo | at_hi)
     tol = NEWTON_TOL_MM / curve.length
-    for _ in range(NEWTON_MAX_STEPS):
+    for step in range(NEWTON_MAX_STEPS):
         if not active.any():
             break
         idx = np.flatnonzero(active)
-        x_new, lo_new, hi_new = _safeguarded_step(curve, points[idx], x[idx], lo[idx], hi[idx])
+        if step == 0:  # every x is still its sample
+            at = nearest[idx]
+            x_new, lo_new, hi_new = _newton_step(points[idx], x[idx], lo[idx], hi[idx], (c[at], d1[at], d2[at]))
+        else:
+            x_new, lo_new, hi_new = _safeguarded_step(curve, points[idx], x[idx], lo[idx], hi[idx])
         done = np.abs(x_new - x[idx]) <= tol
         x[idx], lo[idx], hi[idx] = x_new, lo_new, hi_new
         active[idx[done]] = False
@@ -142,17 +161,19 @@ def _refined_feet(curve: FramedCurve, points: Points, grid: FloatArray, nearest:
     return np.clip(x, 0.0, 1.0)
 
 
-def _slope(curve: FramedCurve, points: Points, l: FloatArray) -> FloatArray:
-    """``g'(l) = -(p - c(l)) . c'(l)``, mm^2."""
-    return -np.einsum("ni,ni->n", points - curve.points(l), curve.derivative(l, 1))
-
-
 def _safeguarded_step(
     curve: FramedCurve, points: Points, x: FloatArray, lo: FloatArray, hi: FloatArray
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """One Newton step on g'(l) = 0 with bisection fallback; returns x, and the shrunk bracket."""
-    offset = points - curve.points(x)
-    d1, d2 = curve.derivative(x, 1), curve.derivative(x, 2)
+    return _newton_step(points, x, lo, hi, (curve.points(x), curve.derivative(x, 1), curve.derivative(x, 2)))
+
+
+def _newton_step(
+    points: Points, x: FloatArray, lo: FloatArray, hi: FloatArray, at_x: tuple[Points, Points, Points]
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """:func:`_safeguarded_step` given c, c' and c'' at x (``at_x``)."""
+    offset = points - at_x[0]
+    d1, d2 = at_x[1], at_x[2]
     slope = -np.einsum("ni,ni->n", offset, d1)
     curvature = np.einsum("ni,ni->n", d1, d1) - np.einsum("ni,ni->n", offset, d2)
     lo = np.where(slope < 0.0, x, lo)

@@ -140,7 +140,7 @@ def fit_wall(
     measured = measure_distances(curve, surface.whole, kept, rng)
     # the hold-out folds are dealt from the measured points, each starting from its closest point
     holdout = holdout_rms(curve, kept.subset(measured.sample), settings, rng, options.holdout,
-                          start=(measured.l, measured.angle), mapper=options.mapper)
+                          start=measured.start, mapper=options.mapper)
     metrics = measured.metrics
     radius = RadiusField.from_links(settings.breaks, surface.links, options.initial_radius_mm)
     try:

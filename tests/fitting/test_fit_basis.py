@@ -119,3 +119,10 @@ def test_knot_insertion_keeps_the_spline_and_leaves_inputs_alone():
     assert np.count_nonzero(new_knots == 0.3) == bb.DEGREE + 1
     np.testing.assert_array_equal(knots, knots_before)
     np.testing.assert_array_equal(coef, coef_before)
+
+
+def test_no_points_give_empty_bases():
+    knots = bb.open_knots([0.0, 1.0], [5])
+    for values in (*bb.open_local_and_slope(knots, [])[1:], bb.open_local(knots, [], 1)[1],
+                   *bb.periodic_local_and_slope(6, [])[1:], bb.periodic_local(6, [], 2)[1]):
+        assert values.shape == (0, bb.DEGREE + 1)

@@ -10,6 +10,8 @@ from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import (
     FitSettings,
     RadiusSpline,
+    design_and_gram,
+    design_matrix,
     fit_radius_surface,
     intervals_per_link,
     split_at_breaks,
@@ -24,6 +26,8 @@ EXACT_TOL_MM = 1e-6
 SPLIT_TOL_MM = 1e-12
 #: Value and slope jumps at joints: rounding of O(5 mm) values.
 JOINT_TOL = 1e-11
+#: The Gram matrix by blocks adds the sparse product's terms in another order: rounding of sums of O(1) terms.
+GRAM_TOL = 1e-12
 
 
 def _ellipse(l, angle, major=4.0, minor=3.0, turn=np.pi / 2):
@@ -158,3 +162,15 @@ def test_the_fit_scales_with_the_case():
     fit_big = fit_radius_surface(polar_big, big.length, FitSettings(knot_spacing_mm=20.0, smoothing=1e-3))
     # Relative rounding of the two solves, times the 25 mm coefficients.
     np.testing.assert_allclose(fit_big.whole.coefficients, 10.0 * fit.whole.coefficients, rtol=0, atol=1e-9)
+
+
+def test_the_gram_by_blocks_is_the_sparse_product_of_the_design_matrix():
+    # points in every span along and around, repeated spans, the wrap and the clamped ends
+    rng = np.random.default_rng(3)
+    l = np.concatenate([rng.random(5000), [0.0, 1.0, 0.5, 0.5]])
+    angle = np.concatenate([rng.uniform(-np.pi, np.pi, 5000), [np.pi, -np.pi, 0.0, 2 * np.pi]])
+    knots = bb.open_knots([0.0, 0.4, 1.0], [7, 9])
+    design, gram = design_and_gram(knots, 6, l, angle)
+    assert (design != design_matrix(knots, 6, l, angle)).nnz == 0
+    assert gram.shape == (design.shape[1], design.shape[1])
+    np.testing.assert_allclose(gram.toarray(), (design.T @ design).toarray(), rtol=0, atol=GRAM_TOL)
