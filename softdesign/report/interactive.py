@@ -11,9 +11,9 @@ casting mould or a hollow body adds them, hidden until clicked in the legend
 (:mod:`softdesign.report.interactive_parts`); the ranges include the mould.
 
 For display only, the tube is tessellated coarser than the export
-(:data:`SPACING_MM`, :data:`ANGLES`) and the vessel surface is decimated by
-VTK's quadric decimation to at most :data:`VESSEL_FACES` triangles, both
-within :data:`DISPLAY_TOLERANCE_MM`: the display error (the largest distance
+(:data:`SPACING_MM`, :data:`ANGLES`) and the vessel surface is decimated
+(:func:`softdesign.report.display_mesh.decimated_vessel`, at most its
+``VESSEL_FACES`` triangles), both within :data:`DISPLAY_TOLERANCE_MM`: the display error (the largest distance
 from the fine surface's points to the displayed mesh, mm) is measured, and
 while it exceeds the tolerance the tube's rings and angles are doubled (at
 most :data:`MAX_REFINEMENTS` times) and the vessel keeps twice the triangles.
@@ -42,6 +42,11 @@ import numpy as np
 
 from softdesign.report import interactive_parts
 from softdesign.report.build_folder import BuildData
+from softdesign.report.display_mesh import (
+    DISPLAY_TOLERANCE_MM,
+    decimated_vessel,
+    max_distance_to_mesh,
+)
 from softdesign.report.plotting import link_colours
 from softdesign.report.surface_figures import VESSEL_RGB, tube_mesh
 from softdesign.types import FloatArray
@@ -57,11 +62,6 @@ SPACING_MM, ANGLES = 1.0, 32
 #: The fine tessellation the display error is measured against: half the display's spacing and angle, so its
 #: points include every displayed cell's edge midpoints and centre, where a chord strays farthest from the surface.
 FINE_FACTOR = 2
-#: At most this many triangles of the vessel surface are shown (more only to meet the display tolerance).
-VESSEL_FACES = 20000
-#: The view shows each surface to this distance (mm), a few pixels of a ~100 mm scene 720 px high; the
-#: exported files carry the exact body.
-DISPLAY_TOLERANCE_MM = 0.5
 #: The tube is refined at most this many times (each doubles rings and angles: 4x the page's tube data).
 MAX_REFINEMENTS = 2
 #: Centerline samples per link and frame.
@@ -85,37 +85,6 @@ HEIGHT_PX = 720
 #: plotly's template ``"none"`` (no styling: plotly.js's own defaults) as plotly's figure classes wrote it in the
 #: layout: plotly's Python side keeps one empty scatter style in it, as it takes an empty template for none given.
 TEMPLATE_NONE: dict[str, Any] = {"data": {"scatter": [{"type": "scatter"}]}}
-
-
-def max_distance_to_mesh(points: FloatArray, vertices: FloatArray, faces: np.ndarray) -> float:
-    """Largest true distance (mm) from ``points`` (n, 3) to the triangle mesh (vertices, faces)."""
-    from softdesign.meshing.compare import squared_distances
-
-    return float(np.sqrt(squared_distances(np.asarray(points, float), vertices, faces).max(initial=0.0)))
-
-
-def decimated_vessel(vertices: FloatArray, faces: np.ndarray, target: int = VESSEL_FACES,
-                     tolerance_mm: float = DISPLAY_TOLERANCE_MM):
-    """(vertices, faces, error_mm): the vessel surface with about ``target`` triangles and its display error.
-
-    The error is the largest distance from an original vertex to the decimated surface (0 when kept whole);
-    while it exceeds ``tolerance_mm`` the target doubles (up to the whole surface).
-    """
-    from vtkmodules.vtkFiltersCore import vtkQuadricDecimation
-
-    from softdesign.io.vtk_polydata import polydata_from_triangles, triangles_from_polydata
-
-    while len(faces) > target:
-        decimate = vtkQuadricDecimation()
-        decimate.SetInputData(polydata_from_triangles(np.asarray(vertices, float), np.asarray(faces, np.int64)))
-        decimate.SetTargetReduction(1.0 - target / len(faces))
-        decimate.Update()
-        small_vertices, small_faces = triangles_from_polydata(decimate.GetOutput())
-        error = max_distance_to_mesh(vertices, small_vertices, small_faces)
-        if error <= tolerance_mm:
-            return small_vertices, small_faces, error
-        target *= 2
-    return np.asarray(vertices, float), np.asarray(faces, np.int64), 0.0
 
 
 def tube_display_error_mm(data: BuildData, q: float = 1.0, spacing_mm: float = SPACING_MM,

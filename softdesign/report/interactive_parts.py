@@ -8,7 +8,7 @@ Mould
     The parts the mould stage wrote (``meshes/mould/{half_a,half_b,core}.stl``,
     the parts ``metrics.mould.parts`` lists), where they are cast: around the
     q = 0 body.  They do not move with q.  Each is decimated for display as the
-    vessel is (:func:`softdesign.report.interactive.decimated_vessel`, at most
+    vessel is (:func:`softdesign.report.display_mesh.decimated_surface`, at most
     :data:`MOULD_FACES` triangles, within the view's display tolerance), the
     measured error stated.
 Chamber
@@ -34,6 +34,7 @@ from softdesign.io.formats import read_mesh
 from softdesign.meshing.volume import BodySpec
 from softdesign.pipeline import layout
 from softdesign.report.build_folder import BuildData
+from softdesign.report.display_mesh import decimated_surface, max_distance_to_mesh
 from softdesign.report.mould_figures import COLOURS as MOULD_COLOURS
 from softdesign.types import FloatArray
 
@@ -59,8 +60,6 @@ def mould_block(data: BuildData) -> dict[str, Any] | None:
 
 def mould_traces(data: BuildData, tolerance_mm: float) -> tuple[list[dict[str, Any]], list[str]]:
     """The mould's parts as hidden plotly mesh3d trace dicts (none without a mould) and notes on their display error."""
-    from softdesign.report.interactive import decimated_vessel
-
     block = mould_block(data)
     if block is None:
         return [], []
@@ -68,7 +67,7 @@ def mould_traces(data: BuildData, tolerance_mm: float) -> tuple[list[dict[str, A
     notes: list[str] = []
     for part in sorted(block["parts"], key=list(MOULD_COLOURS).index):
         vertices, faces = read_mesh(data.build_dir / layout.mould_path(part, "stl"))
-        v, f, error = decimated_vessel(vertices, faces, MOULD_FACES, tolerance_mm)
+        v, f, error = decimated_surface(vertices, faces, MOULD_FACES, tolerance_mm)
         v = v.astype(np.float32)
         traces.append({"color": MOULD_COLOURS[part], "flatshading": True, "hoverinfo": "name", "i": f[:, 0],
                        "j": f[:, 1], "k": f[:, 2], "name": MOULD_PREFIX + part, "opacity": MOULD_OPACITY,
@@ -131,8 +130,6 @@ def display_chamber(data: BuildData, q_values: FloatArray, tolerance_mm: float, 
     :data:`CHAMBER_REFINEMENTS` times) while the largest distance from a ``fine_factor`` times finer chamber's
     vertices to it exceeds the tolerance.
     """
-    from softdesign.report.interactive import max_distance_to_mesh
-
     spacing, angles = CHAMBER_SPACING_MM, CHAMBER_ANGLES
     for refinement in range(CHAMBER_REFINEMENTS + 1):
         rings = chamber_rings(data, q_values, spacing)

@@ -4,7 +4,10 @@ Every panel is a shaded projection (painter's algorithm, two-sided Lambert
 shading) seen along the final centerline's direction of least spread, so the
 patient's shape shows its broadest side.  The actuator is the exported STL
 when that q was exported, else the open tube S(q, l, a) tessellated from the
-radius field (the caption says which).
+radius field (the caption says which).  A vessel of more than
+``VESSEL_FACES`` triangles is shown decimated as the 3D view shows it, within
+its display tolerance (:mod:`softdesign.report.display_mesh`; the caption gives
+the measured error).
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ from softdesign.fitting.radius_field import RadiusField
 from softdesign.io.surface import read_surface
 from softdesign.kinematics.links import LinkChain
 from softdesign.report.build_folder import BuildData
+from softdesign.report.display_mesh import DISPLAY_TOLERANCE_MM, decimated_vessel
 from softdesign.report.plotting import Picture, add_polygons, fixed_figure, picture, styled
 from softdesign.report.projection import View, principal_view, shaded_triangles
 from softdesign.types import FloatArray
@@ -114,9 +118,12 @@ def surface_bodies(data: BuildData) -> list[Body]:
     bodies = []
     if len(data.ingest.faces):
         name = data.manifest.get("metrics", {}).get("ingest", {}).get("surface", {}) or {}
-        bodies.append(
-            Body("input vessel surface", data.ingest.vertices, data.ingest.faces, name.get("file", "input"), VESSEL_RGB)
-        )
+        vertices, faces, error = decimated_vessel(data.ingest.vertices, data.ingest.faces)
+        source = name.get("file", "input")
+        if len(faces) < len(data.ingest.faces):
+            source += (f" (shown decimated: {len(faces)} of {len(data.ingest.faces)} triangles, display error "
+                       f"{error:.3f} mm, tolerance {DISPLAY_TOLERANCE_MM:g} mm)")
+        bodies.append(Body("input vessel surface", vertices, faces, source, VESSEL_RGB))
     for q in (0.0, intermediate_q(data.export_q), 1.0):
         body = actuator_body(data, q)
         if body is not None:

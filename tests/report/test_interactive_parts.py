@@ -20,10 +20,10 @@ from softdesign.io.formats import read_mesh
 from softdesign.pipeline import layout
 from softdesign.pipeline.api import build_through
 from softdesign.report.build_folder import load_build
+from softdesign.report.display_mesh import max_distance_to_mesh
 from softdesign.report.interactive import (
     DISPLAY_TOLERANCE_MM,
     TEMPLATE_NONE,
-    max_distance_to_mesh,
     morph_figure,
     morph_html,
 )

@@ -5,8 +5,10 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 import trimesh
 
+from softdesign.report import display_mesh
 from softdesign.report.html_page import banner_html, compact_check_tables
 from softdesign.report.interactive import decimated_vessel
 from softdesign.report.summary import summary_warnings
@@ -83,7 +85,31 @@ def test_the_vessel_is_decimated_for_display_within_a_measured_error():
 def test_a_vessel_decimated_past_the_tolerance_keeps_more_triangles_until_within_it():
     sphere = trimesh.creation.icosphere(subdivisions=5, radius=10.0)  # 20480 faces
     vertices, faces = np.asarray(sphere.vertices), np.asarray(sphere.faces)
-    _, coarse, coarse_error = decimated_vessel(vertices, faces, target=500, tolerance_mm=10.0)
+    _, coarse, coarse_error = decimated_vessel(vertices, faces, target=500, tolerance_mm=1.0)
     tolerance = 0.5 * coarse_error  # the 500-face decimation misses it: the target must grow
     _, kept, error = decimated_vessel(vertices, faces, target=500, tolerance_mm=tolerance)
     assert len(coarse) <= 500 < len(kept) and error <= tolerance
+
+
+def test_a_large_vessel_is_clustered_first_then_decimated_within_the_tolerance(monkeypatch):
+    sphere = trimesh.creation.icosphere(subdivisions=6, radius=10.0)  # 81920 faces: over 8 x the target
+    vertices, faces = np.asarray(sphere.vertices), np.asarray(sphere.faces)
+    shown_v, shown_f, error = display_mesh.decimated_surface(vertices, faces, target=2000, tolerance_mm=0.2)
+    assert len(shown_f) <= 2000 and 0.0 < error <= 0.2
+    assert error == pytest.approx(display_mesh.max_distance_to_mesh(vertices, shown_v, shown_f), abs=1e-12)
+    cells = []
+    real = display_mesh.clustered
+
+    def counted(v, f, cell_mm):
+        cells.append(cell_mm)
+        return real(v, f, cell_mm)
+
+    monkeypatch.setattr(display_mesh, "clustered", counted)
+    display_mesh.decimated_surface(vertices, faces, target=2000, tolerance_mm=0.2)
+    assert cells == [display_mesh.CLUSTER_CELL_FRACTION * 0.2]
+    # a grid of 8 cells over the sphere's box strays far past the tolerance: the original is decimated instead
+    monkeypatch.setattr(display_mesh, "MAX_CLUSTER_BINS", 8)
+    coarse_v, coarse_f = real(vertices, faces, 0.1)
+    assert display_mesh.max_distance_to_mesh(vertices, coarse_v, coarse_f) > 0.2
+    _, kept, error = display_mesh.decimated_surface(vertices, faces, target=2000, tolerance_mm=0.2)
+    assert len(kept) <= 2000 and error <= 0.2
