@@ -31,7 +31,7 @@ from softdesign.fitting.metrics import (
 from softdesign.fitting.projection import PolarPoints, project_points
 from softdesign.fitting.radius_field import FOLD_SPACING_MM, FoldReport, RadiusField, check_self_folding, fold_margin
 from softdesign.fitting.selection import NetworkContext, SelectionSettings, WallSelection, select_wall_points
-from softdesign.types import FramedCurve
+from softdesign.types import FloatArray, FramedCurve
 
 
 @dataclass(frozen=True)
@@ -74,6 +74,8 @@ class WallFit:
     folding: FoldReport
     field: RadiusField
     ends: dict[str, dict[str, float]] = dataclasses.field(default_factory=dict)
+    #: (n,) mm per surface vertex: the true distance of each measured kept point (the metrics' points), else NaN
+    distance: FloatArray = dataclasses.field(default_factory=lambda: np.zeros(0))
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready figures for the manifest (mm, rad; snake_case keys)."""
@@ -124,10 +126,12 @@ def fit_wall(
     selection = select_wall_points(polar, curve.length, network, options.selection)
     # in order along the path: every later evaluation then reads the splines' pieces in turn
     kept_index = np.flatnonzero(selection.keep)
-    kept = polar.subset(kept_index[np.argsort(polar.l[kept_index], kind="stable")])
+    kept_index = kept_index[np.argsort(polar.l[kept_index], kind="stable")]
+    kept = polar.subset(kept_index)
     margin = options.end_margin_mm / curve.length
     inside = (kept.l >= margin) & (kept.l <= 1.0 - margin)
-    kept = kept if inside.all() else kept.subset(inside)
+    if not inside.all():
+        kept, kept_index = kept.subset(inside), kept_index[inside]
     settings, scores = options.fit, dict[float, float]()
     reference = None if network.inscribed_l is None or network.inscribed_radius is None else (
         np.asarray(network.inscribed_l, float), np.asarray(network.inscribed_radius, float))
@@ -154,4 +158,6 @@ def fit_wall(
         raise FitError(f"{str(err).split('; ')[0]}; {negative_radius_cause(prior, curve.length, l[np.argmin(rho)])}"
                        ) from err
     ends = end_radii(radius, reference) | {"margin": {"mm": options.end_margin_mm, "points": float((~inside).sum())}}
-    return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius, ends)
+    distance = np.full(len(polar), np.nan)
+    distance[kept_index[measured.sample]] = measured.distance
+    return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius, ends, distance)

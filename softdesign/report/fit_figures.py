@@ -69,9 +69,16 @@ def _fit_of(data: BuildData) -> FitResult:
 
 
 def true_distances(data: BuildData) -> FloatArray:
-    """True distances (n_kept,) mm from each kept wall point to the fitted surface at q = 1."""
+    """True distances (m,) mm to the fitted surface at q = 1 of the kept wall points the fit's metrics measured.
+
+    The fit keeps them (``fit/points.npz``, ``distance``: every kept point, or a seeded sample of a large input, as
+    RMS, p95 and p99 are measured); a build folder from before it did has them measured here, for every kept point.
+    """
     fit = _fit_of(data)
     points = fit.points
+    if "distance" in points:
+        measured = np.asarray(points["distance"], float)
+        return measured[np.isfinite(measured)]
     keep = points["reason"] == 0
     polar = PolarPoints(
         data.ingest.vertices[keep], points["l"][keep], points["angle"][keep], points["rho"][keep],
@@ -143,7 +150,9 @@ def distance_histogram(ax, distances: FloatArray, metrics: dict) -> None:
             ax.axvline(metrics[key], color="k", ls=style, lw=1.0, label=f"{label} {metrics[key]:.4f} mm")
     ax.set_xlabel("true distance to the fitted surface (mm)")
     ax.set_ylabel("kept points")
-    ax.set_title(f"{len(distances)} kept points")
+    kept = metrics.get("points", {}).get("kept") if isinstance(metrics.get("points"), dict) else None
+    sampled = isinstance(kept, int) and len(distances) < kept
+    ax.set_title(f"{len(distances)} of {kept} kept points measured" if sampled else f"{len(distances)} kept points")
     ax.legend(loc="upper right")
 
 
@@ -179,8 +188,9 @@ def distance_picture(data: BuildData, distances: FloatArray) -> Picture:
         distance_histogram(figure.add_subplot(grid[0]), distances, metrics)
         exclusion_views(figure.add_subplot(grid[1]), figure.add_subplot(grid[2]), data)
     caption = (
-        "Left: true point-to-surface distances of the kept wall points (recomputed from the kept radius field; "
-        "the lines are the manifest's metrics.fit). Middle and right: every surface vertex by the reason it was "
-        "kept or left out of the fit (other branch, cap, outlier), seen as in the surface figure."
+        "Left: true point-to-surface distances of the kept wall points the fit measured (every one but those "
+        "within fit.end_margin_mm of an end, or a seeded sample of a large input), the points of the manifest's "
+        "metrics.fit, drawn as lines. Middle and right: every surface vertex by the reason it was kept or left out "
+        "of the fit (other branch, cap, outlier), seen as in the surface figure."
     )
     return picture("fit_distances.png", figure, DISTANCE_SIZE_IN, "Fit distances and excluded points", caption)

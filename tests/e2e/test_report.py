@@ -11,6 +11,7 @@ from __future__ import annotations
 import hashlib
 import json
 import shutil
+from dataclasses import replace
 from html.parser import HTMLParser
 from importlib import metadata
 from pathlib import Path
@@ -219,11 +220,17 @@ def test_histogram_distances_are_the_manifests(demo):
     from softdesign.report.fit_figures import true_distances
 
     data = load_build(demo[0])
-    found = summarize_distances(true_distances(data))
+    kept = data.fit.points["distance"]
+    # the fit keeps the distances its metrics summarize; a folder without them (older) has them measured again
+    rebuilt = replace(data, fit=replace(data.fit, points={k: v for k, v in data.fit.points.items() if k != "distance"}))
     fit = data.manifest["metrics"]["fit"]
-    assert found.count == fit["points"]["kept"]
-    for key in ("rms_mm", "p95_mm", "p99_mm", "max_mm"):
-        np.testing.assert_allclose(getattr(found, key), fit[key], rtol=0, atol=DISTANCE_ATOL_MM, err_msg=key)
+    # point by point, in vertex order: each kept distance is its own vertex's
+    np.testing.assert_allclose(true_distances(data), true_distances(rebuilt), rtol=0, atol=DISTANCE_ATOL_MM)
+    for distances in (true_distances(data), true_distances(rebuilt)):
+        found = summarize_distances(distances)
+        assert found.count == fit["points"]["kept"] == np.isfinite(kept).sum()
+        for key in ("rms_mm", "p95_mm", "p99_mm", "max_mm"):
+            np.testing.assert_allclose(getattr(found, key), fit[key], rtol=0, atol=DISTANCE_ATOL_MM, err_msg=key)
 
 
 def test_kinematics_series_at_the_export_q_equals_kinematics_json(demo):

@@ -2,7 +2,8 @@
 
 Kept in the build folder: ``fit/surface.npz`` (the radius field: per link
 knots, final and initial coefficients), ``fit/points.npz`` (every projected
-surface point with its selection reason and residual, for reports) and
+surface point with its selection reason, residual and, where the metrics
+measured it, true distance to the fitted surface, for reports) and
 ``fit/summary.json`` (counts, settings, true-distance metrics, hold-out,
 joint jumps, rho * kappa at q = 1).
 """
@@ -42,10 +43,11 @@ from softdesign.types import FloatArray
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 5  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
+VERSION = 6  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
 # 3: points fitted in path order; distances sampled above 200k points (max still over all)
 # 4: end prior and end radii (issue 20); true distances on the regularized backbone's stretches (``backbone``)
 # 5: each end's cut plane in the end frame (``end_cut``, issue 20)
+# 6: fit/points.npz keeps the true distance of every point the metrics measured (``distance``, NaN elsewhere)
 #: Seed of the hold-out folds: the same case always gets the same folds.
 HOLDOUT_SEED = 4
 #: A failed fit is blamed on the centerline when the smoothed one strays from the input by this fraction of the
@@ -130,6 +132,7 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
         "rho": wall.polar.rho,
         "residual": residual,
         "reason": wall.selection.reason,
+        "distance": wall.distance,
     }
     return FitResult(field, summary, points)
 
