@@ -24,7 +24,7 @@ import numpy as np
 
 from softdesign.config import Case
 from softdesign.fitting.radius_field import RadiusField, fold_margin
-from softdesign.fitting.strain import metric_from_sections, skin_metric
+from softdesign.fitting.strain import skin_metric
 from softdesign.geometry.blend import BlendedShape
 from softdesign.meshing.skin_stretch import (
     Q_SAMPLES,
@@ -43,7 +43,7 @@ from softdesign.meshing.skin_stretch import (
 )
 from softdesign.meshing.tessellate import ring_points
 from softdesign.meshing.volume import BodySpec
-from softdesign.meshing.wall import FD_STEP_MM, offset_sections, port_wall_mm, thinnest, wall_map
+from softdesign.meshing.wall import FD_STEP_MM, offset_metric, port_wall_mm, thinnest, wall_map
 from softdesign.pipeline.bounds import meshes_at_once
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
@@ -90,8 +90,7 @@ class _Body:
         curve = self.shape.curve_at(q)
         if offset_mm == 0.0:
             return lambda l, a: skin_metric(curve, self.field, q, l, a, self.frames)
-        return lambda l, a: metric_from_sections(offset_sections(curve, self.field, q, l, len(a), offset_mm,
-                                                                 self.frames))
+        return lambda l, a: offset_metric(curve, self.field, q, l, len(a), offset_mm, self.frames)
 
     def rest(self, offset_mm: float) -> MetricAt:
         """``surface(0.0, offset_mm)``, each grid's metric computed once: the rest state is the same for every q.
