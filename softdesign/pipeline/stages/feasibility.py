@@ -126,8 +126,10 @@ class _Body:
 
 def _extremes(body: _Body, q: float, offset_mm: float, span: tuple[float, float]) -> StretchExtremes:
     first = body._first.get(q) if offset_mm == 0.0 else None  # the same metrics; used when on the same grid
-    return converged_extremes(body.rest(offset_mm), body.surface(q, offset_mm), body.length,
-                              body.field.breaks, body.field.final[0].angular_intervals, span, first=first)
+    rest = body.rest(offset_mm)
+    deformed = rest if q == 0.0 else body.surface(q, offset_mm)  # at q = 0 the same call on the same grids
+    return converged_extremes(rest, deformed, body.length, body.field.breaks, body.field.final[0].angular_intervals,
+                              span, first=first)
 
 
 def _where(e) -> dict[str, Any]:
