@@ -39,12 +39,16 @@ class SlopeRows:
     Each value is added up as :func:`~softdesign.fitting.bspline_surface.grid_from_local` adds it:
     around first, then along, in ascending basis index, from zero; a block of rows small enough to
     stay in the processor's cache costs far less than the whole grid's arrays at once.  With
-    ``slopes=False`` only rho is prepared (:meth:`values`).
+    ``slopes=False`` only rho is prepared (:meth:`values`); with ``angular=False`` rho and rho_l
+    (:meth:`along`), for a caller that takes the a-derivative otherwise (the offset surfaces of
+    :mod:`softdesign.meshing.wall`).
     """
 
-    def __init__(self, field: RadiusField, q: float, l: npt.ArrayLike, a: npt.ArrayLike, slopes: bool = True) -> None:
+    def __init__(self, field: RadiusField, q: float, l: npt.ArrayLike, a: npt.ArrayLike, slopes: bool = True,
+                 angular: bool = True) -> None:
         l = np.asarray(l, float).reshape(-1)
         self.shape = (len(l), int(np.size(a)))
+        self.slopes, self.angular = slopes, slopes and angular
         around: dict[tuple[int, int], tuple[IntArray, FloatArray]] = {}
         #: per link present: its rows (ascending), local basis indices along l, values, slopes (or values),
         #: and the coefficients summed over the periodic basis (n, m) and over its derivative (or the same)
@@ -52,29 +56,39 @@ class SlopeRows:
         for j, rows, index, values, slopes_l in field.along_bases(l, slopes):
             f, i = field.final[j], field.initial[j]
             m = f.angular_intervals
-            for da in (0, 1) if slopes else (0,):
+            for da in (0, 1) if self.angular else (0,):
                 if (m, da) not in around:
                     around[m, da] = bb.periodic_local(m, a, da)
             coefficients = (1.0 - q) * i.coefficients + q * f.coefficients  # as link_spline blends them
             inner = _around_sum(coefficients, around[m, 0])
-            inner_a = _around_sum(coefficients, around[m, 1]) if slopes else inner
+            inner_a = _around_sum(coefficients, around[m, 1]) if self.angular else inner
             self._links.append((rows, index, values, slopes_l, inner, inner_a))
-        self.slopes = slopes
 
     def __call__(self, start: int, stop: int) -> tuple[FloatArray, FloatArray, FloatArray]:
         """rho, rho_l and rho_a (stop - start, m) on rows ``start:stop`` of the grid."""
+        if not self.angular:
+            raise ValueError("SlopeRows: prepared without slopes (slopes=False) or without rho_a (angular=False); "
+                             "use values() or along()")
+        return self._rows(start, stop, True, True)
+
+    def along(self, start: int, stop: int) -> tuple[FloatArray, FloatArray]:
+        """rho and rho_l (stop - start, m) on rows ``start:stop`` of the grid."""
         if not self.slopes:
             raise ValueError("SlopeRows: prepared without slopes (slopes=False); use values()")
-        return self._rows(start, stop, True)
+        rho, rho_l, _ = self._rows(start, stop, True, False)
+        return rho, rho_l
 
     def values(self, start: int, stop: int) -> FloatArray:
         """rho (stop - start, m) on rows ``start:stop`` of the grid."""
-        return self._rows(start, stop, False)[0]
+        return self._rows(start, stop, False, False)[0]
 
-    def _rows(self, start: int, stop: int, slopes: bool) -> tuple[FloatArray, FloatArray, FloatArray]:
+    def _rows(self, start: int, stop: int, slopes: bool, angular: bool
+              ) -> tuple[FloatArray, FloatArray, FloatArray]:
         shape = (max(0, min(stop, self.shape[0]) - start), self.shape[1])
-        # without slopes, rho_l and rho_a only stand for rho (nothing is added into them)
-        rho, rho_l, rho_a = (np.zeros(shape), np.zeros(shape), np.zeros(shape)) if slopes else (np.zeros(shape),) * 3
+        # what is not asked for only stands for rho (nothing is added into it)
+        rho = np.zeros(shape)
+        rho_l = np.zeros(shape) if slopes else rho
+        rho_a = np.zeros(shape) if angular else rho
         for rows, index, values, slopes_l, inner, inner_a in self._links:
             lo, hi = np.searchsorted(rows, (start, stop))
             if lo == hi:
@@ -91,11 +105,14 @@ class SlopeRows:
                 value += values[lo:hi, r, None] * near
                 if slopes:
                     value_l += slopes_l[lo:hi, r, None] * near
+                if angular:
                     value_a += values[lo:hi, r, None] * inner_a[index[lo:hi, r]]
             if not contiguous:
                 rho[at] = value
                 if slopes:
-                    rho_l[at], rho_a[at] = value_l, value_a
+                    rho_l[at] = value_l
+                if angular:
+                    rho_a[at] = value_a
         return rho, rho_l, rho_a
 
 

@@ -74,13 +74,13 @@ class SectionDerivatives:
 
 def metric_from_sections(d: SectionDerivatives) -> FloatArray:
     """First fundamental form (E, F, G) in (l, a), (p, m, 3): mm^2 per unit l^2, per unit l rad, per rad^2."""
-    return _metric(d.speed, d.curvature, d.twist, d.xy[..., 0], d.xy[..., 1], d.xy_l[..., 0], d.xy_l[..., 1],
-                   d.xy_a[..., 0], d.xy_a[..., 1])
+    return metric_from_planes(d.speed, d.curvature, d.twist, d.xy[..., 0], d.xy[..., 1], d.xy_l[..., 0],
+                              d.xy_l[..., 1], d.xy_a[..., 0], d.xy_a[..., 1])
 
 
-def _metric(speed: FloatArray, curvature: FloatArray, twist: FloatArray, x: FloatArray, y: FloatArray,
-            x_l: FloatArray, y_l: FloatArray, x_a: FloatArray, y_a: FloatArray,
-            out: FloatArray | None = None) -> FloatArray:
+def metric_from_planes(speed: FloatArray, curvature: FloatArray, twist: FloatArray, x: FloatArray, y: FloatArray,
+                       x_l: FloatArray, y_l: FloatArray, x_a: FloatArray, y_a: FloatArray,
+                       out: FloatArray | None = None) -> FloatArray:
     """(E, F, G) (p, m, 3) of the surface ``c + x N + y B`` from its section coordinates and their l and a
     derivatives (p, m) and the centerline's speed (p,), curvature (p, 2) and twist (p,).
 
@@ -141,8 +141,8 @@ def tube_metric(
     rho, rho_l, rho_a = (np.asarray(v, float) for v in (rho, rho_l, rho_a))
     x, y = rho * cos, rho * sin
     x_a, y_a = rho_a * cos + rho * -sin, rho_a * sin + rho * cos
-    return _metric(np.asarray(speed, float), np.asarray(curvature, float), np.asarray(twist, float), x, y,
-                   rho_l * cos, rho_l * sin, x_a, y_a, out)
+    return metric_from_planes(np.asarray(speed, float), np.asarray(curvature, float), np.asarray(twist, float), x, y,
+                              rho_l * cos, rho_l * sin, x_a, y_a, out)
 
 
 def principal_stretches(rest: npt.ArrayLike, deformed: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:

@@ -9,6 +9,7 @@ Offset surfaces
     the l-derivative by a central difference of step ``FD_STEP_MM`` of arc
     length (truncation ~ (h/2)^2 x the third derivative: below 1e-9 relative
     on vessel-sized bodies; the offset has no closed-form l-derivative).
+    :func:`offset_metric` gives that metric a block of rows at a time.
 Thickness
     The true distance from every chamber vertex (exact points of the chamber
     surface, on its (l, a) grid) to the outer surface's triangles, with vtk's
@@ -30,7 +31,8 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.fitting.radius_field import RadiusField
-from softdesign.fitting.strain import SectionDerivatives, curve_terms
+from softdesign.fitting.radius_rows import SlopeRows, row_blocks
+from softdesign.fitting.strain import SectionDerivatives, curve_terms, metric_from_planes
 from softdesign.geometry.frames import FramedSpline
 from softdesign.meshing.body import body_sections
 from softdesign.meshing.compare import squared_distances
@@ -64,6 +66,73 @@ def offset_sections(curve: FramedSpline, field: RadiusField, q: float, l: npt.Ar
     xy_l = (xy_at(l + h) - xy_at(l - h)) / (2.0 * h)
     xy_a = np.moveaxis(angular_derivative(np.moveaxis(xy, -1, 0)), 0, -1)
     return SectionDerivatives(speed, curvature, twist, xy, xy_l, xy_a)
+
+
+def offset_metric(curve: FramedSpline, field: RadiusField, q: float, l: npt.ArrayLike, angular_count: int,
+                  offset_mm: float, frames_mode: str = "rmf") -> FloatArray:
+    """``metric_from_sections(offset_sections(...))``, (p, m, 3), a block of rows at a time: the same bits.
+
+    The sections at l and at l +- h are built a block of rows at a time
+    (about ``BLOCK_POINTS`` points, as the skin's metric), rho and rho_l from
+    one pass over the radius field per grid (:class:`SlopeRows`, the numbers
+    of ``evaluate_grid``), the centerline's terms once per grid: every value
+    is computed point by point, or row by row for the a-derivatives (a
+    transform of each row), so the blocks change no bit.
+    """
+    l = np.asarray(l, float).reshape(-1)
+    a = angle_grid(angular_count)
+    h = FD_STEP_MM / curve.length
+    grids = (l, l + h, l - h)
+    terms = [curve_terms(curve, at, frames_mode) for at in grids]
+    rows = [SlopeRows(field, q, at, a, angular=False) for at in grids]
+    cos, sin = np.cos(a), np.sin(a)
+    planes = np.empty((3, len(l), len(a)))
+    step = row_blocks(len(l), len(a))
+    for start in step:
+        block = slice(start, start + step.step)
+        xy, plus, minus = (_offset_xy(*r.along(start, start + step.step), speed[block], curvature[block], offset_mm,
+                                      cos, sin) for r, (speed, curvature, _) in zip(rows, terms, strict=True))
+        xy_l = np.subtract(plus, minus, out=plus)
+        xy_l /= 2.0 * h
+        xy_a = angular_derivative(xy)
+        speed, curvature, twist = terms[0]
+        metric_from_planes(speed[block], curvature[block], twist[block], xy[0], xy[1], xy_l[0], xy_l[1], xy_a[0],
+                           xy_a[1], out=planes[:, block])
+    return np.moveaxis(planes, 0, -1)
+
+
+def _offset_xy(rho: FloatArray, rho_l: FloatArray, speed: FloatArray, curvature: FloatArray, offset_mm: float,
+               cos: FloatArray, sin: FloatArray) -> FloatArray:
+    """``section_curves(rho, rho_l / speed, curvature, offset_mm)`` as (x, y) planes (2, b, m): its operations
+    on the same numbers in the same order."""
+    xy = np.empty((2,) + rho.shape)
+    x, y = xy
+    np.multiply(rho, cos, out=x)  # points = rho u, u = (cos, sin)
+    np.multiply(rho, sin, out=y)
+    if offset_mm == 0.0:
+        return xy
+    rho_a = angular_derivative(rho)
+    in_x = x - rho_a * -sin  # in_plane = rho u - rho_a w, w = (-sin, cos)
+    in_y = y - rho_a * cos
+    span = np.square(in_x)  # |in_plane|, as np.linalg.norm adds the squares
+    span += np.square(in_y, out=rho_a)
+    np.sqrt(span, out=span)
+    stretch = curvature[:, :1] * cos  # 1 - rho kn
+    stretch += curvature[:, 1:] * sin
+    stretch *= rho
+    np.subtract(1.0, stretch, out=stretch)
+    stretch *= span
+    tan_beta = rho_l / speed[:, None]  # rho rho_s / (stretch span)
+    tan_beta *= rho
+    tan_beta /= stretch
+    factor = np.square(tan_beta, out=tan_beta)  # offset sqrt(1 + tan_beta^2) / span
+    factor += 1.0
+    np.sqrt(factor, out=factor)
+    factor *= offset_mm
+    factor /= span
+    x += np.multiply(factor, in_x, out=in_x)
+    y += np.multiply(factor, in_y, out=in_y)
+    return xy
 
 
 @dataclass(frozen=True)

@@ -192,6 +192,14 @@ def test_slope_rows_give_the_bits_of_the_grid_evaluations_in_any_block_and_order
         assert np.concatenate([values.values(s, s + 5) for s in range(0, len(l), 5)]).tobytes() == whole[0].tobytes()
         with pytest.raises(ValueError, match="slopes=False"):
             values(0, 5)
+        with pytest.raises(ValueError, match="slopes=False"):
+            values.along(0, 5)
+        along = SlopeRows(field, 0.3, l, angle, angular=False)  # rho and rho_l only
+        blocks = [along.along(start, start + 7) for start in range(0, len(l), 7)]
+        for k in range(2):
+            assert np.concatenate([b[k] for b in blocks]).tobytes() == whole[k].tobytes()
+        with pytest.raises(ValueError, match="angular=False"):
+            along(0, 5)
     # the bases along l are kept per l (read-only, within their budget, out of pickles)
     l = np.linspace(0.0, 1.0, 37)
     assert field.along_bases(l) is field.along_bases(l.copy())

@@ -263,9 +263,9 @@ def test_the_metric_and_the_stretches_in_place_are_the_plain_formulas_to_the_las
     p, m = 40, 24
     sections = [rng.normal(0.0, 3.0, (p, m)) for _ in range(6)]
     centerline = (rng.uniform(10.0, 300.0, p), rng.normal(0.0, 0.1, (p, 2)), rng.normal(0.0, 0.01, p))
-    metric = strain._metric(*centerline, *sections)
+    metric = strain.metric_from_planes(*centerline, *sections)
     assert metric.tobytes() == _plain_metric(*centerline, *sections).tobytes()
-    rest = strain._metric(*centerline, *[0.9 * s for s in sections])
+    rest = strain.metric_from_planes(*centerline, *[0.9 * s for s in sections])
     degenerate = metric.copy()
     degenerate[3, 4] = [1.0, 1.0, 1.0]  # E G = F^2: a collapsed rest section
     with pytest.raises(ValueError, match="degenerate"):

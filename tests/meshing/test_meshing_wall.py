@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from softdesign.fitting import radius_rows
+from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.strain import metric_from_sections, principal_stretches, skin_metric
 from softdesign.geometry.blend import blend_shapes
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
@@ -13,7 +15,14 @@ from softdesign.meshing.body import body_sections
 from softdesign.meshing.solids import _chamber
 from softdesign.meshing.tessellate import Sweep, ring_points, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec, angle_grid
-from softdesign.meshing.wall import offset_sections, port_wall_mm, tessellation_error_mm, thinnest, wall_distances
+from softdesign.meshing.wall import (
+    offset_metric,
+    offset_sections,
+    port_wall_mm,
+    tessellation_error_mm,
+    thinnest,
+    wall_distances,
+)
 from tests.fitting.test_fit_strain import _constant_field
 
 RADIUS_MM, WALL_MM, LENGTH_MM, NA = 3.0, 1.0, 30.0, 64
@@ -91,3 +100,22 @@ def test_the_chamber_of_a_bent_tube_stretches_as_its_own_radius_times_kappa():
     skin = principal_stretches(skin_metric(shape.curve_at(0.0), field, 0.0, l, angle_grid(NA)),
                                skin_metric(shape.curve_at(1.0), field, 1.0, l, angle_grid(NA)))
     assert abs(skin[0].max() - (1 + RADIUS_MM / BEND_RADIUS_MM)) <= grid * 1.5 + 1e-6
+
+
+@pytest.mark.parametrize("frames", ["rmf", "frenet"])
+def test_the_offset_metric_in_blocks_of_rows_has_the_bits_of_the_sections_route(monkeypatch, frames):
+    """offset_metric is metric_from_sections(offset_sections(...)) bit for bit, in any block of rows, any offset."""
+    from tests.fitting.test_fit_radius_field import _random_links
+    from tests.fitting.test_fit_strain import BEND_RADIUS_MM, _arc
+
+    final = smooth_curve_from_polyline(_arc(60.0, BEND_RADIUS_MM), CurveOptions(spacing_mm=0.25, smoothing_mm=0.0))
+    shape = blend_shapes(straight_initial_shape(final), final, mode="intrinsic", frames=frames)
+    field = RadiusField.from_links((0.0, 0.4, 1.0), _random_links())  # rho varies along and around: every term counts
+    l = np.unique(np.append(np.linspace(0.02, 0.98, 29), 0.4))
+    for q in (0.6, 1.0):  # bent: Frenet frames need curvature
+        curve = shape.curve_at(q)
+        for offset in (-0.8, 0.0, 0.5):
+            whole = metric_from_sections(offset_sections(curve, field, q, l, 24, offset, frames))
+            for points in (radius_rows.BLOCK_POINTS, 24 * 5, 1):
+                monkeypatch.setattr(radius_rows, "BLOCK_POINTS", points)
+                assert offset_metric(curve, field, q, l, 24, offset, frames).tobytes() == whole.tobytes()

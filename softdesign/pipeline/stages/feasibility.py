@@ -24,7 +24,7 @@ import numpy as np
 
 from softdesign.config import Case
 from softdesign.fitting.radius_field import RadiusField, fold_margin
-from softdesign.fitting.strain import metric_from_sections, skin_metric
+from softdesign.fitting.strain import skin_metric
 from softdesign.geometry.blend import BlendedShape
 from softdesign.meshing.skin_stretch import (
     Q_SAMPLES,
@@ -43,7 +43,7 @@ from softdesign.meshing.skin_stretch import (
 )
 from softdesign.meshing.tessellate import ring_points
 from softdesign.meshing.volume import BodySpec
-from softdesign.meshing.wall import FD_STEP_MM, offset_sections, port_wall_mm, thinnest, wall_map
+from softdesign.meshing.wall import FD_STEP_MM, offset_metric, port_wall_mm, thinnest, wall_map
 from softdesign.pipeline.bounds import meshes_at_once
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
@@ -90,8 +90,7 @@ class _Body:
         curve = self.shape.curve_at(q)
         if offset_mm == 0.0:
             return lambda l, a: skin_metric(curve, self.field, q, l, a, self.frames)
-        return lambda l, a: metric_from_sections(offset_sections(curve, self.field, q, l, len(a), offset_mm,
-                                                                 self.frames))
+        return lambda l, a: offset_metric(curve, self.field, q, l, len(a), offset_mm, self.frames)
 
     def rest(self, offset_mm: float) -> MetricAt:
         """``surface(0.0, offset_mm)``, each grid's metric computed once: the rest state is the same for every q.
@@ -127,8 +126,10 @@ class _Body:
 
 def _extremes(body: _Body, q: float, offset_mm: float, span: tuple[float, float]) -> StretchExtremes:
     first = body._first.get(q) if offset_mm == 0.0 else None  # the same metrics; used when on the same grid
-    return converged_extremes(body.rest(offset_mm), body.surface(q, offset_mm), body.length,
-                              body.field.breaks, body.field.final[0].angular_intervals, span, first=first)
+    rest = body.rest(offset_mm)
+    deformed = rest if q == 0.0 else body.surface(q, offset_mm)  # at q = 0 the same call on the same grids
+    return converged_extremes(rest, deformed, body.length, body.field.breaks, body.field.final[0].angular_intervals,
+                              span, first=first)
 
 
 def _where(e) -> dict[str, Any]:
