@@ -40,7 +40,6 @@ GRID_CACHE_BYTES = 32 * 2**20
 BASIS_CACHE_BYTES = 8 * 2**20
 
 
-
 def axisymmetric(spline: RadiusSpline) -> RadiusSpline:
     """The mean of rho over a at each l, as a spline on the same knots (exact)."""
     mean = spline.coefficients.mean(axis=1, keepdims=True)
