@@ -28,7 +28,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import ConfigError
-from softdesign.fitting.bspline_surface import FitSettings, RadiusSpline, fold_fits
+from softdesign.fitting.bspline_surface import FitSettings, RadiusSpline, fold_solver
 from softdesign.fitting.mapping import Mapper, serial_map
 from softdesign.fitting.projection import PolarPoints
 from softdesign.types import FloatArray, FramedCurve, Points
@@ -459,15 +459,15 @@ def _holdout(
     curve: FramedCurve, polar: PolarPoints, settings: FitSettings, labels: np.ndarray,
     start: SearchStart | None = None, mapper: Mapper = serial_map,
 ) -> HoldoutReport:
-    splines = fold_fits(polar, curve.length, settings, labels)
+    solve = fold_solver(polar, curve.length, settings, labels)
 
-    def held_out(k: int) -> FloatArray:
+    def held_out(k: int) -> FloatArray:  # fold k's fit and its distances: on one process, after the assembly
         test = labels == k
         begin = None if start is None else start.subset(test)
-        return closest_surface_points(curve, splines[k], polar.subset(test), begin)[0]
+        return closest_surface_points(curve, solve(k), polar.subset(test), begin)[0]
 
     squares, fold_rms = [], []
-    for d in mapper(held_out, range(len(splines))):
+    for d in mapper(held_out, range(int(labels.max()) + 1)):
         squares.append(d**2)
         fold_rms.append(np.sqrt(np.mean(d**2)))
     return HoldoutReport(float(np.sqrt(np.mean(np.concatenate(squares)))), np.array(fold_rms), len(polar))
