@@ -26,6 +26,7 @@ in value and derivatives up to rounding.
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -244,19 +245,33 @@ def fold_fits(polar: PolarPoints, length_mm: float, settings: FitSettings, label
     training set's median rho), assembled once: fold k's normal equations are those of every
     point minus the rows of fold k, equal to a fresh assembly up to rounding.
     """
+    solve = fold_solver(polar, length_mm, settings, labels)
+    return [solve(k) for k in range(int(labels.max()) + 1)]
+
+
+def fold_solver(
+    polar: PolarPoints, length_mm: float, settings: FitSettings, labels: np.ndarray
+) -> Callable[[int], RadiusSpline]:
+    """:func:`fold_fits` one fold at a time: the systems assembled here, ``solve(k)`` fold k's spline.
+
+    Each fold's solve is its own (the hold-out runs it with the fold's distances, perhaps on
+    another process): the same spline whenever and wherever it is solved.
+    """
     knots = path_knots(length_mm, settings)
     design = design_matrix(knots, settings.angular_intervals, polar.l, polar.angle)
     rows = [np.flatnonzero(labels == k) for k in range(int(labels.max()) + 1)]
     parts = [(design[r].T @ design[r], design[r].T @ polar.rho[r]) for r in rows]
     gram, moment = sum(p[0] for p in parts), sum(p[1] for p in parts)
-    splines = []
-    for held, (fold_gram, fold_moment) in zip(rows, parts, strict=True):
+
+    def solve(k: int) -> RadiusSpline:
+        fold_gram, fold_moment = parts[k]
         train = np.ones(len(polar), bool)
-        train[held] = False
+        train[rows[k]] = False
         scale = float(np.median(polar.rho[train]))
         coef = _solve(gram - fold_gram, moment - fold_moment, int(train.sum()), knots, scale, length_mm, settings)
-        splines.append(RadiusSpline(knots, coef.reshape(-1, settings.angular_intervals)))
-    return splines
+        return RadiusSpline(knots, coef.reshape(-1, settings.angular_intervals))
+
+    return solve
 
 
 def path_knots(length_mm: float, settings: FitSettings) -> FloatArray:

@@ -21,15 +21,15 @@ fold is measured against the fit on the other k - 1 folds.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from typing import Any, Protocol
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import ConfigError
-from softdesign.fitting.bspline_surface import FitSettings, RadiusSpline, fold_fits
+from softdesign.fitting.bspline_surface import FitSettings, RadiusSpline, fold_solver
+from softdesign.fitting.mapping import Mapper, serial_map
 from softdesign.fitting.projection import PolarPoints
 from softdesign.types import FloatArray, FramedCurve, Points
 
@@ -186,16 +186,6 @@ def surface_points(curve: FramedCurve, spline: RadiusSpline, l: FloatArray, angl
     return curve.points(l) + rho[:, None] * direction
 
 
-#: ``mapper(task, items)`` is ``[task(item) for item in items]``, perhaps on other processes (the build's
-#: :func:`softdesign.pipeline.parallel.map_items`); the results in the order of ``items``.
-Mapper = Callable[[Callable[[Any], Any], Sequence[Any]], list[Any]]
-
-
-def serial_map(task: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
-    """The :data:`Mapper` that runs every item here, in turn."""
-    return [task(item) for item in items]
-
-
 class RadiusSurface(Protocol):
     """rho(l, a) of a fitted surface: a :class:`RadiusSpline`, or a radius field at one q (the report's)."""
 
@@ -233,16 +223,21 @@ def _search_start(polar: PolarPoints, start: tuple[FloatArray, FloatArray] | Sea
 
 
 def _closest(
-    curve: FramedCurve, spline: RadiusSurface, p: Points, start: SearchStart
+    curve: FramedCurve, spline: RadiusSurface, p: Points, start: SearchStart, mapper: Mapper = serial_map,
 ) -> tuple[FloatArray, FloatArray, FloatArray, CurvePart]:
     """:func:`closest_surface_points` on the points p (n, 3) mm, also returning the curve's part at the result.
 
     Every point's search is its own: they run ``CLOSEST_CHUNK`` points at a time, whose arrays stay in
-    the processor's caches (the same numbers as all at once, in less time).
+    the processor's caches (the same numbers as all at once, in less time), the blocks by ``mapper``
+    (perhaps on other processes: the same numbers; a single block always runs here).
     """
     twist = frame_twist_table(curve)
     rows = [slice(lo, lo + CLOSEST_CHUNK) for lo in range(0, max(len(p), 1), CLOSEST_CHUNK)]
-    pieces = [_closest_piece(curve, spline, twist, p[r], start.subset(r)) for r in rows]
+
+    def piece(r: slice) -> tuple[FloatArray, FloatArray, FloatArray, CurvePart]:
+        return _closest_piece(curve, spline, twist, p[r], start.subset(r))
+
+    pieces = mapper(piece, rows) if len(rows) > 1 else [piece(rows[0])]
     if len(pieces) == 1:
         return pieces[0]
     dist, l, a = (np.concatenate([piece[k] for piece in pieces]) for k in range(3))
@@ -381,6 +376,7 @@ def measure_distances(
     polar: PolarPoints,
     rng: np.random.Generator,
     max_points: int = DISTANCE_SAMPLE_MAX,
+    mapper: Mapper = serial_map,
 ) -> MeasuredDistances:
     """True distances of every kept point, or of a seeded sample above ``max_points``, and the exact max.
 
@@ -391,6 +387,7 @@ def measure_distances(
     polar : the kept wall points with their projection
     rng : draws the sample (large inputs only)
     max_points : the most points measured for RMS, p95 and p99
+    mapper : runs the blocks of measured points (each point's search is its own); the same figures for any
 
     Returns
     -------
@@ -398,7 +395,8 @@ def measure_distances(
     """
     sample = holdout_sample(len(polar), max_points, rng)
     measured = polar.subset(sample)
-    distance, l, angle, part = _closest(curve, spline, measured.points, SearchStart(measured.l, measured.angle))
+    distance, l, angle, part = _closest(curve, spline, measured.points, SearchStart(measured.l, measured.angle),
+                                        mapper)
     metrics = summarize_distances(distance)
     if len(sample) < len(polar):
         rest = np.setdiff1d(np.arange(len(polar)), sample, assume_unique=True)
@@ -461,15 +459,15 @@ def _holdout(
     curve: FramedCurve, polar: PolarPoints, settings: FitSettings, labels: np.ndarray,
     start: SearchStart | None = None, mapper: Mapper = serial_map,
 ) -> HoldoutReport:
-    splines = fold_fits(polar, curve.length, settings, labels)
+    solve = fold_solver(polar, curve.length, settings, labels)
 
-    def held_out(k: int) -> FloatArray:
+    def held_out(k: int) -> FloatArray:  # fold k's fit and its distances: on one process, after the assembly
         test = labels == k
         begin = None if start is None else start.subset(test)
-        return closest_surface_points(curve, splines[k], polar.subset(test), begin)[0]
+        return closest_surface_points(curve, solve(k), polar.subset(test), begin)[0]
 
     squares, fold_rms = [], []
-    for d in mapper(held_out, range(len(splines))):
+    for d in mapper(held_out, range(int(labels.max()) + 1)):
         squares.append(d**2)
         fold_rms.append(np.sqrt(np.mean(d**2)))
     return HoldoutReport(float(np.sqrt(np.mean(np.concatenate(squares)))), np.array(fold_rms), len(polar))

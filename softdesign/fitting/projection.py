@@ -23,6 +23,7 @@ import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from softdesign.errors import InputDataError
+from softdesign.fitting.mapping import Mapper, serial_map
 from softdesign.types import FloatArray, FramedCurve, Points
 
 #: Spacing of the curve samples that seed the Newton iteration, mm.
@@ -33,6 +34,9 @@ NEWTON_TOL_MM = 1e-10
 NEWTON_MAX_STEPS = 60
 #: Feet refined together (500k in one go took ~25 % longer: their arrays no longer stay in cache).
 FOOT_CHUNK = 1 << 15
+#: Points projected by one task of the mapper: a 1,000,000-vertex surface in 8 blocks, which two
+#: processes share evenly; up to this many (any smaller surface) are projected here in one go.
+PROJECT_BLOCK = 1 << 17
 
 
 @dataclass(frozen=True)
@@ -66,13 +70,15 @@ class PolarPoints:
         )
 
 
-def project_points(curve: FramedCurve, points: npt.ArrayLike) -> PolarPoints:
+def project_points(curve: FramedCurve, points: npt.ArrayLike, mapper: Mapper = serial_map) -> PolarPoints:
     """Foot point, angle and distance of every point on a framed centerline.
 
     Parameters
     ----------
     curve : the smooth centerline (normalized l, frames with columns N, B, T)
     points : (n, 3) float, mm
+    mapper : runs the blocks of ``PROJECT_BLOCK`` points (each point's projection is its own), perhaps
+        on other processes; the same numbers for any, and for any block size
 
     Returns
     -------
@@ -89,6 +95,16 @@ def project_points(curve: FramedCurve, points: npt.ArrayLike) -> PolarPoints:
             f"surface points: expected an (n, 3) array of finite mm coordinates, got shape {points.shape}; "
             "check the surface file"
         )
+    if len(points) <= PROJECT_BLOCK:
+        return PolarPoints(points.copy(), *_polar(curve, points))
+    blocks = [slice(lo, lo + PROJECT_BLOCK) for lo in range(0, len(points), PROJECT_BLOCK)]
+    parts = mapper(lambda rows: _polar(curve, points[rows]), blocks)
+    l, angle, rho, side = (np.concatenate([part[k] for part in parts]) for k in range(4))
+    return PolarPoints(points.copy(), l, angle, rho, side)
+
+
+def _polar(curve: FramedCurve, points: Points) -> tuple[FloatArray, FloatArray, FloatArray, npt.NDArray[np.int8]]:
+    """l, angle, rho and end side of the points (n, 3) mm, checked (:func:`project_points`)."""
     l = foot_parameters(curve, points)
     order = np.argsort(l, kind="stable")  # the curve evaluated in order along it, then put back
     origin, frames = np.empty_like(points), np.empty((len(l), 3, 3))
@@ -99,7 +115,7 @@ def project_points(curve: FramedCurve, points: npt.ArrayLike) -> PolarPoints:
     side = np.zeros(len(points), np.int8)
     side[(l <= 0.0) & (offset @ tangent_part[0] < 0.0)] = -1
     side[(l >= 1.0) & (offset @ tangent_part[1] > 0.0)] = 1
-    return PolarPoints(points.copy(), l, np.arctan2(local[:, 1], local[:, 0]), np.linalg.norm(offset, axis=1), side)
+    return l, np.arctan2(local[:, 1], local[:, 0]), np.linalg.norm(offset, axis=1), side
 
 
 def foot_parameters(curve: FramedCurve, points: Points) -> FloatArray:

@@ -18,15 +18,14 @@ from softdesign.errors import FitError
 from softdesign.fitting.bspline_surface import FitSettings, SurfaceFit, fit_radius_surface
 from softdesign.fitting.end_checks import end_radii, negative_radius_cause
 from softdesign.fitting.end_prior import end_prior
+from softdesign.fitting.mapping import Mapper, serial_map
 from softdesign.fitting.metrics import (
     FitMetrics,
     HoldoutReport,
     HoldoutSettings,
-    Mapper,
     choose_knot_spacing,
     holdout_rms,
     measure_distances,
-    serial_map,
 )
 from softdesign.fitting.projection import PolarPoints, project_points
 from softdesign.fitting.radius_field import FOLD_SPACING_MM, FoldReport, RadiusField, check_self_folding, fold_margin
@@ -47,7 +46,8 @@ class WallFitOptions:
     initial_radius_mm : constant rho0; None for the axially symmetric mean of the fit
     fold_limit : the largest rho * kappa allowed at q = 1
     end_margin_mm : kept points within this arc length of either end are left out of the fit, mm
-    mapper : runs independent pieces (the hold-out's folds), perhaps on other processes; same figures for any
+    mapper : runs independent pieces (the hold-out's folds, the projection's and the metrics' blocks of
+        points), perhaps on other processes; the same figures for any
     """
 
     fit: FitSettings = field(default_factory=FitSettings)
@@ -122,7 +122,7 @@ def fit_wall(
     FitError
         The wall does not surround the path, the solve fails, or the tube folds at q = 1.
     """
-    polar = project_points(curve, vertices)
+    polar = project_points(curve, vertices, options.mapper)
     selection = select_wall_points(polar, curve.length, network, options.selection)
     # in order along the path: every later evaluation then reads the splines' pieces in turn
     kept_index = np.flatnonzero(selection.keep)
@@ -141,7 +141,7 @@ def fit_wall(
         spacing, scores = choose_knot_spacing(curve, kept, settings, rng, options.holdout)
         settings = replace(settings, knot_spacing_mm=spacing)
     surface = fit_radius_surface(kept, curve.length, settings)
-    measured = measure_distances(curve, surface.whole, kept, rng)
+    measured = measure_distances(curve, surface.whole, kept, rng, mapper=options.mapper)
     # the hold-out folds are dealt from the measured points, each starting from its closest point
     holdout = holdout_rms(curve, kept.subset(measured.sample), settings, rng, options.holdout,
                           start=measured.start, mapper=options.mapper)

@@ -142,6 +142,16 @@ class BlendedShape:
             self._framed[q] = framed
         return self._framed[q]
 
+    def keep_curve(self, q: float, framed: FramedSpline) -> None:
+        """Keep ``framed``, built from this shape by :meth:`curve_at` (in a worker process), as c(q, .) and its frames.
+
+        A stage that builds the curves of its q values on worker processes hands them back to the
+        shape of the build process this way, so later stages find them built, as when built here.
+        """
+        q = float(q)
+        self._framed.setdefault(q, framed)
+        self._smooth.setdefault(q, self._framed[q].curve)
+
     def stats_at(self, q: float, l_range: tuple[float, float] = (0.0, 1.0)) -> BlendStats:
         """Length, stretch range and curvature range at q over ``l_range`` (dense grid)."""
         curve = self.smooth_curve_at(q)

@@ -2,8 +2,9 @@
 
 A build runs with ``jobs`` worker processes (``--jobs N``; default: the cores
 this process may run on).  The stages whose work is one independent
-computation per export q (export's solids, feasibility's figures) hand it to
-:func:`map_per_q`; every other stage is unchanged.
+computation per export q (kinematics' poses, export's solids, feasibility's
+figures) hand it to :func:`map_per_q`, and the fit its blocks of points to
+:func:`map_items`; every other stage is unchanged.
 
 Why processes started by ``fork``: the per-q work is numpy, scipy, vtk and
 manifold3d code that holds the GIL in places, so threads would not use the

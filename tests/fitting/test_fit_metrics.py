@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from softdesign.errors import ConfigError
+from softdesign.fitting import metrics
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface, fold_fits
 from softdesign.fitting.metrics import (
     CLOSEST_TOL_MM,
@@ -22,6 +23,7 @@ from softdesign.fitting.metrics import (
     surface_points,
 )
 from softdesign.fitting.projection import project_points
+from softdesign.pipeline.parallel import jobs_for_build, map_items
 from tests.helpers.analytic import Arc, FrenetHelix, Helix, Line, grid_parameters, tube_points
 
 #: Gauss-Newton stops at 1e-5 mm steps, past which the distance barely moves: the distances here come out within
@@ -208,3 +210,26 @@ def test_auto_spacing_rejects_knots_too_coarse_for_the_shape():
     assert set(scores) == {1.0, 2.0, 8.0}
     assert best in (1.0, 2.0)
     assert scores[8.0] > 3 * scores[best]
+
+
+def test_distances_are_the_same_bits_in_blocks_on_worker_processes(monkeypatch):
+    # the build hands the blocks of points to its worker processes (map_items): each point's search is its own
+    curve, noisy = _noisy_tube(sigma=0.2)
+    spline = fit_radius_surface(noisy, curve.length, FitSettings()).whole
+    whole = measure_distances(curve, spline, noisy, np.random.default_rng(0))
+    monkeypatch.setattr(metrics, "CLOSEST_CHUNK", 500)
+    blocks = []
+
+    def mapper(task, items):
+        blocks.append(len(items))
+        with jobs_for_build(2):
+            return map_items(task, items)
+
+    split = measure_distances(curve, spline, noisy, np.random.default_rng(0), mapper=mapper)
+    assert blocks == [5]
+    assert split.metrics == whole.metrics
+    for name in ("distance", "l", "angle"):
+        np.testing.assert_array_equal(getattr(split, name), getattr(whole, name))
+    assert split.curve_part is not None and whole.curve_part is not None
+    for a, b in zip(split.curve_part.arrays(), whole.curve_part.arrays(), strict=True):
+        np.testing.assert_array_equal(a, b)

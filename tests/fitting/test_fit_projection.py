@@ -6,7 +6,9 @@ import numpy as np
 import pytest
 
 from softdesign.errors import InputDataError
+from softdesign.fitting import projection
 from softdesign.fitting.projection import NEWTON_TOL_MM, project_points
+from softdesign.pipeline.parallel import jobs_for_build, map_items
 from tests.helpers.analytic import Arc, Helix, Line, tube_points
 
 #: Newton stops at NEWTON_TOL_MM of arc; 100x leaves room for rounding in c(l) at ~100 mm coordinates.
@@ -62,3 +64,25 @@ def test_input_is_not_modified_and_bad_input_is_refused():
         project_points(curve, np.zeros((4, 2)))
     with pytest.raises(InputDataError, match="finite"):
         project_points(curve, np.array([[np.nan, 0.0, 1.0]]))
+
+
+def test_blocks_on_worker_processes_give_the_same_bits(monkeypatch):
+    # the build hands a large surface's blocks of points to its worker processes (map_items)
+    curve = Helix(8.0, 3.0, 1.2)
+    rng = np.random.default_rng(5)
+    n = 2000
+    points = tube_points(curve, rng.uniform(-0.02, 1.02, n), rng.uniform(-np.pi, np.pi, n), rng.uniform(0.5, 5.0, n))
+    whole = project_points(curve, points)
+    monkeypatch.setattr(projection, "PROJECT_BLOCK", 300)
+    blocks = []
+
+    def mapper(task, items):
+        blocks.append(len(items))
+        with jobs_for_build(2):
+            return map_items(task, items)
+
+    split = project_points(curve, points, mapper)
+    assert blocks == [7]
+    for name in ("points", "l", "angle", "rho", "end_side"):
+        np.testing.assert_array_equal(getattr(split, name), getattr(whole, name))
+    assert split.end_side.dtype == np.int8 and split.end_side.any()

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pickle
+
 import numpy as np
 import pytest
 from scipy.integrate import quad
@@ -201,3 +203,17 @@ def test_stats_over_a_range_shorter_than_a_dense_step(final):
     stats = shape.stats_at(1.0, (0.5, 0.5001))
     np.testing.assert_allclose(stats.length_mm, 0.0001 * final.length, rtol=1e-9, atol=0)
     np.testing.assert_allclose(stats.curvature_max_per_mm, 1 / RADIUS, rtol=1e-6, atol=0)
+
+
+def test_a_kept_curve_is_the_one_curve_at_returns(final):
+    # a stage's worker processes build the curves; the build process keeps them instead of building them again
+    straight = straight_initial_shape(final)
+    built = blend_shapes(straight, final).curve_at(0.3)
+    shape = blend_shapes(straight, final)
+    shape.keep_curve(0.3, pickle.loads(pickle.dumps(built)))
+    kept = shape.curve_at(0.3)
+    assert shape.smooth_curve_at(0.3) is kept.curve
+    l = np.linspace(0.0, 1.0, 7)
+    assert np.array_equal(kept.frames(l), built.frames(l)) and np.array_equal(kept.points(l), built.points(l))
+    shape.keep_curve(0.3, built)  # the first one kept stays
+    assert shape.curve_at(0.3) is kept

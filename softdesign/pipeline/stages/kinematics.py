@@ -15,10 +15,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from softdesign.geometry.frames import FramedSpline
 from softdesign.kinematics.arc_check import arc_check_metrics, arc_misses, link_arcs_at_final_shape
 from softdesign.kinematics.links import LinkChain, LinkReport
 from softdesign.kinematics.poe import PoeSplit
 from softdesign.pipeline import layout
+from softdesign.pipeline.parallel import map_per_q
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.links import LinksResult
 from softdesign.pipeline.store import Staging
@@ -98,9 +100,18 @@ def shape_figures(chain: LinkChain, q: float) -> dict[str, Any]:
     }
 
 
+def _at_q(chain: LinkChain, q: float) -> tuple[dict[str, Any], dict[str, Any], FramedSpline]:
+    """The shape's figures and the pose at q, and the framed curve built for them (to keep in the build process)."""
+    return shape_figures(chain, q), pose_document(chain, q), chain.shape.curve_at(q)
+
+
 def run_kinematics(case: Case, links: LinksResult) -> KinematicsResult:
-    """Link transforms and POE at every export q."""
+    """Link transforms and POE at every export q (one q per worker process at a time, results in q order)."""
     chain = links.chain
+    q_values = case.export.q_values()
+    per_q = map_per_q(lambda q: _at_q(chain, q), q_values)
+    for q, (_, _, curve) in zip(q_values, per_q, strict=True):
+        chain.shape.keep_curve(q, curve)  # export and feasibility then use them, as when built here
     document = {
         "frames": case.frames,
         "convention": CONVENTION,
@@ -109,8 +120,8 @@ def run_kinematics(case: Case, links: LinksResult) -> KinematicsResult:
             {"index": j, "l_start": float(chain.breaks[j]), "l_end": float(chain.breaks[j + 1])}
             for j in range(chain.count)
         ],
-        "per_q": [shape_figures(chain, q) for q in case.export.q_values()],
-        "poses": [pose_document(chain, q) for q in case.export.q_values()],
+        "per_q": [figures for figures, _, _ in per_q],
+        "poses": [pose for _, pose, _ in per_q],
     }
     return KinematicsResult(chain, document)
 

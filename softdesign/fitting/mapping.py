@@ -1,0 +1,21 @@
+"""How the fit runs independent pieces: a :data:`Mapper`, serial here, perhaps on other processes in a build.
+
+The fitting code never starts processes itself: the fit stage passes the
+build's :func:`softdesign.pipeline.parallel.map_items`, and every other caller
+(tests, the report) gets :func:`serial_map`.  Either way the results come back
+in the order of the items, so the figures do not depend on the mapper.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+#: ``mapper(task, items)`` is ``[task(item) for item in items]``, perhaps on other processes (the build's
+#: :func:`softdesign.pipeline.parallel.map_items`); the results in the order of ``items``.
+Mapper = Callable[[Callable[[Any], Any], Sequence[Any]], list[Any]]
+
+
+def serial_map(task: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
+    """The :data:`Mapper` that runs every item here, in turn."""
+    return [task(item) for item in items]
