@@ -36,6 +36,12 @@ Start-up
     console script beside this Python), wall time from start to exit, and
     the median CPU time (user + system) of the same runs.
 
+Report
+    ``softdesign report`` against a forced ``softdesign build`` of the same
+    case, fresh processes with the cores available (issue 17: the report no
+    slower than the build on the sample case); the aorta and the largest
+    synthetic input at the fewest frames for information.
+
 Usage: ``python pipelines/bench.py [--triangles 250000,500000,1000000]
 [--frames 11,41] [--jobs N] [--profile] [--keep DIR]``; ``make bench`` runs the defaults.
 """
@@ -76,6 +82,10 @@ TARGET_PEAK_MIB = 2048.0
 TARGET_HELP_S = 0.3
 TARGET_VALIDATE_S = 0.6
 STARTUP_REPEATS = 5
+#: ``softdesign report`` no slower than ``softdesign build`` on the sample case (issue 17): wall ratio, median of
+#: REPORT_REPEATS interleaved pairs of fresh processes (the scaled case is measured once, for information).
+TARGET_REPORT_RATIO = 1.0
+REPORT_REPEATS = 3
 #: Time ~ size^e counts as linear up to this e (timings on a shared machine jitter by ~10 %).
 LINEAR_EXPONENT_MAX = 1.15
 #: The scaled case's links and default sizes.
@@ -405,6 +415,39 @@ def startup_lines(figures: dict[str, float]) -> list[str]:
     ]
 
 
+def report_figures(case_file: Path, out: Path, repeats: int = REPORT_REPEATS) -> dict[str, float]:
+    """Median wall and CPU seconds of a forced ``softdesign build`` of ``case_file`` into ``out`` and of
+    ``softdesign report out`` after it, each a fresh process, the two interleaved ``repeats`` times."""
+    base = softdesign_command()
+    builds, reports = [], []
+    for _ in range(repeats):
+        builds.append(median_runs([*base, "build", str(case_file), "--out", str(out), "--force"], 1))
+        reports.append(median_runs([*base, "report", str(out)], 1))
+    return {
+        "build_s": statistics.median(b[0] for b in builds), "build_cpu_s": statistics.median(b[1] for b in builds),
+        "report_s": statistics.median(r[0] for r in reports), "report_cpu_s": statistics.median(r[1] for r in reports),
+        "repeats": repeats,
+    }
+
+
+def report_line(label: str, figures: dict[str, float], judged: bool) -> str:
+    """One case's build and report times and their ratio; judged against the target on the sample case only."""
+    ratio = figures["report_s"] / figures["build_s"]
+    judgement = f"  target <= {TARGET_REPORT_RATIO:g}  {verdict(ratio <= TARGET_REPORT_RATIO)}" if judged else ""
+    return (f"  {label:<38} build {figures['build_s']:5.2f} s (cpu {figures['build_cpu_s']:5.2f})  "
+            f"report {figures['report_s']:5.2f} s (cpu {figures['report_cpu_s']:5.2f})  "
+            f"report/build {ratio:4.2f}{judgement}")
+
+
+def report_lines(cases: Sequence[tuple[str, Path, int, bool]], scratch: Path) -> list[str]:
+    """``softdesign report`` against ``softdesign build``: (label, case file, repeats, judged) per case."""
+    lines = ["report against its build (issue 17): wall, median of interleaved fresh processes "
+             "(build --force, then report), both with the cores available:"]
+    for k, (label, case_file, repeats, judged) in enumerate(cases):
+        lines.append(report_line(label, report_figures(case_file, scratch / f"report-{k}", repeats), judged))
+    return lines
+
+
 # ---------------------------------------------------------------- tables
 
 
@@ -621,6 +664,12 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
     emit(centerline_lines() + [""])
     plan = synthetic_plan(scratch, args.triangles, args.frames)
     results = run_synthetic(plan, scratch, args.jobs)
+    largest = next(c for c in plan if (c.triangles, c.frames) == (max(args.triangles), min(args.frames)))
+    report_cases = [("sample case (configs/demo.yaml)", DEMO_CASE, REPORT_REPEATS, True)]
+    if aorta is not None:
+        report_cases.append(("VMTK aorta (path 0)", aorta.case_file, REPORT_REPEATS, False))
+    report_cases.append((largest.label, largest.case_file, 1, False))
+    emit(report_lines(report_cases, scratch) + [""])
     top_t, top_f = max(args.triangles), max(args.frames)
     scaled = next(r for r in results if r["size"] == {"triangles": top_t, "frames": top_f})
     emit([f"scaled case ({SYNTHETIC_LINKS} links):"] + stage_table(scaled) + [""])

@@ -132,3 +132,22 @@ def test_the_startup_command_is_the_softdesign_entry_point(bench):
 
     done = subprocess.run([*bench.softdesign_command(), "--help"], capture_output=True, text=True, cwd=REPO)
     assert done.returncode == 0 and "Usage" in done.stdout
+
+
+def test_the_report_line_judges_the_ratio_on_the_sample_case_only(bench):
+    figures = {"build_s": 2.0, "build_cpu_s": 2.5, "report_s": 2.5, "report_cpu_s": 4.0}
+    judged = bench.report_line("sample", figures, judged=True)
+    assert "build  2.00 s" in judged and "report  2.50 s" in judged and "report/build 1.25" in judged
+    assert judged.rstrip().endswith("MISSED")
+    assert bench.report_line("sample", {**figures, "report_s": 1.5}, judged=True).rstrip().endswith("met")
+    shown = bench.report_line("aorta", figures, judged=False)
+    assert "report/build 1.25" in shown and "MISSED" not in shown and "target" not in shown
+
+
+@pytest.mark.slow
+def test_report_figures_time_a_forced_build_and_its_report(bench, tmp_path):
+    case = bench.synthetic_case(tmp_path / "inputs", 20_000, 2)
+    figures = bench.report_figures(case.case_file, tmp_path / "run", repeats=1)
+    assert figures["repeats"] == 1
+    assert all(figures[key] > 0 for key in ("build_s", "build_cpu_s", "report_s", "report_cpu_s"))
+    assert (tmp_path / "run" / "report" / "index.html").is_file()
