@@ -65,7 +65,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from softdesign.pipeline.parallel import MAX_JOBS, available_cores
+from softdesign.pipeline.parallel import MAX_JOBS, available_cores, one_blas_thread
 
 if TYPE_CHECKING:
     import cProfile
@@ -723,6 +723,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--profile-dir", type=Path, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker:
+        one_blas_thread()  # as softdesign's command line does, before the worker loads numpy
         print(json.dumps(run_worker(args.worker[0], args.worker[1], args.profile_dir, args.jobs)))
         return 0
     if not 1 <= args.jobs <= MAX_JOBS:

@@ -26,6 +26,7 @@ from softdesign.cli.pcc import PCC_SHORT_HELP, pcc_app
 from softdesign.cli.pose import pose
 from softdesign.cli.report import report
 from softdesign.cli.sample import sample
+from softdesign.pipeline.parallel import one_blas_thread
 
 #: Help is click's plain text, not typer's rich panels: rich markup ate every ``[default: ...]`` in the option
 #: help (``--out`` read "Build folder .") and importing rich for it doubled the time of ``softdesign --help``
@@ -52,9 +53,11 @@ def main() -> None:
     When the command is done (its files written and closed, whatever the exit code), everything alive is frozen
     out of the garbage collector's reach: the interpreter's exit then skips a last full collection over the
     hundreds of thousands of objects a build or a report leaves (0.3 to 0.5 s of the demo's build and report).
-    Module teardown, atexit handlers and the flushing of stdout and stderr still run.  Only here: the command
-    line run in-process (tests' CliRunner, ``app``) is left alone.
+    Module teardown, atexit handlers and the flushing of stdout and stderr still run.  OpenBLAS is asked for one
+    thread per process (:func:`softdesign.pipeline.parallel.one_blas_thread`) unless the environment sets it.
+    Only here: the command line run in-process (tests' CliRunner, ``app``) is left alone.
     """
+    one_blas_thread()  # before any command loads numpy
     try:
         app()
     finally:
