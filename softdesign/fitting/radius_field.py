@@ -16,7 +16,9 @@ measures the largest value on a dense grid.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -133,10 +135,7 @@ class RadiusField:
         """
         l = np.ascontiguousarray(l, float).reshape(-1)
         key = (l.tobytes(), bool(slopes))
-        cache = self.__dict__.get("_basis_cache")
-        if cache is None:
-            cache = {}
-            object.__setattr__(self, "_basis_cache", cache)  # frozen: the cache is not part of the value
+        cache = self._cache("_basis_cache")
         bases = cache.pop(key, None)  # put back last: the dict runs from least to most recently used
         if bases is None:
             owner = self.link_of(l)
@@ -153,9 +152,7 @@ class RadiusField:
                 found.append((int(j), rows, index, values, slopes_l))
             bases = tuple(found)
         cache[key] = bases
-        while len(cache) > 1 and sum(a.nbytes for b in cache.values() for item in b for a in item[1:]) > (
-                BASIS_CACHE_BYTES):
-            cache.pop(next(iter(cache)))
+        _trim(cache, BASIS_CACHE_BYTES, lambda b: sum(a.nbytes for item in b for a in item[1:]), keep=1)
         return bases
 
     def end_grids(self, l: npt.ArrayLike, a: npt.ArrayLike, dl: int = 0, da: int = 0) -> tuple[FloatArray, FloatArray]:
@@ -169,18 +166,14 @@ class RadiusField:
         l = np.ascontiguousarray(l, float).reshape(-1)
         a = np.ascontiguousarray(a, float).reshape(-1)
         key = (l.tobytes(), a.tobytes(), int(dl), int(da))
-        cache = self.__dict__.get("_grid_cache")
-        if cache is None:
-            cache = {}
-            object.__setattr__(self, "_grid_cache", cache)  # frozen: the cache is not part of the value
+        cache = self._cache("_grid_cache")
         grids = cache.pop(key, None)  # put back last: the dict runs from least to most recently used
         if grids is None:
             ends = [np.stack([i.coefficients, f.coefficients]) for f, i in zip(self.final, self.initial, strict=True)]
             grids = self._link_grids(ends, l, a, dl, da)
             grids.setflags(write=False)
         cache[key] = grids
-        while sum(g.nbytes for g in cache.values()) > GRID_CACHE_BYTES:
-            cache.pop(next(iter(cache)))
+        _trim(cache, GRID_CACHE_BYTES, lambda g: g.nbytes, keep=0)
         return grids[0], grids[1]
 
     def blend_grid(self, q: float, l: npt.ArrayLike, a: npt.ArrayLike, dl: int = 0, da: int = 0) -> FloatArray:
@@ -205,6 +198,14 @@ class RadiusField:
                 around[m] = bb.periodic_local(m, a, da)
             out[:, rows] = grid_from_local(stacks[j], bb.open_local(knots, l[rows], dl), around[m])
         return out
+
+    def _cache(self, name: str) -> dict[Any, Any]:
+        """The field's cache ``name`` (a dict, least recently used first), made on first use; not part of its value."""
+        cache = self.__dict__.get(name)
+        if cache is None:
+            cache = {}
+            object.__setattr__(self, name, cache)  # frozen: the cache is not part of the value
+        return cache
 
     def __getstate__(self) -> dict[str, object]:
         # pickles carry the field, not the grids cached from it
@@ -297,3 +298,10 @@ def check_self_folding(curve: FramedCurve, field: RadiusField, q: float = 1.0, l
             "(resample.smoothing_mm), a longer straight end (resample.end_straight_mm), or a smaller radius"
         )
     return report
+
+
+def _trim(cache: dict[Any, Any], limit: int, size: Callable[[Any], int], keep: int) -> None:
+    """Drop ``cache``'s least recently used entries while they take more than ``limit`` bytes and more than
+    ``keep`` are left."""
+    while len(cache) > keep and sum(size(value) for value in cache.values()) > limit:
+        cache.pop(next(iter(cache)))
