@@ -9,7 +9,7 @@ shown surface keeps twice the triangles.
 Large surfaces (a segmentation's 10^5 to 10^6 triangles) are first clustered
 on a grid (VTK's quadric clustering, linear in the triangles), then decimated
 (VTK's quadric decimation, whose cost grows faster than the triangles: 6 s a
-pass on a 1,000,000-triangle vessel, against 0.2 s for clustering it to 74,000
+pass on a 1,000,000-triangle vessel, against 0.3 s for clustering it to 72,000
 triangles and 0.3 s for decimating those).  The grid's cells
 are a fraction of the tolerance, coarser only where :data:`MAX_CLUSTER_BINS`
 cells would not cover the surface's box (VTK keeps a quadric per cell, about
