@@ -238,24 +238,16 @@ def fit_radius_surface(polar: PolarPoints, length_mm: float, settings: FitSettin
     return SurfaceFit(whole, links, value_jump, slope_jump, scale, float(np.sqrt(np.mean(residual**2))), len(polar))
 
 
-def fold_fits(polar: PolarPoints, length_mm: float, settings: FitSettings, labels: np.ndarray) -> list[RadiusSpline]:
-    """The whole-path spline fitted to the points outside each fold in turn (fold k: ``labels != k``).
-
-    The same penalized least squares as :func:`fit_radius_surface` (penalty scale from each
-    training set's median rho), assembled once: fold k's normal equations are those of every
-    point minus the rows of fold k, equal to a fresh assembly up to rounding.
-    """
-    solve = fold_solver(polar, length_mm, settings, labels)
-    return [solve(k) for k in range(int(labels.max()) + 1)]
-
-
 def fold_solver(
     polar: PolarPoints, length_mm: float, settings: FitSettings, labels: np.ndarray
 ) -> Callable[[int], RadiusSpline]:
-    """:func:`fold_fits` one fold at a time: the systems assembled here, ``solve(k)`` fold k's spline.
+    """``solve(k)``: the whole-path spline fitted to the points outside fold k (``labels != k``).
 
-    Each fold's solve is its own (the hold-out runs it with the fold's distances, perhaps on
-    another process): the same spline whenever and wherever it is solved.
+    The same penalized least squares as :func:`fit_radius_surface` (penalty scale from each
+    training set's median rho), assembled once here: fold k's normal equations are those of every
+    point minus the rows of fold k, equal to a fresh assembly up to rounding.  Each fold's solve is
+    its own (the hold-out runs it with the fold's distances, perhaps on another process): the same
+    spline whenever and wherever it is solved.
     """
     knots = path_knots(length_mm, settings)
     design = design_matrix(knots, settings.angular_intervals, polar.l, polar.angle)
