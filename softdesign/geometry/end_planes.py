@@ -44,6 +44,7 @@ from typing import Any
 
 import numpy as np
 
+from softdesign.geometry.edges import EdgeTable, run_starts
 from softdesign.geometry.end_cut import MAX_CUT_TILT_DEG
 from softdesign.types import FloatArray, IntArray, Points
 
@@ -116,7 +117,7 @@ def end_planes(
     """
     vertices, faces = np.asarray(vertices, float), np.asarray(faces, np.int64)
     ends, inscribed_mm = np.asarray(ends, float), np.asarray(inscribed_mm, float)
-    edges = _EdgeTable.of(faces, len(vertices))
+    edges = EdgeTable.of(faces, len(vertices))
     rims = [("open_end", loop) for loop in _boundary_loops(edges)]
     # a cap's faces lie within its rim, whose centre is within END_SEARCH_RADII inscribed radii of the end
     reach = (END_SEARCH_RADII + 1.0 / np.cos(np.radians(MAX_TILT_DEG))) * inscribed_mm
@@ -176,54 +177,7 @@ def _end_plane(
     return None if best is None else best[1]
 
 
-@dataclass(frozen=True)
-class _EdgeTable:
-    """The faces' edges (``faces_to_edges`` order: f0-f1, f1-f2, f2-f0 of each face), grouped by vertex pair.
-
-    One sort of integer keys ``min V + max`` (V vertices, int64 up to V = 3e9) stands in for trimesh's row grouping
-    (``group_rows`` on ``edges_sorted``), which hashes and sorts the 3 F rows again for each question.
-
-    Attributes
-    ----------
-    n_vertices : V, the vertex count the keys are made with
-    keys : (3 F,) int64, the edges' keys, sorted
-    order : (3 F,) int64, the edge (3 f + p) at each position of ``keys``
-    starts : (G,) int64, where each group of equal keys begins in ``keys``
-    uses : (G,) int64, the group's size: how many face edges join that vertex pair
-    """
-
-    n_vertices: int
-    keys: IntArray
-    order: IntArray
-    starts: IntArray
-    uses: IntArray
-
-    @classmethod
-    def of(cls, faces: IntArray, n_vertices: int) -> _EdgeTable:
-        """The table of ``faces`` (F, 3) on ``n_vertices`` vertices."""
-        start, end = faces.ravel(), faces[:, [1, 2, 0]].ravel()
-        key = np.minimum(start, end) * n_vertices + np.maximum(start, end)
-        order = np.argsort(key, kind="stable")  # a tessellation's keys come in long sorted runs
-        keys = key[order]
-        first = np.ones(len(keys), bool)
-        first[1:] = keys[1:] != keys[:-1]
-        starts = np.flatnonzero(first)
-        return cls(n_vertices, keys, order, starts, np.diff(np.append(starts, len(keys))))
-
-    def single_edges(self) -> IntArray:
-        """(B, 2) vertex ids, smaller first, of the edges used by one face edge only, in key order."""
-        single = self.keys[self.starts[self.uses == 1]]
-        return np.column_stack((single // self.n_vertices, single % self.n_vertices))
-
-    def face_pairs(self) -> IntArray:
-        """(P, 2) the two faces on each edge that exactly two face edges use, when the faces are distinct:
-        trimesh's ``face_adjacency`` up to the order of the pairs and within them."""
-        twice = self.starts[self.uses == 2]
-        pairs = self.order[np.column_stack((twice, twice + 1))] // 3
-        return pairs[pairs[:, 0] != pairs[:, 1]]
-
-
-def _boundary_loops(edges: _EdgeTable) -> list[IntArray]:
+def _boundary_loops(edges: EdgeTable) -> list[IntArray]:
     """Vertex ids of each chain of boundary edges (edges of one face), as connected components."""
     import trimesh
 
@@ -259,7 +213,7 @@ def _faces_near(vertices: Points, faces: IntArray, ends: Points, reach: FloatArr
     return near
 
 
-def _flat_regions(vertices: Points, faces: IntArray, edges: _EdgeTable, near: np.ndarray) -> list[IntArray]:
+def _flat_regions(vertices: Points, faces: IntArray, edges: EdgeTable, near: np.ndarray) -> list[IntArray]:
     """Face ids of each connected region of two or more faces whose neighbours differ by < ``FLAT_ANGLE_DEG``.
 
     Only the regions holding a face of ``near`` (bool per face), in the order of their smallest face id.
@@ -299,8 +253,6 @@ def _region_rim(faces: IntArray, facet: IntArray, n_vertices: int) -> IntArray:
     Only the region's own 3 F edges are grouped (not a mask over the whole mesh's edges): the cost
     follows the region's size, which matters on a million-triangle wall with hundreds of flat pairs.
     """
-    ids = np.sort(_EdgeTable.of(faces[facet], n_vertices).single_edges(), axis=None)
+    ids = np.sort(EdgeTable.of(faces[facet], n_vertices).single_edges(), axis=None)
     # np.unique, sorted; numpy 2.4's np.unique hashes integers first, ten times slower at these sizes
-    first = np.ones(len(ids), bool)
-    first[1:] = ids[1:] != ids[:-1]
-    return ids[first]
+    return ids[run_starts(ids)]

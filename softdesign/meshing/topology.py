@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from softdesign.geometry.edges import edge_keys, run_starts
 from softdesign.types import FloatArray, IntArray
 
 
@@ -207,10 +208,10 @@ def edge_uses(faces: npt.ArrayLike, n_vertices: int) -> tuple[IntArray, IntArray
     uses : (E,) int64
     """
     faces = np.asarray(faces, np.int64)
-    key = np.sort(_half_edge_keys(faces, n_vertices) >> 1)
+    key = np.sort(edge_keys(faces, n_vertices))
     if key.size == 0:
         return np.zeros((0, 2), np.int64), np.zeros(0, np.int64)
-    starts = np.flatnonzero(np.concatenate([[True], key[1:] != key[:-1]]))
+    starts = run_starts(key)
     edge = key[starts]
     uses = np.diff(np.append(starts, key.size))
     return np.column_stack([edge // n_vertices, edge % n_vertices]), uses
@@ -266,9 +267,9 @@ def _checked_arrays(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> tuple[Floa
 
 
 def _half_edge_keys(faces: IntArray, n_vertices: int) -> IntArray:
-    """Key ``2 (min(a, b) V + max(a, b)) + (a > b)`` of half-edge j = 3f + p, a = faces[f, p] -> b = faces[f, p + 1]."""
-    start, end = faces.ravel(), np.roll(faces, -1, axis=1).ravel()
-    return 2 * (np.minimum(start, end) * n_vertices + np.maximum(start, end)) + (start > end)
+    """Key ``2 (min(a, b) V + max(a, b)) + (a > b)`` of half-edge j = 3f + p, a = faces[f, p] -> b = faces[f, p + 1]:
+    twice its edge's :func:`~softdesign.geometry.edges.edge_keys`, plus its direction."""
+    return 2 * edge_keys(faces, n_vertices) + (faces.ravel() > faces[:, [1, 2, 0]].ravel())
 
 
 def _half_edges(faces: IntArray, n_vertices: int) -> tuple[IntArray | None, bool, bool, int]:

@@ -158,7 +158,7 @@ def test_the_faces_near_an_end_are_those_whose_centres_lie_within_reach():
 def test_the_edge_table_pairs_faces_and_finds_boundary_edges_as_trimesh_does():
     import trimesh
 
-    from softdesign.geometry.end_planes import _EdgeTable
+    from softdesign.geometry.edges import EdgeTable
 
     # an open tube with a duplicated face (edges of 3 and 4 face edges), degenerate faces (one on an edge of the
     # wall, one whose only edge a-c no other face has, used twice by it alone) and faces in shuffled order
@@ -169,7 +169,7 @@ def test_the_edge_table_pairs_faces_and_finds_boundary_edges_as_trimesh_does():
     faces = np.concatenate([faces, faces[:1], [[a, b, a], [a, c, a]]])
     faces = faces[np.random.default_rng(0).permutation(len(faces))]
     mesh = trimesh.Trimesh(tube.vertices, faces, process=False)
-    table = _EdgeTable.of(faces, len(mesh.vertices))
+    table = EdgeTable.of(faces, len(mesh.vertices))
     assert {tuple(sorted(p)) for p in table.face_pairs().tolist()} == {tuple(p) for p in mesh.face_adjacency.tolist()}
     once = mesh.edges_sorted[trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1)]
     assert sorted(map(tuple, table.single_edges().tolist())) == sorted(map(tuple, once.tolist()))

@@ -1,0 +1,73 @@
+"""A triangle mesh's edges grouped by vertex pair, by one sort of integer keys.
+
+Edge 3 f + p of face f joins ``faces[f, p]`` and ``faces[f, (p + 1) % 3]``
+(trimesh's ``faces_to_edges`` order); its key ``min V + max`` (V vertices,
+int64 up to V = 3e9) is the same for both directions.  Sorted, the keys put
+the face edges of one vertex pair next to each other: the mesh checks
+(:mod:`softdesign.meshing.topology`) and the end planes
+(:mod:`softdesign.geometry.end_planes`) read boundaries, adjacency and edge
+counts from them instead of trimesh's row grouping, which hashes and sorts
+the 3 F rows again for each question.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from softdesign.types import IntArray
+
+
+def edge_keys(faces: IntArray, n_vertices: int) -> IntArray:
+    """(3 F,) int64: the key ``min V + max`` of each face edge, in the order 3 f + p."""
+    start, end = faces.ravel(), faces[:, [1, 2, 0]].ravel()
+    return np.minimum(start, end) * n_vertices + np.maximum(start, end)
+
+
+def run_starts(values: IntArray) -> IntArray:
+    """Where each run of equal values of the sorted ``values`` begins (their first positions), (G,) int64."""
+    first = np.ones(len(values), bool)
+    first[1:] = values[1:] != values[:-1]
+    return np.flatnonzero(first)
+
+
+@dataclass(frozen=True)
+class EdgeTable:
+    """The faces' edges (3 f + p, :func:`edge_keys`), grouped by vertex pair.
+
+    Attributes
+    ----------
+    n_vertices : V, the vertex count the keys are made with
+    keys : (3 F,) int64, the edges' keys, sorted
+    order : (3 F,) int64, the edge (3 f + p) at each position of ``keys``
+    starts : (G,) int64, where each group of equal keys begins in ``keys``
+    uses : (G,) int64, the group's size: how many face edges join that vertex pair
+    """
+
+    n_vertices: int
+    keys: IntArray
+    order: IntArray
+    starts: IntArray
+    uses: IntArray
+
+    @classmethod
+    def of(cls, faces: IntArray, n_vertices: int) -> EdgeTable:
+        """The table of ``faces`` (F, 3) on ``n_vertices`` vertices."""
+        key = edge_keys(faces, n_vertices)
+        order = np.argsort(key, kind="stable")  # a tessellation's keys come in long sorted runs
+        keys = key[order]
+        starts = run_starts(keys)
+        return cls(n_vertices, keys, order, starts, np.diff(np.append(starts, len(keys))))
+
+    def single_edges(self) -> IntArray:
+        """(B, 2) vertex ids, smaller first, of the edges used by one face edge only, in key order."""
+        single = self.keys[self.starts[self.uses == 1]]
+        return np.column_stack((single // self.n_vertices, single % self.n_vertices))
+
+    def face_pairs(self) -> IntArray:
+        """(P, 2) the two faces on each edge that exactly two face edges use, when the faces are distinct:
+        trimesh's ``face_adjacency`` up to the order of the pairs and within them."""
+        twice = self.starts[self.uses == 2]
+        pairs = self.order[np.column_stack((twice, twice + 1))] // 3
+        return pairs[pairs[:, 0] != pairs[:, 1]]
