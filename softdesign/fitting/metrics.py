@@ -28,6 +28,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import ConfigError
+from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import FitSettings, RadiusSpline, fold_solver
 from softdesign.fitting.mapping import Mapper, serial_map
 from softdesign.fitting.projection import PolarPoints
@@ -232,7 +233,7 @@ def _closest(
     (perhaps on other processes: the same numbers; a single block always runs here).
     """
     twist = frame_twist_table(curve)
-    rows = [slice(lo, lo + CLOSEST_CHUNK) for lo in range(0, max(len(p), 1), CLOSEST_CHUNK)]
+    rows = bb.chunks(len(p), CLOSEST_CHUNK)
 
     def piece(r: slice) -> tuple[FloatArray, FloatArray, FloatArray, CurvePart]:
         return _closest_piece(curve, spline, twist, p[r], start.subset(r))

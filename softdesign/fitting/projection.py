@@ -23,6 +23,7 @@ import numpy.typing as npt
 from scipy.spatial import cKDTree
 
 from softdesign.errors import InputDataError
+from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.mapping import Mapper, serial_map
 from softdesign.types import FloatArray, FramedCurve, Points
 
@@ -97,7 +98,7 @@ def project_points(curve: FramedCurve, points: npt.ArrayLike, mapper: Mapper = s
         )
     if len(points) <= PROJECT_BLOCK:
         return PolarPoints(points.copy(), *_polar(curve, points))
-    blocks = [slice(lo, lo + PROJECT_BLOCK) for lo in range(0, len(points), PROJECT_BLOCK)]
+    blocks = bb.chunks(len(points), PROJECT_BLOCK)
     parts = mapper(lambda rows: _polar(curve, points[rows]), blocks)
     l, angle, rho, side = (np.concatenate([part[k] for part in parts]) for k in range(4))
     return PolarPoints(points.copy(), l, angle, rho, side)

@@ -263,14 +263,12 @@ def fold_margin(curve: FramedCurve, field: RadiusField, q: float = 1.0) -> FoldR
     cos, sin = np.cos(a)[None, :], np.sin(a)[None, :]
     rows = SlopeRows(field, q, l, a, slopes=False)
     best, at, smallest = -np.inf, (0, 0), []
-    step = row_blocks(len(l), len(a))
-    for start in step:  # the largest first in row-major order, as np.argmax over the whole grid
-        rho = rows.values(start, start + step.step)
-        block = slice(start, start + step.step)
+    for block in row_blocks(len(l), len(a)):  # the largest first in row-major order, as np.argmax over the whole grid
+        rho = rows.values(block.start, block.stop)
         product = rho * (k_n[block, None] * cos + k_b[block, None] * sin)
         i, j = np.unravel_index(int(np.argmax(product)), product.shape)
-        if start == 0 or (not np.isnan(best) and (np.isnan(product[i, j]) or product[i, j] > best)):
-            best, at = float(product[i, j]), (start + int(i), int(j))
+        if block.start == 0 or (not np.isnan(best) and (np.isnan(product[i, j]) or product[i, j] > best)):
+            best, at = float(product[i, j]), (block.start + int(i), int(j))
         smallest.append(rho.min())
     row, column = at
     return FoldReport(best, float(l[row]), float(l[row] * curve.length), float(a[column]), float(np.min(smallest)))

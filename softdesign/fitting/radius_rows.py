@@ -28,9 +28,10 @@ if TYPE_CHECKING:  # the field builds its bases; this module only reads them
 BLOCK_POINTS = 16384
 
 
-def row_blocks(rows: int, points_per_row: int) -> range:
-    """Starts of the blocks of whole rows of about ``BLOCK_POINTS`` points (at least one row each)."""
-    return range(0, rows, max(1, BLOCK_POINTS // max(1, points_per_row)))
+def row_blocks(rows: int, points_per_row: int) -> list[slice]:
+    """The blocks of whole rows of about ``BLOCK_POINTS`` points (at least one row each), in order; none for no row."""
+    size = max(1, BLOCK_POINTS // max(1, points_per_row))
+    return [slice(start, start + size) for start in range(0, rows, size)]
 
 
 class SlopeRows:

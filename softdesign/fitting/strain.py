@@ -160,9 +160,7 @@ def principal_stretches(rest: npt.ArrayLike, deformed: npt.ArrayLike) -> tuple[F
     if rest.shape != deformed.shape or rest.ndim < 2:
         return _principal_stretches(rest, deformed)
     lam1, lam2 = np.empty(rest.shape[:-1]), np.empty(rest.shape[:-1])
-    step = row_blocks(len(rest), rest[0].size // 3)
-    for start in step:
-        rows = slice(start, start + step.step)
+    for rows in row_blocks(len(rest), rest[0].size // 3):
         lam1[rows], lam2[rows] = _principal_stretches(rest[rows], deformed[rows])
     return lam1, lam2
 
@@ -240,9 +238,7 @@ def skin_metric(curve: FramedDerivatives, field: RadiusField, q: float, l: npt.A
     speed, curvature, twist = curve_terms(curve, l, frames_mode)
     rows = SlopeRows(field, q, l, a)
     planes = np.empty((3, len(l), np.size(a)))
-    step = row_blocks(len(l), np.size(a))
-    for start in step:
-        block = slice(start, start + step.step)
-        tube_metric(speed[block], curvature[block], twist[block], a, *rows(start, start + step.step),
+    for block in row_blocks(len(l), np.size(a)):
+        tube_metric(speed[block], curvature[block], twist[block], a, *rows(block.start, block.stop),
                     out=planes[:, block])
     return np.moveaxis(planes, 0, -1)

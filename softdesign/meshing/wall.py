@@ -87,10 +87,8 @@ def offset_metric(curve: FramedSpline, field: RadiusField, q: float, l: npt.Arra
     rows = [SlopeRows(field, q, at, a, angular=False) for at in grids]
     cos, sin = np.cos(a), np.sin(a)
     planes = np.empty((3, len(l), len(a)))
-    step = row_blocks(len(l), len(a))
-    for start in step:
-        block = slice(start, start + step.step)
-        xy, plus, minus = (_offset_xy(*r.along(start, start + step.step), speed[block], curvature[block], offset_mm,
+    for block in row_blocks(len(l), len(a)):
+        xy, plus, minus = (_offset_xy(*r.along(block.start, block.stop), speed[block], curvature[block], offset_mm,
                                       cos, sin) for r, (speed, curvature, _) in zip(rows, terms, strict=True))
         xy_l = np.subtract(plus, minus, out=plus)
         xy_l /= 2.0 * h

@@ -23,8 +23,8 @@ from softdesign.fitting.metrics import (
     surface_points,
 )
 from softdesign.fitting.projection import project_points
-from softdesign.pipeline.parallel import jobs_for_build, map_items
 from tests.helpers.analytic import Arc, FrenetHelix, Helix, Line, grid_parameters, tube_points
+from tests.helpers.workers import two_worker_mapper
 
 #: Gauss-Newton stops at 1e-5 mm steps, past which the distance barely moves: the distances here come out within
 #: ~1e-13 mm of the closed forms (the fitted shapes are exact to ~1e-12 mm).
@@ -220,13 +220,7 @@ def test_distances_are_the_same_bits_in_blocks_on_worker_processes(monkeypatch):
     spline = fit_radius_surface(noisy, curve.length, FitSettings()).whole
     whole = measure_distances(curve, spline, noisy, np.random.default_rng(0))
     monkeypatch.setattr(metrics, "CLOSEST_CHUNK", 500)
-    blocks = []
-
-    def mapper(task, items):
-        blocks.append(len(items))
-        with jobs_for_build(2):
-            return map_items(task, items)
-
+    mapper, blocks = two_worker_mapper()
     split = measure_distances(curve, spline, noisy, np.random.default_rng(0), mapper=mapper)
     assert blocks == [5]
     assert split.metrics == whole.metrics

@@ -8,8 +8,8 @@ import pytest
 from softdesign.errors import InputDataError
 from softdesign.fitting import projection
 from softdesign.fitting.projection import NEWTON_TOL_MM, project_points
-from softdesign.pipeline.parallel import jobs_for_build, map_items
 from tests.helpers.analytic import Arc, Helix, Line, tube_points
+from tests.helpers.workers import two_worker_mapper
 
 #: Newton stops at NEWTON_TOL_MM of arc; 100x leaves room for rounding in c(l) at ~100 mm coordinates.
 ARC_TOL_MM = 100 * NEWTON_TOL_MM
@@ -74,13 +74,7 @@ def test_blocks_on_worker_processes_give_the_same_bits(monkeypatch):
     points = tube_points(curve, rng.uniform(-0.02, 1.02, n), rng.uniform(-np.pi, np.pi, n), rng.uniform(0.5, 5.0, n))
     whole = project_points(curve, points)
     monkeypatch.setattr(projection, "PROJECT_BLOCK", 300)
-    blocks = []
-
-    def mapper(task, items):
-        blocks.append(len(items))
-        with jobs_for_build(2):
-            return map_items(task, items)
-
+    mapper, blocks = two_worker_mapper()
     split = project_points(curve, points, mapper)
     assert blocks == [7]
     for name in ("points", "l", "angle", "rho", "end_side"):
