@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import zipfile
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -45,6 +46,16 @@ class BuildData:
     kinematics: KinematicsResult
     fit: FitResult | None
     export_summary: dict[str, Any] | None
+
+    @cached_property
+    def vessel_display(self) -> tuple[Any, Any, float]:
+        """(vertices, faces, display error mm): the input vessel as the report shows it, found once per build data.
+
+        :func:`softdesign.report.display_mesh.decimated_vessel`; the 3D view and the surface figure both show it.
+        """
+        from softdesign.report.display_mesh import decimated_vessel
+
+        return decimated_vessel(self.ingest.vertices, self.ingest.faces)
 
     @property
     def name(self) -> str:

@@ -44,7 +44,6 @@ from softdesign.report import interactive_parts
 from softdesign.report.build_folder import BuildData
 from softdesign.report.display_mesh import (
     DISPLAY_TOLERANCE_MM,
-    decimated_vessel,
     max_distance_to_mesh,
 )
 from softdesign.report.plotting import link_colours
@@ -169,7 +168,7 @@ def morph_figure(data: BuildData, frames: int = FRAMES) -> tuple[dict[str, Any],
     notes.extend(chamber.notes if chamber is not None else [])
     moving = list(range(len(traces)))
     if len(data.ingest.faces):
-        v, f, error = decimated_vessel(data.ingest.vertices, data.ingest.faces)
+        v, f, error = data.vessel_display
         v = v.astype(np.float32)
         traces.append({"color": _rgb(VESSEL_RGB), "hoverinfo": "skip", "i": f[:, 0], "j": f[:, 1], "k": f[:, 2],
                        "name": "patient's vessel (input)", "opacity": VESSEL_OPACITY, "showlegend": True,

@@ -20,7 +20,7 @@ from softdesign.fitting.radius_field import RadiusField
 from softdesign.io.surface import read_surface
 from softdesign.kinematics.links import LinkChain
 from softdesign.report.build_folder import BuildData
-from softdesign.report.display_mesh import DISPLAY_TOLERANCE_MM, decimated_vessel
+from softdesign.report.display_mesh import DISPLAY_TOLERANCE_MM
 from softdesign.report.plotting import Picture, add_polygons, fixed_figure, picture, styled
 from softdesign.report.projection import View, principal_view, shaded_triangles
 from softdesign.types import FloatArray
@@ -118,7 +118,7 @@ def surface_bodies(data: BuildData) -> list[Body]:
     bodies = []
     if len(data.ingest.faces):
         name = data.manifest.get("metrics", {}).get("ingest", {}).get("surface", {}) or {}
-        vertices, faces, error = decimated_vessel(data.ingest.vertices, data.ingest.faces)
+        vertices, faces, error = data.vessel_display
         source = name.get("file", "input")
         if len(faces) < len(data.ingest.faces):
             source += (f" (shown decimated: {len(faces)} of {len(data.ingest.faces)} triangles, display error "

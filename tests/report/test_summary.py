@@ -9,8 +9,8 @@ import pytest
 import trimesh
 
 from softdesign.report import display_mesh
+from softdesign.report.display_mesh import decimated_vessel
 from softdesign.report.html_page import banner_html, compact_check_tables
-from softdesign.report.interactive import decimated_vessel
 from softdesign.report.summary import summary_warnings
 from softdesign.report.tables import Check
 
