@@ -53,7 +53,7 @@ def _frame_geometry(chain: LinkChain, field: RadiusField | None, q: float, view:
 
 def morph_frames(chain: LinkChain, field: RadiusField | None, frames: int = FRAMES) -> list:
     """The frames as RGB Pillow images of :data:`SIZE_IN` at :data:`DPI`."""
-    from matplotlib.collections import PolyCollection
+    from softdesign.report.flat_triangles import FlatTriangles
 
     curve = chain.shape.curve_at(1.0)
     samples = curve.points(np.linspace(0.0, 1.0, 101))
@@ -67,8 +67,8 @@ def morph_frames(chain: LinkChain, field: RadiusField | None, frames: int = FRAM
         ax.set_aspect("equal", adjustable="datalim")
         ax.autoscale_view()
         ax.set(xlabel=view.labels[0], ylabel=view.labels[1])
-        artist = ax.plot([], [], color="k", lw=2.0)[0] if field is None else ax.add_collection(
-            PolyCollection([], linewidths=0.0, antialiaseds=False)  # aliased faces leave no seams to hide
+        artist = ax.plot([], [], color="k", lw=2.0)[0] if field is None else ax.add_artist(
+            FlatTriangles(np.zeros((0, 3, 2)), np.zeros((0, 3)))
         )
         background = _background(figure, ax, artist, geometry[0])
         return [_draw_frame(figure, ax, artist, background, frame) for frame in geometry]
@@ -80,8 +80,7 @@ def _set_frame(ax, artist, frame) -> None:
     if colours is None:
         artist.set_data(shape[:, 0], shape[:, 1])
     else:
-        artist.set_verts(shape)
-        artist.set_facecolor(colours)
+        artist.set_data(shape, colours)
     ax.set_title(f"q = {q:.2f}")
 
 

@@ -68,9 +68,10 @@ def mould_figure_png(build_dir: str | Path) -> bytes | None:
 def _exploded_png(build_dir: Path, block: dict[str, Any] | None) -> bytes | None:
     """The picture of the mould the manifest's ``metrics.mould`` ``block`` describes; None without a mould."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.collections import PolyCollection
     from matplotlib.figure import Figure
     from matplotlib.patches import Patch
+
+    from softdesign.report.flat_triangles import FlatTriangles
 
     if not block or not block.get("requested"):
         return None
@@ -90,7 +91,7 @@ def _exploded_png(build_dir: Path, block: dict[str, Any] | None) -> bytes | None
     figure = Figure(figsize=SIZE_IN, dpi=DPI)
     FigureCanvasAgg(figure)
     ax = figure.add_axes((0.02, 0.02, 0.96, 0.9))
-    ax.add_collection(PolyCollection(list(screen[order]), facecolors=rgba[order], edgecolors="none"), autolim=False)
+    ax.add_artist(FlatTriangles(screen[order], rgba[order]))
     ax.set_xlim(screen[..., 0].min(), screen[..., 0].max())
     ax.set_ylim(screen[..., 1].min(), screen[..., 1].max())
     ax.set_aspect("equal")

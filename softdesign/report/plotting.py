@@ -133,16 +133,6 @@ def picture(name: str, figure, size_in: tuple[float, float], title: str, caption
     return Picture(name, data, pixel_size(size_in), title, caption)
 
 
-def add_polygons(ax, collection, points) -> None:
-    """Add a polygon ``collection`` to ``ax``, its data limits from its ``points`` (..., 2) (mm on screen).
-
-    The limits are the points' bounds, which matplotlib's own ``autolim`` finds too but by building every
-    polygon's path extents (about 0.2 s for the tens of thousands of triangles of a shaded body).
-    """
-    ax.add_collection(collection, autolim=False)
-    ax.update_datalim(np.asarray(points, float).reshape(-1, 2))
-
-
 def link_colours(count: int) -> list[tuple[float, float, float, float]]:
     """One distinct colour per link, none of them the triads' red, green or blue."""
     import matplotlib

@@ -17,7 +17,7 @@ from softdesign.fitting.strain import principal_stretches, skin_metric
 from softdesign.meshing.volume import BodySpec
 from softdesign.meshing.wall import wall_map
 from softdesign.report.build_folder import BuildData
-from softdesign.report.plotting import Picture, add_polygons, fixed_figure, picture, styled
+from softdesign.report.plotting import Picture, fixed_figure, picture, styled
 from softdesign.report.projection import principal_view, shaded_triangles
 from softdesign.report.surface_figures import tube_mesh
 from softdesign.types import FloatArray
@@ -102,7 +102,8 @@ def stretch_picture(data: BuildData) -> Picture | None:
 def _body(figure, ax, data: BuildData, grid) -> None:
     """lambda1 at q = 1 painted on the tube, seen as the surfaces figure sees it."""
     import matplotlib
-    from matplotlib.collections import PolyCollection
+
+    from softdesign.report.flat_triangles import add_triangles
 
     assert data.fit is not None
     chain = data.kinematics.chain
@@ -117,9 +118,7 @@ def _body(figure, ax, data: BuildData, grid) -> None:
     values = lam1[cell // MAP_ANGLES, cell % MAP_ANGLES]
     norm = matplotlib.colors.Normalize(1.0, max(float(lam1.max()), 1.0))
     colours = matplotlib.colormaps["magma"](norm(values))[:, :3] * shaded.brightness[:, None]
-    # an (n, 3, 2) array is a documented verts argument (matplotlib's fast path); the stubs accept only a Sequence
-    add_polygons(ax, PolyCollection(shaded.triangles, facecolors=colours, edgecolors=colours,  # type: ignore[arg-type]
-                                    linewidths=0.15), shaded.triangles)
+    add_triangles(ax, shaded.triangles, colours)
     ax.set_aspect("equal", adjustable="datalim")
     ax.autoscale_view()
     ax.set_title("lambda1 at q = 1 on the body")

@@ -21,7 +21,7 @@ from softdesign.io.surface import read_surface
 from softdesign.kinematics.links import LinkChain
 from softdesign.report.build_folder import BuildData
 from softdesign.report.display_mesh import DISPLAY_TOLERANCE_MM
-from softdesign.report.plotting import Picture, add_polygons, fixed_figure, picture, styled
+from softdesign.report.plotting import Picture, fixed_figure, picture, styled
 from softdesign.report.projection import View, principal_view, shaded_triangles
 from softdesign.types import FloatArray
 
@@ -98,14 +98,10 @@ def actuator_body(data: BuildData, q: float) -> Body | None:
 
 def draw_shaded(ax, body: Body, view: View) -> None:
     """One shaded body on a 2-D axes with equal scale."""
-    from matplotlib.collections import PolyCollection
+    from softdesign.report.flat_triangles import add_triangles
 
     triangles, brightness, _ = shaded_triangles(body.vertices, body.faces, view, cull=body.closed)
-    colours = np.clip(brightness[:, None] * np.asarray(body.rgb)[None, :], 0.0, 1.0)
-    # edges in the face colour close the hairline gaps antialiasing leaves between neighbours
-    # an (n, 3, 2) array is a documented verts argument (and matplotlib's fast path); the stubs accept only a Sequence
-    shaded = PolyCollection(triangles, facecolors=colours, edgecolors=colours, linewidths=0.15)  # type: ignore[arg-type]
-    add_polygons(ax, shaded, triangles)
+    add_triangles(ax, triangles, np.clip(brightness[:, None] * np.asarray(body.rgb)[None, :], 0.0, 1.0))
     ax.set_aspect("equal", adjustable="datalim")
     ax.autoscale_view()
     ax.set_title(body.title)

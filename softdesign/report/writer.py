@@ -182,6 +182,8 @@ def _import_drawing_libraries() -> None:
     import PIL.Image  # noqa: F401
     import plotly.io  # noqa: F401
 
+    import softdesign.report.flat_triangles  # noqa: F401
+
 
 @dataclass(frozen=True)
 class ReportResult:
