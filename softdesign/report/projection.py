@@ -99,6 +99,23 @@ def shaded_triangles(vertices: npt.ArrayLike, faces: npt.ArrayLike, view: View, 
     return ShadedFaces(tri[index[order], :, :2], brightness[order], index[order])
 
 
+def painted_last(screen_points: npt.ArrayLike, cell: float) -> np.ndarray:
+    """Indices (sorted) of the last point in every square ``cell`` of the screen: what a painter leaves visible.
+
+    ``screen_points`` (n, 2) are in drawing order (far to near); of the points sharing a cell, the last is
+    drawn over the others, so drawing only it, at its own position, changes the picture by less than a cell.
+    """
+    p = np.asarray(screen_points, float).reshape(-1, 2)
+    if not len(p):
+        return np.zeros(0, np.int64)
+    if not cell > 0.0:
+        raise ValueError(f"cell must be > 0, got {cell}")
+    keys = np.floor((p - p.min(axis=0)) / cell).astype(np.int64)
+    flat = keys[:, 0] * (int(keys[:, 1].max()) + 1) + keys[:, 1]
+    _, first_from_end = np.unique(flat[::-1], return_index=True)
+    return np.sort(len(flat) - 1 - first_from_end)
+
+
 def bounding_limits(
     screen_points: list[FloatArray], margin: float = 0.04
 ) -> tuple[tuple[float, float], tuple[float, float]]:

@@ -535,3 +535,18 @@ def test_the_hollow_body_is_cut_through_its_wall_and_chamber(tmp_path):
     glb = trimesh.load(tmp_path / "build" / "meshes" / "q_1.000.glb", force="mesh")
     stl = trimesh.load(tmp_path / "build" / "meshes" / "q_1.000.stl")
     np.testing.assert_allclose(glb.extents * 1000.0, stl.extents, rtol=1e-6, atol=0)  # glTF in metres
+
+
+def test_a_large_surface_map_draws_the_points_left_on_top_and_says_so(demo, monkeypatch):
+    from softdesign.report import fit_figures
+    from softdesign.report.build_folder import load_build
+
+    data = load_build(demo[0])
+    distances = fit_figures.true_distances(data)
+    total = len(data.ingest.vertices)
+    assert "The map draws" not in fit_figures.distance_picture(data, distances).caption  # under MAP_POINTS: all
+    monkeypatch.setattr(fit_figures, "MAP_POINTS", 1000)  # the demo's 8,455 vertices count as a large surface
+    caption = fit_figures.distance_picture(data, distances).caption
+    shown = int(caption.split("The map draws ")[1].split(" of ")[0])
+    assert f"of the {total} vertices" in caption
+    assert 0 < shown < total
