@@ -80,7 +80,7 @@ demo: bytecode
 test: $(STAMP) $(CLUSTER_STAMP)
 	$(BIN)/python -m pytest
 
-# Everything but the tests marked slow (whole builds, cohorts, reports): under a minute.
+# Everything but the tests marked slow (whole builds, cohorts, reports): about 2 minutes on 2 cores.
 test-fast: $(STAMP) $(CLUSTER_STAMP)
 	$(BIN)/python -m pytest -m "not slow"
 
