@@ -217,6 +217,6 @@ def distance_picture(data: BuildData, distances: FloatArray) -> Picture:
     )
     total = len(data.ingest.vertices)
     if shown < total:
-        caption += (f" The map draws {shown} of the {total} vertices: in each cell of {MAP_CELL_PX:g} pixel, the one "
-                    "drawn last (nearest the viewer), so the picture differs by under a pixel.")
+        caption += (f" The map draws {shown} of the {total} vertices: of those within each {MAP_CELL_PX:g}-pixel "
+                    "square, the one drawn last (nearest the viewer), so the picture differs by under a pixel.")
     return picture("fit_distances.png", figure, DISTANCE_SIZE_IN, "Fit distances and excluded points", caption)

@@ -110,8 +110,11 @@ def painted_last(screen_points: npt.ArrayLike, cell: float) -> np.ndarray:
         return np.zeros(0, np.int64)
     if not cell > 0.0:
         raise ValueError(f"cell must be > 0, got {cell}")
+    span = np.floor(np.ptp(p, axis=0) / cell) + 1.0  # cells along x and y
+    if span[0] * span[1] > 2.0**62:
+        raise ValueError(f"cell {cell} is too small for the points' extent {np.ptp(p, axis=0)}: more than 2^62 cells")
     keys = np.floor((p - p.min(axis=0)) / cell).astype(np.int64)
-    flat = keys[:, 0] * (int(keys[:, 1].max()) + 1) + keys[:, 1]
+    flat = keys[:, 0] * int(span[1]) + keys[:, 1]
     _, first_from_end = np.unique(flat[::-1], return_index=True)
     return np.sort(len(flat) - 1 - first_from_end)
 

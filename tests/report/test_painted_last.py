@@ -28,6 +28,8 @@ def test_no_points_and_a_bad_cell():
     assert len(painted_last(np.zeros((0, 2)), 1.0)) == 0
     with pytest.raises(ValueError, match="cell must be > 0"):
         painted_last(np.ones((3, 2)), 0.0)
+    with pytest.raises(ValueError, match="too small for the points' extent"):
+        painted_last(np.array([[0.0, 0.0], [1e9, 1e9]]), 1e-9)
 
 
 def _scatter_pixels(xy: np.ndarray, colours: np.ndarray) -> np.ndarray:
