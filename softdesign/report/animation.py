@@ -19,8 +19,8 @@ import numpy as np
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.kinematics.links import LinkChain
 from softdesign.report.plotting import DPI, Picture, link_colours, new_figure, styled
-from softdesign.report.projection import View, bounding_limits, principal_view, shaded_triangles
-from softdesign.report.surface_figures import tube_mesh
+from softdesign.report.projection import View, bounding_limits, shaded_triangles
+from softdesign.report.surface_figures import final_view, tube_mesh
 from softdesign.types import FloatArray
 
 SIZE_IN = (6.4, 4.0)
@@ -55,9 +55,7 @@ def morph_frames(chain: LinkChain, field: RadiusField | None, frames: int = FRAM
     """The frames as RGB Pillow images of :data:`SIZE_IN` at :data:`DPI`."""
     from softdesign.report.flat_triangles import FlatTriangles
 
-    curve = chain.shape.curve_at(1.0)
-    samples = curve.points(np.linspace(0.0, 1.0, 101))
-    view = principal_view(samples, samples[-1] - samples[0])
+    view = final_view(chain)
     geometry = [(q, *_frame_geometry(chain, field, float(q), view)) for q in frame_q(frames)]
     xlim, ylim = bounding_limits([g[1].reshape(-1, 2) for g in geometry])
     with styled():

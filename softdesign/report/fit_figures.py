@@ -25,7 +25,8 @@ from softdesign.fitting.selection import REASONS
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.report.build_folder import BuildData
 from softdesign.report.plotting import Picture, fixed_figure, grid_shape, panels, picture, styled
-from softdesign.report.projection import painted_last, principal_view
+from softdesign.report.projection import painted_last
+from softdesign.report.surface_figures import final_view
 from softdesign.types import FloatArray
 
 RESIDUAL_SIZE_IN = (12.0, 6.0)
@@ -173,9 +174,7 @@ def exclusion_views(ax_map, ax_bar, data: BuildData) -> int:
     from matplotlib.colors import to_rgba_array
 
     reason = _fit_of(data).points["reason"]
-    curve = data.kinematics.chain.shape.curve_at(1.0)
-    samples = curve.points(np.linspace(0.0, 1.0, 101))
-    view = principal_view(samples, samples[-1] - samples[0])
+    view = final_view(data.kinematics.chain)
     order = np.argsort(view.coordinates(data.ingest.vertices)[:, 2], kind="stable")
     xy = view.project(data.ingest.vertices)[order]
     colours = to_rgba_array(REASON_COLOURS)[reason[order]]

@@ -18,8 +18,8 @@ from softdesign.meshing.volume import BodySpec
 from softdesign.meshing.wall import wall_map
 from softdesign.report.build_folder import BuildData
 from softdesign.report.plotting import Picture, fixed_figure, picture, styled
-from softdesign.report.projection import principal_view, shaded_triangles
-from softdesign.report.surface_figures import tube_mesh
+from softdesign.report.projection import shaded_triangles
+from softdesign.report.surface_figures import final_view, tube_mesh
 from softdesign.types import FloatArray
 
 SIZE_IN = (13.0, 8.0)
@@ -109,8 +109,7 @@ def _body(figure, ax, data: BuildData, grid) -> None:
     chain = data.kinematics.chain
     l, a, lam1, _ = grid
     vertices, faces, _ = tube_mesh(chain, data.fit.field, 1.0, MAP_SPACING_MM, MAP_ANGLES)
-    samples = chain.shape.curve_at(1.0).points(np.linspace(0.0, 1.0, 101))
-    view = principal_view(samples, samples[-1] - samples[0])
+    view = final_view(chain)
     shaded = shaded_triangles(vertices, faces, view)
     # each face's ring and angle: faces come in two blocks of (rings - 1) x angles cells
     cells = len(faces) // 2

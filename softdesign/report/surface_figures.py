@@ -32,6 +32,8 @@ MARGINS_IN, GAPS_IN = (0.7, 0.2, 0.45, 0.3), (0.8, 0.75)
 #: Tube tessellation when a q has no exported mesh: spacing along the centerline (mm) and angles around.
 TUBE_SPACING_MM = 0.5
 TUBE_ANGLES = 48
+#: Samples of the final centerline whose direction of least spread every shaded figure looks along.
+VIEW_SAMPLES = 101
 #: Base colours (RGB), scaled by the brightness: the patient's vessel and the actuator.
 VESSEL_RGB = (0.86, 0.42, 0.38)
 ACTUATOR_RGB = (0.45, 0.62, 0.85)
@@ -47,6 +49,12 @@ class Body:
     source: str
     rgb: tuple[float, float, float] = ACTUATOR_RGB
     closed: bool = False  #: a checked, outward-wound solid: faces turned away are hidden and need not be drawn
+
+
+def final_view(chain: LinkChain) -> View:
+    """The view of every shaded figure: along the final (q = 1) centerline's direction of least spread, inlet first."""
+    samples = chain.shape.curve_at(1.0).points(np.linspace(0.0, 1.0, VIEW_SAMPLES))
+    return principal_view(samples, samples[-1] - samples[0])
 
 
 def intermediate_q(q_values: list[float]) -> float:
@@ -132,9 +140,7 @@ def surface_picture(data: BuildData) -> Picture | None:
     if data.fit is None:
         return None
     bodies = surface_bodies(data)
-    curve = data.kinematics.chain.shape.curve_at(1.0)
-    samples = curve.points(np.linspace(0.0, 1.0, 101))
-    view = principal_view(samples, samples[-1] - samples[0])
+    view = final_view(data.kinematics.chain)
     with styled():
         figure = fixed_figure(SIZE_IN, MARGINS_IN, GAPS_IN, (2, 2))
         for k, body in enumerate(bodies):
