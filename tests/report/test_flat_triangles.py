@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from softdesign.report.flat_triangles import FlatTriangles, add_triangles
-from softdesign.report.plotting import new_figure
+from tests.helpers.pixels import drawn_pixels
 
 #: 8-bit colour channels: a flat fill is exact up to the renderer's rounding of the interpolated corners.
 CHANNEL_ATOL = 2
@@ -15,14 +15,7 @@ RED, BLUE = (1.0, 0.0, 0.0), (0.0, 0.0, 1.0)
 
 def _canvas(draw) -> np.ndarray:
     """RGB pixels (rows from the top) of a 200 x 200 px axes spanning data (0, 1) x (0, 1) on white."""
-    figure = new_figure((2.0, 2.0), fixed=True)
-    ax = figure.add_axes((0.0, 0.0, 1.0, 1.0))
-    ax.set_axis_off()
-    draw(ax)
-    ax.set_xlim(0.0, 1.0)
-    ax.set_ylim(0.0, 1.0)
-    figure.canvas.draw()
-    return np.asarray(figure.canvas.buffer_rgba())[:, :, :3].astype(int)
+    return drawn_pixels(draw, 2.0, (0.0, 1.0))
 
 
 def _pixel(image: np.ndarray, x: float, y: float) -> np.ndarray:

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from softdesign.report.plotting import new_figure
 from softdesign.report.projection import painted_last
+from tests.helpers.pixels import drawn_pixels
 
 #: Share of the painted pixels a drawing of the kept points may change by more than an eighth of full scale
 #: (where markers of different colours overlap at a cell's border).
@@ -33,14 +33,8 @@ def test_no_points_and_a_bad_cell():
 
 
 def _scatter_pixels(xy: np.ndarray, colours: np.ndarray) -> np.ndarray:
-    figure = new_figure((3.0, 3.0), fixed=True)
-    ax = figure.add_axes((0.0, 0.0, 1.0, 1.0))
-    ax.set_axis_off()
-    ax.scatter(xy[:, 0], xy[:, 1], s=1.0, c=colours, linewidths=0)
-    ax.set_xlim(-1.0, 1.0)
-    ax.set_ylim(-1.0, 1.0)
-    figure.canvas.draw()
-    return np.asarray(figure.canvas.buffer_rgba())[:, :, :3].astype(int)
+    """RGB pixels of the points as the exclusion map draws them, on a 300 x 300 px axes spanning (-1, 1)."""
+    return drawn_pixels(lambda ax: ax.scatter(xy[:, 0], xy[:, 1], s=1.0, c=colours, linewidths=0), 3.0, (-1.0, 1.0))
 
 
 def test_drawing_only_the_kept_points_leaves_the_picture_as_it_was():
