@@ -26,8 +26,9 @@ COHORT_SOFTDESIGN ?= $(BIN)/softdesign
 # Worker processes per case build (softdesign build --jobs): make -jN already builds N cases at a
 # time, so each case runs in one process; raise it for a few large cases on a machine with cores to spare.
 COHORT_JOBS ?= 1
-# What a case build needs first (not a reason to rebuild): the installed venv.
-COHORT_NEEDS ?= $(STAMP)
+# What a case build needs first (not a reason to rebuild): the installed venv and the package's bytecode
+# (`make bytecode`: a cohort starts a softdesign process per case and stage).
+COHORT_NEEDS ?= bytecode
 COHORT_TOOL = $(COHORT_PYTHON) pipelines/cohort_tool.py
 
 COHORT_DIR := $(patsubst %/,%,$(COHORT))
