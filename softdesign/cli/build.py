@@ -5,6 +5,7 @@ Parsing and printing live here; the stages are :mod:`softdesign.pipeline`.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -197,7 +198,7 @@ def _print_pose(payload: dict[str, Any]) -> None:
         omega = "null" if p["omega"] is None else "[" + ", ".join(f"{v:.4f}" for v in p["omega"]) + "]"
         typer.echo(
             f"link {link['index']} l {link['l_start']:.3f}..{link['l_end']:.3f}: length {link['length']:.3f} mm, "
-            f"theta1 {p['theta1']:.4f} mm, theta2 {p['theta2']:.5f} rad about {omega}"
+            f"theta1 {p['theta1']:.4f} mm, theta2 {math.degrees(p['theta2']):.4f} deg about {omega}"
         )
     typer.echo("base_to_tip:")
     for row in payload["base_to_tip"]:

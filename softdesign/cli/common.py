@@ -33,6 +33,8 @@ QOpt = Annotated[
                  show_default=False),
 ]
 
+#: The one angle convention of every text output (JSON keeps radians, DESIGN.md).
+TEXT_ANGLES = "angles in degrees in this text (the JSON of --json gives radians)"
 #: What Ctrl-C prints (exit 130, the shell's code for SIGINT).
 INTERRUPTED = "interrupted; the previous build is kept (nothing half-written is left)"
 
