@@ -18,6 +18,7 @@ from scipy.spatial import cKDTree
 
 from softdesign.centerline.closing import ClosedSurface, Opening, close_surface
 from softdesign.centerline.endpoints import caps_from_regions, choose_inlet, graph_extremities, planar_caps
+from softdesign.centerline.ends import EndTargets, reach_ends
 from softdesign.centerline.paths import (
     bridge_components,
     check_path_length,
@@ -71,6 +72,10 @@ class Centerlines:
     outlets : (3,) float per outlet
     voronoi_vertices : how many internal Voronoi vertices the paths were searched among
     notes : what was done on the way
+    continued_mm : (inlet, outlet) per path: how far each end was continued straight past the Voronoi
+        diagram's last vertex to its opening's centre (or a rounded end's axis tip), mm
+    short_mm : (inlet, outlet) per path: how far each end still is from its opening's centre, mm
+        (0 when reached, or when the end has no opening)
     """
 
     paths: tuple[Points, ...]
@@ -80,6 +85,8 @@ class Centerlines:
     outlets: tuple[FloatArray, ...]
     voronoi_vertices: int
     notes: tuple[str, ...] = field(default=())
+    continued_mm: tuple[tuple[float, float], ...] = field(default=())
+    short_mm: tuple[tuple[float, float], ...] = field(default=())
 
 
 def extract_centerlines(
@@ -110,19 +117,50 @@ def extract_centerlines(
     closed = close_surface(vertices, faces, where)
     graph = internal_voronoi(closed.vertices, closed.faces)
     kind, inlet, outlets, seeds = _endpoints(closed, graph, options, where)
-    spacing = SPACING_REL * mean_edge_length(closed.vertices, closed.faces)
-    smoothing = SMOOTHING_REL * mean_edge_length(closed.vertices, closed.faces)
+    edge = mean_edge_length(closed.vertices, closed.faces)
     tree = cKDTree(closed.vertices)
-    paths, radii = [], []
+    paths, radii, continued, short = [], [], [], []
     graph = bridge_components(graph, seeds)
     for k, ids in enumerate(least_cost_paths(graph, seeds[0], seeds[1:])):
         if kind == "graph extremities":
             ids = trim_rounded_ends(ids, graph)
         check_path_length(graph.points[ids], k)
-        points, radius = smooth_path(graph.points[ids], tree, spacing, smoothing)
+        targets = _targets(kind, options, inlet, outlets[k])
+        reached = reach_ends(graph.points[ids], graph.radius[ids], targets, (closed.vertices, closed.faces),
+                             SPACING_REL * edge)
+        points, radius = smooth_path(reached.points, tree, SPACING_REL * edge, SMOOTHING_REL * edge)
         paths.append(points)
-        radii.append(radius)
-    return Centerlines(tuple(paths), tuple(radii), kind, inlet, tuple(outlets), len(graph.points), closed.notes)
+        radii.append(hold_radius_on_runs(points, radius, reached.continued_mm))
+        continued.append(reached.continued_mm)
+        short.append(reached.short_mm)
+    return Centerlines(tuple(paths), tuple(radii), kind, inlet, tuple(outlets), len(graph.points), closed.notes,
+                       tuple(continued), tuple(short))
+
+
+def _targets(kind: str, options: CenterlineOptions, inlet: FloatArray, outlet: FloatArray) -> EndTargets:
+    """What each end of a path reaches for: the openings' centres, or the axis tip of a rounded end."""
+    if kind == "graph extremities":
+        return EndTargets(None, None, (options.inlet is None, True))
+    # a point the user gave is where the path should pass near, not an opening to reach
+    given_inlet = options.inlet is not None and np.array_equal(inlet, np.asarray(options.inlet, float))
+    return EndTargets(None if given_inlet else inlet, None if options.outlets else outlet)
+
+
+def hold_radius_on_runs(points: Points, radius: FloatArray, continued_mm: tuple[float, float]) -> FloatArray:
+    """The radius (n,) with each straight continuation held at its value where the Voronoi path ends.
+
+    Past the last Voronoi vertex the nearest surface point is the cap or the opening's rim, not the wall
+    across the lumen, so the distance to it is no inscribed radius; the last inscribed sphere's is kept.
+    """
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    start, stop = continued_mm[0], s[-1] - continued_mm[1]
+    inside = (s >= start) & (s <= stop)
+    if not inside.any():
+        return radius
+    held = radius.copy()
+    held[s < start] = radius[np.flatnonzero(inside)[0]]
+    held[s > stop] = radius[np.flatnonzero(inside)[-1]]
+    return held
 
 
 def _endpoints(

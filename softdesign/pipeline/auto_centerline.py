@@ -60,4 +60,6 @@ def extraction_summary(extracted: Centerlines) -> dict[str, Any]:
         "inlet_mm": [float(v) for v in extracted.inlet],
         "outlets_mm": [[float(v) for v in o] for o in extracted.outlets],
         "voronoi_vertices": extracted.voronoi_vertices,
+        "continued_mm": [[round(v, 6) for v in ends] for ends in extracted.continued_mm],
+        "short_of_opening_mm": [[round(v, 6) for v in ends] for ends in extracted.short_mm],
     }
