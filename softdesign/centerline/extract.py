@@ -116,7 +116,7 @@ def extract_centerlines(
         raise ConfigError(f"--outlet: {len(options.outlets)} outlets given, at most {MAX_OUTLETS}")
     closed = close_surface(vertices, faces, where)
     graph = internal_voronoi(closed.vertices, closed.faces)
-    kind, inlet, outlets, seeds = _endpoints(closed, graph, options, where)
+    kind, inlet, outlets, seeds, found_notes = _endpoints(closed, graph, options, where)
     edge = mean_edge_length(closed.vertices, closed.faces)
     tree = cKDTree(closed.vertices)
     paths, radii, continued, short = [], [], [], []
@@ -133,7 +133,8 @@ def extract_centerlines(
         radii.append(hold_radius_on_runs(points, radius, reached.continued_mm))
         continued.append(reached.continued_mm)
         short.append(reached.short_mm)
-    return Centerlines(tuple(paths), tuple(radii), kind, inlet, tuple(outlets), len(graph.points), closed.notes,
+    return Centerlines(tuple(paths), tuple(radii), kind, inlet, tuple(outlets), len(graph.points),
+                       closed.notes + tuple(f"warning: {where}: {line}" for line in found_notes),
                        tuple(continued), tuple(short))
 
 
@@ -165,15 +166,15 @@ def hold_radius_on_runs(points: Points, radius: FloatArray, continued_mm: tuple[
 
 def _endpoints(
     closed: ClosedSurface, graph: VoronoiGraph, options: CenterlineOptions, where: str
-) -> tuple[str, FloatArray, list[FloatArray], list[int]]:
-    """How the endpoints were found, the inlet, the outlets, and the Voronoi seed of each (inlet first)."""
-    kind, candidates = _candidates(closed, options)
+) -> tuple[str, FloatArray, list[FloatArray], list[int], tuple[str, ...]]:
+    """How the endpoints were found, the inlet, the outlets, the Voronoi seed of each (inlet first), notes."""
+    kind, candidates, notes = _candidates(closed, graph, options)
     if len(candidates) == 0 and not options.outlets:
         ends = graph_extremities(graph)
         inlet_id = ends[0] if options.inlet is None else seed_vertex(graph, closed.vertices, options.inlet)
         ends = [e for e in ends if e != inlet_id] if options.inlet is None else ends[1:]
         points = [graph.points[e] for e in ends]
-        return "graph extremities", graph.points[inlet_id], points, [inlet_id, *ends]
+        return "graph extremities", graph.points[inlet_id], points, [inlet_id, *ends], notes
     if candidates:
         first = choose_inlet(candidates, options.inlet)
         inlet = candidates[first].centre
@@ -191,18 +192,29 @@ def _endpoints(
             "clip the vessel open at both ends, or give --inlet x,y,z and --outlet x,y,z"
         )
     seeds = [seed_vertex(graph, closed.vertices, point) for point in [inlet, *outlets]]
-    return kind if not options.outlets else "given", inlet, outlets, seeds
+    return kind if not options.outlets else "given", inlet, outlets, seeds, notes
 
 
-def _candidates(closed: ClosedSurface, options: CenterlineOptions) -> tuple[str, tuple[Opening, ...]]:
-    """The openings, else the labelled caps, else the flat caps (empty when there are fewer than two)."""
+def _candidates(
+    closed: ClosedSurface, graph: VoronoiGraph, options: CenterlineOptions
+) -> tuple[str, tuple[Opening, ...], tuple[str, ...]]:
+    """The openings, else the labelled caps, else the flat caps (empty when there are fewer than two); notes.
+
+    Labels that are not caps are ignored (the notes say which and why); when fewer than two labels are
+    caps, the flat caps are looked for as on an unlabelled surface.
+    """
     if closed.openings:
-        return "openings", closed.openings
+        return "openings", closed.openings, ()
     regions = options.regions
+    notes: tuple[str, ...] = ()
     if regions is not None and len(regions) == len(closed.faces) and len(np.unique(regions)) > 1:
-        return "face regions", caps_from_regions(closed.vertices, closed.faces, regions)
+        labelled, notes = caps_from_regions(closed.vertices, closed.faces, regions, graph)
+        if len(labelled) >= 2:
+            return "face regions", labelled, notes
+        notes += (f"fewer than two face labels are caps ({len(labelled)}); the endpoints are looked for as on an "
+                  "unlabelled surface",)
     caps = planar_caps(closed.vertices, closed.faces)
-    return ("planar caps", caps) if len(caps) >= 2 else ("graph extremities", ())
+    return ("planar caps", caps, notes) if len(caps) >= 2 else ("graph extremities", (), notes)
 
 
 def points_from_user(values: list[tuple[float, float, float]], scale: float) -> tuple[Points, ...]:
