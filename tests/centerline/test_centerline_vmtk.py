@@ -112,10 +112,18 @@ def test_open_surface_paths_reach_the_openings_as_vmtk_does(aorta_dir):
 
 def test_capped_surface_paths_continue_to_the_rounded_ends(aorta_dir):
     """The capped aorta's caps are domes (no flat face, no labels): each end is continued to the centre of the
-    sphere touching the dome's tip.  Measured (issue 29): 74.42 and 72.35 mm against VMTK's 77.81 and 76.16
-    (-4.4 %, -5.0 %; before: 66.61 and 64.80, -14.4 %, -14.9 %); ends 1.64 to 1.69 mm from VMTK's (before:
-    4.5 to 6.3 mm).  Issue 29's 1 mm / 2 % target is not met here: a dome has no centre to reach, and VMTK's
-    ends sit at the bases of the domes, which this surface does not mark."""
+    sphere touching the dome's tip, where the medial axis of a rounded end stops.  Measured (issue 29): 74.42
+    and 72.35 mm against VMTK's 77.81 and 76.16 (-4.4 %, -5.0 %; before: 66.61 and 64.80, -14.4 %, -14.9 %);
+    ends 1.64 to 1.69 mm from VMTK's (before: 4.5 to 6.3 mm).
+
+    Issue 29's 1 mm / 2 % target is not met here, and no rule that finds this surface's own ends can meet it:
+    the capped surface runs 3.3 to 3.8 mm past the open surface's openings (measured below), near which
+    VMTK's ends lie, so its domes' bases are about 2 mm beyond VMTK's ends and the medial axis's ends about
+    1.5 mm short of them.
+    """
+    from softdesign.centerline.closing import boundary_loops
+
+    open_vertices, open_faces = read_surface(aorta_dir / "aorta-surface-open-ends.stl")
     vertices, faces = read_surface(aorta_dir / "aorta-surface.stl")
     result = extract_centerlines(vertices, faces)
     reference = [p.points for p in read_centerline_network(aorta_dir / "aorta-centerline.vtp").polylines]
@@ -125,3 +133,13 @@ def test_capped_surface_paths_continue_to_the_rounded_ends(aorta_dir):
         for ours, theirs in ((points[0], vmtk[0]), (points[-1], vmtk[-1])):
             assert float(np.linalg.norm(ours - theirs)) <= 2.0 * END_TOL_MM
         assert abs(_path_length(points) / _path_length(vmtk) - 1.0) <= 3.0 * LENGTH_RTOL
+    middle = open_vertices.mean(axis=0)
+    for loop in boundary_loops(open_faces):
+        rim = open_vertices[loop]
+        centre = rim.mean(axis=0)
+        normal = np.linalg.svd(rim - centre)[2][-1]
+        normal *= np.sign((centre - middle) @ normal)  # outwards
+        along = (vertices - centre) @ normal
+        beside = np.linalg.norm(vertices - centre - along[:, None] * normal, axis=1) < 1.2 * np.sqrt(
+            np.mean(np.sum((rim - centre) ** 2, axis=1)))
+        assert 3.0 < along[beside].max() < 4.0  # how far the capped surface runs past this opening, mm
