@@ -63,3 +63,13 @@ def extraction_summary(extracted: Centerlines) -> dict[str, Any]:
         "continued_mm": [[round(v, 6) for v in ends] for ends in extracted.continued_mm],
         "short_of_opening_mm": [[round(v, 6) for v in ends] for ends in extracted.short_mm],
     }
+
+
+def continuation_note(extracted: Centerlines) -> str:
+    """How far each extracted path's ends were continued straight past the Voronoi diagram, for the ingest notes."""
+    ends = "; ".join(f"path {k}: {a:.2f} mm at the inlet, {b:.2f} mm at the outlet"
+                     for k, (a, b) in enumerate(extracted.continued_mm))
+    short = [f"path {k} stops {max(gap):.2f} mm short of an opening's centre (the straight run would leave the "
+             "surface)" for k, gap in enumerate(extracted.short_mm) if max(gap) > 0.0]
+    return (f"extracted centerline: the ends continued straight past the Voronoi diagram to the openings' centres "
+            f"(a rounded end: to the centre of the sphere touching its tip): {ends}" + "".join(f"; {s}" for s in short))

@@ -62,7 +62,11 @@ def test_demo_builds_from_its_surface_alone_and_is_cached(tmp_path):
 @pytest.mark.slow
 @pytest.mark.parametrize("surface", ["aorta-surface.stl", "aorta-surface-open-ends.stl"])
 def test_aorta_builds_from_its_surface_alone(tmp_path, aorta_dir, surface):
-    manifest, _, _ = _build(tmp_path, aorta_dir / surface)
+    manifest, _, output = _build(tmp_path, aorta_dir / surface)
+    # the build says how far each end was continued past the Voronoi diagram (issue 29)
+    assert "the ends continued straight past the Voronoi diagram" in output
+    continued = manifest["metrics"]["ingest"]["centerline"]["extracted"]["continued_mm"]
+    assert len(continued) == 2 and all(min(ends) > 2.0 for ends in continued)
     length = manifest["metrics"]["ingest"]["centerline"]["selected_length_mm"]
     assert 60.0 < length < 100.0  # VMTK's paths are 78 and 76 mm
     assert all(o["watertight"] for o in manifest["outputs"] if o["path"].startswith("meshes/"))

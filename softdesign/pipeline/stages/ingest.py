@@ -19,7 +19,12 @@ from softdesign.io.centerline import read_centerline_network
 from softdesign.io.surface import read_surface
 from softdesign.meshing.topology import SurfaceInfo, describe_surface
 from softdesign.pipeline import layout
-from softdesign.pipeline.auto_centerline import extract_for_case, extraction_summary, write_extracted
+from softdesign.pipeline.auto_centerline import (
+    continuation_note,
+    extract_for_case,
+    extraction_summary,
+    write_extracted,
+)
 from softdesign.pipeline.backbone_step import regularized_path
 from softdesign.pipeline.end_plane_step import end_plane_summary
 from softdesign.pipeline.stage import Stage
@@ -86,7 +91,9 @@ def run_ingest(case: Case) -> IngestResult:
     path = select_path(network, case.final.path, orientation)
     check_vessel_scale(path.length, path.radius, case.units, f"final.centerline {_centerline_name(case)}")
     others = tuple(p for p in all_paths(network, Orientation(inlet=path.points[0])) if p.index != path.index)
-    notes = list(network.notes) + list(path.notes) + (list(extracted.notes) if extracted is not None else [])
+    notes = list(network.notes) + list(path.notes)
+    if extracted is not None:
+        notes += [*extracted.notes, continuation_note(extracted)]
     vertices, faces, info = _final_surface(case, path, scale)
     inlet_rule = path.notes[-1]
     path, backbone = regularized_path(case, path)
