@@ -3,7 +3,8 @@
 The steps (each module says where it follows VMTK's ``vmtkcenterlines`` and
 where it differs): check and close the surface (:mod:`.closing`), its
 internal Voronoi diagram (:mod:`.voronoi`), the endpoints (:mod:`.endpoints`),
-the least-cost paths and their smoothing (:mod:`.paths`).
+the least-cost paths (:mod:`.paths`), each continued straight to its
+openings' centres (:mod:`.ends`), then smoothed.
 
 No files, no printing: numpy and scipy only.
 """
