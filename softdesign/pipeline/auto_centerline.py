@@ -15,6 +15,7 @@ import numpy as np
 
 from softdesign.centerline.extract import CenterlineOptions, Centerlines, extract_centerlines
 from softdesign.geometry.network import CenterlineNetwork, Polyline
+from softdesign.geometry.plausibility import check_vessel_scale
 from softdesign.pipeline import layout
 from softdesign.pipeline.store import Staging
 from softdesign.types import UNIT_SCALE_TO_MM
@@ -39,6 +40,9 @@ def extract_for_case(case: Case) -> tuple[CenterlineNetwork, Centerlines]:
     inlet = None if case.final.inlet is None else np.asarray(case.final.inlet, float) * scale
     options = CenterlineOptions(inlet=inlet, regions=read_face_regions(surface))
     vertices, faces = read_surface(surface, surface_scale)
+    # a wrong unit is refused before the extraction's work, from the surface's largest extent
+    check_vessel_scale(float(np.ptp(vertices, axis=0).max()), None, case.final.surface_units or case.units,
+                       f"final.surface {surface.name} (its largest extent)")
     extracted = extract_centerlines(vertices, faces, options, f"final.surface {surface.name}")
     polylines = tuple(Polyline(p, r) for p, r in zip(extracted.paths, extracted.radii, strict=True))
     return CenterlineNetwork(polylines, source=f"auto ({surface.name})"), extracted

@@ -134,3 +134,21 @@ def test_a_surface_in_other_units_is_caught_and_surface_units_fixes_it(tmp_path)
              "set final.surface_units")
     fixed = write_case(tmp_path, "fixed", final={**final, "surface_units": "m"})
     assert _validate(fixed).exit_code == 0
+
+
+def test_build_refuses_a_wrong_unit_of_an_auto_case_before_extracting_and_the_named_units_fix_it(tmp_path):
+    from softdesign.io.formats import write_mesh
+    from tests.helpers.vessels import straight_tube as open_tube
+
+    surface = tmp_path / "open.stl"
+    write_mesh(surface, *open_tube(radius=3.0, length=40.0, edge=0.6))  # millimetres
+    final = {"centerline": "auto", "surface": str(surface)}
+    case = write_case(tmp_path, units="m", final=final)
+    result = runner.invoke(app, ["ingest", str(case), "--out", str(tmp_path / "build")])
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    assert "final.surface open.stl (its largest extent): with units: m" in result.output
+    assert "with units: mm it would be" in result.output
+    assert not (tmp_path / "build" / "ingest").exists()  # nothing extracted, nothing written
+    fixed = write_case(tmp_path, "fixed", units="mm", final=final)
+    result = runner.invoke(app, ["ingest", str(fixed), "--out", str(tmp_path / "build")])
+    assert result.exit_code == 0, result.output
