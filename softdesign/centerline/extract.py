@@ -51,7 +51,8 @@ class CenterlineOptions:
     ----------
     inlet : (3,) float or None -- the inlet is the opening (or cap) nearest this point; on a surface with
         neither, this point itself
-    outlets : (3,) floats -- the outlets, in this order; default every opening or cap but the inlet
+    outlets : (3,) floats -- the outlets, in this order; default every opening or cap but the inlet; a point
+        within an opening (nearer its centre than its radius) stands for the opening's centre
     regions : (F,) int or None -- one label per input face (ModelFaceID, CellEntityIds)
     """
 
@@ -117,7 +118,8 @@ def extract_centerlines(
         raise ConfigError(f"--outlet: {len(options.outlets)} outlets given, at most {MAX_OUTLETS}")
     closed = close_surface(vertices, faces, where)
     graph = internal_voronoi(closed.vertices, closed.faces)
-    kind, inlet, outlets, seeds, found_notes = _endpoints(closed, graph, options, where)
+    ends = _endpoints(closed, graph, options, where)
+    kind, inlet, outlets, seeds = ends.kind, ends.inlet, ends.outlets, ends.seeds
     edge = mean_edge_length(closed.vertices, closed.faces)
     tree = cKDTree(closed.vertices)
     paths, radii, continued, short = [], [], [], []
@@ -126,7 +128,7 @@ def extract_centerlines(
         if kind == "graph extremities":
             ids = trim_rounded_ends(ids, graph)
         check_path_length(graph.points[ids], k)
-        targets = _targets(kind, options, inlet, outlets[k])
+        targets = _targets(ends, options, k)
         reached = reach_ends(graph.points[ids], graph.radius[ids], targets, (closed.vertices, closed.faces),
                              SPACING_REL * edge)
         points, radius = smooth_path(reached.points, tree, SPACING_REL * edge, SMOOTHING_REL * edge)
@@ -135,17 +137,28 @@ def extract_centerlines(
         continued.append(reached.continued_mm)
         short.append(reached.short_mm)
     return Centerlines(tuple(paths), tuple(radii), kind, inlet, tuple(outlets), len(graph.points),
-                       closed.notes + tuple(f"warning: {where}: {line}" for line in found_notes),
+                       closed.notes + tuple(f"warning: {where}: {line}" for line in ends.notes),
                        tuple(continued), tuple(short))
 
 
-def _targets(kind: str, options: CenterlineOptions, inlet: FloatArray, outlet: FloatArray) -> EndTargets:
-    """What each end of a path reaches for: the openings' centres, or the axis tip of a rounded end."""
-    if kind == "graph extremities":
+@dataclass(frozen=True)
+class _Ends:
+    """The endpoints found: how, where (mm), their Voronoi seeds (inlet first), which are openings' centres."""
+
+    kind: str
+    inlet: FloatArray
+    outlets: list[FloatArray]
+    seeds: list[int]
+    notes: tuple[str, ...] = ()
+    centres: tuple[bool, ...] = ()  # inlet, then each outlet: an opening's (or cap's) centre, to be reached
+
+
+def _targets(ends: _Ends, options: CenterlineOptions, k: int) -> EndTargets:
+    """What the ends of path ``k`` reach for: the openings' centres, or the axis tip of a rounded end."""
+    if ends.kind == "graph extremities":
         return EndTargets(None, None, (options.inlet is None, True))
-    # a point the user gave is where the path should pass near, not an opening to reach
-    given_inlet = options.inlet is not None and np.array_equal(inlet, np.asarray(options.inlet, float))
-    return EndTargets(None if given_inlet else inlet, None if options.outlets else outlet)
+    inlet = ends.inlet if ends.centres[0] else None
+    return EndTargets(inlet, ends.outlets[k] if ends.centres[k + 1] else None)
 
 
 def hold_radius_on_runs(points: Points, radius: FloatArray, continued_mm: tuple[float, float]) -> FloatArray:
@@ -165,23 +178,28 @@ def hold_radius_on_runs(points: Points, radius: FloatArray, continued_mm: tuple[
     return held
 
 
-def _endpoints(
-    closed: ClosedSurface, graph: VoronoiGraph, options: CenterlineOptions, where: str
-) -> tuple[str, FloatArray, list[FloatArray], list[int], tuple[str, ...]]:
-    """How the endpoints were found, the inlet, the outlets, the Voronoi seed of each (inlet first), notes."""
+def _endpoints(closed: ClosedSurface, graph: VoronoiGraph, options: CenterlineOptions, where: str) -> _Ends:
+    """How the endpoints were found, the inlet, the outlets, the Voronoi seed of each (inlet first), notes.
+
+    A given outlet within an opening (nearer its centre than the opening's radius) is that opening's centre.
+    """
     kind, candidates, notes = _candidates(closed, graph, options)
     if len(candidates) == 0 and not options.outlets:
         ends = graph_extremities(graph)
         inlet_id = ends[0] if options.inlet is None else seed_vertex(graph, closed.vertices, options.inlet)
         ends = [e for e in ends if e != inlet_id] if options.inlet is None else ends[1:]
         points = [graph.points[e] for e in ends]
-        return "graph extremities", graph.points[inlet_id], points, [inlet_id, *ends], notes
+        return _Ends("graph extremities", graph.points[inlet_id], points, [inlet_id, *ends], notes)
     if candidates:
         first = choose_inlet(candidates, options.inlet)
-        inlet = candidates[first].centre
-        outlets = list(options.outlets) or [c.centre for k, c in enumerate(candidates) if k != first]
+        inlet, centres = candidates[first].centre, [True]
+        given = [_opening_at(p, candidates) for p in options.outlets]
+        outlets = [p if c is None else c.centre for p, c in zip(options.outlets, given, strict=True)] or [
+            c.centre for k, c in enumerate(candidates) if k != first]
+        centres += [c is not None for c in given] if options.outlets else [True] * len(outlets)
     elif options.inlet is not None:
         kind, inlet, outlets = "given", np.asarray(options.inlet, float), list(options.outlets)
+        centres = [False] * (1 + len(outlets))
     else:
         raise InputDataError(
             f"{where}: --outlet given but no inlet: the surface has no openings or caps to choose it from; "
@@ -193,7 +211,14 @@ def _endpoints(
             "clip the vessel open at both ends, or give --inlet x,y,z and --outlet x,y,z"
         )
     seeds = [seed_vertex(graph, closed.vertices, point) for point in [inlet, *outlets]]
-    return kind if not options.outlets else "given", inlet, outlets, seeds, notes
+    return _Ends(kind if not options.outlets else "given", inlet, outlets, seeds, notes, tuple(centres))
+
+
+def _opening_at(point: FloatArray, openings: tuple[Opening, ...]) -> Opening | None:
+    """The opening whose centre ``point`` (3,) mm lies within the radius of, or None."""
+    point = np.asarray(point, float)
+    nearest = min(openings, key=lambda o: float(np.linalg.norm(o.centre - point)))
+    return nearest if float(np.linalg.norm(nearest.centre - point)) <= nearest.radius else None
 
 
 def _candidates(

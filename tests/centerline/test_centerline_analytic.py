@@ -61,6 +61,16 @@ def test_inlet_option_picks_the_other_opening():
     np.testing.assert_allclose(result.inlet, [0.0, 0.0, 40.0], rtol=0, atol=1e-9)
 
 
+def test_a_given_outlet_inside_the_vessel_is_not_continued():
+    vertices, faces = straight_tube(radius=3.0, length=40.0, edge=EDGE)
+    given = np.array([0.0, 0.0, 25.0])  # inside, 15 mm from the far opening: no opening to reach
+    result = extract_centerlines(vertices, faces, CenterlineOptions(outlets=(given,)))
+    assert result.endpoints == "given"
+    assert result.continued_mm[0][1] == 0.0 and result.short_mm[0] == (0.0, 0.0)
+    assert result.continued_mm[0][0] > 2.0  # the inlet is still its opening's centre
+    assert abs(result.paths[0][-1, 2] - 25.0) < 4.0  # the pole nearest the point, about one radius from it
+
+
 def test_y_bifurcation_axes_radii_and_caps():
     trunk, branch, length = 4.0, 3.0, 30.0
     vertices, faces, axes = y_bifurcation(trunk, branch, length, np.radians(30.0), EDGE)

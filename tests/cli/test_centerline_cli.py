@@ -203,7 +203,11 @@ def test_label_checks_name_each_reason():
 def test_outlet_option_gives_one_path_per_outlet(aorta_dir, tmp_path):
     out = tmp_path / "cl.vtp"
     surface = str(aorta_dir / "aorta-surface-open-ends.stl")
-    result = runner.invoke(app, ["centerline", surface, "--outlet", "210.1,102.9,30.7", "--output", str(out)])
+    result = runner.invoke(app, ["centerline", surface, "--outlet", "210.1,102.9,30.7", "--output", str(out),
+                                 "--json"])
     assert result.exit_code == 0, result.output
     (line,) = read_centerline_network(out).polylines
-    assert line.points[0, 1] > 165.0 and np.linalg.norm(line.points[-1] - [210.1, 102.9, 30.7]) < 8.0
+    # the point lies within the left iliac's opening: the path ends at that opening's centre (issue 29)
+    centre = [210.102643, 102.861336, 30.738235]
+    assert line.points[0, 1] > 165.0 and np.linalg.norm(line.points[-1] - centre) < 0.2
+    assert '"short_of_opening": [\n        0.0,\n        0.0\n      ]' in result.output
