@@ -83,15 +83,21 @@ def _stage_command(case_file: Path, out: Path | None, target: str, force: bool, 
 
 
 def validate(case_file: CaseArg) -> None:
-    """Check a case file (schema, ranges, input files present) without building."""
+    """Check a case file (schema, ranges) and open every input file (type, counts, arrays, size in the units)."""
 
     def action() -> None:
         from softdesign.config import load_case
+        from softdesign.errors import errors_named_for
+        from softdesign.pipeline.input_report import open_inputs
         from softdesign.pipeline.inputs import input_files
 
         case = load_case(case_file)
         files = input_files(case)
-        typer.echo(f"{case_file}: valid (case '{case.name}', {len(files)} input file(s) found)")
+        with errors_named_for(case_file):
+            lines = open_inputs(case)
+        typer.echo(f"{case_file}: valid (case '{case.name}', {len(files)} input file(s) opened)")
+        for line in lines:
+            typer.echo(f"  {line}")
 
     run_guarded(action)
 
