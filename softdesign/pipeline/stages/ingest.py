@@ -34,7 +34,9 @@ if TYPE_CHECKING:  # only annotations: the report loads stage results without th
 #: the rule that chose the inlet (``centerline.inlet_rule``: the clearly widest end first).
 #: 4: each end's flat cap or open loop, its tilt to the end tangent and the rim's gap past the body (``end_planes``).
 #: 5: the rim-gap warning moved to the fit, which decides whether the body is cut at the plane (``fit.end_cut``).
-VERSION = 5
+#: 6: the backbone's reach uses the wall's fold radius; a turn no smoothing brings below the target is warned
+#: about, not refused (issue 29).
+VERSION = 6
 
 
 @dataclass(frozen=True)
@@ -86,7 +88,7 @@ def run_ingest(case: Case) -> IngestResult:
     notes = list(path.notes) + (list(extracted.notes) if extracted is not None else [])
     vertices, faces, info = _final_surface(case, path, scale)
     inlet_rule = path.notes[-1]
-    path, backbone = regularized_path(case, path)
+    path, backbone = regularized_path(case, path, vertices, others)
     notes += [n for n in path.notes if n not in notes]
     ends = end_plane_summary(case, path, vertices, faces)
     initial_path = None
