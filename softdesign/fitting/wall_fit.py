@@ -16,6 +16,7 @@ import numpy.typing as npt
 
 from softdesign.errors import FitError
 from softdesign.fitting.bspline_surface import FitSettings, SurfaceFit, fit_radius_surface
+from softdesign.fitting.coverage import WallCoverage, measure_coverage
 from softdesign.fitting.end_checks import end_radii, negative_radius_cause
 from softdesign.fitting.end_prior import end_prior
 from softdesign.fitting.mapping import Mapper, serial_map
@@ -76,6 +77,8 @@ class WallFit:
     ends: dict[str, dict[str, float]] = dataclasses.field(default_factory=dict)
     #: (n,) mm per surface vertex: the true distance of each measured kept point (the metrics' points), else NaN
     distance: FloatArray = dataclasses.field(default_factory=lambda: np.zeros(0))
+    #: the fit against all of the path's own wall, and where it saw none (None: not measured)
+    coverage: WallCoverage | None = None
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready figures for the manifest (mm, rad; snake_case keys)."""
@@ -97,7 +100,7 @@ class WallFit:
             "min_rho_mm": self.folding.min_rho_mm,
             "end_prior": {} if self.settings.prior is None else self.settings.prior.ends,
             "ends": self.ends,
-        }
+        } | ({} if self.coverage is None else self.coverage.as_dict())
 
 
 def fit_wall(
@@ -160,4 +163,7 @@ def fit_wall(
     ends = end_radii(radius, reference) | {"margin": {"mm": options.end_margin_mm, "points": float((~inside).sum())}}
     distance = np.full(len(polar), np.nan)
     distance[kept_index[measured.sample]] = measured.distance
-    return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius, ends, distance)
+    coverage = measure_coverage(curve, surface.whole, polar, selection, kept_index, settings.knot_spacing_mm,
+                                reference, {} if prior is None else prior.ends, options.mapper)
+    return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius, ends, distance,
+                   coverage)

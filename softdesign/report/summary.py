@@ -97,7 +97,7 @@ def _feasibility_facts(m: dict[str, Any]) -> list[Fact]:
 
 
 def summary_warnings(data: BuildData, checks: list[Check]) -> list[str]:
-    """Every warning of the build, most serious first: stale, failed checks, infeasible, fold, arc misfit."""
+    """Every warning of the build, most serious first: stale, failed checks, infeasible, fold, fit, arc misfit."""
     m = data.manifest
     warnings = [f"stale: stage {s['name']} is out of date (its outputs here were built from other inputs or settings); "
                 "run softdesign build" for s in m.get("stages", []) if s.get("status") == "stale"]
@@ -112,6 +112,7 @@ def summary_warnings(data: BuildData, checks: list[Check]) -> list[str]:
     rho_kappa = resolve_or(m, "/metrics/fit/max_rho_kappa", None)
     if rho_kappa is not None and rho_kappa >= FOLD_LIMIT:
         warnings.append(f"the surface folds through itself at q = 1: largest rho * kappa {rho_kappa:.3g} >= 1")
+    warnings += [f"fit: {w}" for w in resolve_or(m, "/metrics/fit/warnings", [])]  # dropped wall, unseen stretches
     arc = resolve_or(m, "/metrics/kinematics/arc_check/warnings", [])
     warnings += [f"large arc misfit: {w}" for w in arc]
     return warnings

@@ -43,11 +43,12 @@ from softdesign.types import FloatArray
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 6  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
+VERSION = 7  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
 # 3: points fitted in path order; distances sampled above 200k points (max still over all)
 # 4: end prior and end radii (issue 20); true distances on the regularized backbone's stretches (``backbone``)
 # 5: each end's cut plane in the end frame (``end_cut``, issue 20)
 # 6: fit/points.npz keeps the true distance of every point the metrics measured (``distance``, NaN elsewhere)
+# 7: the fit against all of the path's own wall, its coverage and flags (``all_wall``, ``coverage``, issue 29)
 #: Seed of the hold-out folds: the same case always gets the same folds.
 HOLDOUT_SEED = 4
 #: A failed fit is blamed on the centerline when the smoothed one strays from the input by this fraction of the
@@ -211,6 +212,10 @@ def fit_metrics(result: FitResult) -> dict[str, Any]:
         "ends": s.get("ends", {}),
         "end_prior": s.get("end_prior", {}),
         "end_cut": s.get("end_cut", {}),
+        # rms_mm .. max_mm above are on the kept points; the same under ``kept``, and on all of the path's own
+        # wall under ``all_wall``, with the ``coverage`` and the ``flags`` the report names (issue 29)
+        "kept": {k: d[k] for k in ("rms_mm", "p95_mm", "p99_mm", "max_mm", "count")},
+        **{k: s[k] for k in ("all_wall", "coverage", "flags", "warnings") if k in s},
     }
 
 
@@ -224,13 +229,29 @@ def describe_fit(result: FitResult) -> list[str]:
         f"cap {p['cap']}, outlier {p['outlier']}",
         f"spline: knots every {st['knot_spacing_mm']:g} mm, {st['angular_intervals']} angular intervals, "
         f"smoothing {st['smoothing']:g}",
-        f"true distance to the fitted surface (mm){_sampled_note(result.summary['distance'])}:",
+        f"true distance to the fitted surface, kept points (mm){_sampled_note(result.summary['distance'])}:",
         f"  RMS {m['rms_mm']:.4f}  p95 {m['p95_mm']:.4f}  p99 {m['p99_mm']:.4f}  max {m['max_mm']:.4f}",
         f"  hold-out RMS ({result.summary['holdout_points']} points, k-fold) {m['holdout_rms_mm']:.4f}",
+        *coverage_lines(result.summary),
         f"joints: value jump {m['joint_value_jump_mm']:.2e} mm, slope jump {m['joint_slope_jump']:.2e}",
         f"max rho * kappa at q = 1: {m['max_rho_kappa']:.3f} (folds at 1; every export q is checked at export)",
         f"radius at q = 0: {result.summary['initial_radius']}",
     ] + end_lines(result.summary) + describe_backbone_fit(result.summary.get("backbone", [])) + _stray_lines(result)
+
+
+def coverage_lines(summary: dict[str, Any]) -> list[str]:
+    """The all-wall figures, the coverage, each unseen stretch and the warnings (none for older builds)."""
+    if "all_wall" not in summary:
+        return []
+    a, c = summary["all_wall"], summary["coverage"]
+    lines = [
+        f"true distance, all of the path's own wall ({c['own_wall_points']} vertices, {c['fraction']:.1%} of them "
+        f"fitted):",
+        f"  RMS {a['rms_mm']:.4f}  p95 {a['p95_mm']:.4f}  p99 {a['p99_mm']:.4f}  max {a['max_mm']:.4f}",
+    ]
+    lines += [f"  wall not seen all round at {s['from_mm']:.1f}-{s['to_mm']:.1f} mm ({s['length_mm']:.1f} mm, local "
+              f"diameter {s['diameter_mm']:.1f} mm): {s['how']}" for s in c["unseen_stretches"]]
+    return lines + [f"  warning: {w}" for w in summary.get("warnings", [])]
 
 
 def _stray_lines(result: FitResult) -> list[str]:
