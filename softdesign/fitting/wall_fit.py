@@ -29,7 +29,14 @@ from softdesign.fitting.metrics import (
     measure_distances,
 )
 from softdesign.fitting.projection import PolarPoints, project_points
-from softdesign.fitting.radius_field import FOLD_SPACING_MM, FoldReport, RadiusField, check_self_folding, fold_margin
+from softdesign.fitting.radius_field import (
+    FOLD_SPACING_MM,
+    FoldReport,
+    RadiusField,
+    capped,
+    check_self_folding,
+    fold_margin,
+)
 from softdesign.fitting.selection import NetworkContext, SelectionSettings, WallSelection, select_wall_points
 from softdesign.types import FloatArray, FramedCurve
 
@@ -47,6 +54,8 @@ class WallFitOptions:
     initial_radius_mm : constant rho0; None for the axially symmetric mean of the fit
     fold_limit : the largest rho * kappa allowed at q = 1
     end_margin_mm : kept points within this arc length of either end are left out of the fit, mm
+    max_radius_mm : the fitted rho held at most this (:func:`~softdesign.fitting.radius_field.capped`), mm;
+        None: as fitted
     mapper : runs independent pieces (the hold-out's folds, the projection's and the metrics' blocks of
         points), perhaps on other processes; the same figures for any
     """
@@ -58,6 +67,7 @@ class WallFitOptions:
     initial_radius_mm: float | None = None
     fold_limit: float = 1.0
     end_margin_mm: float = 0.0
+    max_radius_mm: float | None = None
     mapper: Mapper = serial_map
 
 
@@ -144,6 +154,9 @@ def fit_wall(
         spacing, scores = choose_knot_spacing(curve, kept, settings, rng, options.holdout)
         settings = replace(settings, knot_spacing_mm=spacing)
     surface = fit_radius_surface(kept, curve.length, settings)
+    if options.max_radius_mm is not None:  # every figure below is of the body built
+        cap = options.max_radius_mm
+        surface = replace(surface, whole=capped(surface.whole, cap), links=tuple(capped(s, cap) for s in surface.links))
     measured = measure_distances(curve, surface.whole, kept, rng, mapper=options.mapper)
     # the hold-out folds are dealt from the measured points, each starting from its closest point
     holdout = holdout_rms(curve, kept.subset(measured.sample), settings, rng, options.holdout,

@@ -131,11 +131,15 @@ class BackboneRegularization:
 
 
 class BackboneError(ValueError):
-    """No width in ``SIGMA_FACTORS`` brings the reach below ``TARGET_REACH``; ``reach`` and ``arc_mm`` say where."""
+    """No width in ``SIGMA_FACTORS`` brings the reach below ``TARGET_REACH``.
 
-    def __init__(self, reach: float, arc_mm: float, radius_mm: float) -> None:
+    ``reach``, ``arc_mm`` and ``radius_mm`` are the input's largest reach, where it is and r there;
+    ``smoothed`` the largest reach left by the widest smoothing tried.
+    """
+
+    def __init__(self, reach: float, arc_mm: float, radius_mm: float, smoothed: float = float("nan")) -> None:
         super().__init__(f"r * kappa {reach:.3f} at {arc_mm:.1f} mm")
-        self.reach, self.arc_mm, self.radius_mm = reach, arc_mm, radius_mm
+        self.reach, self.arc_mm, self.radius_mm, self.smoothed = reach, arc_mm, radius_mm, smoothed
 
 
 def wall_fold_radius(points: npt.ArrayLike, radius: npt.ArrayLike, wall: npt.ArrayLike,
@@ -227,7 +231,8 @@ def regularize_backbone(points: npt.ArrayLike, radius: npt.ArrayLike, options: C
     s = _arc(points)
     runs = _runs(arc, reach >= TARGET_REACH)
     scales = [float(np.interp(np.linspace(a, b, 9), s, radius).max()) for a, b in runs]
-    worst = (before, float(arc[np.argmax(reach)]))
+    at = float(arc[np.argmax(reach)])
+    smoothed = before
     for factor in SIGMA_FACTORS:
         sigmas = [factor * r for r in scales]
         moved = points.copy()
@@ -235,11 +240,11 @@ def regularize_backbone(points: npt.ArrayLike, radius: npt.ArrayLike, options: C
             weight = _ramp_weight(s, a, b, RAMP_SIGMAS * sigma)
             rows = np.flatnonzero(weight > 0.0)
             moved[rows] += weight[rows, None] * (_gaussian(s, points, sigma, rows) - points[rows])
-        after, after_arc = reach_along(moved, fold, options)
+        after, _ = reach_along(moved, fold, options)
         if after.max() < TARGET_REACH:
             return _result(points, moved, before, float(after.max()), runs, scales, sigmas)
-        worst = (float(after.max()), float(after_arc[np.argmax(after)]))
-    raise BackboneError(worst[0], worst[1], float(np.interp(worst[1], s, fold)))
+        smoothed = float(after.max())
+    raise BackboneError(before, at, float(np.interp(at, s, fold)), smoothed)
 
 
 def _result(points, moved, before, after, runs, scales, sigmas) -> BackboneRegularization:

@@ -101,14 +101,14 @@ def _unresolved(case: Case, path: SelectedPath, radius: FloatArray, err: Backbon
     note = (
         f"warning: the centerline turns tighter than the vessel is wide at {err.arc_mm:.1f} mm from the inlet "
         f"(l = {err.arc_mm / path.length:.4f}, {to_end:.1f} mm from the nearer end): r * kappa = {err.reach:.3f} "
-        f"with {which} {err.radius_mm:.3f} mm, and smoothing the backbone over up to twice the radius does not "
-        f"bring it below {TARGET_REACH:g}; the backbone is left as it is and the fit checks whether the fitted "
-        "body folds there (if it does, it names the body radius that fits)"
+        f"with {which} {err.radius_mm:.3f} mm, and smoothing the backbone over up to twice the radius leaves "
+        f"{err.smoothed:.3f} (expected < {TARGET_REACH:g}); the backbone is left as it is and the fit checks "
+        "whether the fitted body folds there (if it does, it names the body radius that fits)"
     )
     summary = {"regularized": False, "trigger_reach": REGULARIZE_REACH, "target_reach": TARGET_REACH,
                "reach_before": err.reach, "reach_after": err.reach, "max_moved_mm": 0.0, "stretches": [],
                "unresolved": {"arc_mm": err.arc_mm, "l": err.arc_mm / path.length, "reach": err.reach,
-                              "radius_mm": err.radius_mm}}
+                              "radius_mm": err.radius_mm, "smoothed_reach": err.smoothed}}
     if fold is not None:
         summary |= {"trigger_reach": WALL_REGULARIZE_REACH, "fold_radius": "wall"}
     return replace(path, notes=(*path.notes, note, *_inscribed_warning(case, path.points, radius, fold))), summary

@@ -18,7 +18,8 @@ import pytest
 from typer.testing import CliRunner
 
 from softdesign.cli import app
-from tests.helpers.bend_vessels import inner_reach, write_flat_bend_vessel
+from softdesign.fitting.radius_field import FOLD_FIX_REACH
+from tests.helpers.bend_vessels import inner_reach, write_flat_bend_vessel, write_takeoff_vessel
 from tests.helpers.cases import write_case
 from tests.helpers.robust_vessels import wall_to_body_mm
 
@@ -61,3 +62,32 @@ def test_a_bend_tighter_than_the_inscribed_radius_with_a_flatter_inner_side_buil
     distance = wall_to_body_mm(wall[inside], (np.asarray(body.vertices), np.asarray(body.faces)))
     assert inside.sum() > 1000
     assert distance.max() < WALL_FRACTION * RADIUS
+
+
+def test_a_branch_take_off_is_refused_naming_the_body_radius_that_fits_and_building_with_it_succeeds(
+        tmp_path: Path):
+    # issue 29, items 2 and 6: a 6 mm trunk whose path turns 90 degrees on a 3 mm arc into a 2.5 mm branch, 3 mm
+    # from the inlet: round 3 refused it at ingest with advice (resample.end_straight_mm) that does not work
+    import re
+
+    import yaml
+
+    centerline, surface = write_takeoff_vessel(tmp_path / "takeoff", 6.0, 2.5, 3.0, 3.0, 90.0)
+    final = {"centerline": str(centerline), "surface": str(surface), "path": 1}
+    refused = runner.invoke(app, ["build", str(write_case(tmp_path, "takeoff", final=final)),
+                                  "--out", str(tmp_path / "out")])
+    assert refused.exit_code == 1
+    assert "the tube folds through itself" in refused.output and "tighter than the body is wide" in refused.output
+    assert "mm from the inlet" in refused.output and "resample." not in refused.output
+    cap = float(re.search(r"set fit\.max_radius_mm: ([0-9.]+)", refused.output).group(1))
+    assert 0.5 < cap < 6.0  # thinner than the trunk, not a thread
+    fixed = write_case(tmp_path, "fixed", final=final, fit={"max_radius_mm": cap})
+    result = runner.invoke(app, ["build", str(fixed), "--out", str(tmp_path / "fixed")])
+    assert result.exit_code == 0, result.output
+    manifest = json.loads((tmp_path / "fixed" / "manifest.json").read_text())
+    assert yaml.safe_load(fixed.read_text())["fit"]["max_radius_mm"] == cap
+    # held at most that wide, the body's rho * kappa stays at the 0.7 the fix states, at every exported q
+    assert manifest["metrics"]["fit"]["max_rho_kappa"] <= FOLD_FIX_REACH + 1e-9
+    meshes = [o for o in manifest["outputs"] if o["path"].startswith("meshes/")]
+    assert len(meshes) == 3 and all(m["watertight"] for m in meshes)
+    assert all(row["rho_kappa_max"] < 1.0 for row in manifest["metrics"]["feasibility"]["per_q"])

@@ -94,3 +94,37 @@ def _flat_bend_wall(points: np.ndarray, radius: float, turn_from: float, turn_to
         else:
             faces += [np.stack([p, q1, q], 1), np.stack([p, p1, q1], 1)]
     return rings.reshape(-1, 3), np.concatenate(faces)
+
+
+def write_takeoff_vessel(folder: Path, trunk_radius: float = 6.0, branch_radius: float = 2.5,
+                         branch_at_mm: float = 3.0, bend_mm: float = 3.0, turn_deg: float = 120.0,
+                         length_mm: float = 40.0) -> tuple[Path, Path]:
+    """A wide straight trunk along +z, capped flat at both ends, with a branch taking off near its inlet.
+
+    Path 1 (VMTK-style, from the inlet) runs up the trunk's axis for ``branch_at_mm``, turns ``turn_deg``
+    towards +x on an arc of radius ``bend_mm`` and runs 30 mm straight on: the branch, a tube of radius
+    ``branch_radius`` about the arc and the straight part.  Its inscribed radius is the trunk's on the stub,
+    falls linearly to the branch's over the arc, and is the branch's after.  Path 0 is the trunk.  The wall
+    is the boolean union of the two sample-generator tubes: a path that turns from a wide trunk into a branch
+    tighter than the trunk is wide (``trunk_radius / bend_mm`` > 1).
+    """
+    from softdesign.io.formats import write_mesh
+    from softdesign.io.polylines_vtp import write_polylines_vtp
+    from softdesign.meshing.solids import checked
+    from tests.helpers.robust_vessels import capped_tube, segment
+
+    plane, _ = stub_turn_axis(branch_at_mm, bend_mm, turn_deg, 30.0, step=0.25)
+    path = plane[:, [0, 2, 1]]  # the stub along +z, turning towards +x
+    trunk = segment(np.zeros(3), np.array([0.0, 0.0, length_mm]), 0.25)
+    limb = path[path[:, 2] >= branch_at_mm - 1e-9]
+    mesh = checked(capped_tube(trunk, trunk_radius, "trunk") + capped_tube(limb, branch_radius, "branch"),
+                   "trunk and branch").to_mesh64()
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
+    arc_end = branch_at_mm + bend_mm * np.radians(turn_deg)
+    radius = np.interp(s, [branch_at_mm, arc_end], [trunk_radius, branch_radius])
+    folder.mkdir(parents=True, exist_ok=True)
+    centerline = write_polylines_vtp(folder / "centerline.vtp", [trunk, path],
+                                     {"MaximumInscribedSphereRadius": [np.full(len(trunk), trunk_radius), radius]})
+    surface = write_mesh(folder / "surface.stl", np.asarray(mesh.vert_properties, float)[:, :3],
+                         np.asarray(mesh.tri_verts, np.int64))
+    return centerline, surface

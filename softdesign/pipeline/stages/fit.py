@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softdesign.errors import ConfigError, FitError
+from softdesign.errors import ConfigError, FitError, FoldError
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
 from softdesign.fitting.end_checks import thin_end_warnings
 from softdesign.fitting.metrics import HoldoutSettings
@@ -104,13 +104,14 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
         holdout=HoldoutSettings(folds=fit.holdout_folds),
         initial_radius_mm=case.initial.radius_mm,
         end_margin_mm=case.fit.end_margin_mm,
+        max_radius_mm=case.fit.max_radius_mm,
         mapper=map_items,  # the hold-out's folds on the build's worker processes
     )
     try:
         wall = fit_wall(curve, ingest.vertices, network, options, np.random.default_rng(HOLDOUT_SEED))
     except FitError as err:
         stray = centerline_stray(case, curve.curve, path)
-        if stray is None:
+        if stray is None or isinstance(err, FoldError):  # a fold names the body radius that fits: that is the fix
             raise
         raise ConfigError(f"{str(err).split('; ')[0]}; {stray}") from err
     field = wall.field
