@@ -18,6 +18,7 @@ from softdesign.errors import FitError
 from softdesign.fitting.bspline_surface import FitSettings, SurfaceFit, fit_radius_surface
 from softdesign.fitting.coverage import WallCoverage, measure_coverage
 from softdesign.fitting.end_checks import end_radii, negative_radius_cause
+from softdesign.fitting.end_hold import negative_end
 from softdesign.fitting.end_prior import end_prior
 from softdesign.fitting.mapping import Mapper, serial_map
 from softdesign.fitting.metrics import (
@@ -113,6 +114,22 @@ class WallFit:
         } | ({} if self.coverage is None else self.coverage.as_dict())
 
 
+def _fit_kept(curve: FramedCurve, kept: PolarPoints, options: WallFitOptions,
+              reference: tuple[FloatArray, FloatArray] | None, rng: np.random.Generator):
+    """The end prior, the knot spacing (``auto``), the surface fitted to ``kept``, held at ``max_radius_mm``."""
+    settings, scores = options.fit, dict[float, float]()
+    prior = end_prior(kept, curve.length, settings.knot_spacing_mm, settings.angular_intervals, reference)
+    settings = replace(settings, prior=prior)
+    if options.auto_spacing:
+        spacing, scores = choose_knot_spacing(curve, kept, settings, rng, options.holdout)
+        settings = replace(settings, knot_spacing_mm=spacing)
+    surface = fit_radius_surface(kept, curve.length, settings)
+    if options.max_radius_mm is not None:  # every figure after is of the body built
+        cap = options.max_radius_mm
+        surface = replace(surface, whole=capped(surface.whole, cap), links=tuple(capped(s, cap) for s in surface.links))
+    return settings, scores, prior, surface
+
+
 def fit_wall(
     curve: FramedCurve,
     vertices: npt.ArrayLike,
@@ -145,18 +162,14 @@ def fit_wall(
     inside = (kept.l >= margin) & (kept.l <= 1.0 - margin)
     if not inside.all():
         kept, kept_index = kept.subset(inside), kept_index[inside]
-    settings, scores = options.fit, dict[float, float]()
     reference = None if network.inscribed_l is None or network.inscribed_radius is None else (
         np.asarray(network.inscribed_l, float), np.asarray(network.inscribed_radius, float))
-    prior = end_prior(kept, curve.length, settings.knot_spacing_mm, settings.angular_intervals, reference)
-    settings = replace(settings, prior=prior)
-    if options.auto_spacing:
-        spacing, scores = choose_knot_spacing(curve, kept, settings, rng, options.holdout)
-        settings = replace(settings, knot_spacing_mm=spacing)
-    surface = fit_radius_surface(kept, curve.length, settings)
-    if options.max_radius_mm is not None:  # every figure below is of the body built
-        cap = options.max_radius_mm
-        surface = replace(surface, whole=capped(surface.whole, cap), links=tuple(capped(s, cap) for s in surface.links))
+    settings, scores, prior, surface = _fit_kept(curve, kept, options, reference, rng)
+    hold = negative_end(surface.whole, curve.length, settings.knot_spacing_mm)
+    if hold is not None:  # rho <= 0 at an end: held at the inscribed radius there, fitted again
+        keep = hold.keeps(kept.l)
+        kept, kept_index = kept.subset(keep), kept_index[keep]
+        settings, scores, prior, surface = _fit_kept(curve, kept, options, reference, rng)
     measured = measure_distances(curve, surface.whole, kept, rng, mapper=options.mapper)
     # the hold-out folds are dealt from the measured points, each starting from its closest point
     holdout = holdout_rms(curve, kept.subset(measured.sample), settings, rng, options.holdout,
@@ -174,6 +187,8 @@ def fit_wall(
         raise FitError(f"{str(err).split('; ')[0]}; {negative_radius_cause(prior, curve.length, l[np.argmin(rho)])}"
                        ) from err
     ends = end_radii(radius, reference) | {"margin": {"mm": options.end_margin_mm, "points": float((~inside).sum())}}
+    if hold is not None:
+        ends[f"{hold.end}_held"] = hold.as_dict(curve.length)
     distance = np.full(len(polar), np.nan)
     distance[kept_index[measured.sample]] = measured.distance
     coverage = measure_coverage(curve, surface.whole, polar, selection, kept_index, settings.knot_spacing_mm,

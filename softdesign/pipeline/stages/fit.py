@@ -267,6 +267,10 @@ def end_lines(summary: dict[str, Any]) -> list[str]:
         f"held at the inscribed radius ({e['reference_min_mm']:.3f} to {e['reference_max_mm']:.3f} mm)"
         for end, e in summary.get("end_prior", {}).items()
     ]
+    lines += [f"  warning: the fitted radius went to {h['rho_min_mm']:.3f} mm at {h['at_mm']:.1f} mm from the "
+              f"{end.removesuffix('_held')} (its wall points lean inwards): that end is held at the inscribed radius "
+              f"over {h['from_mm']:.1f}-{h['to_mm']:.1f} mm and fitted again"
+              for end, h in summary.get("ends", {}).items() if end.endswith("_held")]
     cuts = summary.get("end_cut", {})
     lines += [f"{end}: cut at the detected plane (tilt {c['tilt_deg']:.1f} deg, rim gap {c['rim_gap_mm']:.3f} mm)"
               if c["applied"] else f"{end}: cut square to the end tangent ({c['reason']})" for end, c in cuts.items()]
