@@ -21,6 +21,7 @@ from softdesign.errors import ConfigError, FitError, FoldError
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
 from softdesign.fitting.end_checks import thin_end_warnings
 from softdesign.fitting.metrics import HoldoutSettings
+from softdesign.fitting.morph_folds import fold_over_morph
 from softdesign.fitting.projection import project_points
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.selection import NetworkContext, SelectionSettings, inscribed_profile
@@ -28,6 +29,7 @@ from softdesign.fitting.wall_fit import WallFitOptions, fit_wall
 from softdesign.geometry.curves import SmoothCurve, measure_deviation
 from softdesign.geometry.end_cut import choose_end_cuts
 from softdesign.geometry.end_planes import rim_gap_warnings
+from softdesign.geometry.morph_fold import MORPH_Q_SAMPLES
 from softdesign.geometry.network import SelectedPath
 from softdesign.kinematics.links import LinkChain
 from softdesign.meshing.mould_frame import parting_frame
@@ -123,6 +125,11 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
                                           curve.frames(np.array([0.0, 1.0])), chain.shape.keys[-1].length,
                                           mould=case.export.mould is not None,
                                           parting_local=_parting_local(chain) if case.export.mould else None)}
+    # the fitted body itself at every q of the morph's search, not only at q = 1 (issue 29)
+    morph = fold_over_morph(chain.shape.curve_at, field, np.linspace(0.0, 1.0, MORPH_Q_SAMPLES))
+    summary["morph_fold"] = morph.as_dict()
+    if morph.warning() is not None:
+        summary["warnings"] = [*summary.get("warnings", []), morph.warning()]
     # the end prior can hold the ends a straying centerline leaves one-sided: the fit then succeeds, so say it
     stray = centerline_stray(case, curve.curve, path)
     if stray is not None:
@@ -216,7 +223,7 @@ def fit_metrics(result: FitResult) -> dict[str, Any]:
         # rms_mm .. max_mm above are on the kept points; the same under ``kept``, and on all of the path's own
         # wall under ``all_wall``, with the ``coverage`` and the ``flags`` the report names (issue 29)
         "kept": {k: d[k] for k in ("rms_mm", "p95_mm", "p99_mm", "max_mm", "count")},
-        **{k: s[k] for k in ("all_wall", "coverage", "flags", "warnings") if k in s},
+        **{k: s[k] for k in ("all_wall", "coverage", "flags", "warnings", "morph_fold") if k in s},
     }
 
 
@@ -236,6 +243,7 @@ def describe_fit(result: FitResult) -> list[str]:
         *coverage_lines(result.summary),
         f"joints: value jump {m['joint_value_jump_mm']:.2e} mm, slope jump {m['joint_slope_jump']:.2e}",
         f"max rho * kappa at q = 1: {m['max_rho_kappa']:.3f} (folds at 1; every export q is checked at export)",
+        *_morph_lines(result.summary),
         f"radius at q = 0: {result.summary['initial_radius']}",
     ] + end_lines(result.summary) + describe_backbone_fit(result.summary.get("backbone", [])) + _stray_lines(result)
 
@@ -253,6 +261,14 @@ def coverage_lines(summary: dict[str, Any]) -> list[str]:
     lines += [f"  wall not seen all round at {s['from_mm']:.1f}-{s['to_mm']:.1f} mm ({s['length_mm']:.1f} mm, local "
               f"diameter {s['diameter_mm']:.1f} mm): {s['how']}" for s in c["unseen_stretches"]]
     return lines + [f"  warning: {w}" for w in summary.get("warnings", [])]
+
+
+def _morph_lines(summary: dict[str, Any]) -> list[str]:
+    m = summary.get("morph_fold")
+    if m is None:
+        return []
+    return [f"max rho * kappa over the morph ({m['q_samples']} q, refined): {m['max_rho_kappa']:.3f} at q = "
+            f"{m['q']:.3f}, l = {m['l']:.4f}"]
 
 
 def _stray_lines(result: FitResult) -> list[str]:
