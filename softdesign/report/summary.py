@@ -97,7 +97,7 @@ def _feasibility_facts(m: dict[str, Any]) -> list[Fact]:
 
 
 def summary_warnings(data: BuildData, checks: list[Check]) -> list[str]:
-    """Every warning of the build, most serious first: stale, failed checks, fold.
+    """Every warning of the build, most serious first: stale, failed checks, fold, fit (dropped wall).
 
     The feasibility verdict's causes are the verdict box's (:mod:`softdesign.report.verdict`), not repeated here;
     one-arc-per-link misfits are information about a PCC reading of the body, shown in the tables' notes.
@@ -112,6 +112,7 @@ def summary_warnings(data: BuildData, checks: list[Check]) -> list[str]:
     rho_kappa = resolve_or(m, "/metrics/fit/max_rho_kappa", None)
     if rho_kappa is not None and rho_kappa >= FOLD_LIMIT:
         warnings.append(f"the surface folds through itself at q = 1: largest rho * kappa {rho_kappa:.3g} >= 1")
+    warnings += [f"fit: {w}" for w in resolve_or(m, "/metrics/fit/warnings", [])]  # dropped wall, unseen stretches
     return warnings
 
 

@@ -35,16 +35,20 @@ def build_verdict(manifest: dict[str, Any]) -> Verdict:
     block = resolve_or(manifest, "/metrics/feasibility", None)
     feasible = block.get("feasible") if isinstance(block, dict) else None
     extras = _extras(manifest)
+    # the fit's own warnings (a long stretch held at the inscribed radius, wall far from the body): the figures of
+    # the design hold only where the body matches the vessel
+    fit_notes = tuple(f"fit: {w}" for w in resolve_or(manifest, "/metrics/fit/warnings", []))
     if feasible is None:
         headline = "Not judged: the case declares no material (add material: {name: ecoflex-00-30}, or another "
         headline += "preset, to judge the design against its limits)"
-        return Verdict("not judged", headline, (), tuple(extras))
+        return Verdict("not judged", headline, (), (*extras, *fit_notes))
     material = (block.get("material") or {}).get("name", "its material")
     reasons = tuple(block.get("reasons", []))
     if feasible:
-        return Verdict("feasible", "; ".join([f"Feasible for {material}", *extras]), (), ())
+        caveat = ["but the fit does not match the vessel everywhere (below)"] if fit_notes else []
+        return Verdict("feasible", "; ".join([f"Feasible for {material}", *extras, *caveat]), (), fit_notes)
     first = reasons[0] if reasons else "a limit of the material is crossed"
-    return Verdict("infeasible", f"NOT feasible: {first}", reasons[1:], tuple(extras))
+    return Verdict("infeasible", f"NOT feasible: {first}", reasons[1:], (*extras, *fit_notes))
 
 
 def _extras(manifest: dict[str, Any]) -> list[str]:

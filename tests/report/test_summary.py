@@ -39,6 +39,16 @@ def test_every_kind_of_warning_is_listed_stale_first_and_the_verdicts_causes_are
     assert banner_html(warnings).count("<li>") == 3 and 'role="alert"' in banner_html(warnings)
 
 
+def test_the_fit_s_coverage_warnings_are_named_in_the_banner():
+    # issue 29: a held stretch longer than a diameter, an all-wall p95 above its stated fraction of the radius
+    held = "no wall seen all round over 30.0 mm at 0.0-30.0 mm from the inlet, longer than the local diameter 6.0 mm"
+    manifest = {"stages": [{"name": "fit", "status": "ran"}],
+                "metrics": {"fit": {"max_rho_kappa": 0.3, "flags": ["unseen_stretch_longer_than_diameter"],
+                                    "warnings": [held]},
+                            "kinematics": {"arc_check": {"warnings": []}}}}
+    assert summary_warnings(_data(manifest), []) == [f"fit: {held}"]  # type: ignore[arg-type]
+
+
 def test_a_clean_build_has_no_warning_and_says_so():
     manifest = {"stages": [{"name": "fit", "status": "ran"}],
                 "metrics": {"feasibility": {"feasible": None, "reasons": ["no material"]},

@@ -46,3 +46,13 @@ def test_a_failed_mould_check_is_said():
 def test_without_a_material_the_design_is_not_judged_and_the_line_says_how_to_judge_it():
     verdict = build_verdict(_manifest(feasibility={"feasible": None, "material": None, "reasons": ["no material"]}))
     assert verdict.status == "not judged" and "material:" in verdict.headline
+
+
+def test_the_fits_warnings_are_named_in_the_verdict():
+    held = "no wall seen all round over 30.0 mm at 0.0-30.0 mm from the inlet, longer than the local diameter 6.0 mm"
+    manifest = _manifest(feasibility={"feasible": True, "material": {"name": "x"}, "reasons": []},
+                         fit={"warnings": [held]})
+    verdict = build_verdict(manifest)
+    assert verdict.headline.endswith("but the fit does not match the vessel everywhere (below)")
+    assert verdict.notes == (f"fit: {held}",)
+    assert f"fit: {held}" in verdict_html(verdict, "Checks: 1 of 1 passed.")

@@ -42,7 +42,9 @@ if TYPE_CHECKING:  # only annotations: the report loads stage results without th
 #: 5: the rim-gap warning moved to the fit, which decides whether the body is cut at the plane (``fit.end_cut``).
 #: 6: a centerline without radii takes them from final.surface; 2-point segments and unstructured grids are
 #: joined into paths; extracted centerlines reach the openings (issue 29).
-VERSION = 6
+#: 7: the backbone's reach uses the wall's fold radius; a turn no smoothing brings below the target is warned
+#: about, not refused (issue 29).
+VERSION = 7
 
 
 @dataclass(frozen=True)
@@ -96,7 +98,7 @@ def run_ingest(case: Case) -> IngestResult:
         notes += [*extracted.notes, continuation_note(extracted)]
     vertices, faces, info = _final_surface(case, path, scale)
     inlet_rule = path.notes[-1]
-    path, backbone = regularized_path(case, path)
+    path, backbone = regularized_path(case, path, vertices, others)
     notes += [n for n in path.notes if n not in notes]
     ends = end_plane_summary(case, path, vertices, faces)
     initial_path = None
