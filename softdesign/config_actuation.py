@@ -20,12 +20,14 @@ chamber 1 where seed 003's encoder 1 sits (90 degrees from N).
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from softdesign.config_types import FiniteFloat
-from softdesign.meshing.chamber_layout import ActuationSpec
+
+if TYPE_CHECKING:  # numpy stays out of `softdesign validate`
+    from softdesign.meshing.chamber_layout import ActuationSpec
 
 #: The largest size any actuation key takes, mm (a vessel is at most 20 mm in median radius, limits at ingest).
 MAX_ACTUATION_MM = 50.0
@@ -66,5 +68,7 @@ class Actuation(BaseModel):
 
     def spec(self) -> ActuationSpec:
         """The layout's numbers."""
+        from softdesign.meshing.chamber_layout import ActuationSpec
+
         return ActuationSpec(self.distance_mm, self.diameter_mm, self.feed_diameter_mm, self.end_wall_mm,
                              self.first_angle_deg, self.chambers_per_section)
