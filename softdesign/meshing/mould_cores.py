@@ -53,9 +53,12 @@ from softdesign.meshing.mould_checks import (
 from softdesign.meshing.mould_frame import PartingFrame, parting_frame
 from softdesign.meshing.mould_make import Mould, MouldMesh
 from softdesign.meshing.solids import checked, cut_body, manifold_from_mesh
-from softdesign.meshing.tessellate import Region, TubeMesh, TubeSections, sweep_from_sections, tessellate
+from softdesign.meshing.tessellate import Region, Sweep, TubeMesh, TubeSections, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec
 from softdesign.types import FloatArray
+
+#: A base face whose points lie within this of one plane normal to T(0) is square (not cut on a slant), mm.
+SQUARE_TOL_MM = 1e-9
 
 
 def _cores(curve, sections: TubeSections, layout: ChamberLayout, reach_mm: float) -> list[tuple[str, m3.Manifold]]:
@@ -84,15 +87,33 @@ def _plate_plane(body_mesh: TubeMesh, base: FloatArray, outward: FloatArray) -> 
     return float(np.min((body_mesh.vertices[cap] - base) @ outward))
 
 
-def _split(parts: MouldParts, frame: PartingFrame, base: FloatArray, outward: FloatArray, at: float
-           ) -> tuple[m3.Manifold, m3.Manifold, m3.Manifold]:
-    """Halves A and B up to the base plane, and the plate beyond it (mould frame)."""
-    n = frame.direction_to_frame(outward)
-    offset = float(frame.to_frame(base) @ n + at)
-    half_a = parts.half_a.trim_by_plane(tuple(-n), -offset)
-    half_b = parts.half_b.trim_by_plane(tuple(-n), -offset)
-    plate = parts.half_a.trim_by_plane(tuple(n), offset) + parts.half_b.trim_by_plane(tuple(n), offset)
-    return half_a, half_b, plate
+def _base_prism(outer: Sweep, length_mm: float) -> m3.Manifold:
+    """The body's base section extruded ``length_mm`` out of the body along -T(0), world frame (its inner ring is
+    the body's own first ring, bit for bit, so it joins the body's square base face without a seam)."""
+    frame, centre = outer.frames[0], outer.centers[0]
+    prism = Sweep(outer.q, np.zeros(2), np.array([-length_mm, 0.0]),
+                  np.stack([centre - length_mm * frame[:, 2], centre]), np.stack([frame, frame]),
+                  np.stack([outer.xy[0], outer.xy[0]]))
+    mesh = tessellate(prism)
+    return manifold_from_mesh(mesh.vertices, mesh.faces, "mould: base prism")[0]
+
+
+def _split(parts: MouldParts, frame: PartingFrame, plane: tuple[FloatArray, float], cores: m3.Manifold,
+           prism: m3.Manifold | None) -> tuple[m3.Manifold, m3.Manifold, m3.Manifold]:
+    """Halves A and B up to the base plane, and the plate beyond it (mould frame), each less body, channels, cores.
+
+    The box is cut first and the body subtracted after, as round 2 cuts the box at the parting plane.  A square
+    base face lies on the plane: the halves then lose the body extended through it (``prism``), and the plate
+    the channels and cores only (it meets the body on the plane), so no face of a difference is coplanar.
+    """
+    n, offset = plane
+    inner, outer = parts.box.trim_by_plane(tuple(-n), -offset), parts.box.trim_by_plane(tuple(n), offset)
+    body = parts.body if prism is None else parts.body + prism
+    voids = body + parts.channels + cores
+    half_a = (inner.trim_by_plane((0.0, 0.0, 1.0), 0.0) + parts.bumps) - voids
+    half_b = inner.trim_by_plane((0.0, 0.0, -1.0), 0.0) - parts.sockets - voids
+    plate = outer - (parts.channels + cores if prism is not None else voids)
+    return (checked(half_a, "mould half A"), checked(half_b, "mould half B"), checked(plate, "mould core plate"))
 
 
 def make_actuated_mould(sections: TubeSections, body_spec: BodySpec, spec: MouldSpec, curve,
@@ -120,9 +141,10 @@ def make_actuated_mould(sections: TubeSections, body_spec: BodySpec, spec: Mould
     cores = [(name, core.transform(frame.frame_from_world()).as_original())
              for name, core in _cores(curve, sections, layout, at + box_size + spec.print_mm)]
     all_cores = m3.Manifold.batch_boolean([c for _, c in cores], m3.OpType.Add)
-    half_a, half_b, plate = _split(parts, frame, base, outward, at)
-    half_a, half_b = (checked(h - all_cores, f"mould half {k}") for h, k in ((half_a, "A"), (half_b, "B")))
-    plate = checked(plate - all_cores, "mould core plate")
+    n = frame.direction_to_frame(outward)
+    square = -_plate_plane(body_mesh, base, -outward) - at <= SQUARE_TOL_MM  # the base face lies on the plane
+    prism = _base_prism(outer, box_size).transform(frame.frame_from_world()) if square else None
+    half_a, half_b, plate = _split(parts, frame, (n, float(frame.to_frame(base) @ n + at)), all_cores, prism)
     figures = _check(parts, half_a, half_b, plate, cores, frame, frame.direction_to_frame(outward),
                      facet_tolerance(outer.xy.shape[1]))
     figures["core"] = _core_note(frame, layout, len(cores))
@@ -219,7 +241,8 @@ def _pulls(parts: MouldParts, half_a: m3.Manifold, half_b: m3.Manifold, plate: m
         # half of that nub outside the cavity from below; it is trimmed off with the sprue before the plate is pulled
         sprue = [f for f in failures if f.where == "sprue" and not f.blocked]
         failures = [f for f in failures if f not in sprue]
-        result = {**result, "ok": not failures, "sprue_nub_faces": len(sprue)}
+        result = {**result, "ok": not failures, "against_pull": result["against_pull"] - len(sprue),
+                  "sprue_nub_faces": len(sprue)}
         lean = _pin_lean(pins, outward)
         if failures or lean > PIN_SIDE_TOL:
             raise MouldRefused(f"export.mould: the core plate does not pull free along the base tangent "
