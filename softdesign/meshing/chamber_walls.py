@@ -43,7 +43,11 @@ RINGS_PER_MM = 2.0
 
 @dataclass(frozen=True)
 class Wall:
-    """A thinnest wall: its kind, thickness (mm), and where (section and chamber 1-based, q, l, angle deg)."""
+    """A thinnest wall: its kind, thickness (mm), and where (section and chamber 1-based, q, l, angle deg).
+
+    A feed's wall names the chamber the feed leads to; a wall between tubes (the same in every chamber of its
+    section, at every q and l) has chamber 0 and no q, l or angle.
+    """
 
     kind: str
     thickness_mm: float
@@ -59,7 +63,10 @@ class Wall:
 
     def place(self) -> str:
         """``section 2 chamber 1 q=0.500 l=0.3120 angle 95 deg`` (parts that are None left out)."""
-        parts = [f"section {self.section} chamber {self.chamber}"]
+        if self.chamber == 0:  # a ring wall: the same for every chamber of the section, at every q and l
+            return f"section {self.section} (every chamber, q and l)"
+        feed = "feed of " if self.kind.startswith("feed") else ""
+        parts = [f"{feed}section {self.section} chamber {self.chamber}"]
         if self.q is not None:
             parts.append(f"q={self.q:.3f}")
         if self.l is not None:

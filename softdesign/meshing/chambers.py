@@ -193,3 +193,44 @@ def build_actuated(sections: TubeSections, spec: BodySpec, curve: FramedSpline, 
     cavities = cavity_sweeps(curve, sections.q, layout, sections.l, feed_extension_mm(spec, layout))
     solid = carve_cavities(body, cavities, outer.max_rho_kappa, label)
     return replace(solid, volume_offset_mm3=added - cavity_volume_mm3(curve, layout))
+
+
+def measured_skin_walls(sections: TubeSections, spec: BodySpec, curve: FramedSpline, layout: ChamberLayout
+                        ) -> list[tuple[str, float, int, int, float]]:
+    """The thinnest skin over each chamber and over each feed as meshed at this q: the true distance from every
+    vertex of its tube to the body's outer mesh (end caps, cut on a slant or not, included), mm.
+
+    Returns (kind, thickness_mm, section, chamber, l) with kind ``chamber-skin (mesh)`` or ``feed-skin (mesh)``;
+    a feed's rings within ``end_wall_mm`` of the base face, where it opens, are left out.  A check of the exported
+    geometry itself beside the in-section figures of :mod:`chamber_walls`: the tubes' polygons are area-matched,
+    so a vertex lies up to ``r (sqrt(2 pi / (n sin(2 pi / n))) - 1)`` outside the design circle (0.3 % of r at 32
+    sides) and the figure errs low by that much.
+    """
+    from softdesign.meshing.compare import squared_distances
+    from softdesign.meshing.tessellate import ring_points
+
+    outer = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
+    body, _ = cut_body(outer, spec, f"q={sections.q:.3f}")
+    picked = []
+    for cavity in cavity_sweeps(curve, sections.q, layout, sections.l, 0.0):
+        sweep = cavity.sweep
+        keep = sweep.s >= sweep.s[0] + layout.spec.end_wall_mm if cavity.kind == "feed" else np.ones(len(sweep.s), bool)
+        # along the tube the skin's nearest point faces away from the backbone: the outer half of each ring; the
+        # end rings whole (a cut end cap may lean towards the backbone)
+        centre = sweep.xy[0].mean(axis=0)
+        half = (sweep.xy[0] - centre) @ centre >= -1e-12
+        rings = ring_points(sweep)
+        ends = np.zeros(len(sweep.s), bool)
+        ends[[0, -1]] = True
+        points = np.concatenate([rings[keep & ~ends][:, half].reshape(-1, 3), rings[keep & ends].reshape(-1, 3)])
+        owner = np.concatenate([np.repeat(sweep.l[keep & ~ends], half.sum()),
+                                np.repeat(sweep.l[keep & ends], rings.shape[1])])
+        picked.append((cavity, points, owner))
+    gaps = np.sqrt(squared_distances(np.concatenate([p for _, p, _ in picked]), body.vertices, body.faces))
+    out, start = [], 0  # one locator for every tube
+    for cavity, points, l in picked:
+        gap = gaps[start:start + len(points)]
+        start += len(points)
+        i = int(np.argmin(gap))
+        out.append((f"{cavity.kind}-skin (mesh)", float(gap[i]), cavity.section, cavity.chamber, float(l[i])))
+    return out

@@ -16,7 +16,7 @@ from softdesign.kinematics.pcc_fit import fit_link
 from softdesign.meshing.body import sections_on_grid
 from softdesign.meshing.chamber_layout import ActuationSpec, ChamberLayout, plan_layout
 from softdesign.meshing.chamber_walls import chamber_lengths_mm, ring_walls, skin_walls
-from softdesign.meshing.chambers import build_actuated, cavity_sweeps, feed_extension_mm
+from softdesign.meshing.chambers import build_actuated, cavity_sweeps, feed_extension_mm, measured_skin_walls
 from softdesign.meshing.checks import Expectation, check_solid
 from softdesign.meshing.solids import manifold_from_mesh
 from softdesign.meshing.tessellate import tessellate
@@ -182,3 +182,17 @@ def test_arc_section_lengths_follow_seed_003() -> None:
     run = (c.l_end - c.l_start) * LENGTH
     np.testing.assert_allclose(mesh_lengths[c.section, c.index],
                                run * (1 - kappa * SPEC.distance_mm * np.cos(c.angle - phi)), rtol=0, atol=1e-6)
+
+
+def test_measured_skin_over_a_straight_body_is_the_analytic_wall() -> None:
+    curve = straight()
+    walls = measured_skin_walls(body(curve), BodySpec(), curve, layout_on(curve))
+    chamber = min(w[1] for w in walls if w[0] == "chamber-skin (mesh)")
+    feed = min(w[1] for w in walls if w[0] == "feed-skin (mesh)")
+    # the skin's 64-gon is inscribed (sagitta R (1 - cos(pi/64)) = 0.0036 mm) and a tube's area-matched polygon
+    # reaches 0.3 % of its radius outside the circle: the mesh's wall is thinner than R - d - D/2 by up to both
+    sagitta = RADIUS * (1 - np.cos(np.pi / ANGULAR))
+    for value, design, segments in ((chamber, RADIUS - 2.0 - 0.4, 32), (feed, RADIUS - 2.0 - 0.2, 16)):
+        reach = (SPEC.diameter_mm if segments == 32 else SPEC.feed_diameter_mm) / 2 * (
+            np.sqrt(2 * np.pi / segments / np.sin(2 * np.pi / segments)) - 1)
+        assert design - sagitta - reach - 1e-9 <= value <= design + 1e-9, (value, design)

@@ -33,9 +33,13 @@ import numpy as np
 from softdesign.errors import ConfigError
 from softdesign.kinematics.chamber_lengths import chamber_lengths_from_arc
 from softdesign.kinematics.pcc_fit import fit_links
+from softdesign.meshing.body import body_sections
 from softdesign.meshing.chamber_layout import ChamberLayout, analytic_walls, chamber_angles, plan_layout
 from softdesign.meshing.chamber_walls import Wall, chamber_lengths_mm, ring_walls, skin_walls
+from softdesign.meshing.chambers import measured_skin_walls
+from softdesign.pipeline.bounds import export_workers
 from softdesign.pipeline.layout import q_label
+from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
@@ -201,6 +205,25 @@ def _skin(kinematics: KinematicsResult, fit: FitResult, layout: ChamberLayout, g
     return out
 
 
+def _meshed(case: Case, kinematics: KinematicsResult, fit: FitResult, layout: ChamberLayout) -> list[Wall]:
+    """At every export q (on the build's worker processes), the thinnest skin over chambers and feeds measured
+    on the meshes the export makes."""
+    from softdesign.pipeline.stages.export import body_spec  # export imports this stage's layout
+
+    e, spec = case.export, body_spec(case, fit)
+
+    def at(q: float) -> list[Wall]:
+        curve = kinematics.chain.shape.curve_at(q)
+        sections = body_sections(curve, fit.field, q, e.spacing_mm, e.angular_count)
+        walls = [Wall(kind, value, section + 1, chamber + 1, q, l, None)
+                 for kind, value, section, chamber, l in measured_skin_walls(sections, spec, curve, layout)]
+        return [min((w for w in walls if w.kind == kind), key=lambda w: w.thickness_mm)
+                for kind in dict.fromkeys(w.kind for w in walls)]
+
+    longest = max(key.length for key in kinematics.chain.shape.keys)
+    return [w for walls in map_items(at, e.q_values(), most=export_workers(case, longest)) for w in walls]
+
+
 def judge(walls: list[Wall], extensions: list[dict[str, Any]], limits: dict[str, Any] | None) -> list[str]:
     """One reason per wall or extension beyond the material's limits (empty when none, or no material)."""
     if limits is None:
@@ -247,6 +270,7 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult) -> A
             rows += _rows_at(kinematics, layout, q, export, reference)[0]
     qs = [q for q, _ in grid]
     walls = ring_walls(layout) + _skin(kinematics, fit, layout, qs, case.export.offset_mm)
+    walls += _meshed(case, kinematics, fit, layout)
     extensions = _extensions(kinematics, layout, qs)
     limits = case.material.limits().as_dict() if case.material is not None else None
     reasons = judge(walls, extensions, limits)
@@ -268,7 +292,8 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult) -> A
         "reasons": reasons if limits is not None else ["no material: in the case file: figures only, not judged"],
         "method": "lengths: seed 003 on each section's best arc at q (backbone started on the section's base "
                   "frame); extension: the chamber's axis on the body at q over q = 0; walls in the sections' "
-                  "normal planes (chamber-skin, feed-skin at every q; between tubes constant over q)",
+                  "normal planes (chamber-skin, feed-skin at every q; between tubes constant over q), and at every "
+                  "export q the skin over each tube measured on the mesh (end caps included)",
     }
     return ActuationResult(summary, table_text(rows))
 
@@ -313,7 +338,8 @@ def describe_actuation(result: ActuationResult | None) -> list[str]:
 STAGE = Stage(
     name="actuation",
     version=VERSION,
-    reads=("actuation", "export.q", "export.frames", "export.offset_mm", "material"),
+    reads=("actuation", "export.q", "export.frames", "export.offset_mm", "export.spacing_mm", "export.angular_count",
+           "material"),
     upstream=("kinematics", "fit"),
     compute=lambda case, results: run_actuation(case, results["kinematics"], results["fit"]),
     write=write_actuation,
