@@ -197,13 +197,15 @@ def build_actuated(sections: TubeSections, spec: BodySpec, curve: FramedSpline, 
 
 def measured_skin_walls(sections: TubeSections, spec: BodySpec, curve: FramedSpline, layout: ChamberLayout
                         ) -> list[tuple[str, float, int, int, float]]:
-    """The thinnest skin over each chamber and over each feed as meshed at this q: the true distance from every
-    vertex of its tube to the body's outer mesh (end caps, cut on a slant or not, included), mm.
+    """The thinnest skin over each chamber and over each feed as meshed at this q: the true distance from the
+    vertices of its tube to the body's outer mesh, mm.
 
-    Returns (kind, thickness_mm, section, chamber, l) with kind ``chamber-skin (mesh)`` or ``feed-skin (mesh)``;
-    a feed's rings within ``end_wall_mm`` of the base face, where it opens, are left out.  A check of the exported
-    geometry itself beside the in-section figures of :mod:`chamber_walls`: the tubes' polygons are area-matched,
-    so a vertex lies up to ``r (sqrt(2 pi / (n sin(2 pi / n))) - 1)`` outside the design circle (0.3 % of r at 32
+    Returns (kind, thickness_mm, section, chamber, l) with kind ``chamber-skin (mesh)`` (to the whole outer
+    mesh: a chamber's end walls count, cut on a slant or not) or ``feed-skin (mesh)`` (to the side wall only:
+    a feed opens through the base face).  Along a tube the skin's nearest point faces away from the backbone,
+    so the outer half of each ring is measured, and the end rings whole.  A check of the exported geometry
+    itself beside the in-section figures of :mod:`chamber_walls`: the tubes' polygons are area-matched, so a
+    vertex lies up to ``r (sqrt(2 pi / (n sin(2 pi / n))) - 1)`` outside the design circle (0.3 % of r at 32
     sides) and the figure errs low by that much.
     """
     from softdesign.meshing.compare import squared_distances
@@ -211,26 +213,23 @@ def measured_skin_walls(sections: TubeSections, spec: BodySpec, curve: FramedSpl
 
     outer = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
     body, _ = cut_body(outer, spec, f"q={sections.q:.3f}")
-    picked = []
+    targets = {"chamber": body.faces, "feed": body.faces[body.regions == Region.WALL]}
+    picked: dict[str, list[tuple[Cavity, FloatArray, FloatArray]]] = {"chamber": [], "feed": []}
     for cavity in cavity_sweeps(curve, sections.q, layout, sections.l, 0.0):
         sweep = cavity.sweep
-        keep = sweep.s >= sweep.s[0] + layout.spec.end_wall_mm if cavity.kind == "feed" else np.ones(len(sweep.s), bool)
-        # along the tube the skin's nearest point faces away from the backbone: the outer half of each ring; the
-        # end rings whole (a cut end cap may lean towards the backbone)
         centre = sweep.xy[0].mean(axis=0)
         half = (sweep.xy[0] - centre) @ centre >= -1e-12
         rings = ring_points(sweep)
-        ends = np.zeros(len(sweep.s), bool)
-        ends[[0, -1]] = True
-        points = np.concatenate([rings[keep & ~ends][:, half].reshape(-1, 3), rings[keep & ends].reshape(-1, 3)])
-        owner = np.concatenate([np.repeat(sweep.l[keep & ~ends], half.sum()),
-                                np.repeat(sweep.l[keep & ends], rings.shape[1])])
-        picked.append((cavity, points, owner))
-    gaps = np.sqrt(squared_distances(np.concatenate([p for _, p, _ in picked]), body.vertices, body.faces))
-    out, start = [], 0  # one locator for every tube
-    for cavity, points, l in picked:
-        gap = gaps[start:start + len(points)]
-        start += len(points)
-        i = int(np.argmin(gap))
-        out.append((f"{cavity.kind}-skin (mesh)", float(gap[i]), cavity.section, cavity.chamber, float(l[i])))
+        points = np.concatenate([rings[1:-1, half].reshape(-1, 3), rings[[0, -1]].reshape(-1, 3)])
+        owner = np.concatenate([np.repeat(sweep.l[1:-1], half.sum()), np.repeat(sweep.l[[0, -1]], rings.shape[1])])
+        picked[cavity.kind].append((cavity, points, owner))
+    out = []
+    for kind, tubes in picked.items():
+        gaps = np.sqrt(squared_distances(np.concatenate([p for _, p, _ in tubes]), body.vertices, targets[kind]))
+        start = 0  # one locator for every tube of the kind
+        for cavity, points, l in tubes:
+            gap = gaps[start:start + len(points)]
+            start += len(points)
+            i = int(np.argmin(gap))
+            out.append((f"{kind}-skin (mesh)", float(gap[i]), cavity.section, cavity.chamber, float(l[i])))
     return out
