@@ -115,8 +115,8 @@ def build(
         _print_runs(outcome.build_dir, outcome.runs)
         if with_report:
             report_after_build(outcome.build_dir, jobs=jobs)
-        feasibility = outcome.results.get("feasibility")
-        return feasibility is not None and feasibility.summary.get("feasible") is False
+        judged = [outcome.results.get(name) for name in ("feasibility", "actuation")]  # actuation: walls, extension
+        return any(r is not None and r.summary.get("feasible") is False for r in judged)
 
     infeasible = run_guarded(action)
     if strict and infeasible:

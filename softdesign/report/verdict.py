@@ -31,9 +31,12 @@ class Verdict:
 
 
 def build_verdict(manifest: dict[str, Any]) -> Verdict:
-    """The verdict of a build's manifest (see the module notes)."""
+    """The verdict of a build's manifest (see the module notes): the skin's (feasibility) and, with chambers, the
+    chambers' walls and extensions (actuation) against the material."""
     block = resolve_or(manifest, "/metrics/feasibility", None)
     feasible = block.get("feasible") if isinstance(block, dict) else None
+    actuation = resolve_or(manifest, "/metrics/actuation", None)
+    chambers_ok = actuation.get("feasible") if isinstance(actuation, dict) else None
     extras = _extras(manifest)
     # the fit's own warnings (a long stretch held at the inscribed radius, wall far from the body): the figures of
     # the design hold only where the body matches the vessel
@@ -44,6 +47,9 @@ def build_verdict(manifest: dict[str, Any]) -> Verdict:
         return Verdict("not judged", headline, (), (*extras, *fit_notes))
     material = (block.get("material") or {}).get("name", "its material")
     reasons = tuple(block.get("reasons", []))
+    if chambers_ok is False:  # the chambers' walls and extensions (the actuation stage) are judged too
+        feasible = False
+        reasons += tuple(f"chambers: {r}" for r in actuation.get("reasons", []))
     if feasible:
         caveat = ["but the fit does not match the vessel everywhere (below)"] if fit_notes else []
         return Verdict("feasible", "; ".join([f"Feasible for {material}", *extras, *caveat]), (), fit_notes)

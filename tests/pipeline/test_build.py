@@ -20,7 +20,7 @@ from softdesign.versions import software_versions
 from tests.helpers.paths import REPO
 
 runner = CliRunner()
-STAGES = ["ingest", "blend", "links", "kinematics", "fit", "export", "mould", "volume_mesh", "feasibility"]
+STAGES = ["ingest", "blend", "links", "kinematics", "fit", "actuation", "export", "mould", "volume_mesh", "feasibility"]
 
 
 def snapshot(folder: Path) -> dict[str, str]:
@@ -69,37 +69,39 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     edit(demo_case, "fit", smoothing=2.0e-5)
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "ran",
-        "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
+        "actuation": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
     edit(demo_case, "export", q=[0, 0.5, 1])
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "ran", "fit": "skipped",
-        "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
+        "actuation": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
     # The mesh formats are read by export (and the mould's formats): kinematics, the fit and the feasibility
     # figures stay cached.
     edit(demo_case, "export", formats=["stl", "ply"])
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "skipped",
-        "export": "ran", "mould": "ran", "volume_mesh": "skipped", "feasibility": "skipped",
+        "actuation": "skipped", "export": "ran", "mould": "ran", "volume_mesh": "skipped", "feasibility": "skipped",
     }
     # A mould is read by the mould stage and by the fit (which turns the end cuts into the mould's parting
     # plane): the fit and what follows it are redone; ingest, blend, links and kinematics stay.
     edit(demo_case, "export", mould={"margin_mm": 8})
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "ran",
-        "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
+        "actuation": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
     assert (out / "meshes" / "mould" / "half_a.ply").is_file()
     # New link breaks: the links, their kinematics and the per-link fit are redone; ingest and blend are not.
     edit(demo_case, "links", count=None, breaks=[0, 0.4, 1])
     assert statuses(build(demo_case, out)) == {
-        "ingest": "skipped", "blend": "skipped", "links": "ran", "kinematics": "ran", "fit": "ran", "export": "ran",
-        "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
+        "ingest": "skipped", "blend": "skipped", "links": "ran", "kinematics": "ran", "fit": "ran", "actuation": "ran",
+        "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
-    # A material is read by the feasibility verdict alone: every mesh stays (the demo declares ecoflex-00-30).
+    # A material is read by the feasibility and actuation verdicts alone: every mesh stays (the demo declares
+    # ecoflex-00-30).
     edit(demo_case, "material", name="dragon-skin-10")
-    assert statuses(build(demo_case, out)) == {**dict.fromkeys(STAGES, "skipped"), "feasibility": "ran"}
+    assert statuses(build(demo_case, out)) == {**dict.fromkeys(STAGES, "skipped"), "actuation": "ran",
+                                               "feasibility": "ran"}
     assert statuses(build(demo_case, out, "--force")) == dict.fromkeys(STAGES, "ran")
 
 
@@ -118,7 +120,7 @@ def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tm
     ran, manifest = run_fit()
     assert ran == {
         "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "skipped",
-        "export": "kept", "mould": "kept", "volume_mesh": "kept", "feasibility": "kept",
+        "actuation": "kept", "export": "kept", "mould": "kept", "volume_mesh": "kept", "feasibility": "kept",
     }
     outputs = {o["path"]: o for o in manifest["outputs"]}
     assert all(outputs[m]["watertight"] and outputs[m]["volume_mm3"] > 0 and "stale" not in outputs[m] for m in meshes)

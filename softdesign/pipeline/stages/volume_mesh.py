@@ -189,7 +189,7 @@ STAGE = Stage(
     name="volume_mesh",
     version=VERSION,
     reads=("export.volume_mesh", "export.offset_mm", "export.wall_mm", "export.port_mm", "export.spacing_mm",
-           "export.angular_count"),
+           "export.angular_count", "actuation"),  # actuation: the export's solid it meshes has the chambers
     upstream=("kinematics", "fit"),
     compute=lambda case, results: run_volume_mesh(case, results["kinematics"], results["fit"]),
     write=write_volume_mesh,
