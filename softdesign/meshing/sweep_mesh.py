@@ -33,6 +33,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from softdesign.errors import MeshError
 from softdesign.meshing.cross_section import Circle, CrossSection, cross_section
@@ -121,7 +122,7 @@ class SweptMesh:
         return solid_side[:, ::-1].copy()
 
 
-def layer_grid(l: Sequence[float], holes: Sequence[Hole]) -> FloatArray:
+def layer_grid(l: npt.ArrayLike, holes: Sequence[Hole]) -> FloatArray:
     """``l`` (strictly increasing, from 0 to 1) with every hole's ends put in, near neighbours dropped."""
     grid = np.asarray(l, float)
     if grid.ndim != 1 or grid.size < 2 or grid[0] != 0.0 or grid[-1] != 1.0 or np.any(np.diff(grid) <= 0):
@@ -254,7 +255,7 @@ def _lids(section: CrossSection, holes: Sequence[Hole], l: FloatArray, used: Int
     return lids
 
 
-def swept_disk(outer_count: int, holes: Sequence[Hole], size: float, l: Sequence[float]) -> SweptMesh:
+def swept_disk(outer_count: int, holes: Sequence[Hole], size: float, l: npt.ArrayLike) -> SweptMesh:
     """:func:`cross_section` with the holes' circles, swept through :func:`layer_grid` of ``l``."""
     section = cross_section(outer_count, [h.circle for h in holes], size)
     return sweep_mesh(section, layer_grid(l, holes), holes)
