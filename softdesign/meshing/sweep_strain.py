@@ -83,9 +83,10 @@ def extreme_of(values: FloatArray, places: tuple[IntArray, FloatArray, FloatArra
 
 
 def strain_at(mesh: SweptMesh, rest: FloatArray, moved: FloatArray, law: HyperelasticLaw | None,
-              free: FloatArray) -> ElementStrain:
-    """Every tetrahedron's strain (and stress, with a law) between ``rest`` (q = 0) and ``moved``."""
-    return element_strain(rest, moved, mesh.tets, law, free)
+              free: FloatArray, inverses: FloatArray | None = None) -> ElementStrain:
+    """Every tetrahedron's strain (and stress, with a law) between ``rest`` (q = 0) and ``moved``;
+    ``inverses`` (:func:`~softdesign.mechanics.kinematic_stress.rest_inverses`) computed once for every q."""
+    return element_strain(rest, moved, mesh.tets, law, free, inverses)
 
 
 def skin_stretches(mesh: SweptMesh, rest: FloatArray, moved: FloatArray) -> tuple[FloatArray, FloatArray]:

@@ -58,3 +58,15 @@ def test_a_rotation_is_free_of_strain_and_stress():
     F = deformation_gradients(TET, TET @ R.T, np.array([[0, 1, 2, 3]]))
     np.testing.assert_allclose(principal_stretches_3d(F), 1.0, rtol=EXACT_RTOL)
     np.testing.assert_allclose(cauchy_stress(NEO, F), 0.0, atol=1e-10)
+
+
+def test_closed_form_eigenvalues_match_lapack():
+    rng = np.random.default_rng(7)
+    M = rng.normal(size=(500, 3, 3))
+    A = M + M.transpose(0, 2, 1)
+    A[:10] = np.eye(3)  # a triple root
+    A[10:20] = np.diag([2.0, 1.0, 1.0])  # a double root
+    from softdesign.mechanics.kinematic_stress import symmetric_eigenvalues
+
+    # near a repeated root the trigonometric form keeps about half the digits
+    np.testing.assert_allclose(symmetric_eigenvalues(A), np.linalg.eigvalsh(A)[:, ::-1], rtol=0, atol=1e-7)

@@ -95,9 +95,10 @@ def test_stress_on_the_tube_under_uniaxial_stretch(bent, stretch):
     strain = strain_at(mesh, rest, moved, NEO, free_directions(mesh, rest))
     expected = NEO.mu_kpa * (stretch**2 - 1.0 / stretch)
     assert strain.stress_max is not None
-    # in compression the axial stress is the least principal one; the other two are 0
-    np.testing.assert_allclose(strain.stress_max, max(expected, 0.0), rtol=1e-9, atol=1e-9)
-    np.testing.assert_allclose(strain.stretches[:, 0], max(stretch, stretch**-0.5), rtol=1e-9)
+    # in compression the axial stress is the least principal one; the other two are 0, a double root, where
+    # the closed-form eigenvalues keep half the digits: atol sqrt(eps) x the stresses' scale (mu ~ 40 kPa)
+    np.testing.assert_allclose(strain.stress_max, max(expected, 0.0), rtol=1e-9, atol=1e-8 * 2 * NEO.mu_kpa)
+    np.testing.assert_allclose(strain.stretches[:, 0], max(stretch, stretch**-0.5), rtol=1e-8)  # a double root
 
 
 def test_skin_stretches_match_the_surface_metric(bent):
