@@ -72,3 +72,28 @@ def test_swept_mesh_of_a_hollow_tube(tmp_path):
     assert runner.invoke(app, ["build", str(case), "--out", str(again)]).exit_code == 0
     for name in ("q_0.000.vtu", "q_0.000.msh", "q_1.000.vtu", "chamber_q_1.000.stl"):
         assert (volume / name).read_bytes() == (again / "meshes" / "volume" / name).read_bytes(), name
+
+
+def test_strict_fails_on_the_3d_stress_alone(tmp_path):
+    """A bent tube of a material too weak for its stress but stretchy enough for the skin's limit: the skin's
+    feasibility passes, the swept mesh's 3D stress does not, and --strict exits 1 saying so."""
+    import yaml
+
+    from tests.helpers.parts_cases import bent_solid_case
+
+    case = bent_solid_case(tmp_path)
+    data = yaml.safe_load(case.read_text())
+    data["export"]["volume_mesh"] = {"q": [1.0], "size_mm": 1.5}
+    data["material"] = {"custom": {"name": "weak", "shore": "00-10", "tensile_strength_mpa": 0.001,
+                                   "elongation_at_break_pct": 800, "source": "a test",
+                                   "law": {"kind": "neo-hookean", "c1_kpa": 15.0, "c2_kpa": 0.0, "c3_kpa": 0.0}},
+                        "min_stretch": 0.01}
+    case.write_text(yaml.safe_dump(data))
+    out = tmp_path / "strict"
+    result = runner.invoke(app, ["build", str(case), "--out", str(out), "--strict"])
+    assert result.exit_code == 1, result.output
+    assert json.loads((out / "feasibility" / "summary.json").read_text())["feasible"] is True
+    summary = json.loads((out / "volume_mesh" / "summary.json").read_text())
+    assert summary["feasible"] is False and "3D stress" in summary["reasons"][0]
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert "volume_mesh" in json.dumps(manifest) and "stress_max_kpa" in json.dumps(manifest)
