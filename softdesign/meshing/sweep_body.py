@@ -12,6 +12,10 @@ Map
     - solid: ``t O(a)``;
     - hollow, chamber radius ``r_c`` in the reference: ``(t / r_c) I(a)`` for
       t <= r_c, ``I + (t - r_c) / (1 - r_c) (O - I)`` beyond (depth through the wall);
+    - chambered (issue 31's layout, :func:`holes_from_layout`): a rigid core
+      ``R0 (x, y)`` for t <= t_c, holding every chamber and feed as the exact
+      circle in mm the layout gives, then ``C + (t - t_c) / (1 - t_c) (O - C)``
+      out to the skin, C the core's circle ``t_c R0 u(a)``;
 
     ``O(a)``, ``I(a)`` linear between the grid's angles, so the outer circle's
     nodes (at the grid angles) are the surface mesh's vertices and the mesh's
@@ -37,11 +41,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from softdesign.errors import MeshError
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.geometry.frames import FramedSpline
 from softdesign.meshing.body import sections_on_grid
+from softdesign.meshing.chamber_layout import ChamberLayout
 from softdesign.meshing.end_cut import CutPlane, _cut_last_end, cut_planes
-from softdesign.meshing.sweep_mesh import SweptMesh
+from softdesign.meshing.sweep_mesh import Hole, SweptMesh
 from softdesign.meshing.tessellate import Sweep, sweep_from_sections
 from softdesign.meshing.volume import BodySpec, angle_grid
 from softdesign.types import FloatArray
@@ -55,10 +61,14 @@ class SweepReference:
     ----------
     chamber_radius : float, r_c, the chamber's circle in section radii (0: a solid body)
     chamber_layers : (j0, j1), the layers of the chamber's ends (hollow), else (0, 0)
+    core : float, t_c, the rigid core's radius in reference units (0: none; chambered bodies)
+    scale_mm : float, R0, mm per reference unit inside the core
     """
 
     chamber_radius: float = 0.0
     chamber_layers: tuple[int, int] = (0, 0)
+    core: float = 0.0
+    scale_mm: float = 0.0
 
 
 def l_at_arclength(curve: FramedSpline, s: FloatArray) -> FloatArray:
@@ -88,15 +98,28 @@ def _on_curve(xy: FloatArray, angles: FloatArray) -> FloatArray:
     return (1.0 - f) * xy[:, k] + f * xy[:, (k + 1) % na]
 
 
-def section_xy(points: FloatArray, outer: Sweep, inner: Sweep | None, chamber_radius: float) -> FloatArray:
+def section_xy(points: FloatArray, outer: Sweep, inner: Sweep | None, ref: SweepReference) -> FloatArray:
     """The reference section ``points`` (P, 2) in every layer's (N, B) plane, (n, P, 2) mm."""
     t = np.linalg.norm(points, axis=1)
     angles = np.arctan2(points[:, 1], points[:, 0])
     o = _on_curve(outer.xy, angles)
+    if ref.core > 0.0:
+        tc, r0 = ref.core, ref.scale_mm
+        reach = np.einsum("npk,pk->np", o, np.column_stack([np.cos(angles), np.sin(angles)]))
+        skin = reach[:, t >= 1.0 - 1e-9]
+        if np.any(skin <= tc * r0):
+            row = int(np.argmin(np.min(skin, axis=1)))
+            raise MeshError(f"volume mesh at q={outer.q:.3f}, l={outer.l[row]:.4f}: the skin comes within "
+                            f"{tc * r0:.3f} mm of the centerline, inside the chambers' ring; the layout does not "
+                            "fit this section: use smaller actuation.distance_mm or diameter_mm")
+        core = r0 * points[None, :, :]
+        rim = (tc * r0) * np.column_stack([np.cos(angles), np.sin(angles)])[None]
+        out = rim + np.clip((t - tc) / (1.0 - tc), 0.0, None)[None, :, None] * (o - rim)
+        return np.where((t <= tc)[None, :, None], core, out)
     if inner is None:
         return t[None, :, None] * o
     i = _on_curve(inner.xy, angles)
-    rc = chamber_radius
+    rc = ref.chamber_radius
     depth = np.clip((t - rc) / (1.0 - rc), 0.0, None)[None, :, None]
     return np.where((t <= rc)[None, :, None], (t / rc)[None, :, None] * i, i + depth * (o - i))
 
@@ -163,13 +186,13 @@ def place_mesh(mesh: SweptMesh, ref: SweepReference, curve: FramedSpline, field:
         As the export would: a fold, a wall or offset the local radius cannot take, an end plane too far.
     """
     outer, inner = section_sweeps(mesh, ref, curve, field, q, spec, angular_count)
-    grid = _grid_points(outer, section_xy(mesh.section.points, outer, inner, ref.chamber_radius))
+    grid = _grid_points(outer, section_xy(mesh.section.points, outer, inner, ref))
     grid = cut_grid(grid, outer, ref, spec, f"volume mesh at q={q:.3f}")
     return grid[mesh.node_layer, mesh.node_point]
 
 
 def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec: BodySpec, angular_count: int,
-              size_mm: float) -> tuple[SweptMesh, SweepReference]:
+              size_mm: float, layout: ChamberLayout | None = None) -> tuple[SweptMesh, SweepReference]:
     """The swept mesh of the body and its reference, laid out on the body at q = 0 (the cast state).
 
     Parameters
@@ -181,6 +204,7 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
         through the base cap)
     angular_count : nodes on the outer circle and on the chamber's and port's circles (the export's angles)
     size_mm : the largest edge inside the section, mm
+    layout : issue 31's chambers and feeds (a solid body's), or None
 
     The chamber's reference radius is the median ratio of the chamber's to the outer section's radius
     at q = 0 (so the depth coordinate is about uniform); the port's is its radius over the chamber's
@@ -192,6 +216,11 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
     a = angle_grid(angular_count)
     rho = field.evaluate_grid(0.0, layers, a)
     size = size_mm / float(np.median(rho))
+    if layout is not None:
+        if spec.wall_mm > 0:
+            raise MeshError("volume mesh: actuation chambers and export.wall_mm's single chamber together; give one")
+        holes, ref = holes_from_layout(layout, float(np.median(rho)), float(np.min(rho)), angular_count)
+        return swept_disk(angular_count, holes, size, layers), ref
     if spec.wall_mm == 0:
         return swept_disk(angular_count, [], size, layers), SweepReference()
     ends = l_at_arclength(curve0, np.array([spec.wall_mm, curve0.length - spec.wall_mm]))
@@ -209,3 +238,43 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
     mesh = swept_disk(angular_count, holes, size, layers)
     j = [int(np.argmin(np.abs(mesh.l - e))) for e in ends]
     return mesh, SweepReference(rc, (j[0], j[1]))
+
+
+#: The rigid core reaches this fraction of the way from the chambers' outer edge to the thinnest skin.
+CORE_GAP_FRACTION = 0.5
+#: Fewest nodes on a chamber's or feed's circle: its polygon holds 1 - sin(h)/h = 0.64 % less than the circle.
+MIN_CHAMBER_NODES = 32
+
+
+def holes_from_layout(layout: ChamberLayout, scale_mm: float, rho_min_mm: float,
+                      angular_count: int) -> tuple[list[Hole], SweepReference]:
+    """Issue 31's chambers and feeds as holes of the reference section, and the rigid core holding them.
+
+    Chamber (section i, chamber j) is ``s{i}_c{j}`` (surfaces ``s{i}_c{j}_wall``, ``_cap``); its feed
+    ``s{i}_c{j}_feed`` belongs to the same cavity and opens at the base (``s{i}_c{j}_feed_inlet``).
+    ``scale_mm`` (R0) is mm per reference unit, ``rho_min_mm`` the thinnest section's radius at q = 0.
+    """
+    from softdesign.meshing.cross_section import Circle
+
+    reach = max([c.distance_mm + 0.5 * c.diameter_mm for c in layout.chambers]
+                + [f.ring_mm + 0.5 * f.diameter_mm for f in layout.feeds])
+    core_mm = reach + CORE_GAP_FRACTION * (rho_min_mm - reach)
+    if not reach < core_mm < rho_min_mm:
+        raise MeshError(f"volume mesh: the chambers reach {reach:.3f} mm from the centerline, the thinnest section "
+                        f"is {rho_min_mm:.3f} mm: no wall; use smaller actuation.distance_mm or diameter_mm")
+    h_outer = 2.0 * np.pi / angular_count
+
+    def circle(distance: float, angle: float, diameter: float) -> Circle:
+        radius = 0.5 * diameter / scale_mm
+        nodes = max(MIN_CHAMBER_NODES, int(np.ceil(2.0 * np.pi * radius / h_outer)))
+        return Circle((distance * np.cos(angle) / scale_mm, distance * np.sin(angle) / scale_mm), radius, nodes)
+
+    holes = []
+    for c in layout.chambers:
+        holes.append(Hole(f"s{c.section}_c{c.index}", circle(c.distance_mm, c.angle, c.diameter_mm),
+                          (c.l_start, c.l_end)))
+    for f in layout.feeds:
+        name = f"s{f.section}_c{f.chamber}"
+        holes.append(Hole(f"{name}_feed", circle(f.ring_mm, f.angle, f.diameter_mm), (f.l_start, f.l_end),
+                          cavity=name))
+    return holes, SweepReference(core=core_mm / scale_mm, scale_mm=scale_mm)

@@ -122,3 +122,47 @@ def test_skin_stretches_match_the_surface_metric(bent):
     s1, s2 = principal_stretches(rest_m, bent_m)
     np.testing.assert_allclose(lam1[order][::7], s1, rtol=STRETCH_RTOL)
     np.testing.assert_allclose(lam2[order][::7], s2, rtol=STRETCH_RTOL)
+
+
+def _layout(shape):
+    from softdesign.meshing.chamber_layout import ActuationSpec, plan_layout
+
+    curve0 = shape.curve_at(0.0)
+    l = curve0.curve.dense_l()
+    spec = ActuationSpec(distance_mm=1.5, diameter_mm=0.8, feed_diameter_mm=0.4, end_wall_mm=1.0,
+                         first_angle_deg=90.0)
+    return plan_layout(spec, (0.0, 0.5, 1.0), l, curve0.curve.arc_length(l))
+
+
+def test_chambers_and_feeds_of_a_layout_are_exact_circles_closed_cavities(bent):
+    """A synthetic issue-31 layout (two sections, three chambers each, a feed per chamber from the base):
+    every cavity closed with the analytic volume of its chamber and feed within 1 %, the chambers' circles
+    exact in mm, every tet positive straight and bent."""
+    shape, field = bent
+    layout = _layout(shape)
+    spec = BodySpec()
+    mesh, ref = plan_mesh(shape.curve_at(0.0), field, np.linspace(0.0, 1.0, 61), spec, NA, 0.5, layout)
+    rest = place_mesh(mesh, ref, shape.curve_at(0.0), field, 0.0, spec, NA)
+    moved = place_mesh(mesh, ref, shape.curve_at(1.0), field, 1.0, spec, NA)
+    assert _volumes(rest, mesh.tets).min() > 0 and _volumes(moved, mesh.tets).min() > 0
+    assert "s1_c2_wall" in mesh.groups and "s1_c2_feed_inlet" in mesh.lids
+    for chamber in layout.chambers:
+        name = f"s{chamber.section}_c{chamber.index}"
+        topology = mesh_topology(rest, mesh.cavity_surface(name))
+        assert topology.watertight and topology.winding_consistent
+        feed = next(f for f in layout.feeds if (f.section, f.chamber) == (chamber.section, chamber.index))
+        length = (chamber.l_end - chamber.l_start) * LENGTH_MM
+        expected = np.pi * (chamber.diameter_mm / 2) ** 2 * length + np.pi * (feed.diameter_mm / 2) ** 2 * (
+            chamber.l_start * LENGTH_MM)
+        np.testing.assert_allclose(topology.volume, expected, rtol=0.01)  # the issue's bound
+        # the chamber's wall nodes lie on its circle in mm, about its axis c + d (cos b N + sin b B), straight and
+        # bent (the section's core is rigid)
+        wall = np.unique(mesh.group_faces(f"{name}_wall"))
+        l = mesh.reference_points()[wall, 2]
+        for q, points in ((0.0, rest), (1.0, moved)):
+            curve = shape.curve_at(q)
+            frames = curve.frames(l)
+            axis = curve.points(l) + chamber.distance_mm * (np.cos(chamber.angle) * frames[:, :, 0]
+                                                            + np.sin(chamber.angle) * frames[:, :, 1])
+            radii = np.linalg.norm(points[wall] - axis, axis=1)
+            np.testing.assert_allclose(radii, chamber.diameter_mm / 2, rtol=1e-9)

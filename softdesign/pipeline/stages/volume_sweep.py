@@ -218,11 +218,25 @@ class _Placed:
         return _strain_figures(self, points)
 
 
+def actuation_layout_of(case: Case, kinematics: KinematicsResult) -> Any:
+    """Issue 31's chambers and feeds when the case has ``actuation:`` (its stage's own layout), else None.
+
+    Written against issue 31's ``softdesign.pipeline.stages.actuation.actuation_layout``; on a tree without
+    it (no actuation key in the case file) there is nothing to conform to.
+    """
+    if getattr(case, "actuation", None) is None:
+        return None
+    import importlib
+
+    return importlib.import_module("softdesign.pipeline.stages.actuation").actuation_layout(case, kinematics)
+
+
 def _plan(case: Case, kinematics: KinematicsResult, fit: FitResult, vm: VolumeMeshSpec) -> _Placed:
     e, spec, shape = case.export, body_spec(case, fit), kinematics.chain.shape
     layers = _layers(case, kinematics, fit, vm)
     _check_count(layers, case, fit, vm.size_mm)
-    mesh, ref = plan_mesh(shape.curve_at(0.0), fit.field, layers, spec, e.angular_count, vm.size_mm)
+    layout = actuation_layout_of(case, kinematics)
+    mesh, ref = plan_mesh(shape.curve_at(0.0), fit.field, layers, spec, e.angular_count, vm.size_mm, layout)
     rest = place_mesh(mesh, ref, shape.curve_at(0.0), fit.field, 0.0, spec, e.angular_count)
     return _Placed(mesh, ref, fit, shape, spec, e.angular_count, rest, free_directions(mesh, rest), material_of(case),
                    rest_inverses(rest, mesh.tets), tet_places(mesh, ref, fit.field.link_of))
@@ -244,8 +258,8 @@ def run_sweep(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Sweep
         figures = _quality(points, placed.mesh, placed.places)
         _check(figures, float(solid_at(kinematics, fit, q, case).figures["volume_mm3"]), q)
         strain, data = placed.strain(points)
-        figures.update({"q": q, "size_mm": vm.size_mm, "layers": len(placed.mesh.l), "body_kind": _kind(placed.spec),
-                        "strain": strain,
+        figures.update({"q": q, "size_mm": vm.size_mm, "layers": len(placed.mesh.l),
+                        "body_kind": _kind(placed.spec, placed.mesh), "strain": strain,
                         "boundary_watertight": bool(mesh_topology(points, placed.mesh.faces).watertight)})
         reasons += judge(strain, placed.material, f"q={q:.3f}")
         figures["mesher_s"] = round(time.perf_counter() - start, 3)
@@ -258,8 +272,10 @@ def run_sweep(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Sweep
     return SweepRun(tuple(bodies), per_q, morph, reasons, log)
 
 
-def _kind(spec: Any) -> str:
-    return "solid" if spec.wall_mm == 0 else ("ported" if spec.port_mm > 0 else "hollow")
+def _kind(spec: Any, mesh: SweptMesh) -> str:
+    if spec.wall_mm == 0:
+        return "chambered" if mesh.holes else "solid"
+    return "ported" if spec.port_mm > 0 else "hollow"
 
 
 def _part_label(item: Any) -> str:
