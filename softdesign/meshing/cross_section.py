@@ -55,6 +55,14 @@ class Circle:
     radius: float
     #: nodes on the circle; 0: from the local size (at least MIN_HOLE_NODES)
     nodes: int = 0
+    #: put the nodes on the radius whose polygon has the circle's area (a cavity of the right volume with
+    #: few nodes: r sqrt(h / sin h), h = 2 pi / nodes) rather than on the circle itself
+    equal_area: bool = False
+
+    def node_radius(self, count: int) -> float:
+        """The radius the circle's ``count`` nodes lie on."""
+        h = 2.0 * np.pi / count
+        return float(self.radius * np.sqrt(h / np.sin(h))) if self.equal_area else self.radius
 
 
 @dataclass(frozen=True)
@@ -133,10 +141,11 @@ def _candidates(outer_count: int, circles: Sequence[Circle], size: float):
     for c in circles:
         centre = np.asarray(c.center, float)
         count = c.nodes or max(MIN_HOLE_NODES, round(2.0 * np.pi * c.radius / max(size, h_outer)))
-        fixed.append(_ring(centre, c.radius, count, 0.0))
-        sizes.append(np.full(count, 2.0 * c.radius * np.sin(np.pi / count)))
-        fronts.append(_front(centre, c.radius, sizes[-1][0], max(size, h_outer), False, 2.0))
-        fronts.append(_front(centre, c.radius, sizes[-1][0], max(size, h_outer), True, 2.0))
+        radius = c.node_radius(count)
+        fixed.append(_ring(centre, radius, count, 0.0))
+        sizes.append(np.full(count, 2.0 * radius * np.sin(np.pi / count)))
+        fronts.append(_front(centre, radius, sizes[-1][0], max(size, h_outer), False, 2.0))
+        fronts.append(_front(centre, radius, sizes[-1][0], max(size, h_outer), True, 2.0))
     rings = sorted(((index, f, pts, h) for f, front in enumerate(fronts) for index, pts, h in front),
                    key=lambda item: (item[0], item[1]))
     return fixed, sizes, rings
@@ -147,7 +156,7 @@ def _keep(fixed: list[FloatArray], sizes: list[FloatArray], rings,
     from scipy.spatial import cKDTree
 
     points, local = np.concatenate(fixed), np.concatenate(sizes)
-    bounds = [(np.zeros(2), 1.0, sizes[0][0])] + [(np.asarray(c.center, float), c.radius, e[0])
+    bounds = [(np.zeros(2), 1.0, sizes[0][0])] + [(np.asarray(c.center, float), c.node_radius(len(e)), e[0])
                                                     for c, e in zip(circles, sizes[1:], strict=True)]
     for _, _, pts, h in rings:
         r_ok = np.linalg.norm(pts, axis=1) <= 1.0

@@ -37,7 +37,7 @@ End cuts
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -46,7 +46,7 @@ from softdesign.fitting.radius_field import RadiusField
 from softdesign.geometry.frames import FramedSpline
 from softdesign.meshing.body import sections_on_grid
 from softdesign.meshing.chamber_layout import ChamberLayout
-from softdesign.meshing.end_cut import CutPlane, _cut_last_end, cut_planes
+from softdesign.meshing.end_cut import CutPlane, along_generators, cut_planes, cut_targets
 from softdesign.meshing.sweep_mesh import Hole, SweptMesh
 from softdesign.meshing.tessellate import Sweep, sweep_from_sections
 from softdesign.meshing.volume import BodySpec, angle_grid
@@ -63,12 +63,16 @@ class SweepReference:
     chamber_layers : (j0, j1), the layers of the chamber's ends (hollow), else (0, 0)
     core : float, t_c, the rigid core's radius in reference units (0: none; chambered bodies)
     scale_mm : float, R0, mm per reference unit inside the core
+    outer0 : the outer sweep at q = 0 (its arc lengths carry the cuts' targets to other q)
+    cuts : the end cuts' targets found at q = 0 (:data:`CutTargets`)
     """
 
     chamber_radius: float = 0.0
     chamber_layers: tuple[int, int] = (0, 0)
     core: float = 0.0
     scale_mm: float = 0.0
+    outer0: Sweep | None = None
+    cuts: CutTargets | None = None
 
 
 def l_at_arclength(curve: FramedSpline, s: FloatArray) -> FloatArray:
@@ -129,45 +133,78 @@ def _grid_points(sweep: Sweep, xy: FloatArray) -> FloatArray:
             + xy[..., 1:] * sweep.frames[:, None, :, 1])
 
 
-def _cut(points: FloatArray, sweep: Sweep, end: int, plane: CutPlane, label: str) -> FloatArray:
-    """``points`` (n, P, 3) with the generators slid so the base (end 0) or tip (1) layer lies in ``plane``."""
+#: Per cut (body base, body tip, chamber base, chamber tip): each node's arc length along its generator at
+#: q = 0 after the cut (:func:`~softdesign.meshing.end_cut.cut_targets`), or None where there is no cut.
+CutTargets = tuple[FloatArray | None, FloatArray | None, FloatArray | None, FloatArray | None]
+
+
+def _end_order(sweep: Sweep, end: int) -> tuple[slice, FloatArray, FloatArray, FloatArray]:
+    """The grid's order with the cut end last, its arc lengths from the other end, the outward tangent, centre."""
     k = 0 if end == 0 else -1
-    outward = sweep.frames[k][:, 2] * (-1.0 if end == 0 else 1.0)
     order = slice(None, None, -1) if end == 0 else slice(None)
     s = sweep.s[-1] - sweep.s[::-1] if end == 0 else sweep.s - sweep.s[0]
-    moved, _ = _cut_last_end(points[order], s, sweep.centers[k], outward, plane, label)
+    return order, s, sweep.frames[k][:, 2] * (-1.0 if end == 0 else 1.0), sweep.centers[k]
+
+
+def _carried(target0: FloatArray, s0: FloatArray, s: FloatArray) -> FloatArray:
+    """Arc-length targets at q = 0 carried to this q: the same material fraction between rings, the same
+    millimetres past the end ring (the end's section moves rigidly with its frame)."""
+    return np.where(target0 > s0[-1], s[-1] + (target0 - s0[-1]), np.interp(target0, s0, s))
+
+
+def _cut(points: FloatArray, sweep: Sweep, sweep0: Sweep, end: int, plane: CutPlane | None,
+         target0: FloatArray | None, label: str) -> tuple[FloatArray, FloatArray]:
+    """``points`` (n, P, 3) with the generators slid: at q = 0 (``target0`` None) so the end layer lies in
+    ``plane``; at another q to the same material places (``target0``, found at q = 0)."""
+    order, s, outward, _ = _end_order(sweep, end)
+    grid = points[order]
+    if target0 is None:
+        if plane is None:
+            raise ValueError("_cut: a plane is needed at q = 0")
+        target0 = cut_targets(grid, s, outward, plane, label)
+        target = target0
+    else:
+        target = _carried(target0, _end_order(sweep0, end)[1], s)
     out = points.copy()
-    out[order] = moved
-    return out
+    out[order] = along_generators(grid, s, outward, target)
+    return out, target0
 
 
-def _cap_between(points: FloatArray, s: FloatArray, first: int, last: int) -> FloatArray:
-    """Layers strictly between ``first`` and ``last`` spaced by ``s`` on the straight line joining them."""
-    w = ((s[first:last + 1] - s[first]) / (s[last] - s[first]))[:, None, None]
+def _cap_between(points: FloatArray, s0: FloatArray, first: int, last: int) -> FloatArray:
+    """Layers strictly between ``first`` and ``last`` on the straight line joining them, spaced as at q = 0."""
+    w = ((s0[first:last + 1] - s0[first]) / (s0[last] - s0[first]))[:, None, None]
     out = points.copy()
     out[first:last + 1] = (1.0 - w) * points[first][None] + w * points[last][None]
     return out
 
 
-def cut_grid(points: FloatArray, outer: Sweep, ref: SweepReference, spec: BodySpec, label: str) -> FloatArray:
-    """The layer grid (n, P, 3) cut at the body's end planes (and the chamber's, moved ``wall_mm`` in)."""
+def cut_grid(points: FloatArray, outer: Sweep, outer0: Sweep, ref: SweepReference, spec: BodySpec,
+             label: str) -> tuple[FloatArray, CutTargets]:
+    """The layer grid (n, P, 3) cut at the body's end planes (and the chamber's, moved ``wall_mm`` in), as at
+    q = 0 when ``ref.cuts`` holds the targets found there, else found here (``outer`` is then the q = 0 sweep)."""
+    found: list[FloatArray | None] = [None, None, None, None]
     planes = cut_planes(outer, spec.end_cuts)
+    known = ref.cuts or (None, None, None, None)
     for end, plane in enumerate(planes):
         if plane is not None:
-            points = _cut(points, outer, end, plane, f"{label}: the {('base', 'tip')[end]} end's cut plane")
+            points, found[end] = _cut(points, outer, outer0, end, plane, known[end],
+                                      f"{label}: the {('base', 'tip')[end]} end's cut plane")
     if ref.chamber_radius == 0.0:
-        return points
+        return points, (found[0], found[1], found[2], found[3])
     j0, j1 = ref.chamber_layers
     inset = cut_planes(outer, spec.end_cuts, spec.wall_mm)
+    s0 = outer0.s
     if inset[0] is not None:
-        part = _sub_sweep(outer, j0, None)
-        points[j0:] = _cut(points[j0:], part, 0, inset[0], f"{label}: the chamber's base cut plane")
-        points = _cap_between(points, outer.s, 0, j0)
+        part, part0 = _sub_sweep(outer, j0, None), _sub_sweep(outer0, j0, None)
+        points[j0:], found[2] = _cut(points[j0:], part, part0, 0, inset[0], known[2],
+                                     f"{label}: the chamber's base cut plane")
+        points = _cap_between(points, s0, 0, j0)
     if inset[1] is not None:
-        part = _sub_sweep(outer, None, j1 + 1)
-        points[:j1 + 1] = _cut(points[:j1 + 1], part, 1, inset[1], f"{label}: the chamber's tip cut plane")
-        points = _cap_between(points, outer.s, j1, len(outer.s) - 1)
-    return points
+        part, part0 = _sub_sweep(outer, None, j1 + 1), _sub_sweep(outer0, None, j1 + 1)
+        points[:j1 + 1], found[3] = _cut(points[:j1 + 1], part, part0, 1, inset[1], known[3],
+                                         f"{label}: the chamber's tip cut plane")
+        points = _cap_between(points, s0, j1, len(s0) - 1)
+    return points, (found[0], found[1], found[2], found[3])
 
 
 def _sub_sweep(sweep: Sweep, start: int | None, stop: int | None) -> Sweep:
@@ -178,7 +215,7 @@ def _sub_sweep(sweep: Sweep, start: int | None, stop: int | None) -> Sweep:
 
 def place_mesh(mesh: SweptMesh, ref: SweepReference, curve: FramedSpline, field: RadiusField, q: float,
                spec: BodySpec, angular_count: int) -> FloatArray:
-    """The mesh's nodes at q, (V, 3) mm.
+    """The mesh's nodes at q, (V, 3) mm (``ref`` from :func:`plan_mesh`, its cuts found at q = 0).
 
     Raises
     ------
@@ -187,8 +224,19 @@ def place_mesh(mesh: SweptMesh, ref: SweepReference, curve: FramedSpline, field:
     """
     outer, inner = section_sweeps(mesh, ref, curve, field, q, spec, angular_count)
     grid = _grid_points(outer, section_xy(mesh.section.points, outer, inner, ref))
-    grid = cut_grid(grid, outer, ref, spec, f"volume mesh at q={q:.3f}")
+    if ref.outer0 is None:
+        raise ValueError("place_mesh: the reference has no q = 0 sweep (make it with plan_mesh)")
+    grid, _ = cut_grid(grid, outer, ref.outer0, ref, spec, f"volume mesh at q={q:.3f}")
     return grid[mesh.node_layer, mesh.node_point]
+
+
+def _with_cuts(mesh: SweptMesh, ref: SweepReference, curve0: FramedSpline, field: RadiusField, spec: BodySpec,
+               angular_count: int) -> SweepReference:
+    """``ref`` with the q = 0 sweep and the end cuts' material targets found on it."""
+    outer, inner = section_sweeps(mesh, ref, curve0, field, 0.0, spec, angular_count)
+    grid = _grid_points(outer, section_xy(mesh.section.points, outer, inner, ref))
+    _, cuts = cut_grid(grid, outer, outer, replace(ref, cuts=None), spec, "volume mesh at q=0.000")
+    return replace(ref, outer0=outer, cuts=cuts)
 
 
 def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec: BodySpec, angular_count: int,
@@ -220,9 +268,11 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
         if spec.wall_mm > 0:
             raise MeshError("volume mesh: actuation chambers and export.wall_mm's single chamber together; give one")
         holes, ref = holes_from_layout(layout, float(np.median(rho)), float(np.min(rho)), angular_count)
-        return swept_disk(angular_count, holes, size, layers), ref
+        mesh = swept_disk(angular_count, holes, size, layers)
+        return mesh, _with_cuts(mesh, ref, curve0, field, spec, angular_count)
     if spec.wall_mm == 0:
-        return swept_disk(angular_count, [], size, layers), SweepReference()
+        mesh = swept_disk(angular_count, [], size, layers)
+        return mesh, _with_cuts(mesh, SweepReference(), curve0, field, spec, angular_count)
     ends = l_at_arclength(curve0, np.array([spec.wall_mm, curve0.length - spec.wall_mm]))
     sections = sections_on_grid(curve0, 0.0, layers, rho, field.evaluate_grid(0.0, layers, a, dl=1))
     outer = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
@@ -237,13 +287,14 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
         holes.append(Hole("port", Circle((0.0, 0.0), rp, angular_count), (0.0, float(ends[0])), cavity="chamber"))
     mesh = swept_disk(angular_count, holes, size, layers)
     j = [int(np.argmin(np.abs(mesh.l - e))) for e in ends]
-    return mesh, SweepReference(rc, (j[0], j[1]))
+    return mesh, _with_cuts(mesh, SweepReference(rc, (j[0], j[1])), curve0, field, spec, angular_count)
 
 
 #: The rigid core reaches this fraction of the way from the chambers' outer edge to the thinnest skin.
 CORE_GAP_FRACTION = 0.5
-#: Fewest nodes on a chamber's or feed's circle: its polygon holds 1 - sin(h)/h = 0.64 % less than the circle.
-MIN_CHAMBER_NODES = 32
+#: Nodes on a chamber's and a feed's circle (at least): their polygons have the circle's area
+#: (Circle.equal_area), so the cavity's volume is the layout's; more nodes where the skin's are closer.
+MIN_CHAMBER_NODES, MIN_FEED_NODES = 16, 12
 
 
 def holes_from_layout(layout: ChamberLayout, scale_mm: float, rho_min_mm: float,
@@ -264,17 +315,18 @@ def holes_from_layout(layout: ChamberLayout, scale_mm: float, rho_min_mm: float,
                         f"is {rho_min_mm:.3f} mm: no wall; use smaller actuation.distance_mm or diameter_mm")
     h_outer = 2.0 * np.pi / angular_count
 
-    def circle(distance: float, angle: float, diameter: float) -> Circle:
+    def circle(distance: float, angle: float, diameter: float, least: int) -> Circle:
         radius = 0.5 * diameter / scale_mm
-        nodes = max(MIN_CHAMBER_NODES, int(np.ceil(2.0 * np.pi * radius / h_outer)))
-        return Circle((distance * np.cos(angle) / scale_mm, distance * np.sin(angle) / scale_mm), radius, nodes)
+        nodes = max(least, int(np.ceil(2.0 * np.pi * radius / h_outer)))
+        return Circle((distance * np.cos(angle) / scale_mm, distance * np.sin(angle) / scale_mm), radius, nodes,
+                      equal_area=True)
 
     holes = []
     for c in layout.chambers:
-        holes.append(Hole(f"s{c.section}_c{c.index}", circle(c.distance_mm, c.angle, c.diameter_mm),
-                          (c.l_start, c.l_end)))
+        holes.append(Hole(f"s{c.section}_c{c.index}", circle(c.distance_mm, c.angle, c.diameter_mm,
+                                                             MIN_CHAMBER_NODES), (c.l_start, c.l_end)))
     for f in layout.feeds:
         name = f"s{f.section}_c{f.chamber}"
-        holes.append(Hole(f"{name}_feed", circle(f.ring_mm, f.angle, f.diameter_mm), (f.l_start, f.l_end),
-                          cavity=name))
+        holes.append(Hole(f"{name}_feed", circle(f.ring_mm, f.angle, f.diameter_mm, MIN_FEED_NODES),
+                          (f.l_start, f.l_end), cavity=name))
     return holes, SweepReference(core=core_mm / scale_mm, scale_mm=scale_mm)

@@ -155,8 +155,8 @@ def test_chambers_and_feeds_of_a_layout_are_exact_circles_closed_cavities(bent):
         expected = np.pi * (chamber.diameter_mm / 2) ** 2 * length + np.pi * (feed.diameter_mm / 2) ** 2 * (
             chamber.l_start * LENGTH_MM)
         np.testing.assert_allclose(topology.volume, expected, rtol=0.01)  # the bound
-        # the chamber's wall nodes lie on its circle in mm, about its axis c + d (cos b N + sin b B), straight and
-        # bent (the section's core is rigid)
+        # the chamber's wall nodes lie on a circle about its axis c + d (cos b N + sin b B), straight and bent
+        # (the section's core is rigid): the circle whose polygon has the chamber's area (Circle.equal_area)
         wall = np.unique(mesh.group_faces(f"{name}_wall"))
         l = mesh.reference_points()[wall, 2]
         for q, points in ((0.0, rest), (1.0, moved)):
@@ -165,4 +165,6 @@ def test_chambers_and_feeds_of_a_layout_are_exact_circles_closed_cavities(bent):
             axis = curve.points(l) + chamber.distance_mm * (np.cos(chamber.angle) * frames[:, :, 0]
                                                             + np.sin(chamber.angle) * frames[:, :, 1])
             radii = np.linalg.norm(points[wall] - axis, axis=1)
-            np.testing.assert_allclose(radii, chamber.diameter_mm / 2, rtol=1e-9)
+            hole = next(h for h in mesh.holes if h.name == name)
+            h = 2 * np.pi / hole.circle.nodes
+            np.testing.assert_allclose(radii, chamber.diameter_mm / 2 * np.sqrt(h / np.sin(h)), rtol=1e-9)

@@ -2,9 +2,9 @@
 
 ``export.volume_mesh.mesher: sweep`` (the default).  The mesh
 (:mod:`softdesign.meshing.sweep_mesh`) is laid out once on the body at q = 0,
-layers on the export's rings (``export.spacing_mm``, the finest grid of the
-q values meshed), the section's nodes on the export's angles, its inside at
-``size_mm``; :mod:`softdesign.meshing.sweep_body` places it at each q.
+layers ``size_mm`` apart in arc length (the finest grid of the q values
+meshed, every link joint a layer), the section's nodes on the export's
+angles, its inside at ``size_mm``; :mod:`softdesign.meshing.sweep_body` places it at each q.
 Checks at each q: every tetrahedron positive (else MeshError naming the
 worst one's section, l, angle and depth), the volume within
 ``VOLUME_RTOL`` of the export's surface mesh at that q, the boundary
@@ -69,7 +69,7 @@ class Material:
 
 def _layers(case: Case, kinematics: KinematicsResult, fit: FitResult, vm: VolumeMeshSpec) -> FloatArray:
     shape = kinematics.chain.shape
-    grids = [export_l_grid(shape.curve_at(q), fit.field, case.export.spacing_mm) for q in sorted({0.0, *vm.q})]
+    grids = [export_l_grid(shape.curve_at(q), fit.field, vm.size_mm) for q in sorted({0.0, *vm.q})]
     return max(grids, key=len)
 
 
@@ -81,8 +81,8 @@ def _check_count(layers: FloatArray, case: Case, fit: FitResult, size_mm: float)
     if count > MAX_VOLUME_TETS:
         raise ConfigError(
             f"export.volume_mesh: the swept mesh would hold about {count:.3g} tetrahedra ({len(layers)} layers of "
-            f"{na} angles at export.spacing_mm {case.export.spacing_mm:g}, size_mm {size_mm:g}), more than the "
-            f"limit of {MAX_VOLUME_TETS} (softdesign/limits_volume.py); raise size_mm or export.spacing_mm")
+            f"{na} angles at size_mm {size_mm:g}), more than the limit of {MAX_VOLUME_TETS} "
+            "(softdesign/limits_volume.py); raise size_mm or lower export.angular_count")
 
 
 Places = tuple[Any, FloatArray, FloatArray, FloatArray]
