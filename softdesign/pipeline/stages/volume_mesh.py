@@ -74,6 +74,8 @@ class TetBody:
     tets: IntArray
     chamber: tuple[FloatArray, IntArray] | None
     sets: NamedSets | None = None
+    #: every cavity's closed surface by name (sweep: ``chamber``, or ``s0_c1`` ... with their feeds)
+    cavities: dict[str, tuple[FloatArray, IntArray]] | None = None
 
 
 @dataclass(frozen=True)
@@ -163,13 +165,12 @@ def _run_sweep(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Volu
         mesh = body.mesh
         surfaces = {name: mesh.group_faces(name) for name in mesh.groups} | dict(mesh.lids)
         sets = NamedSets(surfaces, {"base_nodes": mesh.base_nodes()}, body.tet_data)
-        chamber = (body.points, mesh.cavity_surface("chamber")) if any(h.name == "chamber" for h in mesh.holes) \
-            else None
-        meshes.append(TetBody(body.q, body.points, mesh.tets, chamber, sets))
+        cavities = {c: (body.points, mesh.cavity_surface(c)) for c in dict.fromkeys(h.cavity_name for h in mesh.holes)}
+        meshes.append(TetBody(body.q, body.points, mesh.tets, cavities.get("chamber"), sets, cavities))
         for suffix in VOLUME_FORMATS:
             files[layout.volume_mesh_path(body.q, suffix)] = figures
-        if chamber is not None:
-            files[layout.chamber_surface_path(body.q)] = _chamber_figures(body.q, chamber)
+        for name, cavity in cavities.items():
+            files[layout.cavity_surface_path(body.q, name)] = _chamber_figures(body.q, cavity)
     material = material_of(case)
     judged = material.max_stretch is not None or material.tensile_strength_kpa is not None
     first = run.bodies[0].mesh
@@ -193,7 +194,12 @@ def write_volume_mesh(result: VolumeMeshResult, staging: Staging) -> None:
         for suffix in VOLUME_FORMATS:
             data = volume_mesh_bytes(mesh.points, mesh.tets, suffix, mesh.sets)
             staging.write_bytes(layout.volume_mesh_path(mesh.q, suffix), data)
-        if mesh.chamber is not None:
+        if mesh.cavities is not None:
+            for name, (points, faces) in mesh.cavities.items():  # only the cavity's own nodes, not every node
+                used, local = np.unique(faces, return_inverse=True)
+                staging.write_bytes(layout.cavity_surface_path(mesh.q, name),
+                                    mesh_bytes(points[used], local.reshape(-1, 3), "stl"))
+        elif mesh.chamber is not None:
             staging.write_bytes(layout.chamber_surface_path(mesh.q), mesh_bytes(*mesh.chamber, "stl"))
     staging.write_json(layout.VOLUME_SUMMARY, result.summary)
 

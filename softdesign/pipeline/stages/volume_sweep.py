@@ -43,6 +43,8 @@ from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.types import FloatArray
 
+#: Tetrahedra per worker of the morph's q samples (about 0.6 kB each in flight: 300 MB a worker at most).
+MORPH_WORKER_TETS = 500_000
 #: Triangles of a section per node about (Euler: 2 per inside node), for the count bound before meshing.
 TRIANGLES_PER_NODE = 2.0
 
@@ -250,7 +252,7 @@ def run_sweep(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Sweep
     log: list[dict[str, Any]] = []
     start = time.perf_counter()
     placed = _plan(case, kinematics, fit, vm)
-    _tell(tick, "plan", start, log)
+    _tell(tick, "plan", time.perf_counter() - start, log)
     bodies, per_q, reasons = [], [], []
     for q in vm.q:
         start = time.perf_counter()
@@ -265,8 +267,8 @@ def run_sweep(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Sweep
         figures["mesher_s"] = round(time.perf_counter() - start, 3)
         bodies.append(SweptBody(q, points, placed.mesh, data))
         per_q.append(figures)
-        _tell(tick, q, start, log)
-    morph = _morph(placed, per_q, samples, lambda q, t: _tell(tick, q, t, log))
+        _tell(tick, q, time.perf_counter() - start, log)
+    morph = _morph(placed, per_q, samples, lambda q, seconds: _tell(tick, q, seconds, log))
     if morph["stretch_max"] is not None:
         reasons += judge(morph, placed.material, f"over the morph, at q={morph['stretch_max']['q']:.3f}")
     return SweepRun(tuple(bodies), per_q, morph, reasons, log)
@@ -283,9 +285,8 @@ def _part_label(item: Any) -> str:
     return f"{'mesh plan' if part == 'plan' else f'q={part:.3f}'} ({seconds:.2f} s)"
 
 
-def _tell(tick: Any, part: Any, start: float, log: list[dict[str, Any]]) -> None:
+def _tell(tick: Any, part: Any, seconds: float, log: list[dict[str, Any]]) -> None:
     """Tell the bar (on a terminal) and keep the part's time for the log (the stage's description)."""
-    seconds = time.perf_counter() - start
     log.append({"part": part, "seconds": round(seconds, 3)})
     if tick is not None:
         tick((part, seconds), None)
@@ -293,11 +294,16 @@ def _tell(tick: Any, part: Any, start: float, log: list[dict[str, Any]]) -> None
 
 def _morph(placed: _Placed, per_q: list[dict[str, Any]], samples: list[float], tell: Any) -> dict[str, Any]:
     """The largest stretch and stress over the exported q and the morph's q samples, with their q."""
-    rows = [(row["q"], row["strain"]) for row in per_q]
-    for q in samples:
+    from softdesign.pipeline.parallel import map_items
+
+    def task(q: float) -> tuple[dict[str, Any], float]:
         start = time.perf_counter()
-        rows.append((q, placed.strain(placed.at(q))[0]))
-        tell(q, start)
+        return placed.strain(placed.at(q))[0], time.perf_counter() - start
+
+    # forked workers share the mesh; each holds about a dozen (T, 3, 3) arrays at once
+    most = max(1, MORPH_WORKER_TETS // max(1, len(placed.mesh.tets)))
+    done = map_items(task, samples, most=most, on_result=lambda q, result: tell(q, result[1]))
+    rows = [(row["q"], row["strain"]) for row in per_q] + [(q, r[0]) for q, r in zip(samples, done, strict=True)]
     out: dict[str, Any] = {"q_samples": sorted(q for q, _ in rows)}
     for key in ("stretch_max", "green_strain_max", "stress_max_kpa"):
         found = [(q, s[key]) for q, s in rows if s[key] is not None]
