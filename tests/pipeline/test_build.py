@@ -97,9 +97,11 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
         "ingest": "skipped", "blend": "skipped", "links": "ran", "kinematics": "ran", "fit": "ran", "export": "ran",
         "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
-    # A material is read by the feasibility verdict alone: every mesh stays.
+    # A material is read by the feasibility verdict and the volume mesh's (its 3D stress and stretch, issue 32):
+    # every surface mesh stays.
     edit(demo_case, "material", name="ecoflex-00-30")
-    assert statuses(build(demo_case, out)) == {**dict.fromkeys(STAGES, "skipped"), "feasibility": "ran"}
+    assert statuses(build(demo_case, out)) == {**dict.fromkeys(STAGES, "skipped"), "volume_mesh": "ran",
+                                               "feasibility": "ran"}
     assert statuses(build(demo_case, out, "--force")) == dict.fromkeys(STAGES, "ran")
 
 
