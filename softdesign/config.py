@@ -215,8 +215,8 @@ class VolumeMesh(_Section):
     mesher: Literal["sweep", "ftetwild"] = "sweep"
     #: the q values to mesh: [0] (the state the actuator is cast in, which a simulator deforms) by default
     q: list[FiniteFloat] = Field([0.0], min_length=1, max_length=MAX_VOLUME_MESHES)
-    #: target edge length of the tetrahedra (sweep: the layers' spacing along the body and the largest edge
-    #: inside the section; its skin's nodes are on the export's angles)
+    #: target edge length of the tetrahedra (sweep: the largest edge inside the section, and the layers' spacing
+    #: along the body, at most 3 skin edges; its skin's nodes are on the export's angles)
     size_mm: FiniteFloat = Field(2.0, ge=MIN_TET_SIZE_MM, le=50.0)
     #: largest distance of the mesh's boundary from the body's surface
     envelope_mm: FiniteFloat = Field(0.05, ge=0.001, le=1.0)

@@ -284,7 +284,11 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
     if spec.port_mm > 0:
         base = int(np.argmin(np.abs(layers - ends[0])))
         rp = rc * 0.5 * spec.port_mm / float(np.mean(np.linalg.norm(inner.xy[base], axis=-1)))
-        holes.append(Hole("port", Circle((0.0, 0.0), rp, angular_count), (0.0, float(ends[0])), cavity="chamber"))
+        # the chamber's spacing, not the export's angular count (a port of 64 sides in a 1 mm wide channel
+        # made needles 1.5 degrees thin in the caps' layers); its polygon has the channel's area
+        nodes = max(MIN_FEED_NODES, int(np.ceil(angular_count * rp / rc)))
+        holes.append(Hole("port", Circle((0.0, 0.0), rp, nodes, equal_area=True), (0.0, float(ends[0])),
+                          cavity="chamber"))
     mesh = swept_disk(angular_count, holes, size, layers)
     j = [int(np.argmin(np.abs(mesh.l - e))) for e in ends]
     return mesh, _with_cuts(mesh, SweepReference(rc, (j[0], j[1])), curve0, field, spec, angular_count)
