@@ -146,7 +146,25 @@ def element_strain(rest: FloatArray, moved: FloatArray, tets: IntArray, law: Hyp
                    free: FloatArray | None = None, inverses: FloatArray | None = None) -> ElementStrain:
     """Stretches, Green strain and (with a law) the largest principal stress of every tetrahedron."""
     F = deformation_gradients(rest, moved, tets, inverses)
-    stretches = principal_stretches_3d(F)
-    green = 0.5 * (stretches[:, 0] ** 2 - 1.0)
-    stress = None if law is None else principal_stresses(cauchy_stress(law, F, free))[:, 0]
+    squares = np.maximum(symmetric_eigenvalues(F.transpose(0, 2, 1) @ F), 0.0)  # of C, B's too
+    stretches = np.sqrt(squares)
+    green = 0.5 * (squares[:, 0] - 1.0)
+    stress = None if law is None else _largest_stress(law, F, squares, free)
     return ElementStrain(stretches, green, stress)
+
+
+def _largest_stress(law: HyperelasticLaw, F: FloatArray, squares: FloatArray, free: FloatArray | None) -> FloatArray:
+    """The largest principal value of :func:`cauchy_stress` without forming it: ``B_bar``'s eigenvalues are
+    ``J^(-2/3) lambda_i^2`` (B and C share them), so ``sigma_1 = 2 W' J^(-2/3) (lambda_1^2 - m)`` with ``m`` the
+    free direction's ``n . B n = |F^T n|^2`` (or lambda_3^2, the least stretch's)."""
+    cof = _cofactors(F)
+    J = np.einsum("nij,nij->n", F, cof) / 3.0
+    scale = J ** (-2.0 / 3.0)
+    w1, _ = law.energy_derivatives(scale * squares.sum(axis=1))
+    if free is None:
+        normal = squares[:, 2]
+    else:
+        n = (cof @ np.asarray(free, float)[:, :, None])[:, :, 0]
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        normal = np.square(F.transpose(0, 2, 1) @ n[:, :, None])[:, :, 0].sum(axis=1)
+    return np.asarray(2.0 * w1 * scale * (squares[:, 0] - normal), np.float64)

@@ -70,3 +70,18 @@ def test_closed_form_eigenvalues_match_lapack():
 
     # near a repeated root the trigonometric form keeps about half the digits
     np.testing.assert_allclose(symmetric_eigenvalues(A), np.linalg.eigvalsh(A)[:, ::-1], rtol=0, atol=1e-7)
+
+
+@pytest.mark.parametrize("free", [None, "random"])
+def test_the_largest_stress_without_the_tensor_is_the_tensor_s(free):
+    """element_strain's largest principal stress (from the stretches) against cauchy_stress's eigenvalues."""
+    rng = np.random.default_rng(3)
+    F = np.eye(3) + 0.3 * rng.normal(size=(200, 3, 3))
+    F = F[np.linalg.det(F) > 0.2]
+    directions = None if free is None else rng.normal(size=(len(F), 3))
+    moved = np.einsum("nij,kj->nki", F, TET)  # each tetrahedron its own four nodes
+    rest = np.tile(TET, (len(F), 1))
+    tets = np.arange(4 * len(F)).reshape(-1, 4)
+    fast = element_strain(rest, moved.reshape(-1, 3), tets, YEOH, directions).stress_max
+    full = np.linalg.eigvalsh(cauchy_stress(YEOH, F, directions))[:, -1]
+    np.testing.assert_allclose(fast, full, rtol=1e-9, atol=1e-9 * np.abs(full).max())
