@@ -267,7 +267,9 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
     if layout is not None:
         if spec.wall_mm > 0:
             raise MeshError("volume mesh: actuation chambers and export.wall_mm's single chamber together; give one")
-        holes, ref = holes_from_layout(layout, float(np.median(rho)), float(np.min(rho)), angular_count)
+        # the core must stay inside the skin at every q: the thinnest radius over the morph, not at q = 0 alone
+        thinnest = min(float(np.min(field.evaluate_grid(q, layers, a))) for q in CORE_Q_SAMPLES)
+        holes, ref = holes_from_layout(layout, float(np.median(rho)), thinnest, angular_count)
         mesh = swept_disk(angular_count, holes, size, layers)
         return mesh, _with_cuts(mesh, ref, curve0, field, spec, angular_count)
     if spec.wall_mm == 0:
@@ -294,6 +296,8 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
     return mesh, _with_cuts(mesh, SweepReference(rc, (j[0], j[1])), curve0, field, spec, angular_count)
 
 
+#: The q at which the thinnest radius is looked for, for the rigid core of a chambered body.
+CORE_Q_SAMPLES = tuple(np.linspace(0.0, 1.0, 11))
 #: The rigid core reaches this fraction of the way from the chambers' outer edge to the thinnest skin.
 CORE_GAP_FRACTION = 0.5
 #: Nodes on a chamber's and a feed's circle (at least): their polygons have the circle's area
@@ -307,7 +311,7 @@ def holes_from_layout(layout: ChamberLayout, scale_mm: float, rho_min_mm: float,
 
     Chamber (section i, chamber j) is ``s{i}_c{j}`` (surfaces ``s{i}_c{j}_wall``, ``_cap``); its feed
     ``s{i}_c{j}_feed`` belongs to the same cavity and opens at the base (``s{i}_c{j}_feed_inlet``).
-    ``scale_mm`` (R0) is mm per reference unit, ``rho_min_mm`` the thinnest section's radius at q = 0.
+    ``scale_mm`` (R0) is mm per reference unit, ``rho_min_mm`` the thinnest section's radius over the morph.
     """
     from softdesign.meshing.cross_section import Circle
 
