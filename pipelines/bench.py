@@ -316,6 +316,25 @@ def aorta_case(folder: Path) -> BenchCase | None:
     return BenchCase("VMTK aorta (path 0, capped surface)", case)
 
 
+def volume_mesh_case(folder: Path, case: Path, label: str, export: str) -> BenchCase:
+    """``case`` with an ``export`` block asking for the swept volume mesh (issue 32): its stage's row times it."""
+    import yaml
+
+    data = yaml.safe_load(case.read_text(encoding="utf-8"))
+    for key in ("centerline", "surface"):  # the copy lives elsewhere: absolute input paths
+        data["final"][key] = str((case.parent / data["final"][key]).resolve())
+    data["export"] = {**data.get("export", {}), **yaml.safe_load(export)}
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{case.stem}-volume.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    return BenchCase(label, path)
+
+
+#: The swept volume mesh's benchmark: hollow with a port, q = 0, 0.5, 1 (issue 32's cases; solid is the stage's
+#: cheapest).
+VOLUME_EXPORT = "{wall_mm: 1.0, port_mm: 1.2, volume_mesh: {q: [0, 0.5, 1]}}"
+
+
 def write_synthetic_inputs(folder: Path, triangles: int) -> None:
     """The synthetic vessel's centerline.vtp and binary surface.stl with at least ``triangles`` faces."""
     from softdesign.io.formats import write_mesh
@@ -664,6 +683,8 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
         emit([f"VMTK aorta: skipped, {AORTA_DIR} not found", ""])
     else:
         emit(stage_table(measure(aorta, scratch, jobs=args.jobs)) + [""])
+    volume = volume_mesh_case(scratch / "volume", DEMO_CASE, "sample case, hollow, swept volume mesh", VOLUME_EXPORT)
+    emit(stage_table(measure(volume, scratch, jobs=args.jobs)) + [""])
     emit(centerline_lines() + [""])
     plan = synthetic_plan(scratch, args.triangles, args.frames)
     results = run_synthetic(plan, scratch, args.jobs)

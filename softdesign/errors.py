@@ -56,6 +56,10 @@ class MeshError(SoftdesignError):
     """A mesh could not be made into a valid solid."""
 
 
+class SolveError(SoftdesignError):
+    """A finite-element solve did not converge (the message names the load step and the residual)."""
+
+
 @contextmanager
 def errors_named_for(source: Path | str) -> Iterator[None]:
     """Prefix a SoftdesignError raised inside the block with ``source`` (e.g. the case file), keeping its type."""

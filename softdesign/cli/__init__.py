@@ -24,6 +24,7 @@ from softdesign.cli.check import check
 from softdesign.cli.common import list_whole_first_paragraphs
 from softdesign.cli.design import design
 from softdesign.cli.init import init
+from softdesign.cli.materials import materials
 from softdesign.cli.pcc import PCC_SHORT_HELP, pcc_app
 from softdesign.cli.pose import pose
 from softdesign.cli.report import report
@@ -63,7 +64,7 @@ def _options(
 app.add_typer(pcc_app, name="pcc", short_help=PCC_SHORT_HELP)
 for command in (
     validate, build, ingest, blend, links, kinematics, fit, export, mould, pose, check, report, sample, centerline,
-    design, init, schema,
+    design, init, schema, materials,
 ):
     app.command()(command)
 for group in (app, pcc_app):
@@ -89,5 +90,5 @@ def main() -> None:
 
 __all__ = [
     "app", "main", "validate", "build", "ingest", "blend", "links", "kinematics", "fit", "export", "mould",
-    "pose", "check", "report", "sample", "centerline", "design", "init", "schema",
+    "pose", "check", "report", "sample", "centerline", "design", "init", "schema", "materials",
 ]

@@ -115,7 +115,8 @@ def build(
         _print_runs(outcome.build_dir, outcome.runs)
         if with_report:
             report_after_build(outcome.build_dir, jobs=jobs)
-        judged = [outcome.results.get(name) for name in ("feasibility", "actuation")]  # actuation: walls, extension
+        # the skin's stretch (feasibility), the chambers' walls and extension (actuation), the 3D figures (swept mesh)
+        judged = [outcome.results.get(name) for name in ("feasibility", "actuation", "volume_mesh")]
         return any(r is not None and r.summary.get("feasible") is False for r in judged)
 
     infeasible = run_guarded(action)

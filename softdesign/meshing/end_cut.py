@@ -130,6 +130,13 @@ def end_cut_volume(sweep: Sweep, planes: tuple[CutPlane | None, CutPlane | None]
 def _cut_last_end(points: FloatArray, s: FloatArray, centre: FloatArray, outward: FloatArray, plane: CutPlane,
                   name: str) -> tuple[FloatArray, FloatArray]:
     """Rings (n, na, 3) whose last ring is moved into ``plane`` along each generator, and the cap's hub."""
+    moved = along_generators(points, s, outward, cut_targets(points, s, outward, plane, name))
+    return moved, _hub(moved[-1], plane, outward, centre)
+
+
+def cut_targets(points: FloatArray, s: FloatArray, outward: FloatArray, plane: CutPlane, name: str) -> FloatArray:
+    """Where each ring point (n, m, 3) goes along its generator, as arc length (n, m) mm: the last ring onto
+    ``plane``, the end zone's rings re-spaced (module notes); :func:`along_generators` puts them there."""
     f = (points - plane.point) @ plane.normal
     along = float(outward @ plane.normal)
     shift = _shifts(f, s, along, name)
@@ -141,9 +148,7 @@ def _cut_last_end(points: FloatArray, s: FloatArray, centre: FloatArray, outward
             "it); set fit.end_cut: normal"
         )
     weight = np.clip((s - (s[-1] - zone)) / zone, 0.0, 1.0) if zone > 0 else np.zeros_like(s)
-    target = s[:, None] + shift[None, :] * weight[:, None]
-    moved = _along_generators(points, s, outward, target)
-    return moved, _hub(moved[-1], plane, outward, centre)
+    return np.asarray(s[:, None] + shift[None, :] * weight[:, None], np.float64)
 
 
 def _shifts(f: FloatArray, s: FloatArray, along: float, name: str) -> FloatArray:
@@ -161,7 +166,7 @@ def _shifts(f: FloatArray, s: FloatArray, along: float, name: str) -> FloatArray
     return np.where(last <= 0.0, -last / along, crossing - s[-1])
 
 
-def _along_generators(points: FloatArray, s: FloatArray, outward: FloatArray, target: FloatArray) -> FloatArray:
+def along_generators(points: FloatArray, s: FloatArray, outward: FloatArray, target: FloatArray) -> FloatArray:
     """Points (n, na, 3) at arc lengths ``target`` (n, na) along each generator, straight past the end ring."""
     i = np.clip(np.searchsorted(s, target, side="right") - 1, 0, s.size - 2)
     t = np.clip((target - s[i]) / (s[i + 1] - s[i]), 0.0, 1.0)[..., None]

@@ -118,4 +118,9 @@ def volume_mesh_path(q: float, suffix: str) -> str:
 
 def chamber_surface_path(q: float) -> str:
     """``meshes/volume/chamber_q_0.000.stl``: the closed chamber surface of a hollow body at q, normals outwards."""
-    return f"{MESHES_DIR}/volume/chamber_{q_label(q)}.stl"
+    return cavity_surface_path(q, "chamber")
+
+
+def cavity_surface_path(q: float, cavity: str) -> str:
+    """``meshes/volume/s0_c1_q_0.000.stl``: one cavity's closed surface (a chamber with its feed) at q."""
+    return f"{MESHES_DIR}/volume/{cavity}_{q_label(q)}.stl"

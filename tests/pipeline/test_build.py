@@ -97,10 +97,11 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
         "ingest": "skipped", "blend": "skipped", "links": "ran", "kinematics": "ran", "fit": "ran", "actuation": "ran",
         "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
-    # A material is read by the feasibility and actuation verdicts alone: every mesh stays (the demo declares
-    # ecoflex-00-30).
+    # A material is read by the verdicts alone (feasibility, the chambers' actuation, the volume mesh's 3D stress
+    # and stretch): every surface mesh stays (the demo declares ecoflex-00-30).
     edit(demo_case, "material", name="dragon-skin-10")
     assert statuses(build(demo_case, out)) == {**dict.fromkeys(STAGES, "skipped"), "actuation": "ran",
+                                               "volume_mesh": "ran",
                                                "feasibility": "ran"}
     assert statuses(build(demo_case, out, "--force")) == dict.fromkeys(STAGES, "ran")
 

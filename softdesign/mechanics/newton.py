@@ -1,0 +1,152 @@
+"""Static equilibrium by Newton's method with load stepping: the pressures grow from 0 in steps, each solved.
+
+At a load factor ``t`` the residual is ``R(u) = f_int(u) - t f_p(u)`` with the
+follower pressure forces ``f_p`` of :mod:`softdesign.mechanics.pressure`, and
+the Newton matrix is its consistent derivative ``K(u) - t dF_p/dx`` restricted
+to the free unknowns (a sparse LU, SuperLU).  A step converges when the free
+residual is below ``rtol`` times the free pressure load of that step (plus
+``atol``).  A step that does not converge in ``max_iterations``, or whose trial
+turns an element inside out, is halved, at most ``max_cutbacks`` times over the
+solve; past that the solve stops with a :class:`~softdesign.errors.SolveError`
+naming the step, the load factor and the residual: never a silent answer.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from softdesign.errors import SolveError
+from softdesign.mechanics.assembly import (
+    InvertedElementError,
+    force_and_tangent,
+    internal_force,
+    volumetric_state,
+)
+from softdesign.mechanics.laws import HyperelasticLaw
+from softdesign.mechanics.pressure import pressure_load
+from softdesign.mechanics.tets import TetMesh
+from softdesign.types import FloatArray, IntArray
+
+
+@dataclass(frozen=True)
+class NewtonSettings:
+    """How the load is stepped and when Newton stops.
+
+    Attributes
+    ----------
+    load_steps : equal load increments to start with (>= 1)
+    max_iterations : Newton iterations per step (>= 1)
+    max_cutbacks : step halvings allowed over the whole solve (>= 0)
+    rtol : residual tolerance relative to the step's pressure load
+    atol : absolute residual tolerance, mN
+    """
+
+    load_steps: int = 4
+    max_iterations: int = 12
+    max_cutbacks: int = 6
+    rtol: float = 1e-8
+    atol: float = 1e-10
+
+
+@dataclass(frozen=True)
+class PressureProblem:
+    """A mesh, its law, the fixed unknowns and pressurised walls.
+
+    Attributes
+    ----------
+    mesh : the reference mesh
+    law : the material
+    fixed : (3V,) bool, unknowns held at zero displacement
+    faces : (F, 3) int, wall triangles, normals out of the cavity
+    face_cavity : (F,) int, which cavity (index into the pressures) each face bounds
+    """
+
+    mesh: TetMesh
+    law: HyperelasticLaw
+    fixed: np.ndarray
+    faces: IntArray
+    face_cavity: IntArray
+
+
+@dataclass
+class SolveRecord:
+    """What the solve did: per converged step the load factor, iterations and residual history (mN)."""
+
+    load_factors: list[float] = field(default_factory=list)
+    iterations: list[int] = field(default_factory=list)
+    residuals: list[list[float]] = field(default_factory=list)
+    cutbacks: int = 0
+
+
+def _residual(problem: PressureProblem, u: FloatArray, face_pressure: FloatArray, tangent: bool
+              ) -> tuple[FloatArray, FloatArray, sp.csr_matrix | None]:
+    """Residual (3V,), the pressure load (3V,) and, if asked, the Newton matrix at displacement ``u`` (V, 3)."""
+    state = volumetric_state(problem.mesh, problem.law, u)
+    positions = problem.mesh.points + u
+    f_p, dfp = pressure_load(positions, problem.faces, face_pressure, tangent)
+    if not tangent:
+        return internal_force(problem.mesh, problem.law, state) - f_p, f_p, None
+    f_int, K = force_and_tangent(problem.mesh, problem.law, state)
+    return f_int - f_p, f_p, (K - dfp).tocsc() if dfp is not None else None
+
+
+def _newton_step(problem: PressureProblem, u: FloatArray, face_pressure: FloatArray,
+                 settings: NewtonSettings) -> tuple[FloatArray, list[float]] | tuple[None, list[float]]:
+    """Equilibrium at ``face_pressure`` from ``u``: the new displacement and residual history, or None if it failed."""
+    free = ~problem.fixed
+    history: list[float] = []
+    u = u.copy()
+    for _ in range(settings.max_iterations):
+        try:
+            R, f_p, K = _residual(problem, u, face_pressure, tangent=True)
+        except InvertedElementError:
+            return None, history
+        norm = float(np.linalg.norm(R[free]))
+        history.append(norm)
+        if norm <= settings.rtol * float(np.linalg.norm(f_p[free])) + settings.atol:
+            return u, history
+        if K is None:
+            return None, history
+        du = np.zeros(problem.mesh.dof_count)
+        du[free] = spla.splu(K[free][:, free].tocsc()).solve(-R[free])
+        if not np.all(np.isfinite(du)):
+            return None, history
+        u = u + du.reshape(-1, 3)
+    return None, history
+
+
+def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: NewtonSettings
+                    ) -> tuple[FloatArray, SolveRecord]:
+    """Displacement (V, 3) mm at cavity ``pressures`` (k,) kPa, reached in load steps from 0, and the record.
+
+    Raises
+    ------
+    SolveError
+        A step did not converge after every allowed halving (its index, load factor and last residual).
+    """
+    face_pressure = np.asarray(pressures, float)[problem.face_cavity]
+    u = np.zeros_like(problem.mesh.points)
+    record = SolveRecord()
+    t, dt, step = 0.0, 1.0 / settings.load_steps, 0
+    while t < 1.0 - 1e-12:
+        target = min(1.0, t + dt)
+        new_u, history = _newton_step(problem, u, target * face_pressure, settings)
+        if new_u is None:
+            if record.cutbacks >= settings.max_cutbacks:
+                last = f"{history[-1]:.3g} mN" if history else "none (an element turned inside out)"
+                raise SolveError(
+                    f"the solve did not converge at load step {step + 1} (load factor {target:.4g} of the pressures "
+                    f"{', '.join(f'{p:g}' for p in pressures)} kPa) after {record.cutbacks} step halvings; last "
+                    f"residual {last}; lower the pressures or raise simulate.load_steps")
+            record.cutbacks += 1
+            dt /= 2.0
+            continue
+        u, t, step = new_u, target, step + 1
+        record.load_factors.append(t)
+        record.iterations.append(len(history))
+        record.residuals.append(history)
+    return u, record
