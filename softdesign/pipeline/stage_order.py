@@ -13,6 +13,7 @@ from softdesign.pipeline import inputs
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages import (
     blend,
+    design,
     export,
     feasibility,
     fit,
@@ -25,8 +26,8 @@ from softdesign.pipeline.stages import (
 
 #: Every stage, in build order.
 STAGES: list[Stage] = [
-    ingest.STAGE, blend.STAGE, links.STAGE, kinematics.STAGE, fit.STAGE, export.STAGE, mould.STAGE, volume_mesh.STAGE,
-    feasibility.STAGE,
+    ingest.STAGE, design.STAGE, blend.STAGE, links.STAGE, kinematics.STAGE, fit.STAGE, export.STAGE, mould.STAGE,
+    volume_mesh.STAGE, feasibility.STAGE,
 ]
 
 

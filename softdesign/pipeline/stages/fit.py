@@ -83,7 +83,7 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     if len(ingest.faces) == 0:
         raise ConfigError("final.surface is required to fit the actuator's surface; add it to the case file")
     chain = links.chain
-    curve = chain.shape.curve_at(1.0)
+    curve = chain.shape.target_curve()  # the vessel's centerline (blend: pcc carries the wall onto the chain)
     path = ingest.path
     inscribed = (None, None) if path.radius is None else inscribed_profile(curve, path.points, path.radius)
     network = NetworkContext(path.points, tuple(p.points for p in ingest.others), *inscribed)
