@@ -21,12 +21,16 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from softdesign.pipeline.parallel import one_blas_thread
 
 one_blas_thread()  # before numpy loads, as `softdesign` itself does
 
 import numpy as np  # noqa: E402
+
+if TYPE_CHECKING:
+    from softdesign.kinematics.chain_design import ChainTarget
 
 REPO = Path(__file__).resolve().parents[1]
 AORTA_DIR = REPO.parent / "shared" / "data" / "vmtk-aorta"
@@ -35,7 +39,7 @@ TOLERANCES_MM = (0.5, 1.0, 2.0)
 TARGET_S = {"demo": 2.0, "aorta": 2.0, "demo, 1201 points": 5.0}
 
 
-def targets() -> list[tuple[str, object, float]]:
+def targets() -> list[tuple[str, ChainTarget, float]]:
     """(label, target, default shortest section mm) of every case, built as the design stage builds them."""
     from softdesign.config import load_case
     from softdesign.pipeline.stages.design import chain_target, final_curve
@@ -54,12 +58,14 @@ def targets() -> list[tuple[str, object, float]]:
     cases.append(("demo, 1201 points", demo.model_copy(update={"resample": resample})))
     for label, case in cases:
         ingest = run_ingest(case)
+        if ingest.path.radius is None:
+            raise RuntimeError(f"{label}: the centerline has no radius for the default shortest section")
         shortest = float(2.0 * np.median(ingest.path.radius))
         out.append((label, chain_target(final_curve(case, ingest)), shortest))
     return out
 
 
-def after(target, tolerance: float, shortest: float) -> tuple[int, float, float, float, float, float]:
+def after(target: ChainTarget, tolerance: float, shortest: float) -> tuple[int, float, float, float, float, float]:
     from softdesign.kinematics.chain_design import ChainOptions, design_chain
 
     wall, cpu = time.perf_counter(), time.process_time()
@@ -68,7 +74,7 @@ def after(target, tolerance: float, shortest: float) -> tuple[int, float, float,
             time.process_time() - cpu, time.perf_counter() - wall)
 
 
-def before(target, tolerance: float, shortest: float) -> tuple[int, float, float, float, float, float]:
+def before(target: ChainTarget, tolerance: float, shortest: float) -> tuple[int, float, float, float, float, float]:
     """The previous programme's links, their arcs composed from the base frame and measured as a design is."""
     from scipy.spatial import cKDTree
 
