@@ -42,6 +42,9 @@ SUMMARY_COLUMNS = (
     "status",
     "seconds",
     "links",
+    "chain_deviation_mm",
+    "tip_error_mm",
+    "tip_error_deg",
     "fit_rms_mm",
     "fit_p99_mm",
     "fit_max_mm",
@@ -245,8 +248,12 @@ def manifest_figures(build_dir: Path) -> dict[str, Any]:
     per_q = _per_q_figures(build_dir, metrics)
     meshes = [o for o in manifest["outputs"] if o["path"].startswith(MESHES_DIR + "/") and "volume_mm3" in o]
     volumes = [float(o["volume_mm3"]) for o in meshes]
+    design = metrics.get("design") or {}  # the composed-chain design (issue 30); blank without a design: block
     return {
         "links": (metrics.get("kinematics") or {}).get("links", ""),
+        "chain_deviation_mm": design.get("chain_max_deviation_mm", ""),
+        "tip_error_mm": design.get("tip_error_mm", ""),
+        "tip_error_deg": design.get("tip_error_deg", ""),
         "fit_rms_mm": fit.get("rms_mm", ""),
         "fit_p99_mm": fit.get("p99_mm", ""),
         "fit_max_mm": fit.get("max_mm", ""),

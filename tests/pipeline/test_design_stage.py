@@ -175,3 +175,11 @@ def test_the_designed_demo_builds_with_pcc_and_every_mesh_is_watertight(tmp_path
     meshes = [o for o in manifest["outputs"] if o["path"].startswith("meshes/q_")]
     assert len(meshes) == 5 and all(o["watertight"] for o in meshes)
     assert manifest["metrics"]["design"]["links"] == manifest["metrics"]["links"]["count"]
+
+
+def test_a_build_warns_when_its_design_misses_the_tolerance(tmp_path):
+    case = designed_case(tmp_path, DEMO, {"design": {"tolerance_mm": 0.05, "max_links": 2}})
+    result = runner.invoke(app, ["blend", str(case), "--out", str(tmp_path / "build")])
+    assert result.exit_code == 0, result.output
+    assert "warning:" in result.stderr and "the design misses its bounds" in result.stderr
+    assert "design.max_links 2" in result.stderr and "raise design.max_links" in result.stderr
