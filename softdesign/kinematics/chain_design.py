@@ -12,9 +12,9 @@ Method (``METHOD``)
     1. starts: the target's curvature vector in its rotation-minimizing frames
        (constant along an arc of a PCC chain) split into k constant pieces by
        an exact dynamic programme (least squares, pieces >= the shortest
-       link), each piece's mean curvature and length a section; and the best
-       chain of k - 1 sections with its worst section split in two halves of
-       the same arc (the same shape, so k sections start where k - 1 ended);
+       link), each piece's mean curvature and length a section; and the
+       least-squares chain of k - 1 sections (step 2) with its worst section
+       split in two halves of the same arc (the same shape);
     2. a joint least squares over every section's (wx, wy, L) at once: the
        vectors from the target's samples to their closest points on the whole
        chain (exact, :func:`pcc_chain.feet_on_chain`), and the tip's position
@@ -25,8 +25,9 @@ Method (``METHOD``)
     The breaks fall where the chain's joints are, by arc-length fraction:
     ``l_i = (L_1 + ... + L_i) / (L_1 + ... + L_k)`` in normalized l of the
     target, so the target's part [l_i, l_i+1] is carried onto section i by
-    arc-length fraction.  The first k whose measured chain meets every bound is
-    the design; with none up to ``max_links``, the best chain found.
+    arc-length fraction.  Each k's chain is measured (below); the first k
+    whose chain meets every bound is the design; with none up to
+    ``max_links``, the chain with the smallest worst figure found.
 Measured, never estimated
     ``chain_max_deviation_mm`` is the largest true distance both ways: every
     target sample to the chain (closed form per arc), and every point of the
@@ -36,11 +37,15 @@ Measured, never estimated
     between their tangents.
 What is guaranteed
     The reported figures are measurements of the returned chain; ``meets``
-    is true only when they are within the bounds.  The choice of k does not
-    depend on the tolerances (each k's chain is computed the same way whatever
-    they are), so a smaller tolerance never gives fewer sections.  A target
-    that is exactly k arcs (the shortest at least the shortest link) is found
-    with k sections: the dynamic programme starts on its joints.
+    is true only when they are within the bounds.  Looser bounds never give
+    more sections (so a smaller tolerance never gives fewer): the starts and
+    least-squares chain of every k depend on no bound; the minimax refinement
+    runs when that chain's worst residual is within ``MINIMAX_REACH`` times the
+    tolerance (a rule that looser bounds only widen), and its chain is taken
+    when it meets the bounds or improves on a least-squares chain that does
+    not, so a k that meets some bounds meets every looser ones.  A target
+    made of k arcs (each at least the shortest link) starts on its joints:
+    the dynamic programme finds them, and the tests show k sections found.
 What is not
     Fewest sections is not proven: a k whose search missed the bounds is not
     shown to have no chain within them (the problem is not convex).  The
@@ -184,15 +189,20 @@ def design_chain(target: ChainTarget, options: ChainOptions) -> ChainDesign:
             break
         fits = [_solve(work, _packed(w, length), options.min_link_mm) for w, length in candidates]
         x = min(fits, key=lambda f: _worst(work, f))
+        fitted = _measure(target, tree, work.base, *_unpacked(x))
+        chosen = fitted
         if _worst(work, x) <= MINIMAX_REACH * options.tolerance_mm:
-            x = _minimax(work, x, options.min_link_mm)
-        chosen = _measure(target, tree, work.base, *_unpacked(x))
+            refined = _measure(target, tree, work.base, *_unpacked(_minimax(work, x, options.min_link_mm)))
+            # kept when it meets the bounds, or improves on a least-squares chain that does not: a chain that
+            # meets them is never swapped for one that does not (see "What is guaranteed")
+            if _meets(refined, options) or (not _meets(fitted, options) and refined.worst_mm < fitted.worst_mm):
+                chosen = refined
         tried.append((k, chosen.worst_mm))
         if best is None or chosen.worst_mm < best.worst_mm:
             best = chosen
         if _meets(chosen, options):
             return _final(chosen, True, tried)
-        previous = chosen
+        previous = fitted  # the least-squares chain: the next k's split start depends on no bound
     assert best is not None  # k = 1 always has the whole target as one piece
     return _final(best, False, tried)
 

@@ -175,6 +175,10 @@ def test_the_designed_demo_builds_with_pcc_and_every_mesh_is_watertight(tmp_path
     meshes = [o for o in manifest["outputs"] if o["path"].startswith("meshes/q_")]
     assert len(meshes) == 5 and all(o["watertight"] for o in meshes)
     assert manifest["metrics"]["design"]["links"] == manifest["metrics"]["links"]["count"]
+    # the fit says how far the vessel's wall is carried to reach the chain; the chain's two-way deviation is at most
+    # that shift (each point's distance to the other curve is at most its distance to the point at the same l)
+    carried = json.loads((tmp_path / "build" / "fit" / "summary.json").read_text())["pcc"]
+    assert carried["max_axis_shift_mm"] >= manifest["metrics"]["design"]["chain_max_deviation_mm"] - 1e-3
 
 
 def test_a_build_warns_when_its_design_misses_the_tolerance(tmp_path):

@@ -121,6 +121,8 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
                                           curve.frames(np.array([0.0, 1.0])), chain.shape.keys[-1].length,
                                           mould=case.export.mould is not None,
                                           parting_local=_parting_local(chain) if case.export.mould else None)}
+    if chain.shape.mode == "pcc":
+        summary["pcc"] = _carried_to_chain(chain, curve)
     # the end prior can hold the ends a straying centerline leaves one-sided: the fit then succeeds, so say it
     stray = centerline_stray(case, curve.curve, path)
     if stray is not None:
@@ -135,6 +137,21 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
         "distance": wall.distance,
     }
     return FitResult(field, summary, points)
+
+
+def _carried_to_chain(chain: LinkChain, vessel: Any) -> dict[str, Any]:
+    """blend: pcc: how far the wall, fitted around the vessel's centerline, is carried to reach the chain at q = 1."""
+    l = chain.shape.keys[-1].dense_l()
+    moved = np.linalg.norm(chain.shape.smooth_curve_at(1.0).points(l) - vessel.points(l), axis=1)
+    worst = int(np.argmax(moved))
+    return {
+        "max_axis_shift_mm": float(moved[worst]),
+        "at_l": float(l[worst]),
+        "note": "the wall is fitted around the vessel's centerline and carried onto the designed chain by arc-length "
+                "fraction per section: at q = 1 each ring of the body sits on the chain's point at the same l, up to "
+                "max_axis_shift_mm from the vessel's (the chain's true distance to the centerline, "
+                "design/summary.json: chain_max_deviation_mm, is at most this)",
+    }
 
 
 def centerline_stray(case: Case, curve: SmoothCurve, path: SelectedPath) -> str | None:
