@@ -25,9 +25,6 @@ if TYPE_CHECKING:  # numpy is imported where it is used: `softdesign --help` sta
 
     from softdesign.config import Case
 
-#: Kept for callers of the old name: the most sections a design searches.
-MAX_LINKS_LIMIT = MAX_DESIGN_LINKS
-
 
 class DesignFailed(SoftdesignError):
     """No chain within --max-links meets the bounds (exit 1)."""

@@ -221,9 +221,9 @@ def miss_text(document: dict[str, Any]) -> str | None:
 
 
 def describe_design(result: DesignResult | None) -> list[str]:
-    """Human summary lines (none without a design)."""
+    """Human summary lines."""
     if result is None:
-        return []
+        return ["no design: in the case file: no composed-chain design (softdesign design CASE --tolerance-mm T)"]
     d = result.document
     lines = [f"{len(d['links'])} section(s) composed from the base: chain within {d['chain_max_deviation_mm']:.3g} mm "
              f"of the q = 1 centerline (tolerance {d['tolerance_mm']:g} mm), tip off by {d['tip_error_mm']:.3g} mm "
