@@ -187,3 +187,16 @@ def test_a_build_warns_when_its_design_misses_the_tolerance(tmp_path):
     assert result.exit_code == 0, result.output
     assert "warning:" in result.stderr and "the design misses its bounds" in result.stderr
     assert "design.max_links 2" in result.stderr and "raise design.max_links" in result.stderr
+
+
+def test_the_design_is_cached_like_any_stage_and_redone_when_its_block_changes(tmp_path):
+    case = designed_case(tmp_path, DEMO, {"design": {"tolerance_mm": 2.0}})
+    first = build_through(case, tmp_path / "build", target="design")
+    again = build_through(case, tmp_path / "build", target="design")
+    assert [r.status for r in first.runs] == ["ran", "ran"]
+    assert [r.status for r in again.runs if r.name == "design"] == ["skipped"]
+    assert again.results["design"].document == first.results["design"].document
+    case.write_text(case.read_text().replace("tolerance_mm: 2.0", "tolerance_mm: 1.0"))
+    changed = build_through(case, tmp_path / "build", target="design")
+    assert [(r.name, r.status) for r in changed.runs] == [("ingest", "skipped"), ("design", "ran")]
+    assert changed.results["design"].document["tolerance_mm"] == 1.0
