@@ -75,16 +75,19 @@ DEMO_CASE = REPO / "configs" / "demo.yaml"
 AORTA_DIR = REPO.parent / "shared" / "data" / "vmtk-aorta"
 STAGE_NAMES = ("ingest", "blend", "links", "kinematics", "fit", "export", "mould", "volume_mesh", "feasibility")
 
-#: Targets of the scaled case (issue 5, item 9; the build/floor ratio is issue 19's, on 2 cores).
-TARGET_FLOOR_RATIO = 2.0
+#: Targets of the scaled case (issue 5, item 9).  The build/floor ratio on 2 cores, restated in round 3: 4x (2x
+#: would need compiled kernels or subsampled fits).
+TARGET_FLOOR_RATIO = 4.0
 TARGET_PEAK_MIB = 2048.0
 #: Start-up targets (issue 19), seconds, median of STARTUP_REPEATS fresh processes.
 TARGET_HELP_S = 0.3
 TARGET_VALIDATE_S = 0.6
 STARTUP_REPEATS = 5
-#: ``softdesign report`` no slower than ``softdesign build`` on the sample case (issue 17): wall ratio, median of
-#: REPORT_REPEATS interleaved pairs of fresh processes (the scaled case is measured once, for information).
-TARGET_REPORT_RATIO = 1.0
+#: ``softdesign report`` against ``softdesign build`` (issue 17, restated in round 3): at most 1.5x the build on the
+#: sample case, no longer than the build on the largest scaled case; wall ratio, median of REPORT_REPEATS
+#: interleaved pairs of fresh processes (the scaled case measured once; the aorta for information).
+TARGET_REPORT_RATIO_DEMO = 1.5
+TARGET_REPORT_RATIO_LARGE = 1.0
 REPORT_REPEATS = 3
 #: Time ~ size^e counts as linear up to this e (timings on a shared machine jitter by ~10 %).
 LINEAR_EXPONENT_MAX = 1.15
@@ -430,21 +433,21 @@ def report_figures(case_file: Path, out: Path, repeats: int = REPORT_REPEATS) ->
     }
 
 
-def report_line(label: str, figures: dict[str, float], judged: bool) -> str:
-    """One case's build and report times and their ratio; judged against the target on the sample case only."""
+def report_line(label: str, figures: dict[str, float], target: float | None) -> str:
+    """One case's build and report times and their ratio; judged against ``target`` when one is given."""
     ratio = figures["report_s"] / figures["build_s"]
-    judgement = f"  target <= {TARGET_REPORT_RATIO:g}  {verdict(ratio <= TARGET_REPORT_RATIO)}" if judged else ""
+    judgement = f"  target <= {target:g}  {verdict(ratio <= target)}" if target is not None else ""
     return (f"  {label:<38} build {figures['build_s']:5.2f} s (cpu {figures['build_cpu_s']:5.2f})  "
             f"report {figures['report_s']:5.2f} s (cpu {figures['report_cpu_s']:5.2f})  "
             f"report/build {ratio:4.2f}{judgement}")
 
 
-def report_lines(cases: Sequence[tuple[str, Path, int, bool]], scratch: Path) -> list[str]:
-    """``softdesign report`` against ``softdesign build``: (label, case file, repeats, judged) per case."""
+def report_lines(cases: Sequence[tuple[str, Path, int, float | None]], scratch: Path) -> list[str]:
+    """``softdesign report`` against ``softdesign build``: (label, case file, repeats, target or None) per case."""
     lines = ["report against its build (issue 17): wall, median of interleaved fresh processes "
              "(build --force, then report), both with the cores available:"]
-    for k, (label, case_file, repeats, judged) in enumerate(cases):
-        lines.append(report_line(label, report_figures(case_file, scratch / f"report-{k}", repeats), judged))
+    for k, (label, case_file, repeats, target) in enumerate(cases):
+        lines.append(report_line(label, report_figures(case_file, scratch / f"report-{k}", repeats), target))
     return lines
 
 
@@ -666,10 +669,11 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
     plan = synthetic_plan(scratch, args.triangles, args.frames)
     results = run_synthetic(plan, scratch, args.jobs)
     largest = next(c for c in plan if (c.triangles, c.frames) == (max(args.triangles), min(args.frames)))
-    report_cases = [("sample case (configs/demo.yaml)", DEMO_CASE, REPORT_REPEATS, True)]
+    report_cases: list[tuple[str, Path, int, float | None]] = [
+        ("sample case (configs/demo.yaml)", DEMO_CASE, REPORT_REPEATS, TARGET_REPORT_RATIO_DEMO)]
     if aorta is not None:
-        report_cases.append(("VMTK aorta (path 0)", aorta.case_file, REPORT_REPEATS, False))
-    report_cases.append((largest.label, largest.case_file, 1, False))
+        report_cases.append(("VMTK aorta (path 0)", aorta.case_file, REPORT_REPEATS, None))
+    report_cases.append((largest.label, largest.case_file, 1, TARGET_REPORT_RATIO_LARGE))
     emit(report_lines(report_cases, scratch) + [""])
     top_t, top_f = max(args.triangles), max(args.frames)
     scaled = next(r for r in results if r["size"] == {"triangles": top_t, "frames": top_f})

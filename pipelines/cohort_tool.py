@@ -60,10 +60,14 @@ def inputs(args: argparse.Namespace) -> int:
 
 def summary(args: argparse.Namespace) -> int:
     rows = cohort.summary_rows(Path(args.cohort), Path(args.build))
-    cohort.write_summary_csv(rows, Path(args.out))
+    kept = cohort.write_summary_csv(rows, Path(args.out))
+    if kept is not None:
+        print(f"cohort: the previous table is kept as {kept}")
     failed = [row for row in rows if row["status"] != "ok"]
     for row in rows:
-        print(f"  {row['case']:<24} {row['status']:<9} {_seconds(row['seconds'])}  {row['message']}".rstrip())
+        verdict = {"true": "feasible", "false": "NOT feasible", "not judged": "not judged"}.get(row["feasible"], "")
+        print(f"  {row['case']:<24} {row['status']:<9} {verdict:<13} {_seconds(row['seconds'])}  "
+              f"{row['message']}".rstrip())
     if failed:
         names = ", ".join(row["case"] for row in failed)
         print(f"cohort: {len(failed)} of {len(rows)} case(s) failed ({names}); table: {args.out}", file=sys.stderr)

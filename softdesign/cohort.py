@@ -42,14 +42,18 @@ SUMMARY_COLUMNS = (
     "status",
     "seconds",
     "links",
-    "chain_deviation_mm",
-    "tip_error_mm",
-    "tip_error_deg",
     "fit_rms_mm",
     "fit_p99_mm",
     "fit_max_mm",
-    "stretch_min",
-    "stretch_max",
+    "feasible",
+    "skin_stretch_min",
+    "skin_stretch_max",
+    "wall_min_mm",
+    "chain_deviation_mm",
+    "tip_error_mm",
+    "tip_error_deg",
+    "axial_stretch_min",
+    "axial_stretch_max",
     "max_rho_kappa",
     "min_radius_mm",
     "wall_mm",
@@ -240,25 +244,32 @@ def case_row(name: str, build_dir: Path, record: RunRecord | None) -> dict[str, 
 
 
 def manifest_figures(build_dir: Path) -> dict[str, Any]:
-    """Fit, stretch, rho*kappa, radius, wall and volume figures of a build folder's manifest."""
+    """Fit, feasibility, design, stretch, rho*kappa, radius, wall and volume figures of a build folder's manifest.
+
+    ``feasible`` is the feasibility stage's verdict (``not judged`` without a material); the skin's stretches are
+    the extremes over the whole morph and the thinnest wall the least over the export q (feasibility), the axial
+    stretches the centerline's.  ``meshes`` counts the exported q values (one mesh per q, whatever the number of
+    formats), and ``volumes_mm3`` lists one volume per q.
+    """
     build_dir = Path(build_dir)
     manifest = json.loads((build_dir / MANIFEST).read_text(encoding="utf-8"))
     metrics = manifest["metrics"]
     fit = metrics.get("fit") or {}
     per_q = _per_q_figures(build_dir, metrics)
-    meshes = [o for o in manifest["outputs"] if o["path"].startswith(MESHES_DIR + "/") and "volume_mm3" in o]
+    meshes = _one_mesh_per_q(manifest["outputs"])
     volumes = [float(o["volume_mm3"]) for o in meshes]
     design = metrics.get("design") or {}  # the composed-chain design (issue 30); blank without a design: block
     return {
         "links": (metrics.get("kinematics") or {}).get("links", ""),
-        "chain_deviation_mm": design.get("chain_max_deviation_mm", ""),
-        "tip_error_mm": design.get("tip_error_mm", ""),
-        "tip_error_deg": design.get("tip_error_deg", ""),
         "fit_rms_mm": fit.get("rms_mm", ""),
         "fit_p99_mm": fit.get("p99_mm", ""),
         "fit_max_mm": fit.get("max_mm", ""),
-        "stretch_min": min((p["stretch_min"] for p in per_q), default=""),
-        "stretch_max": max((p["stretch_max"] for p in per_q), default=""),
+        **_feasibility_figures(metrics.get("feasibility") or {}),
+        "chain_deviation_mm": design.get("chain_max_deviation_mm", ""),
+        "tip_error_mm": design.get("tip_error_mm", ""),
+        "tip_error_deg": design.get("tip_error_deg", ""),
+        "axial_stretch_min": min((p["stretch_min"] for p in per_q), default=""),
+        "axial_stretch_max": max((p["stretch_max"] for p in per_q), default=""),
         "max_rho_kappa": _max_rho_kappa(fit, build_dir),
         "min_radius_mm": _fit_summary(build_dir).get("min_rho_mm", ""),
         "wall_mm": manifest["case"]["export"].get("wall_mm") or "",
@@ -267,6 +278,30 @@ def manifest_figures(build_dir: Path) -> dict[str, Any]:
         "volume_min_mm3": min(volumes, default=""),
         "volume_max_mm3": max(volumes, default=""),
         "volumes_mm3": " ".join(f"{Path(o['path']).stem}={float(o['volume_mm3']):.6g}" for o in meshes),
+    }
+
+
+def _one_mesh_per_q(outputs: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The exported body meshes (``meshes/q_*.<format>``), one per q: the first format listed for each."""
+    by_q: dict[str, dict[str, Any]] = {}
+    for o in outputs:
+        path = Path(o["path"])
+        if path.parent.as_posix() == MESHES_DIR and path.stem.startswith("q_") and "volume_mm3" in o:
+            by_q.setdefault(path.stem, o)
+    return [by_q[q] for q in sorted(by_q)]
+
+
+def _feasibility_figures(block: dict[str, Any]) -> dict[str, Any]:
+    """The verdict, the skin's stretch extremes over the morph and the thinnest wall over the export q."""
+    if not block or "morph" not in block:
+        return {"feasible": "", "skin_stretch_min": "", "skin_stretch_max": "", "wall_min_mm": ""}
+    walls = [row["wall_min_mm"] for row in block.get("per_q", []) if row.get("wall_min_mm") is not None]
+    verdict = block.get("feasible")
+    return {
+        "feasible": "not judged" if verdict is None else str(bool(verdict)).lower(),
+        "skin_stretch_min": block["morph"]["stretch_min"]["value"],
+        "skin_stretch_max": block["morph"]["stretch_max"]["value"],
+        "wall_min_mm": min(walls, default=""),
     }
 
 
@@ -306,9 +341,24 @@ def summary_csv(rows: list[dict[str, Any]]) -> str:
     return buffer.getvalue()
 
 
-def write_summary_csv(rows: list[dict[str, Any]], path: Path) -> None:
-    """Write the summary table, atomically (a reader never sees half a table)."""
-    _write_atomically(Path(path), summary_csv(rows))
+def write_summary_csv(rows: list[dict[str, Any]], path: Path) -> Path | None:
+    """Write the summary table, atomically (a reader never sees half a table), keeping a different older one.
+
+    A table already at ``path`` with other content is kept as ``<stem>.<k>.csv`` beside it (k the next free
+    number, from 1), so a run never silently destroys the last one; the kept table's path is returned (None
+    when there was none, or it was the same).
+    """
+    path = Path(path)
+    text = summary_csv(rows)
+    kept = None
+    if path.is_file() and path.read_text(encoding="utf-8") != text:
+        k = 1
+        while path.with_name(f"{path.stem}.{k}{path.suffix}").exists():
+            k += 1
+        kept = path.with_name(f"{path.stem}.{k}{path.suffix}")
+        os.link(path, kept)  # a second name for the old table; the new one then replaces the first
+    _write_atomically(path, text)
+    return kept
 
 
 def _write_atomically(path: Path, text: str) -> None:

@@ -166,6 +166,9 @@ class Fit(_Section):
     # where the body ends: at each end's detected cap plane or boundary loop (auto, cap_plane) or square to the
     # end tangent (normal); see geometry/end_cut.py
     end_cut: Literal["auto", "cap_plane", "normal"] = "auto"
+    # the body's radius is held at most this along the whole path (a thinner body makes a turn the vessel's
+    # width cannot: a branch's take-off); a fold's message offers the value (fitting/radius_field.py)
+    max_radius_mm: FiniteFloat | None = Field(None, gt=0.0)
 
     @field_validator("knot_spacing_mm", mode="before")
     @classmethod

@@ -42,6 +42,10 @@ class FitError(SoftdesignError):
     """The surface fit failed or violates a stated bound."""
 
 
+class FoldError(FitError):
+    """The fitted body folds through itself (1 - rho * kappa_n <= 0); the message names the body radius that fits."""
+
+
 class InputFitError(FitError, InputDataError):
     """The fit failed because of the inputs (a surface that does not surround the centerline): bad input, exit 2."""
 

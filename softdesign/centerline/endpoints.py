@@ -6,7 +6,10 @@ the barycentres of the open profiles (``openprofiles``).  Here, in order:
 1. an open surface: the centres of its boundary loops (:mod:`.closing`);
 2. a capped surface whose file labels its faces (``ModelFaceID`` from
    SimVascular, ``CellEntityIds`` from VMTK's ``vmtkmeshgenerator``): the wall
-   is the label of largest area, every other label a cap;
+   is the label of largest area, and every other label is a cap if it looks
+   like one (:func:`caps_from_regions`: flat, disc-like, and as wide as the
+   vessel it closes; SimVascular models label wall faces too), else it is
+   ignored with a note saying why;
 3. a capped surface without labels: flat, nearly planar, disc-like patches
    (a capper's flat ends), :func:`planar_caps`;
 4. otherwise the ends of the Voronoi graph, :func:`graph_extremities`.
@@ -43,6 +46,14 @@ CAP_MIN_EDGES = 2.0
 DISC_FILL = 0.5
 #: ... and its points stay within this fraction of its diameter from their best-fitting plane.
 FLATNESS_REL = 0.01
+#: A labelled face is a cap only if its points stay within this fraction of its diameter from their plane
+#: (a capper's or SimVascular's cap is planar to rounding; a wall face of width w on a vessel of radius R
+#: bows by w / (8 R) of its width, so only a sliver far narrower than the vessel passes) ...
+LABEL_FLATNESS_REL = 0.02
+#: ... and the radius of the disc of its area lies within these multiples of the widest inscribed sphere
+#: touching it: a cap closes the vessel, so it is as wide as the lumen behind it (an elliptic end reaches
+#: about 1.3); a wall face is much wider or much narrower than the lumen it lines.
+LABEL_RADIUS_RANGE = (0.5, 1.5)
 #: A side branch found by farthest-point sweeps must reach this many radii beyond the paths so far.
 BRANCH_MIN_RADII = 3.0
 #: How far behind a graph extremity its width is measured, as a fraction of the graph's longest path.
@@ -58,22 +69,65 @@ def choose_inlet(openings: tuple[Opening, ...], inlet: FloatArray | None) -> int
     return int(np.argmax([o.area for o in openings]))
 
 
-def caps_from_regions(vertices: FloatArray, faces: IntArray, regions: npt.ArrayLike) -> tuple[Opening, ...]:
-    """Caps of a labelled surface: every label but the one of largest area (the wall), by label order.
+def caps_from_regions(
+    vertices: FloatArray, faces: IntArray, regions: npt.ArrayLike, graph: VoronoiGraph
+) -> tuple[tuple[Opening, ...], tuple[str, ...]]:
+    """Caps of a labelled surface, by label order, and a note for each label that is not taken.
+
+    The label of largest area is the wall.  Every other label is a cap only if it is planar (within
+    LABEL_FLATNESS_REL of its diameter), disc-like (DISC_FILL of the disc spanning it) and as wide as the
+    vessel it closes (LABEL_RADIUS_RANGE of the widest inscribed sphere touching it); a label that fails
+    is ignored, and its note names it, its area and the reason.
 
     Parameters
     ----------
     vertices : (V, 3) float, mm
     faces : (F, 3) int
     regions : (F,) int -- one label per face (ModelFaceID, CellEntityIds)
+    graph : the surface's internal Voronoi diagram (the inscribed spheres the labels are measured against)
     """
     regions = np.asarray(regions).reshape(-1)
     areas = _face_areas(vertices, faces)
     labels = np.unique(regions)
     totals = np.array([areas[regions == label].sum() for label in labels])
     wall = labels[int(np.argmax(totals))]
-    return tuple(_patch_opening(vertices, faces[regions == label], areas[regions == label])
-                 for label in labels if label != wall)
+    caps, notes = [], []
+    for label in labels[labels != wall]:
+        chosen = regions == label
+        reason = label_not_a_cap(vertices, faces[chosen], float(areas[chosen].sum()), graph)
+        if reason is None:
+            caps.append(_patch_opening(vertices, faces[chosen], areas[chosen]))
+        else:
+            notes.append(f"face label {int(label)} ({float(areas[chosen].sum()):.1f} mm^2) is not taken as an "
+                         f"opening: {reason}")
+    return tuple(caps), tuple(notes)
+
+
+def label_not_a_cap(vertices: FloatArray, faces: IntArray, area: float, graph: VoronoiGraph) -> str | None:
+    """Why the labelled patch ``faces`` (k, 3) of ``area`` mm^2 is not a cap, or None when it is one."""
+    ids = np.unique(faces)
+    points = vertices[ids]
+    centred = points - points.mean(axis=0)
+    diameter = 2.0 * float(np.linalg.norm(centred, axis=1).max())
+    normal = np.linalg.svd(centred, full_matrices=False)[2][-1]
+    bow = float(np.abs(centred @ normal).max())
+    if bow > LABEL_FLATNESS_REL * diameter:
+        return (f"not planar (its points leave their plane by {bow:.2f} mm, {100 * bow / diameter:.1f} % of its "
+                f"{diameter:.1f} mm width; a cap stays within {100 * LABEL_FLATNESS_REL:.0f} %)")
+    if area < DISC_FILL * np.pi * (diameter / 2.0) ** 2:
+        return (f"not disc-like (it covers {100 * area / (np.pi * diameter**2 / 4):.0f} % of the disc spanning it, "
+                f"a cap at least {100 * DISC_FILL:.0f} %)")
+    touching = np.isin(graph.tets, ids).any(axis=1)
+    if not touching.any():
+        return "no inscribed sphere touches it"
+    lumen = float(graph.radius[touching].max())
+    radius = float(np.sqrt(area / np.pi))
+    low, high = LABEL_RADIUS_RANGE
+    if not low * lumen <= radius <= high * lumen:
+        return (f"{'wider' if radius > high * lumen else 'narrower'} than the vessel it would close (a disc of "
+                f"radius {radius:.2f} mm against the {lumen:.2f} mm inscribed sphere touching it; a cap is "
+                f"{low:g} to {high:g} times it)")
+    return None
 
 
 def planar_caps(vertices: FloatArray, faces: IntArray) -> tuple[Opening, ...]:

@@ -16,8 +16,9 @@ now is).
 
 Each path starts at the *pole* of the inlet (the internal Voronoi vertex
 farthest from the surface point nearest the inlet's centre) and ends at the
-pole of its outlet, as VMTK's paths do by default (``-endpoints 0``): the
-centerline stops about one radius short of the opening.
+pole of its outlet, as VMTK's Voronoi paths do: about one radius short of the
+opening.  :mod:`.ends` then continues each end straight to its opening's
+centre, as VMTK appends its seeds.
 
 No files, no printing: numpy and scipy only.
 """

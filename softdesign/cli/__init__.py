@@ -14,6 +14,7 @@ group); what they share is :mod:`~softdesign.cli.common`.
 from __future__ import annotations
 
 import gc
+from typing import Annotated
 
 import typer
 
@@ -22,10 +23,12 @@ from softdesign.cli.centerline import centerline
 from softdesign.cli.check import check
 from softdesign.cli.common import list_whole_first_paragraphs
 from softdesign.cli.design import design
+from softdesign.cli.init import init
 from softdesign.cli.pcc import PCC_SHORT_HELP, pcc_app
 from softdesign.cli.pose import pose
 from softdesign.cli.report import report
 from softdesign.cli.sample import sample
+from softdesign.cli.schema import schema
 from softdesign.pipeline.parallel import one_blas_thread
 
 #: Help is click's plain text, not typer's rich panels: rich markup ate every ``[default: ...]`` in the option
@@ -37,10 +40,30 @@ app = typer.Typer(
     help="Patient-specific soft actuators from VMTK vessel exports.",
     rich_markup_mode=None,
 )
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        from softdesign import __version__
+
+        typer.echo(f"softdesign {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _options(
+    version: Annotated[
+        bool, typer.Option("--version", help="Print softdesign's version and exit.", callback=_print_version,
+                           is_eager=True)
+    ] = False,
+) -> None:
+    """Patient-specific soft actuators from VMTK vessel exports."""
+
+
 app.add_typer(pcc_app, name="pcc", short_help=PCC_SHORT_HELP)
 for command in (
     validate, build, ingest, blend, links, kinematics, fit, export, mould, pose, check, report, sample, centerline,
-    design,
+    design, init, schema,
 ):
     app.command()(command)
 for group in (app, pcc_app):
@@ -66,5 +89,5 @@ def main() -> None:
 
 __all__ = [
     "app", "main", "validate", "build", "ingest", "blend", "links", "kinematics", "fit", "export", "mould",
-    "pose", "check", "report", "sample", "centerline", "design",
+    "pose", "check", "report", "sample", "centerline", "design", "init", "schema",
 ]

@@ -5,6 +5,7 @@ Parsing and printing live here; the stages are :mod:`softdesign.pipeline`.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -96,15 +97,21 @@ def _stage_command(case_file: Path, out: Path | None, target: str, force: bool, 
 
 
 def validate(case_file: CaseArg) -> None:
-    """Check a case file (schema, ranges, input files present) without building."""
+    """Check a case file (schema, ranges) and open every input file (type, counts, arrays, size in the units)."""
 
     def action() -> None:
         from softdesign.config import load_case
+        from softdesign.errors import errors_named_for
+        from softdesign.pipeline.input_report import open_inputs
         from softdesign.pipeline.inputs import input_files
 
         case = load_case(case_file)
         files = input_files(case)
-        typer.echo(f"{case_file}: valid (case '{case.name}', {len(files)} input file(s) found)")
+        with errors_named_for(case_file):
+            lines = open_inputs(case)
+        typer.echo(f"{case_file}: valid (case '{case.name}', {len(files)} input file(s) opened)")
+        for line in lines:
+            typer.echo(f"  {line}")
 
     run_guarded(action)
 
@@ -211,7 +218,7 @@ def _print_pose(payload: dict[str, Any]) -> None:
         omega = "null" if p["omega"] is None else "[" + ", ".join(f"{v:.4f}" for v in p["omega"]) + "]"
         typer.echo(
             f"link {link['index']} l {link['l_start']:.3f}..{link['l_end']:.3f}: length {link['length']:.3f} mm, "
-            f"theta1 {p['theta1']:.4f} mm, theta2 {p['theta2']:.5f} rad about {omega}"
+            f"theta1 {p['theta1']:.4f} mm, theta2 {math.degrees(p['theta2']):.4f} deg about {omega}"
         )
     typer.echo("base_to_tip:")
     for row in payload["base_to_tip"]:

@@ -103,6 +103,8 @@ def _payload(result: Any, output: Path, units: str, seconds: float) -> dict[str,
                 "points": int(len(points)),
                 "length": round(float(_length(points)) * back, 6),
                 "radius_range": [round(float(radius.min()) * back, 6), round(float(radius.max()) * back, 6)],
+                "continued": [round(v * back, 6) for v in result.continued_mm[k]],
+                "short_of_opening": [round(v * back, 6) for v in result.short_mm[k]],
             }
             for k, (points, radius) in enumerate(zip(result.paths, result.radii, strict=True))
         ],
@@ -117,6 +119,13 @@ def _length(points) -> float:
     return float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum())
 
 
+def _short(short: list[float], units: str) -> str:
+    """'; the inlet stops 1.2 mm short of its opening's centre' when an end could not reach it."""
+    parts = [f"the {end} stops {value:.2f} {units} short of its opening's centre (the straight run would leave "
+             "the surface)" for end, value in zip(("inlet", "outlet"), short, strict=True) if value > 0.0]
+    return "; " + "; ".join(parts) if parts else ""
+
+
 def _print(payload: dict[str, Any]) -> None:
     units = payload["units"]
     typer.echo(f"endpoints from {payload['endpoints']}; inlet at {payload['inlet']} {units}")
@@ -124,4 +133,6 @@ def _print(payload: dict[str, Any]) -> None:
         lo, hi = path["radius_range"]
         typer.echo(f"  centerline {path['centerline_id']}: {path['points']} points, {path['length']:.2f} {units}, "
                    f"radius {lo:.3f} .. {hi:.3f} {units}, to {path['outlet']}")
+        typer.echo(f"    ends continued straight past the Voronoi diagram by {path['continued'][0]:.2f} (inlet) and "
+                   f"{path['continued'][1]:.2f} {units} (outlet)" + _short(path["short_of_opening"], units))
     typer.echo(f"wrote {payload['output']} ({payload['seconds']:.2f} s)")

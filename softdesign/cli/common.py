@@ -33,6 +33,11 @@ QOpt = Annotated[
                  show_default=False),
 ]
 
+#: The one angle convention of every text output (JSON keeps radians, DESIGN.md).
+TEXT_ANGLES = "angles in degrees in this text (the JSON of --json gives radians)"
+#: What Ctrl-C prints (exit 130, the shell's code for SIGINT).
+INTERRUPTED = "interrupted; the previous build is kept (nothing half-written is left)"
+
 Q_FIX = "give one q for every link (e.g. 0.5) or one per link separated by commas (e.g. 0.2,0.8,1), each in [0, 1]"
 
 
@@ -61,7 +66,8 @@ def run_guarded(action: Callable[[], T]) -> T:
     """Run ``action``; turn a SoftdesignError into a message and its exit code.
 
     A user error (bad case file, bad input) exits 2 and a processing failure
-    exits 1, each with a one-paragraph message and no traceback.  Anything
+    exits 1, each with a one-paragraph message and no traceback; Ctrl-C exits
+    130 saying that the previous build is kept.  Anything
     else is a bug and propagates with its traceback.
     """
     try:
@@ -69,6 +75,11 @@ def run_guarded(action: Callable[[], T]) -> T:
     except SoftdesignError as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(code=err.exit_code) from None
+    except KeyboardInterrupt:
+        # every command writes through a staging folder or a temporary name, removed on the way out: a build
+        # folder (or an output file) is the previous one, whole
+        typer.echo(INTERRUPTED, err=True)
+        raise typer.Exit(code=130) from None
 
 
 def finite_number(text: str, what: str, fix: str) -> float:

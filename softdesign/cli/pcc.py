@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Annotated, Any, NamedTuple
 
 import typer
 
-from softdesign.cli.common import JsonOpt, emit_json, note, run_guarded
+from softdesign.cli.common import TEXT_ANGLES, JsonOpt, emit_json, note, run_guarded
 from softdesign.cli.pcc_design import design
 from softdesign.cli.pcc_options import DOpt, LengthsOpt, lengths_from_text, spacing_from_text
 from softdesign.errors import ConfigError, InputDataError
@@ -61,20 +61,19 @@ def forward_payload(lengths: np.ndarray, d: np.ndarray) -> dict:
 
 def _print_forward(payload: dict) -> None:
     typer.echo(
-        f"{'section':>7}  {'kappa [1/mm]':>13}  {'phi [rad]':>10}  {'phi [deg]':>9}  {'L [mm]':>10}  "
-        f"{'theta [rad]':>11}"
+        f"{'section':>7}  {'kappa [1/mm]':>13}  {'phi [deg]':>9}  {'L [mm]':>10}  {'theta [deg]':>11}"
     )
     for i, s in enumerate(payload["sections"], start=1):
         typer.echo(
-            f"{i:>7}  {s['kappa']:>13.6e}  {s['phi']:>10.6f}  {math.degrees(s['phi']):>9.3f}  "
-            f"{s['length']:>10.4f}  {s['theta']:>11.6f}"
+            f"{i:>7}  {s['kappa']:>13.6e}  {math.degrees(s['phi']):>9.3f}  "
+            f"{s['length']:>10.4f}  {math.degrees(s['theta']):>11.4f}"
         )
     x, y, z = payload["tip"]
     typer.echo(f"tip [mm]: x = {x:.4f}, y = {y:.4f}, z = {z:.4f}")
     typer.echo("base-to-tip transform:")
     for row in payload["transform"]:
         typer.echo("  " + "  ".join(f"{v:>10.6f}" for v in row))
-    typer.echo(f"convention: {CONVENTION}")
+    typer.echo(f"{TEXT_ANGLES}; convention: {CONVENTION}")
 
 
 @pcc_app.command()

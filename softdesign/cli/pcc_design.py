@@ -12,7 +12,7 @@ from typing import Annotated
 
 import typer
 
-from softdesign.cli.common import CaseArg, JsonOpt, OutOpt, emit_json, note, run_guarded
+from softdesign.cli.common import TEXT_ANGLES, CaseArg, JsonOpt, OutOpt, emit_json, note, run_guarded
 from softdesign.cli.pcc_options import spacing_from_text
 from softdesign.errors import ConfigError, errors_named_for
 from softdesign.kinematics.arc_tolerance import ARC_TOLERANCE_MM
@@ -20,9 +20,10 @@ from softdesign.kinematics.arc_tolerance import ARC_TOLERANCE_MM
 
 def _print_design(document: dict, case_file: Path) -> None:
     typer.echo(f"{case_file}: one PCC arc per link; d = {', '.join(f'{v:g}' for v in document['d'])} mm")
-    head = (f"{'link':>4}  {'l range':>13}  {'kappa [1/mm]':>12}  {'phi [deg]':>9}  {'L [mm]':>8}  {'theta':>7}  "
-            f"{'chambers l1 l2 l3 [mm]':>24}  {'strain e1 e2 e3 [%]':>23}  {'max [mm]':>9}  {'rms [mm]':>9}  "
-            f"{'tip [mm]':>9}  {'tangent':>8}  {'rotation':>8}")
+    head = (f"{'link':>4}  {'l range':>13}  {'kappa [1/mm]':>12}  {'phi [deg]':>9}  {'L [mm]':>8}  "
+            f"{'theta [deg]':>11}  {'chambers l1 l2 l3 [mm]':>24}  {'strain e1 e2 e3 [%]':>23}  "
+            f"{'max [mm]':>9}  {'rms [mm]':>9}  "
+            f"{'tip [mm]':>9}  {'tangent [deg]':>13}  {'rotation [deg]':>14}")
     for pose in document["poses"]:
         typer.echo(f"\nq = {pose['q']:g}")
         typer.echo(head)
@@ -31,26 +32,29 @@ def _print_design(document: dict, case_file: Path) -> None:
             strain = " ".join(f"{100 * v:+7.2f}" for v in k["chamber_strain"])
             typer.echo(
                 f"{k['index']:>4}  {k['l_start']:6.4f}-{k['l_end']:6.4f}  {k['kappa']:12.6f}  "
-                f"{math.degrees(k['phi']):9.3f}  {k['length']:8.3f}  {k['theta']:7.4f}  {chambers:>24}  {strain:>23}  "
+                f"{math.degrees(k['phi']):9.3f}  {k['length']:8.3f}  {math.degrees(k['theta']):11.4f}  "
+                f"{chambers:>24}  {strain:>23}  "
                 f"{k['backbone_max_mm']:9.3g}  {k['backbone_rms_mm']:9.3g}  {k['tip_error_mm']:9.3g}  "
-                f"{k['tangent_error_rad']:8.2g}  {k['rotation_error_rad']:8.2g}"
+                f"{math.degrees(k['tangent_error_rad']):13.2g}  {math.degrees(k['rotation_error_rad']):14.2g}"
             )
         w = pose["worst"]
         typer.echo(
             f"worst: link {w['index']}, backbone off by up to {w['backbone_max_mm']:.3g} mm "
             f"(rms {w['backbone_rms_mm']:.3g} mm), tip {w['tip_error_mm']:.3g} mm, "
-            f"tangent {w['tangent_error_rad']:.3g} rad, rotation {w['rotation_error_rad']:.3g} rad"
+            f"tangent {math.degrees(w['tangent_error_rad']):.3g} deg, "
+            f"rotation {math.degrees(w['rotation_error_rad']):.3g} deg"
         )
     for line in document.get("warnings", []):
         typer.echo(f"warning: {line}")
-    typer.echo(f"\nangles in rad unless marked; convention: {document['convention']}")
+    typer.echo(f"\n{TEXT_ANGLES}; convention: {document['convention']}")
 
 
 def arc_warnings(document: dict, warn_mm: float) -> list[str]:
     """One sentence per q and link whose arc misses the backbone by more than ``warn_mm`` (backbone_max_mm)."""
     return [
         f"q = {pose['q']:g}, link {k['index']}: one constant-curvature arc misses the design by up to "
-        f"{k['backbone_max_mm']:.3g} mm (--warn-mm {warn_mm:g}) and {k['tangent_error_rad']:.3g} rad of end tangent; "
+        f"{k['backbone_max_mm']:.3g} mm (--warn-mm {warn_mm:g}) and "
+        f"{math.degrees(k['tangent_error_rad']):.3g} deg of end tangent; "
         f"a PCC section cannot make this link: use more links (softdesign design CASE --tolerance-mm {warn_mm:g})"
         for pose in document["poses"] for k in pose["links"] if k["backbone_max_mm"] > warn_mm
     ]

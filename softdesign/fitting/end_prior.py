@@ -91,7 +91,7 @@ def end_prior(
                      angular_intervals - 1)
     counts = np.zeros((intervals, angular_intervals), int)
     np.add.at(counts, (row, col), 1)
-    seen = np.array([_largest_gap(kept.angle[row == k]) <= SEEN_GAP_RAD for k in range(intervals)])
+    seen = np.array([largest_gap(kept.angle[row == k]) <= SEEN_GAP_RAD for k in range(intervals)])
     if not seen.any():  # nothing seen all round: no typical cell to weigh by; the surround check speaks
         return _no_prior()
     typical = float(np.median(counts[seen]))
@@ -134,7 +134,7 @@ def _no_prior() -> EndPrior:
     return EndPrior(empty, empty, empty, empty, {})
 
 
-def _largest_gap(angle: FloatArray) -> float:
+def largest_gap(angle: FloatArray) -> float:
     """The widest empty angular sector of a set of angles, rad (2 pi for fewer than 3 points)."""
     if len(angle) < 3:
         return 2.0 * np.pi

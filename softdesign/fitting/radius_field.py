@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from softdesign.errors import FitError
+from softdesign.errors import FitError, FoldError
 from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import RadiusSpline, grid_from_local
 from softdesign.fitting.radius_rows import SlopeRows, row_blocks
@@ -31,6 +31,9 @@ from softdesign.types import FloatArray, FramedCurve, IntArray
 
 #: Grid spacing along the centerline for the folding check, mm.
 FOLD_SPACING_MM = 0.1
+#: rho * kappa_n the body radius offered as the fix of a fold brings the body to (the regularized backbone's
+#: target, :data:`softdesign.geometry.backbone.TARGET_REACH`: room below 1 for the meshes' own curvature).
+FOLD_FIX_REACH = 0.7
 #: Angles per angular knot interval for the folding check.
 FOLD_ANGLES_PER_INTERVAL = 8
 #: Memory for the grids of rho0 and rhof a field keeps (:meth:`RadiusField.end_grids`), bytes: room
@@ -46,6 +49,15 @@ def axisymmetric(spline: RadiusSpline) -> RadiusSpline:
     """The mean of rho over a at each l, as a spline on the same knots (exact)."""
     mean = spline.coefficients.mean(axis=1, keepdims=True)
     return RadiusSpline(spline.knots.copy(), np.repeat(mean, spline.angular_intervals, axis=1))
+
+
+def capped(spline: RadiusSpline, radius_mm: float) -> RadiusSpline:
+    """rho held at most ``radius_mm``: the coefficients clamped, so the spline stays C2, below both rho and the cap.
+
+    B-splines are non-negative and sum to one, so clamping the coefficients bounds the values by the cap,
+    and by the unclamped spline; within a knot interval of where rho crosses the cap it is a little lower.
+    """
+    return RadiusSpline(spline.knots.copy(), np.minimum(spline.coefficients, float(radius_mm)))
 
 
 def constant_like(spline: RadiusSpline, radius_mm: float) -> RadiusSpline:
@@ -279,8 +291,11 @@ def check_self_folding(curve: FramedCurve, field: RadiusField, q: float = 1.0, l
 
     Raises
     ------
+    FoldError
+        The tube folds: naming q, the place (l, mm, angle), the turn, and the body radius that fits there
+        (``fit.max_radius_mm``, from :func:`fold_fix_radius`).
     FitError
-        Naming q, the place (l, mm, angle) and the fixes to try.
+        rho <= 0 somewhere.
     """
     report = fold_margin(curve, field, q)
     if report.min_rho_mm <= 0.0:
@@ -289,13 +304,48 @@ def check_self_folding(curve: FramedCurve, field: RadiusField, q: float = 1.0, l
             "raise fit.smoothing, or check the wall points near the path's ends"
         )
     if report.max_rho_kappa >= limit:
-        raise FitError(
+        kappa = float(curve_curvature(curve, np.array([report.l]))[0])
+        rho = float(field.evaluate_pairs(q, [report.l], [report.angle])[0])
+        fix = fold_fix_radius(curve, field, q)
+        raise FoldError(
             f"radius field at q = {q:g}: the tube folds through itself: rho * kappa = {report.max_rho_kappa:.3f} "
             f"(expected < {limit:g}) at l = {report.l:.4f} ({report.arc_mm:.1f} mm from the inlet), "
-            f"angle {np.degrees(report.angle):.0f} deg; try more centerline smoothing "
-            "(resample.smoothing_mm), a longer straight end (resample.end_straight_mm), or a smaller radius"
+            f"angle {np.degrees(report.angle):.0f} deg: the path turns there with a radius of curvature of "
+            f"{1.0 / kappa:.3f} mm, tighter than the body is wide (rho {rho:.3f} mm); a body of radius at most "
+            f"{fix:.2f} mm makes rho * kappa <= {FOLD_FIX_REACH:g} wherever it now exceeds it: set "
+            f"fit.max_radius_mm: {fix:.2f} (the body is held at most that wide along the whole path; "
+            "export.offset_mm cannot, it is taken along the folded body's normals)"
         )
     return report
+
+
+def curve_curvature(curve: FramedCurve, l: FloatArray) -> FloatArray:
+    """kappa = |c' x c''| / |c'|^3 at normalized l (n,), 1/mm, for any framed curve."""
+    d1, d2 = curve.derivative(l, 1), curve.derivative(l, 2)
+    return np.linalg.norm(np.cross(d1, d2), axis=1) / np.linalg.norm(d1, axis=1) ** 3
+
+
+def fold_fix_radius(curve: FramedCurve, field: RadiusField, q: float = 1.0, reach: float = FOLD_FIX_REACH) -> float:
+    """The largest body radius (a cap on rho, mm) with which rho * kappa_n <= ``reach`` wherever it now exceeds it.
+
+    The least ``reach / kappa_n`` over the grid points of :func:`fold_margin` where ``rho * kappa_n > reach``
+    (inf where none): held at most that, the body's rho * kappa_n stays at most ``reach`` there, and no larger
+    elsewhere, as :func:`capped` never raises rho.  Rounded down to 0.01 mm.
+    """
+    count = max(int(np.ceil(curve.length / FOLD_SPACING_MM)), 16) + 1
+    l = np.linspace(0.0, 1.0, count)
+    a = np.linspace(0.0, 2.0 * np.pi, FOLD_ANGLES_PER_INTERVAL * field.final[0].angular_intervals, endpoint=False)
+    d1, d2, frames = curve.derivative(l, 1), curve.derivative(l, 2), curve.frames(l)
+    speed2 = np.einsum("ni,ni->n", d1, d1)
+    tangent = d1 / np.sqrt(speed2)[:, None]
+    kvec = (d2 - np.einsum("ni,ni->n", d2, tangent)[:, None] * tangent) / speed2[:, None]
+    k_n = (np.einsum("ni,ni->n", kvec, frames[:, :, 0])[:, None] * np.cos(a)[None, :]
+           + np.einsum("ni,ni->n", kvec, frames[:, :, 1])[:, None] * np.sin(a)[None, :])
+    rho = field.evaluate_grid(q, l, a)
+    over = rho * k_n > reach
+    if not over.any():
+        return float("inf")
+    return float(np.floor(100.0 * np.min(reach / k_n[over]) + 1e-9) / 100.0)  # 1e-9: 13.9999999 is 14.00
 
 
 def _trim(cache: dict[Any, Any], limit: int, size: Callable[[Any], int], keep: int) -> None:

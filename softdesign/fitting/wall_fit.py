@@ -16,7 +16,9 @@ import numpy.typing as npt
 
 from softdesign.errors import FitError
 from softdesign.fitting.bspline_surface import FitSettings, SurfaceFit, fit_radius_surface
+from softdesign.fitting.coverage import WallCoverage, measure_coverage
 from softdesign.fitting.end_checks import end_radii, negative_radius_cause
+from softdesign.fitting.end_hold import negative_end
 from softdesign.fitting.end_prior import end_prior
 from softdesign.fitting.mapping import Mapper, serial_map
 from softdesign.fitting.metrics import (
@@ -28,7 +30,14 @@ from softdesign.fitting.metrics import (
     measure_distances,
 )
 from softdesign.fitting.projection import PolarPoints, project_points
-from softdesign.fitting.radius_field import FOLD_SPACING_MM, FoldReport, RadiusField, check_self_folding, fold_margin
+from softdesign.fitting.radius_field import (
+    FOLD_SPACING_MM,
+    FoldReport,
+    RadiusField,
+    capped,
+    check_self_folding,
+    fold_margin,
+)
 from softdesign.fitting.selection import NetworkContext, SelectionSettings, WallSelection, select_wall_points
 from softdesign.types import FloatArray, FramedCurve
 
@@ -46,6 +55,8 @@ class WallFitOptions:
     initial_radius_mm : constant rho0; None for the axially symmetric mean of the fit
     fold_limit : the largest rho * kappa allowed at q = 1
     end_margin_mm : kept points within this arc length of either end are left out of the fit, mm
+    max_radius_mm : the fitted rho held at most this (:func:`~softdesign.fitting.radius_field.capped`), mm;
+        None: as fitted
     mapper : runs independent pieces (the hold-out's folds, the projection's and the metrics' blocks of
         points), perhaps on other processes; the same figures for any
     """
@@ -57,6 +68,7 @@ class WallFitOptions:
     initial_radius_mm: float | None = None
     fold_limit: float = 1.0
     end_margin_mm: float = 0.0
+    max_radius_mm: float | None = None
     mapper: Mapper = serial_map
 
 
@@ -76,6 +88,8 @@ class WallFit:
     ends: dict[str, dict[str, float]] = dataclasses.field(default_factory=dict)
     #: (n,) mm per surface vertex: the true distance of each measured kept point (the metrics' points), else NaN
     distance: FloatArray = dataclasses.field(default_factory=lambda: np.zeros(0))
+    #: the fit against all of the path's own wall, and where it saw none (None: not measured)
+    coverage: WallCoverage | None = None
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready figures for the manifest (mm, rad; snake_case keys)."""
@@ -97,7 +111,23 @@ class WallFit:
             "min_rho_mm": self.folding.min_rho_mm,
             "end_prior": {} if self.settings.prior is None else self.settings.prior.ends,
             "ends": self.ends,
-        }
+        } | ({} if self.coverage is None else self.coverage.as_dict())
+
+
+def _fit_kept(curve: FramedCurve, kept: PolarPoints, options: WallFitOptions,
+              reference: tuple[FloatArray, FloatArray] | None, rng: np.random.Generator):
+    """The end prior, the knot spacing (``auto``), the surface fitted to ``kept``, held at ``max_radius_mm``."""
+    settings, scores = options.fit, dict[float, float]()
+    prior = end_prior(kept, curve.length, settings.knot_spacing_mm, settings.angular_intervals, reference)
+    settings = replace(settings, prior=prior)
+    if options.auto_spacing:
+        spacing, scores = choose_knot_spacing(curve, kept, settings, rng, options.holdout)
+        settings = replace(settings, knot_spacing_mm=spacing)
+    surface = fit_radius_surface(kept, curve.length, settings)
+    if options.max_radius_mm is not None:  # every figure after is of the body built
+        cap = options.max_radius_mm
+        surface = replace(surface, whole=capped(surface.whole, cap), links=tuple(capped(s, cap) for s in surface.links))
+    return settings, scores, prior, surface
 
 
 def fit_wall(
@@ -132,15 +162,14 @@ def fit_wall(
     inside = (kept.l >= margin) & (kept.l <= 1.0 - margin)
     if not inside.all():
         kept, kept_index = kept.subset(inside), kept_index[inside]
-    settings, scores = options.fit, dict[float, float]()
     reference = None if network.inscribed_l is None or network.inscribed_radius is None else (
         np.asarray(network.inscribed_l, float), np.asarray(network.inscribed_radius, float))
-    prior = end_prior(kept, curve.length, settings.knot_spacing_mm, settings.angular_intervals, reference)
-    settings = replace(settings, prior=prior)
-    if options.auto_spacing:
-        spacing, scores = choose_knot_spacing(curve, kept, settings, rng, options.holdout)
-        settings = replace(settings, knot_spacing_mm=spacing)
-    surface = fit_radius_surface(kept, curve.length, settings)
+    settings, scores, prior, surface = _fit_kept(curve, kept, options, reference, rng)
+    hold = negative_end(surface.whole, curve.length, settings.knot_spacing_mm)
+    if hold is not None:  # rho <= 0 at an end: held at the inscribed radius there, fitted again
+        keep = hold.keeps(kept.l)
+        kept, kept_index = kept.subset(keep), kept_index[keep]
+        settings, scores, prior, surface = _fit_kept(curve, kept, options, reference, rng)
     measured = measure_distances(curve, surface.whole, kept, rng, mapper=options.mapper)
     # the hold-out folds are dealt from the measured points, each starting from its closest point
     holdout = holdout_rms(curve, kept.subset(measured.sample), settings, rng, options.holdout,
@@ -158,6 +187,11 @@ def fit_wall(
         raise FitError(f"{str(err).split('; ')[0]}; {negative_radius_cause(prior, curve.length, l[np.argmin(rho)])}"
                        ) from err
     ends = end_radii(radius, reference) | {"margin": {"mm": options.end_margin_mm, "points": float((~inside).sum())}}
+    if hold is not None:
+        ends[f"{hold.end}_held"] = hold.as_dict(curve.length)
     distance = np.full(len(polar), np.nan)
     distance[kept_index[measured.sample]] = measured.distance
-    return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius, ends, distance)
+    coverage = measure_coverage(curve, surface.whole, polar, selection, kept_index, settings.knot_spacing_mm,
+                                reference, {} if prior is None else prior.ends, options.mapper)
+    return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius, ends, distance,
+                   coverage)

@@ -25,6 +25,14 @@ smooths the polyline there only:
   centerline that ends at a cap), moving only within it, and a straight end
   stays straight.
 
+The radius in ``r * kappa`` is the fold radius (:func:`wall_fold_radius`):
+the inscribed radius, or where the wall's own points lie nearer the centre of
+curvature than that (the flatter inner side of a real bend), how far the wall
+reaches towards it.  The tube map's Jacobian is ``1 - rho(l, a) kappa_n(l, a)``
+with kappa_n the curvature's component towards angle a, so the body folds
+only where the wall on the inner side reaches the centre of curvature, and a
+bend whose inscribed radius alone says ``r * kappa >= 1`` need not fold.
+
 This is not in the papers: seed 000 takes the centerline as the backbone.
 The fit then measures the wall around the regularized backbone, and the build
 reports how far the backbone moved and the fit error on the stretch.
@@ -37,6 +45,7 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+from scipy.ndimage import maximum_filter1d
 
 from softdesign.geometry.curves import CurveOptions, l_from_points, smooth_curve_from_polyline
 from softdesign.types import FloatArray, Points
@@ -45,6 +54,9 @@ from softdesign.types import FloatArray, Points
 REGULARIZE_REACH = 0.8
 #: r * kappa the regularized backbone stays below (room below the trigger for the wall's rho exceeding r).
 TARGET_REACH = 0.7
+#: r * kappa at which a stretch is regularized when r is the wall's own reach (:func:`wall_fold_radius`), not
+#: a lower bound of it: the body folds at 1, and the fitted spline may reach a little past its wall points.
+WALL_REGULARIZE_REACH = 0.9
 #: Gaussian widths tried, in units of the stretch's largest inscribed radius, smallest first.
 SIGMA_FACTORS = (0.25, 0.375, 0.5, 0.75, 1.0, 1.5, 2.0)
 #: Length of the blend-in ramp on each side of a stretch, in Gaussian widths.
@@ -53,6 +65,17 @@ RAMP_SIGMAS = 3.0
 MOVED_FRACTION = 0.01
 #: The Gaussian is cut at this many widths.
 KERNEL_SIGMAS = 4.0
+#: Wall points within this arc length of a centerline point give its fold radius, mm on each side (about
+#: half the fit's default knot interval: the fitted rho follows the wall over a knot interval).
+WALL_WINDOW_MM = 1.0
+#: Bins along the arc in which the wall's reach is gathered before the window's maximum, mm.
+WALL_BIN_MM = 0.1
+#: Wall points within this angle of the curvature's direction are its inner side (their rho * cos lies within
+#: cos 45 deg of rho): the side where the tube folds first.
+INNER_CONE_RAD = 0.25 * np.pi
+#: A wall point farther from the centerline than this many inscribed radii is not the path's wall (the fit's
+#: default outlier factor).
+WALL_OUTLIER_FACTOR = 2.0
 
 
 @dataclass(frozen=True)
@@ -108,11 +131,59 @@ class BackboneRegularization:
 
 
 class BackboneError(ValueError):
-    """No width in ``SIGMA_FACTORS`` brings the reach below ``TARGET_REACH``; ``reach`` and ``arc_mm`` say where."""
+    """No width in ``SIGMA_FACTORS`` brings the reach below ``TARGET_REACH``.
 
-    def __init__(self, reach: float, arc_mm: float, radius_mm: float) -> None:
+    ``reach``, ``arc_mm`` and ``radius_mm`` are the input's largest reach, where it is and r there;
+    ``smoothed`` the largest reach left by the widest smoothing tried.
+    """
+
+    def __init__(self, reach: float, arc_mm: float, radius_mm: float, smoothed: float = float("nan")) -> None:
         super().__init__(f"r * kappa {reach:.3f} at {arc_mm:.1f} mm")
-        self.reach, self.arc_mm, self.radius_mm = reach, arc_mm, radius_mm
+        self.reach, self.arc_mm, self.radius_mm, self.smoothed = reach, arc_mm, radius_mm, smoothed
+
+
+def wall_fold_radius(points: npt.ArrayLike, radius: npt.ArrayLike, wall: npt.ArrayLike,
+                     options: CurveOptions) -> FloatArray:
+    """The fold radius at each centerline point: how far the wall reaches towards the centre of curvature.
+
+    At a point of the smoothed centerline with curvature vector kappa u, a wall point p with foot c gives
+    ``(p - c) . u`` (its rho * kappa_n / kappa) when it lies within ``INNER_CONE_RAD`` of u; the fold radius
+    is the largest of these within ``WALL_WINDOW_MM`` of arc, and never more than the inscribed radius
+    (where no wall point lies on the inner side, as at a branch's mouth, it is the inscribed radius).
+
+    Parameters
+    ----------
+    points : (n, 3) mm, the centerline polyline, inlet first
+    radius : (n,) mm, the inscribed radius at the points
+    wall : (m, 3) mm, the path's own wall (other branches' walls left out)
+    options : the build's resampling and smoothing
+
+    Returns
+    -------
+    (n,) mm, at most ``radius``
+    """
+    points, radius, wall = np.asarray(points, float), np.asarray(radius, float), np.asarray(wall, float)
+    if len(wall) == 0:
+        return radius.copy()
+    curve = smooth_curve_from_polyline(points, options)
+    at, foot = l_from_points(curve, points), l_from_points(curve, wall)
+    order = np.argsort(at, kind="stable")
+    offset = wall - curve.points(foot)
+    kvec = curve.curvature_vectors(foot)
+    kappa = np.linalg.norm(kvec, axis=1)
+    toward = np.einsum("ij,ij->i", offset, kvec) / np.where(kappa > 0.0, kappa, 1.0)
+    rho = np.linalg.norm(offset, axis=1)
+    near = np.interp(foot, at[order], radius[order])
+    inner = ((foot > 0.0) & (foot < 1.0) & (kappa > 0.0) & (toward >= np.cos(INNER_CONE_RAD) * rho)
+             & (rho <= WALL_OUTLIER_FACTOR * near))
+    bins = int(np.ceil(curve.length / WALL_BIN_MM)) + 1
+    per_bin = np.full(bins, -np.inf)
+    np.maximum.at(per_bin, np.rint(foot[inner] * curve.length / WALL_BIN_MM).astype(np.intp), toward[inner])
+    width = 2 * int(round(WALL_WINDOW_MM / WALL_BIN_MM)) + 1
+    window = maximum_filter1d(per_bin, width, mode="constant", cval=-np.inf)
+    reach = window[np.rint(at * curve.length / WALL_BIN_MM).astype(np.intp)]
+    reach[~np.isfinite(reach)] = np.inf  # no inner wall point near: the inscribed radius
+    return np.minimum(radius, reach)
 
 
 def reach_along(points: npt.ArrayLike, radius: npt.ArrayLike, options: CurveOptions) -> tuple[FloatArray, FloatArray]:
@@ -133,14 +204,17 @@ def reach_along(points: npt.ArrayLike, radius: npt.ArrayLike, options: CurveOpti
     return r * curve.curvature(l), l * _arc(points)[-1]
 
 
-def regularize_backbone(points: npt.ArrayLike, radius: npt.ArrayLike, options: CurveOptions) -> BackboneRegularization:
+def regularize_backbone(points: npt.ArrayLike, radius: npt.ArrayLike, options: CurveOptions,
+                        fold_radius: npt.ArrayLike | None = None) -> BackboneRegularization:
     """The centerline with every stretch of ``r * kappa >= REGULARIZE_REACH`` smoothed at the local radius' scale.
 
     Parameters
     ----------
     points : (n, 3) mm, the centerline polyline, inlet first
-    radius : (n,) mm, ``MaximumInscribedSphereRadius`` at the points
+    radius : (n,) mm, ``MaximumInscribedSphereRadius`` at the points (the smoothing widths' scale)
     options : the build's resampling and smoothing (the reach is measured on the curve the build makes)
+    fold_radius : (n,) mm, the r of the reach (:func:`wall_fold_radius`), then regularized from
+        ``WALL_REGULARIZE_REACH``; default ``radius``, regularized from ``REGULARIZE_REACH``
 
     Raises
     ------
@@ -149,14 +223,16 @@ def regularize_backbone(points: npt.ArrayLike, radius: npt.ArrayLike, options: C
     """
     points = np.asarray(points, float)
     radius = np.asarray(radius, float)
-    reach, arc = reach_along(points, radius, options)
+    fold = radius if fold_radius is None else np.asarray(fold_radius, float)
+    reach, arc = reach_along(points, fold, options)
     before = float(reach.max())
-    if before < REGULARIZE_REACH:
+    if before < (REGULARIZE_REACH if fold_radius is None else WALL_REGULARIZE_REACH):
         return BackboneRegularization(points, np.zeros(len(points)), before, before)
     s = _arc(points)
     runs = _runs(arc, reach >= TARGET_REACH)
     scales = [float(np.interp(np.linspace(a, b, 9), s, radius).max()) for a, b in runs]
-    worst = (before, float(arc[np.argmax(reach)]))
+    at = float(arc[np.argmax(reach)])
+    smoothed = before
     for factor in SIGMA_FACTORS:
         sigmas = [factor * r for r in scales]
         moved = points.copy()
@@ -164,11 +240,11 @@ def regularize_backbone(points: npt.ArrayLike, radius: npt.ArrayLike, options: C
             weight = _ramp_weight(s, a, b, RAMP_SIGMAS * sigma)
             rows = np.flatnonzero(weight > 0.0)
             moved[rows] += weight[rows, None] * (_gaussian(s, points, sigma, rows) - points[rows])
-        after, after_arc = reach_along(moved, radius, options)
+        after, _ = reach_along(moved, fold, options)
         if after.max() < TARGET_REACH:
             return _result(points, moved, before, float(after.max()), runs, scales, sigmas)
-        worst = (float(after.max()), float(after_arc[np.argmax(after)]))
-    raise BackboneError(worst[0], worst[1], float(np.interp(worst[1], s, radius)))
+        smoothed = float(after.max())
+    raise BackboneError(before, at, float(np.interp(at, s, fold)), smoothed)
 
 
 def _result(points, moved, before, after, runs, scales, sigmas) -> BackboneRegularization:

@@ -41,10 +41,11 @@ class Polyline:
 
 @dataclass(frozen=True)
 class CenterlineNetwork:
-    """Every polyline of one centerline file, in file order."""
+    """Every polyline of one centerline file, in file order; ``notes``: what reading it did (segments joined)."""
 
     polylines: tuple[Polyline, ...]
     source: str = "centerline"
+    notes: tuple[str, ...] = ()
 
     @property
     def branch_split(self) -> bool:

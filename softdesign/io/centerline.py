@@ -1,10 +1,13 @@
 """Read centerline files into a :class:`CenterlineNetwork` (mm).
 
 Formats, by suffix: ``.vtp`` (VTK XML PolyData, as VMTK writes it,
-zlib-compressed binary included), ``.vtk`` (legacy PolyData), ``.csv`` (a
+zlib-compressed binary included), ``.vtk`` (legacy PolyData or unstructured
+grid), ``.vtu`` (XML unstructured grid), ``.csv`` (a
 header row naming ``x, y, z`` and optionally ``radius``) and ``.npy`` (an
 (n, 3) or (n, 4) array, the 4th column a radius).  CSV and NPY files hold
-one polyline.
+one polyline.  Line cells that are all 2-point segments, and every
+unstructured grid's lines (gmsh's export of VMTK centerlines), are joined into
+one path from the inlet to each outlet (:mod:`softdesign.io.centerline_segments`).
 """
 
 from __future__ import annotations
@@ -17,6 +20,13 @@ import numpy as np
 
 from softdesign.errors import InputDataError
 from softdesign.geometry.network import TRACT_KEYS, CenterlineNetwork, Polyline
+from softdesign.io.centerline_segments import (
+    LineCells,
+    all_two_point,
+    is_unstructured_grid,
+    polylines_from_segments,
+    read_line_cells,
+)
 from softdesign.io.input_checks import check_input_file, check_npy_header
 from softdesign.io.vtk_polydata import polydata_arrays, read_polydata
 
@@ -28,7 +38,7 @@ def read_centerline_network(path: str | Path, scale_to_mm: float = 1.0) -> Cente
 
     Parameters
     ----------
-    path : file with suffix .vtp, .vtk, .csv or .npy
+    path : file with suffix .vtp, .vtk, .vtu, .csv or .npy
     scale_to_mm : factor from the file's units to mm (10 for cm, 1000 for m)
 
     Raises
@@ -44,7 +54,7 @@ def read_centerline_network(path: str | Path, scale_to_mm: float = 1.0) -> Cente
             f"{', '.join(sorted(_READERS))} (convert it, e.g. with vmtkcenterlines -ofile x.vtp)"
         )
     check_input_file(path, "centerline")
-    lines = reader(path)
+    lines, notes = reader(path)
     if not lines:
         raise InputDataError(
             f"{path}: the file has no polylines (no lines); expected VMTK centerlines "
@@ -63,19 +73,29 @@ def read_centerline_network(path: str | Path, scale_to_mm: float = 1.0) -> Cente
         Polyline(line.points * scale_to_mm, None if line.radius is None else line.radius * scale_to_mm, line.cell_data)
         for line in lines
     )
-    return CenterlineNetwork(scaled, source=str(path))
+    return CenterlineNetwork(scaled, source=str(path), notes=notes)
 
 
-def _read_vtk_lines(path: Path) -> list[Polyline]:
+def _read_vtk_lines(path: Path) -> tuple[list[Polyline], tuple[str, ...]]:
+    if is_unstructured_grid(path):
+        return _joined(read_line_cells(path), path)
     poly = read_polydata(path)
     points, point_arrays, cell_arrays = polydata_arrays(poly)
+    cells = _line_cells(poly)
+    if all_two_point(cells):
+        return _joined(LineCells("VTK PolyData", points, cells, point_arrays, cell_arrays), path)
     radius_all = point_arrays.get(RADIUS_KEY)
     lines = []
-    for cell_index, ids in enumerate(_line_cells(poly)):
+    for cell_index, ids in enumerate(cells):
         radius = None if radius_all is None else np.array(radius_all[ids], float).reshape(-1)
         cell_data = {k: int(cell_arrays[k][cell_index]) for k in TRACT_KEYS if k in cell_arrays}
         lines.append(Polyline(np.array(points[ids], float), radius, cell_data))
-    return lines
+    return lines, ()
+
+
+def _joined(lines: LineCells, path: Path) -> tuple[list[Polyline], tuple[str, ...]]:
+    polylines, note = polylines_from_segments(lines, RADIUS_KEY, str(path))
+    return polylines, (note,) if note else ()
 
 
 def _line_cells(poly) -> list[np.ndarray]:
@@ -132,9 +152,10 @@ def _read_npy(path: Path) -> list[Polyline]:
     return [Polyline(values[:, :3], values[:, 3] if values.shape[1] == 4 else None)] if len(values) else []
 
 
-_READERS: dict[str, Callable[[Path], list[Polyline]]] = {
+_READERS: dict[str, Callable[[Path], tuple[list[Polyline], tuple[str, ...]]]] = {
     ".vtp": _read_vtk_lines,
     ".vtk": _read_vtk_lines,
-    ".csv": _read_csv,
-    ".npy": _read_npy,
+    ".vtu": _read_vtk_lines,
+    ".csv": lambda path: (_read_csv(path), ()),
+    ".npy": lambda path: (_read_npy(path), ()),
 }

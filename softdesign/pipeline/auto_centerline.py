@@ -15,6 +15,7 @@ import numpy as np
 
 from softdesign.centerline.extract import CenterlineOptions, Centerlines, extract_centerlines
 from softdesign.geometry.network import CenterlineNetwork, Polyline
+from softdesign.geometry.plausibility import check_vessel_scale
 from softdesign.pipeline import layout
 from softdesign.pipeline.store import Staging
 from softdesign.types import UNIT_SCALE_TO_MM
@@ -39,6 +40,9 @@ def extract_for_case(case: Case) -> tuple[CenterlineNetwork, Centerlines]:
     inlet = None if case.final.inlet is None else np.asarray(case.final.inlet, float) * scale
     options = CenterlineOptions(inlet=inlet, regions=read_face_regions(surface))
     vertices, faces = read_surface(surface, surface_scale)
+    # a wrong unit is refused before the extraction's work, from the surface's largest extent
+    check_vessel_scale(float(np.ptp(vertices, axis=0).max()), None, case.final.surface_units or case.units,
+                       f"final.surface {surface.name} (its largest extent)")
     extracted = extract_centerlines(vertices, faces, options, f"final.surface {surface.name}")
     polylines = tuple(Polyline(p, r) for p, r in zip(extracted.paths, extracted.radii, strict=True))
     return CenterlineNetwork(polylines, source=f"auto ({surface.name})"), extracted
@@ -60,4 +64,16 @@ def extraction_summary(extracted: Centerlines) -> dict[str, Any]:
         "inlet_mm": [float(v) for v in extracted.inlet],
         "outlets_mm": [[float(v) for v in o] for o in extracted.outlets],
         "voronoi_vertices": extracted.voronoi_vertices,
+        "continued_mm": [[round(v, 6) for v in ends] for ends in extracted.continued_mm],
+        "short_of_opening_mm": [[round(v, 6) for v in ends] for ends in extracted.short_mm],
     }
+
+
+def continuation_note(extracted: Centerlines) -> str:
+    """How far each extracted path's ends were continued straight past the Voronoi diagram, for the ingest notes."""
+    ends = "; ".join(f"path {k}: {a:.2f} mm at the inlet, {b:.2f} mm at the outlet"
+                     for k, (a, b) in enumerate(extracted.continued_mm))
+    short = [f"path {k} stops {max(gap):.2f} mm short of an opening's centre (the straight run would leave the "
+             "surface)" for k, gap in enumerate(extracted.short_mm) if max(gap) > 0.0]
+    return (f"extracted centerline: the ends continued straight past the Voronoi diagram to the openings' centres "
+            f"(a rounded end: to the centre of the sphere touching its tip): {ends}" + "".join(f"; {s}" for s in short))

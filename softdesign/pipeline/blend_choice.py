@@ -18,19 +18,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
-from softdesign.errors import InputDataError
 from softdesign.geometry.blend import BlendedShape, BlendMode, blend_shapes
 from softdesign.geometry.curves import SmoothCurve, l_from_points
 from softdesign.geometry.frames import FrameMode
 from softdesign.geometry.morph_fold import MORPH_REACH_LIMIT, MorphReach, morph_reach, radius_profile_on
 from softdesign.geometry.network import SelectedPath
 
-#: A shape whose reach r * kappa (r the inscribed radius, a lower bound of the wall's rho) is at
-#: least this folds whatever the fit gives.
+#: A q = 1 shape whose reach r * kappa (r the inscribed radius) is at least this is warned about: a tube of
+#: that radius would fold, but a real lumen is flatter on a bend's inner side (the fit decides).
 SURE_FOLD = 1.0
-
 
 @dataclass(frozen=True)
 class BlendChoice:
@@ -53,7 +49,6 @@ class BlendChoice:
             "warning": self.warning,
         }
 
-
 def choose_blend(
     initial: SmoothCurve,
     final: SmoothCurve,
@@ -64,10 +59,8 @@ def choose_blend(
 ) -> BlendChoice:
     """Build the blend ``requested`` ("auto", "linear" or "intrinsic") and check its morph for folds.
 
-    Raises
-    ------
-    InputDataError
-        The q = 1 centerline itself turns tighter than the inscribed radius allows.
+    A q = 1 centerline that turns tighter than the inscribed radius gives a warning, not a refusal: the
+    fitted wall, not the inscribed sphere, decides whether the body folds.
     """
     mode: BlendMode = "intrinsic" if requested == "intrinsic" else "linear"
     shape = blend_shapes(initial, final, keyframes, mode, frames)
@@ -75,11 +68,12 @@ def choose_blend(
         return BlendChoice(shape, requested, None, None, f"{mode} ({requested}; no inscribed radii to check folds)")
     profile = radius_profile_on(l_from_points(final, path.points), path.radius)
     reach = morph_reach(shape, *profile)
-    if reach.final_reach >= SURE_FOLD:
-        raise InputDataError(_final_fold_message(reach, final))
+    # the inscribed radius is no bound of the fitted wall on a bend's flatter inner side: a warning, and the
+    # fit tests the fitted body itself (issue 29)
+    tight = _final_fold_message(reach, final) if reach.final_reach >= SURE_FOLD else None
     if mode == "intrinsic" or not reach.blend_folds:
         why = "asked for" if requested == mode else "the linear blend does not fold"
-        return BlendChoice(shape, requested, reach, None, f"{mode} ({why}: {_figure(reach)})")
+        return BlendChoice(shape, requested, reach, None, f"{mode} ({why}: {_figure(reach)})", tight)
     if requested == "linear":
         warning = (f"blend: linear {_fold_text(reach)}; meshes at export q near {reach.q:.3f} will fail: use "
                    "blend: intrinsic (or auto, the default), whose curvature stays within the end shapes'")
@@ -118,10 +112,8 @@ def describe_choice(summary: dict[str, Any]) -> list[str]:
     warning = summary.get("warning")
     return [f"blend chosen: {summary['choice']}"] + ([] if warning is None else [f"  warning: {warning}"])
 
-
 def _figure(reach: MorphReach) -> str:
     return f"largest r * kappa {reach.reach:.3f} at q = {reach.q:.3f}"
-
 
 def _fold_text(reach: MorphReach) -> str:
     return (
@@ -131,25 +123,16 @@ def _fold_text(reach: MorphReach) -> str:
         f"below {reach.end_reach:.3f}): the straight-to-curved linear blend shortens and kinks the middle"
     )
 
-
 def _final_fold_message(reach: MorphReach, final: SmoothCurve) -> str:
     l = reach.final_l
     s = float(final.arc_length([l])[0])
     kappa = float(final.curvature([l])[0])
-    to_end = min(s, final.length - s)
-    end = "inlet" if s <= final.length - s else "outlet"
-    hint = (
-        f"; it is {to_end:.1f} mm from the {end}: straightening that end over more than this "
-        f"(resample.end_straight_mm: {np.ceil(to_end + reach.final_reach / kappa):g}) lets the backbone cut the turn"
-        if to_end <= 4.0 * reach.final_reach / kappa else ""
-    )
     return (
-        f"final.centerline: the centerline turns tighter than the vessel is wide: at l = {l:.4f} ({s:.1f} mm from "
-        f"the inlet) its radius of curvature is {1.0 / kappa:.3f} mm where the inscribed radius is "
-        f"{reach.final_reach / kappa:.3f} mm (r * kappa = {reach.final_reach:.3f}, expected < {SURE_FOLD:g}), so "
-        "the tube around it folds through itself whatever the fit or the blend does; centerline smoothing at the "
-        f"scale of resample.smoothing_mm does not remove a turn this sharp{hint}; otherwise choose another "
-        "final.path or final.inlet, or give a centerline that turns no tighter than the vessel's radius there"
+        f"the q = 1 centerline turns tighter than the inscribed radius: at l = {l:.4f} ({s:.1f} mm from the inlet) "
+        f"its radius of curvature is {1.0 / kappa:.3f} mm where the inscribed radius is "
+        f"{reach.final_reach / kappa:.3f} mm (r * kappa = {reach.final_reach:.3f}); a lumen is flatter on a bend's "
+        "inner side than its inscribed sphere, so the fit tests whether the fitted body folds there "
+        "(1 - rho * kappa_n > 0)"
     )
 
 

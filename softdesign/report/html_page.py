@@ -35,6 +35,11 @@ caption { text-align: left; font-weight: 600; padding-bottom: 0.3em; }
           font-size: 1.05em; } .banner h2 { border: 0; margin: 0 0 0.3em; color: #c62828; }
 .allclear { border: 2px solid #1a7f37; background: #e9f7ee; padding: 0.5em 1em; margin: 1em 0; }
 details { margin: 0.4em 0 1.2em; } summary { cursor: pointer; color: #333; }
+.verdict { padding: 0.6em 1em; margin: 1em 0 0.4em; border: 3px solid; } .verdict .headline { font-size: 1.25em;
+           font-weight: 700; margin: 0.1em 0 0.3em; } .verdict ul { margin: 0.2em 0; }
+.verdict.ok { border-color: #1a7f37; background: #e9f7ee; } .verdict.bad { border-color: #c62828; background: #fdecea; }
+.verdict.bad .headline { color: #8e0000; } .verdict.open { border-color: #9a6700; background: #fff8e1; }
+.tally { color: #555; margin: 0.2em 0 1em; }
 """
 
 
@@ -168,7 +173,7 @@ def _section_html(number: int, section: Section) -> str:
 def banner_html(warnings: list[str]) -> str:
     """Every warning in one box at the top that cannot be missed, or a plain all-clear line."""
     if not warnings:
-        return '<p class="allclear">No warnings: no stale outputs, every check passed, no arc misfit or fold.</p>'
+        return '<p class="allclear">No other warnings: no stale outputs, every check passed, no fold.</p>'
     items = "".join(f"<li>{escape(w)}</li>" for w in warnings)
     return (f'<div class="banner" id="warnings" role="alert"><h2>{len(warnings)} warning(s)</h2>'
             f"<ul>{items}</ul></div>")

@@ -81,6 +81,17 @@ gd.on('plotly_buttonclicked', function (event) {
   });
 });"""
 HEIGHT_PX = 720
+#: The figure's margins, px: room below the plot for the slider and its labels, and on the right for its last one
+#: (with none, the labels were cut at the bottom and "1.00" at the right).
+MARGIN_PX = (("l", 0), ("r", 40), ("t", 30), ("b", 120))
+#: The slider's start and length in the figure's width (its end stays inside the right margin).
+SLIDER_X, SLIDER_LEN = 0.1, 0.85
+#: The camera's distance from the box's centre in plotly's scene units (the box's longest side is 1 long), and its
+#: tilt towards the box's longest and middle sides (see :func:`fitted_camera`).
+CAMERA_DISTANCE = 1.3
+CAMERA_TILT = (0.25, 0.45)
+#: Ticks on the box's longest side (fewer on the others, in proportion).
+MAX_TICKS = 8
 #: plotly's template ``"none"`` (no styling: plotly.js's own defaults) as plotly's figure classes wrote it in the
 #: layout: plotly's Python side keeps one empty scatter style in it, as it takes an empty template for none given.
 TEMPLATE_NONE: dict[str, Any] = {"data": {"scatter": [{"type": "scatter"}]}}
@@ -197,7 +208,8 @@ def _layout(per_q: list[list[dict[str, Any]]], traces: list[dict[str, Any]], q_v
     span = np.maximum(high - low, 1e-6)
     pad = 0.03 * span.max()
     ratio = (span + 2 * pad) / (span + 2 * pad).max()
-    axes = {name: {"title": {"text": f"{name} (mm)"}, "range": [float(low[i] - pad), float(high[i] + pad)]}
+    axes = {name: {"title": {"text": f"{name} (mm)"}, "range": [float(low[i] - pad), float(high[i] + pad)],
+                   "nticks": _tick_count(ratio[i])}
             for i, name in enumerate(("x", "y", "z"))}
     animate = {"mode": "immediate", "frame": {"duration": 0, "redraw": True}, "transition": {"duration": 0}}
     # The slider queues its frames ("afterall") rather than interrupting the one being drawn: plotly.js rejects an
@@ -210,18 +222,42 @@ def _layout(per_q: list[list[dict[str, Any]]], traces: list[dict[str, Any]], q_v
     play = {"frame": {"duration": 120, "redraw": True}, "fromcurrent": True, "transition": {"duration": 0}}
     # keys in the order plotly's figure classes wrote them, so that the page's bytes did not change with them
     return {
-        "template": TEMPLATE_NONE, "margin": {"l": 0, "r": 0, "t": 30, "b": 0}, "legend": {"x": 0.0, "y": 1.0},
+        "template": TEMPLATE_NONE, "margin": dict(MARGIN_PX), "legend": {"x": 0.0, "y": 1.0},
         "scene": {**{f"{k}axis": v for k, v in axes.items()},
-                  "aspectratio": {k: float(r) for k, r in zip("xyz", ratio, strict=True)}, "aspectmode": "manual"},
+                  "aspectratio": {k: float(r) for k, r in zip("xyz", ratio, strict=True)}, "aspectmode": "manual",
+                  "camera": fitted_camera(ratio)},
         "height": HEIGHT_PX,
-        "sliders": [{"active": len(q_values) - 1, "currentvalue": {"prefix": "q = "}, "len": 0.9, "pad": {"t": 20},
-                     "steps": steps, "x": 0.1}],
+        "sliders": [{"active": len(q_values) - 1, "currentvalue": {"prefix": "q = "}, "len": SLIDER_LEN,
+                     "pad": {"t": 20}, "steps": steps, "x": SLIDER_X}],
         "updatemenus": [{"buttons": [{"args": [None, play], "execute": False, "label": "play", "method": "animate"},
                                      {"args": [[None], animate], "execute": False, "label": "pause",
                                       "method": "animate"}],
                          "pad": {"t": 20}, "showactive": False, "type": "buttons", "x": 0.0, "xanchor": "left",
                          "y": 0.0, "yanchor": "top"}],
     }
+
+
+def fitted_camera(ratio: FloatArray) -> dict[str, Any]:
+    """A camera that shows the scene's box large: its longest side across the page's wide panel.
+
+    The eye looks mostly along the box's shortest side, tilted a little towards the others so the view stays
+    three-dimensional; "up" is the middle side, so the longest one runs left to right, the panel's long way.
+    plotly's default eye, (1.25, 1.25, 1.25) for every box, stood far back along the diagonal: a long thin body
+    filled a small part of the panel.  ``ratio`` is the box's aspect ratio (3,), largest side 1.
+    """
+    order = np.argsort(ratio, kind="stable")  # shortest, middle, longest
+    axes = np.eye(3)
+    direction = CAMERA_TILT[0] * axes[order[2]] + CAMERA_TILT[1] * axes[order[1]] + axes[order[0]]
+    eye = CAMERA_DISTANCE * direction / np.linalg.norm(direction)
+    up = axes[order[1]]
+    return {"eye": dict(zip("xyz", (float(v) for v in eye), strict=True)),
+            "up": dict(zip("xyz", (float(v) for v in up), strict=True)),
+            "center": {"x": 0.0, "y": 0.0, "z": 0.0}}
+
+
+def _tick_count(ratio: float) -> int:
+    """Ticks on an axis whose side is ``ratio`` of the longest: few on short sides, so their labels stay apart."""
+    return max(2, int(round(MAX_TICKS * float(ratio))))
 
 
 def morph_html(data: BuildData, frames: int = FRAMES) -> tuple[str, list[str]]:

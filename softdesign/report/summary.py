@@ -97,7 +97,11 @@ def _feasibility_facts(m: dict[str, Any]) -> list[Fact]:
 
 
 def summary_warnings(data: BuildData, checks: list[Check]) -> list[str]:
-    """Every warning of the build, most serious first: stale, failed checks, infeasible, fold, arc misfit."""
+    """Every warning of the build, most serious first: stale, failed checks, fold, fit (dropped wall).
+
+    The feasibility verdict's causes are the verdict box's (:mod:`softdesign.report.verdict`), not repeated here;
+    one-arc-per-link misfits are information about a PCC reading of the body, shown in the tables' notes.
+    """
     m = data.manifest
     warnings = [f"stale: stage {s['name']} is out of date (its outputs here were built from other inputs or settings); "
                 "run softdesign build" for s in m.get("stages", []) if s.get("status") == "stale"]
@@ -105,15 +109,10 @@ def summary_warnings(data: BuildData, checks: list[Check]) -> list[str]:
     if failed:
         names = "; ".join(f"{c.subject}: {c.name}" for c in failed[:5]) + ("; ..." if len(failed) > 5 else "")
         warnings.append(f"{len(failed)} of {len(checks)} checks FAILED ({names}): see the checks table")
-    block = resolve_or(m, "/metrics/feasibility", None)
-    if isinstance(block, dict) and block.get("feasible") is False:
-        warnings += [f"infeasible{' (thin wall)' if 'wall' in reason else ''}: {reason}"
-                     for reason in block.get("reasons", [])]
     rho_kappa = resolve_or(m, "/metrics/fit/max_rho_kappa", None)
     if rho_kappa is not None and rho_kappa >= FOLD_LIMIT:
         warnings.append(f"the surface folds through itself at q = 1: largest rho * kappa {rho_kappa:.3g} >= 1")
-    arc = resolve_or(m, "/metrics/kinematics/arc_check/warnings", [])
-    warnings += [f"large arc misfit: {w}" for w in arc]
+    warnings += [f"fit: {w}" for w in resolve_or(m, "/metrics/fit/warnings", [])]  # dropped wall, unseen stretches
     return warnings
 
 

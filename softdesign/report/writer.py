@@ -61,6 +61,7 @@ from softdesign.report.tables import (
     output_checks,
     software_rows,
 )
+from softdesign.report.verdict import build_verdict, verdict_html
 from softdesign.report.volume_mesh_tables import volume_mesh_checks, volume_mesh_table
 
 T = TypeVar("T")
@@ -219,9 +220,11 @@ def write_report(
     with _collector_for_figures():
         sections, checks, notes = report_sections(data, options, timer)
     passed = sum(c.passed for c in checks)
-    summary = _summary(data, passed, len(checks))
+    summary = _summary(data)
     warnings = summary_warnings(data, checks)
-    top = timer("summary", lambda: banner_html(warnings) + table_html(facts_table(summary_facts(data), data.manifest)))
+    verdict = verdict_html(build_verdict(data.manifest), f"Checks: {passed} of {len(checks)} passed.")
+    top = timer("summary", lambda: verdict + banner_html(warnings)
+                + table_html(facts_table(summary_facts(data), data.manifest)))
     page = render_page(f"softdesign report: {data.name}", summary, sections, top)
     files = {p.name: p.data for s in sections for p in s.pictures}
     files[PAGE] = page.encode("utf-8")
@@ -401,13 +404,12 @@ def _tables_section(data: BuildData) -> tuple[Section, list[Check]]:
     return Section("tables", "Figures, inputs, software and checks", notes=notes, tables=tables), checks
 
 
-def _summary(data: BuildData, passed: int, total: int) -> list[str]:
+def _summary(data: BuildData) -> list[str]:
     blend = data.blend.summary
     q_text = ", ".join(f"{q:g}" for q in data.export_q)
     return [
         f"Case {data.name}: {data.link_count} link(s), {blend['mode']} blend, {blend['frames']} frames, "
         f"export q = {q_text}. Build folder: {data.build_dir.name}.",
-        f"Checks: {passed} of {total} passed.",
     ]
 
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 from softdesign.centerline.extract import SMOOTHING_REL, CenterlineOptions, extract_centerlines
 from tests.helpers.vessels import straight_tube, torus_section, y_bifurcation
@@ -35,8 +34,13 @@ def test_straight_tube_axis_and_radius():
     np.testing.assert_allclose(points[keep, :2], 0.0, rtol=0, atol=AXIS_TOL)
     np.testing.assert_allclose(radius[keep], 3.0, rtol=RADIUS_RTOL, atol=0)
     assert points[0, 2] < points[-1, 2]  # the two openings are equal: the first (lowest vertex) is the inlet
-    # it spans the tube but one inscribed radius (the poles) at each end, as VMTK's does
-    assert points[0, 2] == pytest.approx(3.0, abs=0.5) and points[-1, 2] == pytest.approx(37.0, abs=0.5)
+    # it runs from opening centre to opening centre (issue 29): the Voronoi path stops at the poles, one
+    # inscribed radius inside, and each end is continued straight by that radius, which the result states
+    np.testing.assert_allclose(points[[0, -1]], [[0.0, 0.0, 0.0], [0.0, 0.0, 40.0]], rtol=0, atol=AXIS_TOL)
+    np.testing.assert_allclose(result.continued_mm[0], [3.0, 3.0], rtol=0, atol=0.5)
+    assert result.short_mm[0] == (0.0, 0.0)
+    # the continued runs hold the last inscribed sphere's radius, not the distance to the rim they approach
+    np.testing.assert_allclose(radius[[0, -1]], 3.0, rtol=RADIUS_RTOL, atol=0)
 
 
 def test_torus_section_axis_and_radius():
@@ -57,6 +61,16 @@ def test_inlet_option_picks_the_other_opening():
     np.testing.assert_allclose(result.inlet, [0.0, 0.0, 40.0], rtol=0, atol=1e-9)
 
 
+def test_a_given_outlet_inside_the_vessel_is_not_continued():
+    vertices, faces = straight_tube(radius=3.0, length=40.0, edge=EDGE)
+    given = np.array([0.0, 0.0, 25.0])  # inside, 15 mm from the far opening: no opening to reach
+    result = extract_centerlines(vertices, faces, CenterlineOptions(outlets=(given,)))
+    assert result.endpoints == "given"
+    assert result.continued_mm[0][1] == 0.0 and result.short_mm[0] == (0.0, 0.0)
+    assert result.continued_mm[0][0] > 2.0  # the inlet is still its opening's centre
+    assert abs(result.paths[0][-1, 2] - 25.0) < 4.0  # the pole nearest the point, about one radius from it
+
+
 def test_y_bifurcation_axes_radii_and_caps():
     trunk, branch, length = 4.0, 3.0, 30.0
     vertices, faces, axes = y_bifurcation(trunk, branch, length, np.radians(30.0), EDGE)
@@ -74,6 +88,9 @@ def test_y_bifurcation_axes_radii_and_caps():
             off_axis = np.linalg.norm(points[keep] - along[keep, None] * axis, axis=1)
             np.testing.assert_allclose(off_axis, 0.0, rtol=0, atol=y_axis_tol)
             np.testing.assert_allclose(radius[keep], nominal, rtol=y_radius_rtol, atol=0)
+        # and each path reaches its flat caps' centres (issue 29)
+        np.testing.assert_allclose(points[0], length * axes[0], rtol=0, atol=y_axis_tol)
+        np.testing.assert_allclose(points[-1], length * branch_axis, rtol=0, atol=y_axis_tol)
 
 
 def test_noisy_tube_stays_near_the_axis():

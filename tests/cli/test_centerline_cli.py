@@ -114,8 +114,9 @@ def test_help():
     assert result.exit_code == 0 and "--outlet" in result.output
 
 
-def test_labelled_caps_are_the_endpoints(tmp_path):
-    import vtk
+def _labelled_y(tmp_path, wall_patch: bool):
+    """The capped Y with CellEntityIds: wall 1, the three flat ends 2, 3, 4, and with ``wall_patch`` a patch of
+    the trunk's wall labelled 9, larger than any cap (as SimVascular models label wall faces)."""
     from vtk.util.numpy_support import numpy_to_vtk
 
     from softdesign.io.vtk_polydata import polydata_from_triangles, polydata_writer
@@ -127,25 +128,86 @@ def test_labelled_caps_are_the_endpoints(tmp_path):
     for label, axis in enumerate(axes, start=2):  # each flat end: faces whose centroid lies at its far end
         end = np.abs(centroids @ axis - 30.0) < 1e-6
         labels[end] = label
+    if wall_patch:  # half the trunk's wall from z = -25 to -10: 188 mm^2 against the trunk cap's 50
+        patch = (labels == 1) & (centroids[:, 0] > 0.0) & (centroids[:, 2] > -25.0) & (centroids[:, 2] < -10.0)
+        labels[patch] = 9
     poly = polydata_from_triangles(vertices, faces)
     array = numpy_to_vtk(labels, deep=True)
     array.SetName("CellEntityIds")
     poly.GetCellData().AddArray(array)
     writer = polydata_writer(poly)
-    writer.SetFileName(str(tmp_path / "y.vtp"))
-    assert writer.Write() == 1 and vtk is not None
-    result = runner.invoke(app, ["centerline", str(tmp_path / "y.vtp"), "--output", str(tmp_path / "cl.vtp"), "--json"])
+    path = tmp_path / "y.vtp"
+    writer.SetFileName(str(path))
+    assert writer.Write() == 1
+    return path
+
+
+def test_labelled_caps_are_the_endpoints(tmp_path):
+    surface = _labelled_y(tmp_path, wall_patch=False)
+    result = runner.invoke(app, ["centerline", str(surface), "--output", str(tmp_path / "cl.vtp"), "--json"])
     assert result.exit_code == 0, result.output
-    assert '"endpoints": "face regions"' in result.output
+    assert '"endpoints": "face regions"' in result.output and "face label" not in result.output
     network = read_centerline_network(tmp_path / "cl.vtp")
     assert len(network.polylines) == 2
     assert all(p.points[0, 2] < -20.0 for p in network.polylines)  # from the trunk's (largest) cap
 
 
+def test_a_labelled_wall_face_is_not_taken_for_an_opening(tmp_path):
+    """Issue 29 item 3: the wall patch (label 9) is larger than every cap; unchecked, it was the inlet."""
+    surface = _labelled_y(tmp_path, wall_patch=True)
+    out = tmp_path / "cl.vtp"
+    result = runner.invoke(app, ["centerline", str(surface), "--output", str(out), "--json"])
+    assert result.exit_code == 0, result.output
+    assert '"endpoints": "face regions"' in result.output
+    # the warning names the face and the reason, with the figures behind it
+    assert "warning:" in result.output and "face label 9 (" in result.output and "not planar" in result.output
+    assert "face label 2" not in result.output and "face label 3" not in result.output
+    network = read_centerline_network(out)
+    assert len(network.polylines) == 2  # two outlets: the branch caps, not the patch
+    for line in network.polylines:  # from the trunk's cap centre, (0, 0, -30), to a branch cap's centre
+        np.testing.assert_allclose(line.points[0], [0.0, 0.0, -30.0], rtol=0, atol=0.2)
+        assert line.points[-1, 2] > 20.0
+
+
+def test_label_checks_name_each_reason():
+    """A flat disc of the lumen's width is a cap; a curved wall patch, a flat strip and an oversized or tiny flat
+    disc are not, each for its own stated reason."""
+    from softdesign.centerline.endpoints import label_not_a_cap
+    from softdesign.centerline.voronoi import VoronoiGraph
+
+    def disc(radius, around=24, rings=4):
+        r = np.repeat(np.linspace(0.0, radius, rings + 1)[1:], around)
+        t = np.tile(np.linspace(0.0, 2 * np.pi, around, endpoint=False), rings)
+        points = np.column_stack([np.r_[0.0, r * np.cos(t)], np.r_[0.0, r * np.sin(t)], np.zeros(len(r) + 1)])
+        from scipy.spatial import Delaunay
+
+        return points, Delaunay(points[:, :2]).simplices.astype(np.int64)
+
+    def area(v, f):
+        return float(0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1).sum())
+
+    def touching(v, lumen):  # one inscribed sphere of radius ``lumen`` touching every vertex of the patch
+        return VoronoiGraph(np.zeros((1, 3)), np.array([lumen]), np.array([[0, 1, 2, 3]]), np.zeros((0, 2), int))
+
+    v, f = disc(3.0)
+    assert label_not_a_cap(v, f, area(v, f), touching(v, 3.0)) is None
+    assert "wider than the vessel" in label_not_a_cap(v, f, area(v, f), touching(v, 1.5))
+    assert "narrower than the vessel" in label_not_a_cap(v, f, area(v, f), touching(v, 9.0))
+    bent = v.copy()
+    bent[:, 2] = bent[:, 0] ** 2 / (2 * 4.0)  # the disc laid on a cylinder of radius 4 mm: a wall patch
+    assert "not planar" in label_not_a_cap(bent, f, area(bent, f), touching(v, 3.0))
+    strip = v * [1.0, 0.1, 1.0]
+    assert "not disc-like" in label_not_a_cap(strip, f, area(strip, f), touching(v, 3.0))
+
+
 def test_outlet_option_gives_one_path_per_outlet(aorta_dir, tmp_path):
     out = tmp_path / "cl.vtp"
     surface = str(aorta_dir / "aorta-surface-open-ends.stl")
-    result = runner.invoke(app, ["centerline", surface, "--outlet", "210.1,102.9,30.7", "--output", str(out)])
+    result = runner.invoke(app, ["centerline", surface, "--outlet", "210.1,102.9,30.7", "--output", str(out),
+                                 "--json"])
     assert result.exit_code == 0, result.output
     (line,) = read_centerline_network(out).polylines
-    assert line.points[0, 1] > 165.0 and np.linalg.norm(line.points[-1] - [210.1, 102.9, 30.7]) < 8.0
+    # the point lies within the left iliac's opening: the path ends at that opening's centre (issue 29)
+    centre = [210.102643, 102.861336, 30.738235]
+    assert line.points[0, 1] > 165.0 and np.linalg.norm(line.points[-1] - centre) < 0.2
+    assert '"short_of_opening": [\n        0.0,\n        0.0\n      ]' in result.output

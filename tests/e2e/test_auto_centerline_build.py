@@ -50,7 +50,9 @@ def test_demo_builds_from_its_surface_alone_and_is_cached(tmp_path):
     network = read_centerline_network(out / INGEST_CENTERLINE)
     assert len(network.polylines) == 2 and all(p.radius is not None for p in network.polylines)
     # the sample's main vessel runs from (0, 0, 0) to (0, 0, 90): the largest cap is the inlet
-    assert np.linalg.norm(network.polylines[0].points[0]) < 2 * 3.68  # a pole: about one radius (3.68 mm) in
+    # the inlet cap's centre (issue 29: the path is continued from the pole, one radius (3.68 mm) in, to it)
+    assert np.linalg.norm(network.polylines[0].points[0]) < 0.5
+    assert all(min(ends) > 2.0 for ends in extracted["continued_mm"])
     assert all(o["watertight"] for o in manifest["outputs"] if o["path"].startswith("meshes/"))
     again = runner.invoke(app, ["build", str(tmp_path / "auto.yaml"), "--out", str(out)])
     assert again.exit_code == 0 and "ingest: unchanged, skipped" in again.output
@@ -60,7 +62,11 @@ def test_demo_builds_from_its_surface_alone_and_is_cached(tmp_path):
 @pytest.mark.slow
 @pytest.mark.parametrize("surface", ["aorta-surface.stl", "aorta-surface-open-ends.stl"])
 def test_aorta_builds_from_its_surface_alone(tmp_path, aorta_dir, surface):
-    manifest, _, _ = _build(tmp_path, aorta_dir / surface)
+    manifest, _, output = _build(tmp_path, aorta_dir / surface)
+    # the build says how far each end was continued past the Voronoi diagram (issue 29)
+    assert "the ends continued straight past the Voronoi diagram" in output
+    continued = manifest["metrics"]["ingest"]["centerline"]["extracted"]["continued_mm"]
+    assert len(continued) == 2 and all(min(ends) > 2.0 for ends in continued)
     length = manifest["metrics"]["ingest"]["centerline"]["selected_length_mm"]
-    assert 60.0 < length < 100.0  # VMTK's paths are 83 and 80 mm; ours stop at the poles or the domes' tips
+    assert 60.0 < length < 100.0  # VMTK's paths are 78 and 76 mm
     assert all(o["watertight"] for o in manifest["outputs"] if o["path"].startswith("meshes/"))

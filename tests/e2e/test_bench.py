@@ -134,13 +134,14 @@ def test_the_startup_command_is_the_softdesign_entry_point(bench):
     assert done.returncode == 0 and "Usage" in done.stdout
 
 
-def test_the_report_line_judges_the_ratio_on_the_sample_case_only(bench):
+def test_the_report_line_judges_the_ratio_against_its_cases_target(bench):
     figures = {"build_s": 2.0, "build_cpu_s": 2.5, "report_s": 2.5, "report_cpu_s": 4.0}
-    judged = bench.report_line("sample", figures, judged=True)
+    judged = bench.report_line("large", figures, bench.TARGET_REPORT_RATIO_LARGE)
     assert "build  2.00 s" in judged and "report  2.50 s" in judged and "report/build 1.25" in judged
     assert judged.rstrip().endswith("MISSED")
-    assert bench.report_line("sample", {**figures, "report_s": 1.5}, judged=True).rstrip().endswith("met")
-    shown = bench.report_line("aorta", figures, judged=False)
+    assert bench.report_line("sample", figures, bench.TARGET_REPORT_RATIO_DEMO).rstrip().endswith("met")
+    assert bench.report_line("sample", {**figures, "report_s": 3.5}, 1.5).rstrip().endswith("MISSED")
+    shown = bench.report_line("aorta", figures, None)
     assert "report/build 1.25" in shown and "MISSED" not in shown and "target" not in shown
 
 

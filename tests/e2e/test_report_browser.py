@@ -52,6 +52,12 @@ PIXEL_STEP = 10
 #: After pause, the slider must stay where it stopped for this long (a play frame lasts 120 ms).
 PAUSE_SETTLE_MS = 1_000
 VIEWPORT = {"width": 1280, "height": 1000}
+#: The bounding boxes [left, right, top, bottom] (px, in the page's viewport) of the elements matching a selector.
+BOXES = ("Array.from(document.querySelectorAll('{selector}')).map(e => {{const r = e.getBoundingClientRect(); "
+         "return [r.left, r.right, r.top, r.bottom];}})")
+#: The actuator's bounding box covers at least this share of the 3D canvas at q = 1 and q = 0 (measured 52 % and
+#: 55 % with the fitted camera; plotly's default camera gave 34 % and 36 %).
+BODY_BOX_SHARE = 0.45
 #: Counts the frames plotly starts and clicks pause (as a mouse would) when the second one starts.
 PAUSE_ON_SECOND_FRAME = f"""() => {{
   const gd = document.getElementById('{DIV_ID}');
@@ -99,10 +105,14 @@ def session(tmp_path_factory):
         page.goto((report_dir / PAGE).as_uri())
         page.wait_for_function(f"document.getElementById('{DIV_ID}')?._fullLayout?.sliders !== undefined",
                                timeout=LOAD_TIMEOUT_MS)
+        page.screenshot(path=str(ARTIFACTS / "demo_first_screen.png"))  # what a reader sees first: the verdict
+        record["verdict_top"] = page.evaluate("document.getElementById('verdict').getBoundingClientRect().top")
         view = page.locator(f"#{DIV_ID}")
         view.scroll_into_view_if_needed()
         page.wait_for_timeout(SETTLE_MS)
         record["q1"] = capture(page, "demo_q1")
+        record["labels"] = page.evaluate(BOXES.format(selector=f"#{DIV_ID} .slider-label"))
+        record["view"] = page.evaluate(BOXES.format(selector=f"#{DIV_ID}"))[0]
         grip = page.locator(f"#{DIV_ID} .slider-grip-rect").bounding_box()
         rail = page.locator(f"#{DIV_ID} .slider-rail-rect").bounding_box()
         y = grip["y"] + grip["height"] / 2
@@ -181,6 +191,22 @@ def capture(page, name: str) -> np.ndarray:
     canvas = ARTIFACTS / f"{name}_canvas.png"
     page.locator(f"#{DIV_ID} canvas").first.screenshot(path=str(canvas))
     return np.asarray(Image.open(canvas).convert("RGB"), dtype=np.int16)
+
+
+def body_box_share(pixels: np.ndarray) -> float:
+    """The share of the canvas covered by the bounding box of the coloured (actuator) pixels."""
+    rows, columns = np.nonzero(pixels.max(axis=2) - pixels.min(axis=2) >= COLOURED_SPREAD)
+    return float((np.ptp(rows) + 1) * (np.ptp(columns) + 1) / (pixels.shape[0] * pixels.shape[1]))
+
+
+def test_the_page_opens_on_the_verdict_and_the_3d_view_shows_the_body_large_with_whole_slider_labels(session):
+    assert 0 <= session["verdict_top"] < VIEWPORT["height"] / 2  # the verdict is on the first screen, at its top
+    for q in ("q1", "q0"):
+        assert body_box_share(session[q]) >= BODY_BOX_SHARE, q
+    left, right, top, bottom = session["view"]
+    assert len(session["labels"]) >= 2
+    for label in session["labels"]:  # every slider label ("0.00" ... "1.00") inside the view, none cut
+        assert left <= label[0] and label[1] <= right and top <= label[2] and label[3] <= bottom, label
 
 
 def coloured_fraction(pixels: np.ndarray) -> float:

@@ -8,7 +8,7 @@ import pickle
 import numpy as np
 import pytest
 
-from softdesign.errors import FitError
+from softdesign.errors import FitError, FoldError
 from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting import radius_field, radius_rows
 from softdesign.fitting.bspline_surface import RadiusSpline, split_at_breaks
@@ -108,14 +108,32 @@ def test_a_tube_that_folds_names_the_place_and_the_fix():
     with pytest.raises(FitError) as err:
         check_self_folding(curve, growing, q=1.0)
     message = str(err.value)
+    # issue 29: the fix offered is the body radius that fits, 0.7 x the 20 mm radius of curvature
     for part in ("q = 1", "rho * kappa = 1.100", "expected < 1", "l = 1.0000 (40.0 mm from the inlet)", "angle 0 deg",
-                 "resample.smoothing_mm", "resample.end_straight_mm", "smaller radius"):
+                 "radius of curvature of 20.000 mm", "rho 22.000 mm", "set fit.max_radius_mm: 14.00"):
         assert part in message
+    assert isinstance(err.value, FoldError)
     # Within the limit: the report gives the maximum, 15 mm / 20 mm at the tip.
     report = check_self_folding(curve, _round_field(lambda l: 10.0 + 5.0 * l))
     assert report.max_rho_kappa == pytest.approx(0.75, abs=1e-12)
     with pytest.raises(FitError, match="rho reaches -2 mm"):
         check_self_folding(curve, _round_field(lambda l: 2.0 - 4.0 * l))
+
+
+def test_the_body_radius_offered_for_a_fold_brings_the_capped_body_to_the_stated_reach():
+    curve = Arc(20.0, 2.0)
+    growing = _round_field(lambda l: 10.0 + 12.0 * l)
+    cap = radius_field.fold_fix_radius(curve, growing)
+    assert cap == pytest.approx(radius_field.FOLD_FIX_REACH * 20.0, abs=0.01)
+    held = RadiusField(growing.breaks, tuple(radius_field.capped(s, cap) for s in growing.final),
+                       tuple(radius_field.capped(s, cap) for s in growing.initial))
+    report = check_self_folding(curve, held)
+    assert report.max_rho_kappa <= radius_field.FOLD_FIX_REACH + 1e-12  # round-off of 0.7 / (1 / 20) * (1 / 20)
+    # below the cap the body is the fitted one: capping never raises rho
+    l = np.linspace(0.0, 1.0, 101)
+    a = np.linspace(0.0, 2 * np.pi, 24, endpoint=False)
+    np.testing.assert_array_less(held.evaluate_grid(1.0, l, a), growing.evaluate_grid(1.0, l, a) + 1e-12)
+    assert radius_field.fold_fix_radius(curve, _round_field(lambda l: np.full_like(l, 5.0))) == np.inf
 
 
 def test_an_initial_surface_fitted_with_the_final_layout_blends_with_it():

@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from softdesign.config import Case
-from softdesign.errors import InputDataError
 from softdesign.geometry import backbone as bb
 from softdesign.geometry.backbone import TARGET_REACH, reach_along, regularize_backbone
 from softdesign.geometry.curves import CurveOptions
@@ -70,14 +69,17 @@ def test_the_tangent_stays_continuous_no_kink_between_consecutive_segments():
     assert np.max(turn0 / np.linalg.norm(seg0[1:], axis=1)) * RADIUS > 1.9
 
 
-def test_a_turn_no_width_tried_can_smooth_is_refused_naming_the_place_and_the_fix(monkeypatch):
+def test_a_turn_no_width_tried_can_smooth_is_left_as_it_is_with_a_warning_naming_the_place(monkeypatch):
     monkeypatch.setattr(bb, "SIGMA_FACTORS", (0.05,))
     path = SelectedPath(TIGHT, np.full(len(TIGHT), RADIUS), 0)
-    with pytest.raises(InputDataError) as err:
-        regularized_path(Case.model_validate({"name": "t", "final": {"centerline": "c.vtp"}}), path)
-    text = str(err.value)
-    assert "turns tighter than the vessel is wide at" in text and "l = 0." in text
-    assert "resample.end_straight_mm" in text and "final.path or final.inlet" in text
+    same, summary = regularized_path(Case.model_validate({"name": "t", "final": {"centerline": "c.vtp"}}), path)
+    assert np.array_equal(same.points, TIGHT) and summary is not None and not summary["regularized"]
+    assert summary["unresolved"]["reach"] >= TARGET_REACH and 0.0 < summary["unresolved"]["l"] < 1.0
+    [warning, inscribed] = same.notes
+    assert warning.startswith("warning: the centerline turns tighter than the vessel is wide at")
+    assert "l = 0." in warning
+    assert "the fit checks whether the fitted body folds there" in warning
+    assert inscribed.startswith("warning: at ") and "r * kappa = " in inscribed
 
 
 def test_without_inscribed_radii_nothing_is_checked():

@@ -97,8 +97,8 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
         "ingest": "skipped", "blend": "skipped", "links": "ran", "kinematics": "ran", "fit": "ran", "export": "ran",
         "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
-    # A material is read by the feasibility verdict alone: every mesh stays.
-    edit(demo_case, "material", name="ecoflex-00-30")
+    # A material is read by the feasibility verdict alone: every mesh stays (the demo declares ecoflex-00-30).
+    edit(demo_case, "material", name="dragon-skin-10")
     assert statuses(build(demo_case, out)) == {**dict.fromkeys(STAGES, "skipped"), "feasibility": "ran"}
     assert statuses(build(demo_case, out, "--force")) == dict.fromkeys(STAGES, "ran")
 

@@ -45,6 +45,7 @@ from softdesign.meshing.tessellate import ring_points
 from softdesign.meshing.volume import BodySpec
 from softdesign.meshing.wall import FD_STEP_MM, offset_metric, port_wall_mm, thinnest, wall_map
 from softdesign.pipeline.bounds import meshes_at_once
+from softdesign.pipeline.feasibility_judge import judge
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.export import body_spec
@@ -53,7 +54,7 @@ from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 from softdesign.types import FramedCurve
 
-VERSION = 1
+VERSION = 2  # 2: places in mm from the base (arc_mm), one reason per cause (causes)
 SUMMARY = "feasibility/summary.json"
 #: Memory for the rest state's metrics a body keeps (:meth:`_Body.rest`), bytes: the finest grid's
 #: (E, F, G) of the 1M-triangle benchmark case is 18 MB (729,600 points), and every q asks for the same grids.
@@ -227,43 +228,6 @@ def _morph(found: tuple[MorphExtreme, MorphExtreme], polished: tuple[StretchExtr
     return out
 
 
-def judge(summary: dict[str, Any], limits: dict[str, Any] | None) -> tuple[bool | None, list[str]]:
-    """The verdict and one reason per violated limit (link, l and angle named)."""
-    if limits is None:
-        return None, []
-    reasons = []
-
-    def place(w: dict[str, Any]) -> str:
-        return f"link {w['link']} l={w['l']:.4f} angle {w['angle_deg']:.0f} deg"
-
-    name = limits["name"]
-    for row in summary["per_q"]:
-        q = row["q"]
-        if limits["max_stretch"] is not None and row["stretch_max"] > limits["max_stretch"]:
-            reasons.append(f"q={q:.3f}: skin stretch {row['stretch_max']:.4f} > max_stretch {limits['max_stretch']:g} "
-                           f"({name}) at {place(row['where']['stretch_max'])}")
-        if limits["min_stretch"] is not None and row["stretch_min"] < limits["min_stretch"]:
-            reasons.append(f"q={q:.3f}: skin stretch {row['stretch_min']:.4f} < min_stretch {limits['min_stretch']:g} "
-                           f"({name}) at {place(row['where']['stretch_min'])}")
-        wall = row["wall_min_mm"]
-        if limits["min_wall_mm"] is not None and wall is not None and wall < limits["min_wall_mm"]:
-            reasons.append(f"q={q:.3f}: wall {wall:.3f} mm < min_wall_mm {limits['min_wall_mm']:g} ({name}) at "
-                           f"{place(row['where']['wall_min'])}")
-        port = row.get("port_wall_mm")
-        if limits["min_wall_mm"] is not None and port is not None and port < limits["min_wall_mm"]:
-            reasons.append(f"q={q:.3f}: port wall {port:.3f} mm < min_wall_mm {limits['min_wall_mm']:g} ({name}) "
-                           f"at l={row['port_where']['l']:.4f} angle {row['port_where']['angle_deg']:.0f} deg")
-    morph = summary["morph"]
-    for key, limit, worse in (("stretch_max", limits["max_stretch"], np.greater),
-                              ("stretch_min", limits["min_stretch"], np.less)):
-        m = morph[key]
-        if limit is not None and worse(m["value"], limit):
-            bound = key.replace("stretch_", "") + "_stretch"
-            reasons.append(f"over the morph, at q={m['q']:.4f}: skin stretch {m['value']:.4f} beyond {bound} "
-                           f"{limit:g} ({name}) at {place(m['where'])}")
-    return not reasons, reasons
-
-
 def run_feasibility(case: Case, kinematics: KinematicsResult, fit: FitResult) -> FeasibilityResult:
     """Every figure, then the verdict against the case's material (if any)."""
     body = _Body(kinematics.chain.shape, fit.field, body_spec(case), case.frames)
@@ -292,10 +256,27 @@ def run_feasibility(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
         "material": limits,
         "tolerance": {"stretch": STRETCH_TOL, "q": Q_XTOL},
     }
-    feasible, reasons = judge(summary, limits)
+    _place_in_mm(body, summary)
+    feasible, reasons, causes = judge(summary, limits)
     summary["feasible"] = feasible
     summary["reasons"] = reasons if limits is not None else ["no material: in the case file: figures only, not judged"]
+    summary["causes"] = causes
     return FeasibilityResult(summary)
+
+
+def _place_in_mm(body: _Body, summary: dict[str, Any]) -> None:
+    """Add ``arc_mm`` (mm from the base along the body at that q) to every place of ``summary`` that has an l."""
+    def add(where: dict[str, Any], q: float) -> None:
+        if "l" in where:
+            where["arc_mm"] = float(body.shape.curve_at(q).curve.arc_length(np.array([where["l"]], float))[0])
+
+    for row in summary["per_q"]:
+        for where in row["where"].values():
+            add(where, row["q"])
+        if row.get("port_where"):
+            add(row["port_where"], row["q"])
+    for key in ("stretch_max", "stretch_min"):
+        add(summary["morph"][key]["where"], summary["morph"][key]["q"])
 
 
 def write_feasibility(result: FeasibilityResult, staging: Staging) -> None:

@@ -17,10 +17,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softdesign.errors import ConfigError, FitError
+from softdesign.errors import ConfigError, FitError, FoldError
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
 from softdesign.fitting.end_checks import thin_end_warnings
 from softdesign.fitting.metrics import HoldoutSettings
+from softdesign.fitting.morph_folds import fold_over_morph
 from softdesign.fitting.projection import project_points
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.selection import NetworkContext, SelectionSettings, inscribed_profile
@@ -28,6 +29,7 @@ from softdesign.fitting.wall_fit import WallFitOptions, fit_wall
 from softdesign.geometry.curves import SmoothCurve, measure_deviation
 from softdesign.geometry.end_cut import choose_end_cuts
 from softdesign.geometry.end_planes import rim_gap_warnings
+from softdesign.geometry.morph_fold import MORPH_Q_SAMPLES
 from softdesign.geometry.network import SelectedPath
 from softdesign.kinematics.links import LinkChain
 from softdesign.meshing.mould_frame import parting_frame
@@ -43,11 +45,12 @@ from softdesign.types import FloatArray
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 6  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
+VERSION = 7  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
 # 3: points fitted in path order; distances sampled above 200k points (max still over all)
 # 4: end prior and end radii (issue 20); true distances on the regularized backbone's stretches (``backbone``)
 # 5: each end's cut plane in the end frame (``end_cut``, issue 20)
 # 6: fit/points.npz keeps the true distance of every point the metrics measured (``distance``, NaN elsewhere)
+# 7: the fit against all of the path's own wall, its coverage and flags (``all_wall``, ``coverage``, issue 29)
 #: Seed of the hold-out folds: the same case always gets the same folds.
 HOLDOUT_SEED = 4
 #: A failed fit is blamed on the centerline when the smoothed one strays from the input by this fraction of the
@@ -103,13 +106,14 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
         holdout=HoldoutSettings(folds=fit.holdout_folds),
         initial_radius_mm=case.initial.radius_mm,
         end_margin_mm=case.fit.end_margin_mm,
+        max_radius_mm=case.fit.max_radius_mm,
         mapper=map_items,  # the hold-out's folds on the build's worker processes
     )
     try:
         wall = fit_wall(curve, ingest.vertices, network, options, np.random.default_rng(HOLDOUT_SEED))
     except FitError as err:
         stray = centerline_stray(case, curve.curve, path)
-        if stray is None:
+        if stray is None or isinstance(err, FoldError):  # a fold names the body radius that fits: that is the fix
             raise
         raise ConfigError(f"{str(err).split('; ')[0]}; {stray}") from err
     field = wall.field
@@ -121,6 +125,11 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
                                           curve.frames(np.array([0.0, 1.0])), chain.shape.keys[-1].length,
                                           mould=case.export.mould is not None,
                                           parting_local=_parting_local(chain) if case.export.mould else None)}
+    # the fitted body itself at every q of the morph's search, not only at q = 1 (issue 29)
+    morph = fold_over_morph(chain.shape.curve_at, field, np.linspace(0.0, 1.0, MORPH_Q_SAMPLES))
+    summary["morph_fold"] = morph.as_dict()
+    if morph.warning() is not None:
+        summary["warnings"] = [*summary.get("warnings", []), morph.warning()]
     if chain.shape.mode == "pcc":
         summary["pcc"] = _carried_to_chain(chain, curve)
     # the end prior can hold the ends a straying centerline leaves one-sided: the fit then succeeds, so say it
@@ -228,6 +237,10 @@ def fit_metrics(result: FitResult) -> dict[str, Any]:
         "ends": s.get("ends", {}),
         "end_prior": s.get("end_prior", {}),
         "end_cut": s.get("end_cut", {}),
+        # rms_mm .. max_mm above are on the kept points; the same under ``kept``, and on all of the path's own
+        # wall under ``all_wall``, with the ``coverage`` and the ``flags`` the report names (issue 29)
+        "kept": {k: d[k] for k in ("rms_mm", "p95_mm", "p99_mm", "max_mm", "count")},
+        **{k: s[k] for k in ("all_wall", "coverage", "flags", "warnings", "morph_fold") if k in s},
     }
 
 
@@ -241,13 +254,38 @@ def describe_fit(result: FitResult) -> list[str]:
         f"cap {p['cap']}, outlier {p['outlier']}",
         f"spline: knots every {st['knot_spacing_mm']:g} mm, {st['angular_intervals']} angular intervals, "
         f"smoothing {st['smoothing']:g}",
-        f"true distance to the fitted surface (mm){_sampled_note(result.summary['distance'])}:",
+        f"true distance to the fitted surface, kept points (mm){_sampled_note(result.summary['distance'])}:",
         f"  RMS {m['rms_mm']:.4f}  p95 {m['p95_mm']:.4f}  p99 {m['p99_mm']:.4f}  max {m['max_mm']:.4f}",
         f"  hold-out RMS ({result.summary['holdout_points']} points, k-fold) {m['holdout_rms_mm']:.4f}",
+        *coverage_lines(result.summary),
         f"joints: value jump {m['joint_value_jump_mm']:.2e} mm, slope jump {m['joint_slope_jump']:.2e}",
         f"max rho * kappa at q = 1: {m['max_rho_kappa']:.3f} (folds at 1; every export q is checked at export)",
+        *_morph_lines(result.summary),
         f"radius at q = 0: {result.summary['initial_radius']}",
     ] + end_lines(result.summary) + describe_backbone_fit(result.summary.get("backbone", [])) + _stray_lines(result)
+
+
+def coverage_lines(summary: dict[str, Any]) -> list[str]:
+    """The all-wall figures, the coverage, each unseen stretch and the warnings (none for older builds)."""
+    if "all_wall" not in summary:
+        return []
+    a, c = summary["all_wall"], summary["coverage"]
+    lines = [
+        f"true distance, all of the path's own wall ({c['own_wall_points']} vertices, {c['fraction']:.1%} of them "
+        f"fitted):",
+        f"  RMS {a['rms_mm']:.4f}  p95 {a['p95_mm']:.4f}  p99 {a['p99_mm']:.4f}  max {a['max_mm']:.4f}",
+    ]
+    lines += [f"  wall not seen all round at {s['from_mm']:.1f}-{s['to_mm']:.1f} mm ({s['length_mm']:.1f} mm, local "
+              f"diameter {s['diameter_mm']:.1f} mm): {s['how']}" for s in c["unseen_stretches"]]
+    return lines + [f"  warning: {w}" for w in summary.get("warnings", [])]
+
+
+def _morph_lines(summary: dict[str, Any]) -> list[str]:
+    m = summary.get("morph_fold")
+    if m is None:
+        return []
+    return [f"max rho * kappa over the morph ({m['q_samples']} q, refined): {m['max_rho_kappa']:.3f} at q = "
+            f"{m['q']:.3f}, l = {m['l']:.4f}"]
 
 
 def _stray_lines(result: FitResult) -> list[str]:
@@ -262,6 +300,10 @@ def end_lines(summary: dict[str, Any]) -> list[str]:
         f"held at the inscribed radius ({e['reference_min_mm']:.3f} to {e['reference_max_mm']:.3f} mm)"
         for end, e in summary.get("end_prior", {}).items()
     ]
+    lines += [f"  warning: the fitted radius went to {h['rho_min_mm']:.3f} mm at {h['at_mm']:.1f} mm from the "
+              f"{end.removesuffix('_held')} (its wall points lean inwards): that end is held at the inscribed radius "
+              f"over {h['from_mm']:.1f}-{h['to_mm']:.1f} mm and fitted again"
+              for end, h in summary.get("ends", {}).items() if end.endswith("_held")]
     cuts = summary.get("end_cut", {})
     lines += [f"{end}: cut at the detected plane (tilt {c['tilt_deg']:.1f} deg, rim gap {c['rim_gap_mm']:.3f} mm)"
               if c["applied"] else f"{end}: cut square to the end tangent ({c['reason']})" for end, c in cuts.items()]

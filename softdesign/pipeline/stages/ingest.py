@@ -19,11 +19,17 @@ from softdesign.io.centerline import read_centerline_network
 from softdesign.io.surface import read_surface
 from softdesign.meshing.topology import SurfaceInfo, describe_surface
 from softdesign.pipeline import layout
-from softdesign.pipeline.auto_centerline import extract_for_case, extraction_summary, write_extracted
+from softdesign.pipeline.auto_centerline import (
+    continuation_note,
+    extract_for_case,
+    extraction_summary,
+    write_extracted,
+)
 from softdesign.pipeline.backbone_step import regularized_path
 from softdesign.pipeline.end_plane_step import end_plane_summary
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
+from softdesign.pipeline.surface_radius import with_surface_radius
 from softdesign.types import UNIT_SCALE_TO_MM, FloatArray
 
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
@@ -34,7 +40,11 @@ if TYPE_CHECKING:  # only annotations: the report loads stage results without th
 #: the rule that chose the inlet (``centerline.inlet_rule``: the clearly widest end first).
 #: 4: each end's flat cap or open loop, its tilt to the end tangent and the rim's gap past the body (``end_planes``).
 #: 5: the rim-gap warning moved to the fit, which decides whether the body is cut at the plane (``fit.end_cut``).
-VERSION = 5
+#: 6: a centerline without radii takes them from final.surface; 2-point segments and unstructured grids are
+#: joined into paths; extracted centerlines reach the openings (issue 29).
+#: 7: the backbone's reach uses the wall's fold radius; a turn no smoothing brings below the target is warned
+#: about, not refused (issue 29).
+VERSION = 7
 
 
 @dataclass(frozen=True)
@@ -77,16 +87,18 @@ def run_ingest(case: Case) -> IngestResult:
         The vessel's size is not a human vessel's in the declared ``units`` (checked before the surface is read).
     """
     scale = UNIT_SCALE_TO_MM[case.units]
-    network, extracted = _final_network(case, scale)
+    network, extracted, radius_from = _final_network(case, scale)
     inlet = None if case.final.inlet is None else np.asarray(case.final.inlet, float) * scale
     orientation = Orientation(inlet=inlet, reverse=case.final.reverse)
     path = select_path(network, case.final.path, orientation)
     check_vessel_scale(path.length, path.radius, case.units, f"final.centerline {_centerline_name(case)}")
     others = tuple(p for p in all_paths(network, Orientation(inlet=path.points[0])) if p.index != path.index)
-    notes = list(path.notes) + (list(extracted.notes) if extracted is not None else [])
+    notes = list(network.notes) + list(path.notes)
+    if extracted is not None:
+        notes += [*extracted.notes, continuation_note(extracted)]
     vertices, faces, info = _final_surface(case, path, scale)
     inlet_rule = path.notes[-1]
-    path, backbone = regularized_path(case, path)
+    path, backbone = regularized_path(case, path, vertices, others)
     notes += [n for n in path.notes if n not in notes]
     ends = end_plane_summary(case, path, vertices, faces)
     initial_path = None
@@ -102,6 +114,7 @@ def run_ingest(case: Case) -> IngestResult:
         initial_surface = read_surface(case.initial.surface, scale)
     summary = {**_summary(case, network, path, info), "backbone": backbone, "end_planes": ends}
     summary["centerline"]["inlet_rule"] = inlet_rule
+    summary["centerline"]["radius_from"] = radius_from if path.radius is not None else None
     if extracted is not None:
         summary["centerline"]["extracted"] = extraction_summary(extracted)
     return IngestResult(
@@ -109,11 +122,14 @@ def run_ingest(case: Case) -> IngestResult:
     )
 
 
-def _final_network(case: Case, scale: float) -> tuple[CenterlineNetwork, Any]:
-    """The final centerline network (mm), read, or extracted from the surface (then also the extraction)."""
+def _final_network(case: Case, scale: float) -> tuple[CenterlineNetwork, Any, str]:
+    """The final centerline network (mm), read, or extracted from the surface (then also the extraction), and
+    where its radii come from."""
     if case.final.centerline == "auto":
-        return extract_for_case(case)
-    return read_centerline_network(case.final.centerline, scale), None
+        return *extract_for_case(case), "the extraction (distance to final.surface)"
+    read = read_centerline_network(case.final.centerline, scale)
+    network = with_surface_radius(case, read)
+    return network, None, "MaximumInscribedSphereRadius" if network is read else "distance to final.surface"
 
 
 def _centerline_name(case: Case) -> str:
@@ -226,7 +242,7 @@ def describe_ingest(result: IngestResult) -> list[str]:
         lines.append(f" {mark} path {p['path']}: {p['points']} points, {p['length_mm']:.2f} mm")
     if c["radius_range_mm"]:
         lo, hi = c["radius_range_mm"]
-        lines.append(f"   radius {lo:.3f} .. {hi:.3f} mm (MaximumInscribedSphereRadius)")
+        lines.append(f"   radius {lo:.3f} .. {hi:.3f} mm ({c.get('radius_from') or 'MaximumInscribedSphereRadius'})")
     s = result.summary["surface"]
     if s:
         kind = "capped (watertight)" if s["capped"] else f"open, {s['boundary_loops']} boundary loop(s)"

@@ -9,6 +9,7 @@ base_to_tip.  Conventions are written into the file itself.
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -144,14 +145,14 @@ def describe_kinematics(result: KinematicsResult) -> list[str]:
         lines.append(
             f"  q = {row['q']:.3f}: length {row['length_mm']:.2f} mm, stretch {row['stretch_min']:.4f}"
             f"..{row['stretch_max']:.4f}, max curvature {row['curvature_max_per_mm']:.4f} /mm, "
-            f"largest frame step {row['max_frame_step_rad']:.2e} rad"
+            f"largest frame step {math.degrees(row['max_frame_step_rad']):.2e} deg"
         )
     for pose in result.document["poses"]:
         for link in pose["links"]:
             p = link["poe"]
             lines.append(
                 f"  q = {link['q']:.3f} link {link['index']}: length {link['length']:.2f} mm, "
-                f"theta1 {p['theta1']:.3f} mm, theta2 {p['theta2']:.4f} rad, "
+                f"theta1 {p['theta1']:.3f} mm, theta2 {math.degrees(p['theta2']):.3f} deg, "
                 f"stretch {link['stretch'][0]:.3f}..{link['stretch'][1]:.3f}"
             )
     lines += [f"  warning: {line}" for line in arc_misses(link_arcs_at_final_shape(result.chain))]

@@ -1,0 +1,91 @@
+"""`softdesign init SURFACE [CENTERLINE] [--output case.yaml]`: a commented case file for one's own vessel files."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+from typing import Annotated, Literal
+
+import typer
+
+from softdesign.cli.common import note, run_guarded
+from softdesign.errors import ConfigError
+
+InitSurfaceArg = Annotated[
+    Path, typer.Argument(help="The vessel surface (.stl .ply .obj .vtp .vtk), open at its ends or capped.",
+                         show_default=False)
+]
+InitCenterlineArg = Annotated[
+    Path | None,
+    typer.Argument(help="Its centerlines (.vtp .vtk .csv .npy) [default: extracted from the surface].",
+                   show_default=False),
+]
+InitOutputOpt = Annotated[Path, typer.Option("--output", help="The case file to write.")]
+InitUnitsOpt = Annotated[
+    Literal["mm", "cm", "m"] | None,
+    typer.Option("--units", help="Units of the files [default: guessed from the vessel's size, with the evidence].",
+                 show_default=False),
+]
+InitForceOpt = Annotated[bool, typer.Option("--force", help="Replace an existing case file.")]
+#: A case name: what the case file's ``name`` accepts.
+_NAME = re.compile(r"[^A-Za-z0-9_-]+")
+
+
+def init(
+    surface: InitSurfaceArg,
+    centerline: InitCenterlineArg = None,
+    output: InitOutputOpt = Path("case.yaml"),
+    units: InitUnitsOpt = None,
+    force: InitForceOpt = False,
+) -> None:
+    """Inspect a vessel's files and write a commented case file that builds (paths, sizes, units, inlet)."""
+
+    def action() -> None:
+        from softdesign.cli.schema import schema_text
+        from softdesign.io.atomic import write_bytes_atomically
+        from softdesign.pipeline.case_template import SCHEMA_FILE, init_case_text
+        from softdesign.pipeline.inspect_inputs import inspect_inputs
+
+        _check_output(output, [p for p in (surface, centerline) if p is not None], force)
+        inspection = inspect_inputs(surface, centerline, units)
+        name = _NAME.sub("-", output.stem).strip("-") or "case"
+        text = init_case_text(inspection, output, name)
+        schema_path = output.parent / SCHEMA_FILE
+        try:
+            if not schema_path.exists() or _is_our_schema(schema_path):
+                write_bytes_atomically(schema_path, schema_text().encode())
+            write_bytes_atomically(output, text.encode())
+        except OSError as err:
+            raise ConfigError(f"--output {output}: cannot write it ({err.strerror or err}); choose a writable path"
+                              ) from err
+        if inspection.guess is not None:
+            note(f"units: {inspection.units}, guessed from the sizes ({inspection.guess.evidence[0]}, ...); "
+                 "give --units to say otherwise")
+        for p in inspection.paths:
+            note(f"  path {p.index}: {p.length:.4g} {inspection.units}")
+        typer.echo(f"wrote {output}; build it with: softdesign build {output}")
+
+    run_guarded(action)
+
+
+def _check_output(output: Path, inputs: list[Path], force: bool) -> None:
+    if output.suffix.lower() not in (".yaml", ".yml"):
+        raise ConfigError(f"--output {output}: expected a .yaml case file, got '{output.suffix or '(no suffix)'}'")
+    if output.is_dir():
+        raise ConfigError(f"--output {output}: is a folder, expected a case file name (e.g. case.yaml)")
+    if not output.parent.is_dir():
+        raise ConfigError(f"--output {output}: the folder {output.parent} does not exist; create it first")
+    for path in inputs:
+        if path.exists() and output.exists() and output.resolve() == path.resolve():
+            raise ConfigError(f"--output {output}: is one of the inputs; choose another name for the case file")
+    if output.exists() and not force:
+        raise ConfigError(f"--output {output}: already exists; give --force to replace it, or another name")
+
+
+def _is_our_schema(path: Path) -> bool:
+    """True when ``path`` holds a schema ``softdesign schema`` wrote (so it may be brought up to date)."""
+    try:
+        return json.loads(path.read_text()).get("title") == "softdesign case file"
+    except (OSError, ValueError, AttributeError):
+        return False

@@ -1,0 +1,163 @@
+"""The fit measured against all of the path's own wall, and where the fit saw no wall (issue 29, item 1).
+
+The kept-point figures (:mod:`softdesign.fitting.metrics`) are measured on the
+points the fit used.  Near branches the selection drops much of a path's wall,
+and the fit bridges the gap or holds it at the inscribed radius: figures on
+the kept points then read well while the body is off the wall.  This module
+measures the same true distances on the path's *own wall*: every surface
+vertex whose foot lies within the path (not past an end) and which is not
+nearer another path (the selection's ``other_branch`` and ``cap`` points left
+out, its outliers kept), and reports the coverage:
+
+* the fraction of the own wall the fit used;
+* each *unseen stretch*: a run of knot intervals whose fitted points leave an
+  empty angular sector wider than ``SEEN_GAP_RAD`` (the end prior's test), with
+  where it is, its length, and how the body is made there (held at the
+  inscribed radius by the end prior at an end, bridged by the fit inside).
+
+Two flags, each with a warning: a stretch held at the inscribed radius longer
+than one local diameter, and an all-wall p95 above ``ALL_WALL_P95_FRACTION``
+of the path's median radius.  A stretch bridged inside the path (a branch's
+mouth: no wall there to match) is listed, not flagged.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from softdesign.fitting.bspline_surface import RadiusSpline
+from softdesign.fitting.end_prior import SEEN_GAP_RAD, largest_gap
+from softdesign.fitting.mapping import Mapper, serial_map
+from softdesign.fitting.metrics import FitMetrics, measure_distances
+from softdesign.fitting.projection import PolarPoints
+from softdesign.fitting.selection import REASONS, WallSelection
+from softdesign.types import FloatArray, FramedCurve
+
+#: The all-wall p95 above this fraction of the path's median radius is flagged (a body off the wall by a tenth
+#: of the radius on one point in twenty is visibly not the vessel).
+ALL_WALL_P95_FRACTION = 0.1
+#: Seed of the sample the all-wall figures are measured on above DISTANCE_SAMPLE_MAX points (its own generator,
+#: so the kept-point figures and the hold-out draw exactly as before).
+ALL_WALL_SEED = 29
+#: Flags, by name, as the fit summary carries them.
+FLAG_LONG_STRETCH = "unseen_stretch_longer_than_diameter"
+FLAG_P95 = "all_wall_p95_above_fraction"
+
+
+@dataclass(frozen=True)
+class WallCoverage:
+    """All-wall figures, coverage and flags (JSON-ready through :meth:`as_dict`)."""
+
+    metrics: FitMetrics
+    own_points: int
+    fitted_points: int
+    radius_mm: float
+    stretches: tuple[dict[str, Any], ...]
+    flags: tuple[str, ...]
+    warnings: tuple[str, ...]
+
+    def as_dict(self) -> dict[str, Any]:
+        """``all_wall`` distances (mm), ``coverage`` figures, ``flags`` and ``warnings``."""
+        return {
+            "all_wall": self.metrics.as_dict(),
+            "coverage": {
+                "own_wall_points": self.own_points,
+                "fitted_points": self.fitted_points,
+                "fraction": self.fitted_points / self.own_points if self.own_points else float("nan"),
+                "radius_mm": self.radius_mm,
+                "p95_fraction_limit": ALL_WALL_P95_FRACTION,
+                "unseen_stretches": list(self.stretches),
+            },
+            "flags": list(self.flags),
+            "warnings": list(self.warnings),
+        }
+
+
+def own_wall(polar: PolarPoints, selection: WallSelection) -> np.ndarray:
+    """(n,) bool: the path's own wall: foot within the path, neither another branch's wall nor a cap."""
+    other, cap = 1 + REASONS.index("other_branch"), 1 + REASONS.index("cap")
+    return (polar.end_side == 0) & (selection.reason != other) & (selection.reason != cap)
+
+
+def measure_coverage(
+    curve: FramedCurve,
+    surface: RadiusSpline,
+    polar: PolarPoints,
+    selection: WallSelection,
+    fitted: np.ndarray,
+    interval_mm: float,
+    reference: tuple[FloatArray, FloatArray] | None,
+    held_ends: dict[str, Any],
+    mapper: Mapper = serial_map,
+) -> WallCoverage:
+    """True distances of the own wall to the fitted surface, the coverage, the unseen stretches and the flags.
+
+    Parameters
+    ----------
+    curve : the centerline at q = 1
+    surface : the fitted rho(l, a)
+    polar : every surface point projected on ``curve``
+    selection : the selection's reasons
+    fitted : (k,) indices into ``polar`` of the points the fit used
+    interval_mm : the fit's knot interval along l, mm (the unseen test's cells)
+    reference : normalized l (m,) and inscribed radius (m,) mm, or None (then the fitted points' rho)
+    held_ends : the end prior's per-end figures (which ends are held at the inscribed radius)
+    mapper : runs the distance blocks
+    """
+    own = own_wall(polar, selection)
+    nan = float("nan")
+    measured = measure_distances(curve, surface, polar.subset(own), np.random.default_rng(ALL_WALL_SEED),
+                                 mapper=mapper).metrics if own.any() else FitMetrics(nan, nan, nan, nan, 0)
+    kept = polar.subset(fitted)
+    radius = float(np.median(reference[1] if reference is not None else kept.rho)) if len(kept) else float("nan")
+    stretches = unseen_stretches(kept, curve.length, interval_mm, reference, held_ends)
+    flags, warnings = [], []
+    long = [s for s in stretches if s["length_mm"] > s["diameter_mm"] and s["held"]]
+    if long:
+        flags.append(FLAG_LONG_STRETCH)
+        warnings += [
+            f"no wall seen all round over {s['length_mm']:.1f} mm at {s['from_mm']:.1f}-{s['to_mm']:.1f} mm from the "
+            f"inlet, longer than the local diameter {s['diameter_mm']:.1f} mm: the body there is {s['how']}, not "
+            "matched to the wall (fit.summary coverage)" for s in long]
+    if measured.count and measured.p95_mm > ALL_WALL_P95_FRACTION * radius:
+        flags.append(FLAG_P95)
+        warnings.append(
+            f"against all of the path's own wall ({int(own.sum())} vertices, {len(fitted) / own.sum():.0%} of them "
+            f"fitted) the body's p95 distance is {measured.p95_mm:.3f} mm, above {ALL_WALL_P95_FRACTION:g} of the "
+            f"radius {radius:.3f} mm (max {measured.max_mm:.3f} mm): the kept-point figures do not describe it")
+    return WallCoverage(measured, int(own.sum()), int(len(fitted)), radius, tuple(stretches), tuple(flags),
+                        tuple(warnings))
+
+
+def unseen_stretches(
+    kept: PolarPoints, length_mm: float, interval_mm: float, reference: tuple[FloatArray, FloatArray] | None,
+    held_ends: dict[str, Any],
+) -> list[dict[str, Any]]:
+    """Runs of knot intervals whose fitted points leave an empty sector wider than ``SEEN_GAP_RAD``, mm along the path.
+
+    Each: ``from_mm``, ``to_mm``, ``length_mm``, ``diameter_mm`` (twice the radius at its middle: the
+    inscribed one, else the median rho of the fitted points) and ``how`` the body is made there.
+    """
+    intervals = max(1, int(round(length_mm / interval_mm)))
+    row = np.minimum((kept.l * intervals).astype(int), intervals - 1)
+    order = np.argsort(row, kind="stable")
+    bounds = np.searchsorted(row[order], np.arange(intervals + 1))
+    unseen = np.array([largest_gap(kept.angle[order[bounds[k]:bounds[k + 1]]]) > SEEN_GAP_RAD
+                       for k in range(intervals)])
+    edges = np.diff(np.concatenate([[0], unseen.astype(int), [0]]))
+    out = []
+    for first, stop in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1), strict=True):
+        lo, hi = first * length_mm / intervals, stop * length_mm / intervals
+        middle = 0.5 * (lo + hi) / length_mm
+        r = float(np.interp(middle, *reference)) if reference is not None else (
+            float(np.median(kept.rho)) if len(kept) else float("nan"))
+        end = "inlet" if first == 0 else ("outlet" if stop == intervals else None)
+        held = end is not None and end in held_ends
+        how = (f"held at the inscribed radius in its empty cells (the {end}'s end prior)" if held
+               else "bridged by the fit's smoothing (a branch's mouth, or wall dropped there)")
+        out.append({"from_mm": lo, "to_mm": hi, "length_mm": hi - lo, "diameter_mm": 2.0 * r, "held": held,
+                    "how": how, "end": end})
+    return out

@@ -1,0 +1,73 @@
+"""Does the fitted body fold anywhere in the morph?  ``1 - rho(q) * kappa_n(q) > 0`` at every q searched.
+
+The fit checks the q = 1 body (:func:`softdesign.fitting.radius_field.check_self_folding`)
+and the export each exported q; between them a body can fold where no mesh
+is made, or where one will be.  :func:`fold_over_morph` evaluates the tube
+map's Jacobian with the fitted radius field, rho(q) = (1 - q) rho0 + q rhof,
+on the same q grid as the morph's reach search before the fit
+(:data:`softdesign.geometry.morph_fold.MORPH_Q_SAMPLES` values, passed in),
+then refines the worst q by a bounded search between its neighbours.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from softdesign.fitting.radius_field import FoldReport, RadiusField, fold_margin
+from softdesign.types import FramedCurve
+
+#: The bounded refinement stops at this width in q.
+Q_XTOL = 1e-3
+
+
+@dataclass(frozen=True)
+class MorphFold:
+    """The largest rho(q) * kappa_n(q) over the morph: where (q, l, mm, angle) and how many q were looked at."""
+
+    q: float
+    report: FoldReport
+    samples: int
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready (rad for the angle, mm along the shape at q)."""
+        r = self.report
+        return {"max_rho_kappa": r.max_rho_kappa, "q": self.q, "l": r.l, "arc_mm": r.arc_mm, "angle": r.angle,
+                "min_rho_mm": r.min_rho_mm, "q_samples": self.samples}
+
+    def warning(self) -> str | None:
+        """A line when the body folds before q = 1 (q = 1 itself is refused by the fit), else None."""
+        r = self.report
+        if r.max_rho_kappa < 1.0 or self.q >= 1.0:
+            return None
+        return (f"the fitted body folds mid-morph: at q = {self.q:.3f}, l = {r.l:.4f} ({r.arc_mm:.1f} mm from the "
+                f"inlet), angle {np.degrees(r.angle):.0f} deg, rho * kappa = {r.max_rho_kappa:.3f} (folds at 1): "
+                "meshes at export q near it will fail; blend: intrinsic keeps the curvature within the end "
+                "shapes', or hold the body thinner (fit.max_radius_mm)")
+
+
+def fold_over_morph(shape_at: Callable[[float], FramedCurve], field: RadiusField, q_grid: np.ndarray) -> MorphFold:
+    """The largest ``rho(q) * kappa_n(q)`` over ``q_grid`` (increasing, in [0, 1]), refined around the worst.
+
+    Parameters
+    ----------
+    shape_at : q -> the framed centerline c(q, .)
+    field : the fitted radius field
+    q_grid : (k,) the q values searched first
+    """
+    q_grid = np.asarray(q_grid, float)
+    reports = [fold_margin(shape_at(float(q)), field, float(q)) for q in q_grid]
+    best = int(np.argmax([r.max_rho_kappa for r in reports]))
+    q, report = float(q_grid[best]), reports[best]
+    if 0 < best < len(q_grid) - 1:
+        found = minimize_scalar(lambda t: -fold_margin(shape_at(float(t)), field, float(t)).max_rho_kappa,
+                                bounds=(q_grid[best - 1], q_grid[best + 1]), method="bounded",
+                                options={"xatol": Q_XTOL})
+        if -found.fun > report.max_rho_kappa:
+            q = float(found.x)
+            report = fold_margin(shape_at(q), field, q)
+    return MorphFold(q, report, len(q_grid))

@@ -1,0 +1,91 @@
+"""The commented case file ``softdesign init`` writes for a user's own vessel files.
+
+Every key it sets is one a newcomer is likely to change; the comments say
+what each does and list what the files hold (paths with their lengths and
+radius ranges, the openings), so the file is its own first documentation.
+Paths are written relative to the case file's folder, as the case file
+reads them.  The first line names the case file's JSON Schema
+(``softdesign schema``) for editors that complete and check YAML
+(``yaml-language-server``).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from softdesign.pipeline.inspect_inputs import Inspection
+
+#: The file beside the case that holds the case file's JSON Schema (written by ``init``).
+SCHEMA_FILE = "softdesign-case.schema.json"
+#: The material a new case is judged against: the commonest silicone of soft actuators, so a first build
+#: gives a feasible / not-feasible verdict.
+DEFAULT_MATERIAL = "ecoflex-00-30"
+#: About one link (section) per this much path length, between 1 and MAX_INIT_LINKS.
+LINK_LENGTH_MM = 25.0
+MAX_INIT_LINKS = 8
+
+
+def init_case_text(inspection: Inspection, case_path: Path, name: str) -> str:
+    """The case file's text (see the module notes).
+
+    Parameters
+    ----------
+    inspection : what the files hold
+    case_path : where the case file will be written (paths are made relative to its folder)
+    name : the case's name (a slug: letters, digits, ``-``, ``_``)
+    """
+    from softdesign.types import UNIT_SCALE_TO_MM
+
+    unit = inspection.units
+    scale = UNIT_SCALE_TO_MM[unit]
+    first = inspection.paths[0]
+    links = min(MAX_INIT_LINKS, max(1, round(first.length * scale / LINK_LENGTH_MM)))
+    folder = case_path.parent
+    centerline = "auto" if inspection.centerline is None else _relative(inspection.centerline, folder)
+    inlet = ", ".join(f"{v:.6g}" for v in inspection.inlet)
+    lines = [
+        f"# yaml-language-server: $schema={SCHEMA_FILE}",
+        f"# Written by softdesign init from {inspection.surface.name}"
+        + ("" if inspection.centerline is None else f" and {inspection.centerline.name}")
+        + ". Build it with: softdesign build " + case_path.name,
+        *_units_comment(inspection),
+        f"name: {name}",
+        f"units: {unit}                 # the unit of the input files (and of final.inlet)",
+        "final:                      # the patient's shape, q = 1",
+        f"  centerline: {centerline}" + ("   # extracted from the surface at ingest" if centerline == "auto" else ""),
+        f"  surface: {_relative(inspection.surface, folder)}",
+        "  path: 0                   # which path the actuator follows; the files hold:",
+        *_path_comments(inspection),
+        f"  inlet: [{inlet}]   # l = 0, where the actuator is mounted: the end nearest this point",
+        "initial: {kind: straight}   # the insertion shape, q = 0",
+        "resample: {spacing_mm: 0.5, smoothing_mm: 0.1}",
+        f"links: {{count: {links}}}          # sections of the actuator (about one per {LINK_LENGTH_MM:g} mm)",
+        "fit: {knot_spacing_mm: 1.5, angular_intervals: 24}",
+        "export: {q: [0, 0.5, 1], formats: [stl]}   # meshes at these q; add mould: {} for a casting mould",
+        f"material: {{name: {DEFAULT_MATERIAL}}}    # the stretch and wall limits the design is judged against",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def _relative(path: Path, folder: Path) -> str:
+    return Path(os.path.relpath(path.resolve(), folder.resolve())).as_posix()
+
+
+def _units_comment(inspection: Inspection) -> list[str]:
+    if inspection.guess is None:
+        return [f"# units: {inspection.units}, as given to init"]
+    evidence = [f"#   {line}" for line in inspection.guess.evidence]
+    return [f"# units: {inspection.units}, guessed from the sizes:", *evidence]
+
+
+def _path_comments(inspection: Inspection) -> list[str]:
+    unit = inspection.units
+    out = []
+    for p in inspection.paths:
+        size = f"{p.length:.4g} {unit} long"
+        if p.radius is not None:
+            size += f", radius {p.radius.min():.3g} to {p.radius.max():.3g} {unit}"
+        end = ", ".join(f"{v:.4g}" for v in p.points[-1])
+        out.append(f"  #   path {p.index}: {size}, ends at [{end}]")
+    return out

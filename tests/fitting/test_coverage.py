@@ -1,0 +1,68 @@
+"""The fit against all of the path's own wall (issue 29, item 1): figures that cannot hide dropped wall."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from softdesign.fitting import coverage as cov
+from softdesign.fitting.projection import project_points
+from softdesign.fitting.selection import NetworkContext, WallSelection, inscribed_profile
+from softdesign.fitting.wall_fit import WallFitOptions, fit_wall
+from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
+from softdesign.geometry.frames import framed_curve
+from tests.helpers.vessels import straight_tube
+
+R, LENGTH = 3.0, 40.0
+#: The inlet's first BULGE_MM bulge on the +x side to BULGE_RHO: rho > 2 R, so the selection drops them as outliers.
+BULGE_MM, BULGE_RHO = 10.0, 7.0
+
+
+def bulged_vessel(bulge: bool = True):
+    vertices, _ = straight_tube(R, LENGTH + 2.0, 0.5)
+    vertices = vertices.copy()
+    if bulge:
+        out = (vertices[:, 2] < BULGE_MM) & (vertices[:, 0] > 0.0)
+        vertices[out, :2] *= BULGE_RHO / R
+    z = np.linspace(0.0, LENGTH, 81)
+    axis = np.column_stack([np.zeros_like(z), np.zeros_like(z), z])
+    curve = framed_curve(smooth_curve_from_polyline(axis, CurveOptions(0.5, smoothing_mm=0.0, end_straight_mm=0.0)))
+    network = NetworkContext(axis, (), *inscribed_profile(curve, axis, np.full(len(z), R)))
+    return curve, vertices, network
+
+
+def test_the_own_wall_leaves_out_other_branches_and_caps_but_keeps_outliers():
+    curve, vertices, _ = bulged_vessel(bulge=False)
+    polar = project_points(curve, vertices)
+    reason = np.zeros(len(polar), np.int8)
+    reason[:4] = [1, 2, 3, 0]  # other branch, cap, outlier, kept
+    own = cov.own_wall(polar, WallSelection(reason, {}))
+    inside = polar.end_side == 0
+    assert np.array_equal(own[:4], [False, False, inside[2], inside[3]])
+    assert np.array_equal(own[4:], inside[4:])
+
+
+def test_dropped_wall_shows_in_the_all_wall_figures_the_coverage_and_the_flags():
+    curve, vertices, network = bulged_vessel()
+    fit = fit_wall(curve, vertices, network, WallFitOptions(), np.random.default_rng(0))
+    s = fit.summary()
+    kept, every = s["distance"], s["all_wall"]
+    # the kept points are on the body; the bulge's wall, dropped as outliers, is 4 mm off it
+    assert kept["max_mm"] < 0.05 and every["max_mm"] == pytest.approx(BULGE_RHO - R, abs=0.05)
+    assert every["count"] == s["coverage"]["own_wall_points"] > s["coverage"]["fitted_points"]
+    dropped = s["points"]["outlier"]
+    assert dropped > 0 and s["coverage"]["fraction"] == pytest.approx(1 - dropped / every["count"])
+    assert every["p95_mm"] > cov.ALL_WALL_P95_FRACTION * R
+    [held] = [x for x in s["coverage"]["unseen_stretches"] if x["held"]]
+    assert held["end"] == "inlet" and held["from_mm"] == 0.0
+    assert held["length_mm"] == pytest.approx(BULGE_MM, abs=1.5) and held["diameter_mm"] == pytest.approx(2 * R)
+    assert s["flags"] == [cov.FLAG_LONG_STRETCH, cov.FLAG_P95]
+    assert "no wall seen all round over" in s["warnings"][0] and "held at the inscribed radius" in s["warnings"][0]
+
+
+def test_a_wall_fitted_all_round_is_fully_covered_and_unflagged():
+    curve, vertices, network = bulged_vessel(bulge=False)
+    s = fit_wall(curve, vertices, network, WallFitOptions(), np.random.default_rng(0)).summary()
+    assert s["coverage"]["fraction"] == 1.0 and s["coverage"]["unseen_stretches"] == []
+    assert s["flags"] == [] and s["warnings"] == []
+    assert s["all_wall"]["rms_mm"] == pytest.approx(s["distance"]["rms_mm"], rel=1e-12)

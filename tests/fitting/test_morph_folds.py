@@ -1,0 +1,34 @@
+"""The fitted body's fold test at every q of the morph's search (issue 29, item 0)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from softdesign.fitting.morph_folds import Q_XTOL, fold_over_morph
+from tests.fitting.test_fit_radius_field import _round_field
+from tests.helpers.analytic import Arc
+
+RHO = 5.0
+GRID = np.linspace(0.0, 1.0, 41)
+
+
+def test_a_morph_bending_steadily_reaches_its_largest_rho_kappa_at_q_1_and_is_not_warned_about():
+    # arcs of length 10 mm bending to a 20 mm radius at q = 1: rho * kappa = rho / R(q), largest at q = 1
+    found = fold_over_morph(lambda q: Arc(20.0 / max(q, 1e-3), 0.5 * max(q, 1e-3)),
+                            _round_field(lambda l: np.full_like(l, RHO)), GRID)
+    assert found.q == 1.0 and found.report.max_rho_kappa == pytest.approx(RHO / 20.0, abs=1e-9)
+    assert found.warning() is None and found.as_dict()["q_samples"] == 41
+
+
+def test_a_body_folding_between_the_grid_q_is_found_and_warned_about():
+    # curvature 4 q (1 - q) / 4 mm: the body of radius 5 mm folds mid-morph, worst at q = 0.5, between grid values
+    def shape(q: float) -> Arc:
+        kappa = max(4.0 * q * (1.0 - q), 1e-3) / 4.0
+        return Arc(1.0 / kappa, 10.0 * kappa)
+
+    found = fold_over_morph(shape, _round_field(lambda l: np.full_like(l, RHO)), np.linspace(0.0, 1.0, 8))
+    assert found.q == pytest.approx(0.5, abs=10 * Q_XTOL)
+    assert found.report.max_rho_kappa == pytest.approx(RHO / 4.0, rel=1e-4)
+    warning = found.warning()
+    assert warning is not None and "folds mid-morph: at q = 0.5" in warning and "fit.max_radius_mm" in warning
