@@ -18,18 +18,18 @@ MAX_DESIGN_LINKS = 40
 class Design(BaseModel):
     """Sections of constant curvature composed from the base frame, within these bounds of the q = 1 centerline."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
 
-    #: largest true distance between the composed chain and the centerline, both ways, the tip included, mm
     tolerance_mm: FiniteFloat = Field(1.0, gt=0.0, le=100.0)
-    #: largest distance between the chain's tip and the centerline's end, mm (default: tolerance_mm)
+    """Largest true distance between the composed chain and the q = 1 centerline, both ways, the tip included, mm."""
     tip_tolerance_mm: FiniteFloat | None = Field(None, gt=0.0, le=100.0)
-    #: largest angle between the chain's tip tangent and the centerline's end tangent, degrees (default: none)
+    """Largest distance between the chain's tip and the centerline's end, mm (default: tolerance_mm)."""
     tip_tolerance_deg: FiniteFloat | None = Field(None, gt=0.0, le=180.0)
-    #: most sections searched
+    """Largest angle between the chain's tip tangent and the centerline's end tangent, degrees (default: none)."""
     max_links: Integer = Field(20, ge=1, le=MAX_DESIGN_LINKS)
-    #: shortest section, mm (default: the vessel's median inscribed diameter)
+    """Most sections searched (k = 1, 2, ... up to this)."""
     min_link_mm: FiniteFloat | None = Field(None, gt=0.0)
+    """Shortest section, mm (default: the vessel's median inscribed diameter)."""
 
 
 def pcc_blend_problems(blend: str, design: Design | None, initial_kind: str, keyframes: int) -> list[str]:
