@@ -686,6 +686,7 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
     volume = volume_mesh_case(scratch / "volume", DEMO_CASE, "sample case, hollow, swept volume mesh", VOLUME_EXPORT)
     emit(stage_table(measure(volume, scratch, jobs=args.jobs)) + [""])
     emit(centerline_lines() + [""])
+    emit(design_lines() + [""])
     plan = synthetic_plan(scratch, args.triangles, args.frames)
     results = run_synthetic(plan, scratch, args.jobs)
     largest = next(c for c in plan if (c.triangles, c.frames) == (max(args.triangles), min(args.frames)))
@@ -726,6 +727,15 @@ def centerline_lines() -> list[str]:
     if done.returncode != 0:
         raise RuntimeError(f"bench_centerline.py failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
     return done.stdout.splitlines()
+
+
+def design_lines() -> list[str]:
+    """The design stage on the sample case, the aorta and 1201 points (pipelines/bench_design.py, issue 30)."""
+    done = subprocess.run([sys.executable, str(REPO / "pipelines" / "bench_design.py")],
+                          capture_output=True, text=True, cwd=REPO)
+    if done.returncode not in (0, 1):  # 1: a target missed, which its lines say
+        raise RuntimeError(f"bench_design.py failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
+    return ["design stage (issue 30), CPU s of the core per case and tolerance:"] + done.stdout.splitlines()
 
 
 def parse_counts(text: str) -> list[int]:

@@ -51,6 +51,7 @@ SUMMARY_COLUMNS = (
     "wall_min_mm",
     "chain_deviation_mm",
     "tip_error_mm",
+    "tip_error_deg",
     "axial_stretch_min",
     "axial_stretch_max",
     "max_rho_kappa",
@@ -257,14 +258,16 @@ def manifest_figures(build_dir: Path) -> dict[str, Any]:
     per_q = _per_q_figures(build_dir, metrics)
     meshes = _one_mesh_per_q(manifest["outputs"])
     volumes = [float(o["volume_mm3"]) for o in meshes]
+    design = metrics.get("design") or {}  # the composed-chain design (issue 30); blank without a design: block
     return {
         "links": (metrics.get("kinematics") or {}).get("links", ""),
         "fit_rms_mm": fit.get("rms_mm", ""),
         "fit_p99_mm": fit.get("p99_mm", ""),
         "fit_max_mm": fit.get("max_mm", ""),
         **_feasibility_figures(metrics.get("feasibility") or {}),
-        "chain_deviation_mm": (metrics.get("design") or {}).get("chain_max_deviation_mm", ""),
-        "tip_error_mm": (metrics.get("design") or {}).get("tip_error_mm", ""),
+        "chain_deviation_mm": design.get("chain_max_deviation_mm", ""),
+        "tip_error_mm": design.get("tip_error_mm", ""),
+        "tip_error_deg": design.get("tip_error_deg", ""),
         "axial_stretch_min": min((p["stretch_min"] for p in per_q), default=""),
         "axial_stretch_max": max((p["stretch_max"] for p in per_q), default=""),
         "max_rho_kappa": _max_rho_kappa(fit, build_dir),

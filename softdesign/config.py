@@ -34,6 +34,7 @@ from pydantic import (
 from softdesign.config_actuation import Actuation
 from softdesign.config_material import CustomMaterial
 from softdesign.config_types import FiniteFloat, Integer
+from softdesign.design_config import Design, pcc_blend_problems
 from softdesign.errors import ConfigError
 from softdesign.io.case_yaml import parse_case_yaml, read_case_text
 from softdesign.io.format_names import MESH_FORMATS
@@ -332,7 +333,9 @@ class Case(_Section):
     intermediate: list[IntermediateShape] = []
     resample: Resample = Resample()
     frames: Literal["rmf", "frenet"] = "rmf"
-    blend: Literal["auto", "linear", "intrinsic"] = "auto"
+    blend: Literal["auto", "linear", "intrinsic", "pcc"] = "auto"
+    #: the composed-chain design stage (between ingest and blend); blend: pcc morphs its chain
+    design: Design | None = None
     links: Links = Links(count=4)
     fit: Fit = Fit()
     export: Export = Export()
@@ -342,6 +345,13 @@ class Case(_Section):
     actuation: Actuation | None = None
 
     _base: Path = PrivateAttr(default_factory=Path.cwd)
+
+    @model_validator(mode="after")
+    def _pcc_needs_a_design(self) -> Case:
+        problems = pcc_blend_problems(self.blend, self.design, self.initial.kind, len(self.intermediate))
+        if problems:
+            raise ValueError("; ".join(problems))
+        return self
 
     @field_validator("frames")
     @classmethod

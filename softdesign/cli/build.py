@@ -52,7 +52,21 @@ def _run(case_file: Path, out: Path | None, target: str | None, force: bool, job
     with build_progress() as (stage_line, per_mesh), items_told_to(per_mesh):  # the mesh bar: on a terminal only
         outcome = build_through(case_file, out, target, force, progress=stage_line, jobs=workers)
     _warn_arc_misses(case_file, outcome.results)
+    _warn_design_miss(case_file, outcome.results)
     return outcome
+
+
+def _warn_design_miss(case_file: Path, results: dict[str, Any]) -> None:
+    """On stderr: the case's design (design: block) misses its tolerance (issue 30)."""
+    design = results.get("design")
+    if design is None:
+        return
+    from softdesign.cli.common import note
+    from softdesign.pipeline.stages.design import miss_text
+
+    miss = miss_text(design.document)
+    if miss is not None:
+        note(f"warning: {case_file}: {miss}")
 
 
 def _warn_arc_misses(case_file: Path, results: dict[str, Any]) -> None:

@@ -22,6 +22,7 @@ the keys are blended along the SE(3) geodesic (identical once registered).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -41,7 +42,8 @@ from softdesign.geometry.frames import (
 from softdesign.geometry.se3 import inverse_pose, pose_from_twist, rotation_from_rotvec, twist_from_pose
 from softdesign.types import FloatArray
 
-BlendMode = Literal["linear", "intrinsic"]
+BlendMode = Literal["linear", "intrinsic", "pcc"]
+#: The modes :func:`blend_shapes` builds; "pcc" (a designed chain) is built by :func:`sampled_shape`.
 BLEND_MODES = ("linear", "intrinsic")
 #: Gauss-Legendre points of the 2-point (fourth-order) Magnus step, on [0, 1].
 _GAUSS2 = np.array([0.5 - np.sqrt(3.0) / 6.0, 0.5 + np.sqrt(3.0) / 6.0])
@@ -111,17 +113,22 @@ class BlendedShape:
     frames: FrameMode
     base_normal: FloatArray
     _intrinsic: _Intrinsic | None = field(default=None, repr=False)
+    #: mode "pcc": c(q, .) at the ``l_grid`` samples as a function of q (:func:`sampled_shape`)
+    _sampler: Callable[[float], FloatArray] | None = field(default=None, repr=False, compare=False)
     # c(q, .) and its frames are pure functions of q; links, stats and exports ask for the
     # same q many times, so each is built once (the shape is immutable)
     _smooth: dict[float, SmoothCurve] = field(default_factory=dict, repr=False, compare=False)
     _framed: dict[float, FramedSpline] = field(default_factory=dict, repr=False, compare=False)
+    _targets: dict[str, FramedSpline] = field(default_factory=dict, repr=False, compare=False)
 
     def smooth_curve_at(self, q: float) -> SmoothCurve:
         """The centerline c(q, .) as a :class:`SmoothCurve` (no frames)."""
         q = float(q)
         if q not in self._smooth:
             a, w = self._segment(q)
-            if self._intrinsic is None:  # mode "linear": blend_shapes prepares the data of "intrinsic" only
+            if self._sampler is not None:
+                self._smooth[q] = smooth_curve_from_samples(self._sampler(q))
+            elif self._intrinsic is None:  # mode "linear": blend_shapes prepares the data of "intrinsic" only
                 self._smooth[q] = _linear(self.keys[a], self.keys[a + 1], w)
             else:
                 self._smooth[q] = _integrate_intrinsic(self.keys[0], self._intrinsic, a, w)
@@ -141,6 +148,18 @@ class BlendedShape:
                                     "(or auto, the default)") from err
             self._framed[q] = framed
         return self._framed[q]
+
+    def target_curve(self) -> FramedSpline:
+        """The q = 1 centerline the body's wall is fitted around, with its frames.
+
+        It is c(1, .) except for a sampled shape (``pcc``), whose q = 1 shape is the designed chain and whose
+        wall is the vessel's, fitted around the final key (the vessel's centerline) and carried to the chain.
+        """
+        if self._sampler is None:
+            return self.curve_at(1.0)
+        if "target" not in self._targets:
+            self._targets["target"] = framed_curve(self.keys[-1], self.frames, self.base_normal, label="q = 1 target")
+        return self._targets["target"]
 
     def keep_curve(self, q: float, framed: FramedSpline) -> None:
         """Keep ``framed``, built from this shape by :meth:`curve_at` (in a worker process), as c(q, .) and its frames.
@@ -219,6 +238,19 @@ def blend_shapes(
     base_normal = base_normal_from_tangent(final.tangents([0.0])[0])
     intrinsic = _prepare_intrinsic(keys, base_normal) if mode == "intrinsic" else None
     return BlendedShape(key_q, keys, mode, frames, base_normal, intrinsic)
+
+
+def sampled_shape(
+    final: SmoothCurve, sampler: Callable[[float], FloatArray], mode: BlendMode, frames: FrameMode = "rmf"
+) -> BlendedShape:
+    """A shape whose c(q, .) is ``sampler(q)`` ((m, 3) mm at ``final.l_grid``, equal arc length), splined per q.
+
+    ``final`` is the centerline the wall is fitted around (:meth:`BlendedShape.target_curve`); the keys are
+    ``sampler(0)`` and ``final``.  The pipeline builds ``pcc`` this way (each section's curvature scaled by q).
+    """
+    initial = smooth_curve_from_samples(sampler(0.0))
+    base_normal = base_normal_from_tangent(final.tangents([0.0])[0])
+    return BlendedShape(np.array([0.0, 1.0]), (initial, final), mode, frames, base_normal, None, sampler)
 
 
 def _check_common_grid(keys: tuple[SmoothCurve, ...], key_q: FloatArray) -> None:

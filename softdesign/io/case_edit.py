@@ -41,11 +41,23 @@ def case_text_with_breaks(text: str, breaks: list[float], source_dir: Path, targ
     -------
     (text, kept) : the new text, and whether the user's text was kept (False: written whole by safe_dump)
     """
+    return case_text_with_keys(text, {"links": ({"breaks": rounded_breaks(breaks)}, breaks_text(breaks))},
+                               source_dir, target_dir)
+
+
+def case_text_with_keys(text: str, updates: dict[str, tuple[Any, str]], source_dir: Path,
+                        target_dir: Path) -> tuple[str, bool]:
+    """The case file ``text`` with top-level keys set (``{key: (value, its YAML flow text)}``), paths rebased.
+
+    Returns
+    -------
+    (text, kept) : the new text, and whether the user's text was kept (False: written whole by safe_dump)
+    """
     raw = yaml.safe_load(text)
     root = yaml.compose(text)
-    expected = _expected(raw, breaks, source_dir, target_dir)
+    expected = _expected(raw, updates, source_dir, target_dir)
     if isinstance(root, yaml.MappingNode) and not root.flow_style:
-        edited = _edited(text, root, breaks, source_dir, target_dir)
+        edited = _edited(text, root, updates, source_dir, target_dir)
         try:
             if yaml.safe_load(edited) == expected:
                 return edited, True
@@ -72,14 +84,16 @@ def _path_slots(raw: dict[str, Any]) -> list[tuple[Any, ...]]:
     return slots
 
 
-def _expected(raw: dict[str, Any], breaks: list[float], source_dir: Path, target_dir: Path) -> dict[str, Any]:
+def _expected(raw: dict[str, Any], updates: dict[str, tuple[Any, str]], source_dir: Path,
+              target_dir: Path) -> dict[str, Any]:
     out = copy.deepcopy(raw)
     for slot in _path_slots(out):
         holder = out
         for key in slot[:-1]:
             holder = holder[key]
         holder[slot[-1]] = _rebased(holder[slot[-1]], source_dir, target_dir)
-    out["links"] = {"breaks": rounded_breaks(breaks)}
+    for key, (value, _) in updates.items():
+        out[key] = copy.deepcopy(value)
     return out
 
 
@@ -101,7 +115,8 @@ def _content_end(node: yaml.Node) -> int:
     return node.end_mark.index
 
 
-def _edited(text: str, root: yaml.MappingNode, breaks: list[float], source_dir: Path, target_dir: Path) -> str:
+def _edited(text: str, root: yaml.MappingNode, updates: dict[str, tuple[Any, str]], source_dir: Path,
+            target_dir: Path) -> str:
     edits: list[tuple[int, int, str]] = []
     raw = yaml.safe_load(text)
     for slot in _path_slots(raw):
@@ -115,18 +130,22 @@ def _edited(text: str, root: yaml.MappingNode, breaks: list[float], source_dir: 
         new = _rebased(value, source_dir, target_dir)
         if isinstance(node, yaml.ScalarNode) and new != value:
             edits.append((node.start_mark.index, node.end_mark.index, json.dumps(new)))
-    found = _child(root, "links")
-    if found is None:
-        tail = "" if text.endswith("\n") or not text else "\n"
-        edits.append((len(text), len(text), f"{tail}links: {breaks_text(breaks)}\n"))
-    else:
+    appended = ""
+    for name, (_, flow) in updates.items():
+        found = _child(root, name)
+        if found is None:
+            appended += f"{name}: {flow}\n"
+            continue
         key, value_node = found
         if isinstance(value_node, (yaml.MappingNode, yaml.SequenceNode)) and not value_node.flow_style:
             end = text.find("\n", _content_end(value_node))
             end = len(text) if end < 0 else end
-            edits.append((key.end_mark.index, end, f": {breaks_text(breaks)}"))
+            edits.append((key.end_mark.index, end, f": {flow}"))
         else:
-            edits.append((value_node.start_mark.index, value_node.end_mark.index, breaks_text(breaks)))
+            edits.append((value_node.start_mark.index, value_node.end_mark.index, flow))
+    if appended:
+        tail = "" if text.endswith("\n") or not text else "\n"
+        edits.append((len(text), len(text), tail + appended))
     for start, end, new_text in sorted(edits, reverse=True):
         text = text[:start] + new_text + text[end:]
     return text

@@ -37,12 +37,14 @@ def build_through(
     force: bool = False,
     progress: Callable[[str], None] = lambda line: None,
     jobs: int = 1,
+    case: Case | None = None,
 ) -> BuildOutcome:
     """Run the stages up to ``target`` (every stage when None), per-q work on ``jobs`` processes.
 
-    Errors name the case file.
+    ``case``: the case file's case as loaded and then changed by the caller (``softdesign design``'s options);
+    default: loaded from ``case_file``.  Errors name the case file.
     """
-    case = load_case(case_file)
+    case = load_case(case_file) if case is None else case
     build_dir = default_build_dir(case, out)
     stages = STAGES if target is None else stages_through(target)
     later = tuple(s for s in STAGES if s not in stages)

@@ -83,6 +83,28 @@ def choose_blend(
     why = f"intrinsic (auto: the linear blend {_fold_text(reach)}; intrinsic: {_figure(fold)})"
     return BlendChoice(intrinsic, requested, fold, reach, why)
 
+
+def pcc_choice(shape: BlendedShape, path: SelectedPath, design: dict[str, Any]) -> dict[str, Any]:
+    """The blend summary's extra keys for ``blend: pcc``: the reach of the chain's morph and the design's breaks.
+
+    Each section's curvature is q * kappa, so the morph's largest reach r * kappa is the chain's at q = 1; it is
+    reported (and warned about at the fold limit), not refused: the design's tolerance is the user's choice.
+    """
+    reach = None
+    warning = None
+    if path.radius is not None:
+        reach = morph_reach(shape, *radius_profile_on(l_from_points(shape.keys[-1], path.points), path.radius))
+        if reach.reach >= SURE_FOLD:
+            warning = (f"blend: pcc: the designed chain turns tighter than the vessel is wide at l = {reach.l:.4f} "
+                       f"(r * kappa = {reach.reach:.3f} at q = {reach.q:.3f}): the body folds there; design with a "
+                       "smaller design.tolerance_mm or a larger design.min_link_mm")
+    reason = (f"pcc (each of the design's {len(design['links'])} section(s) an arc of its own length, curvature "
+              "q * kappa, composed from the base"
+              + ("" if reach is None else f"; {_figure(reach)}") + ")")
+    return {"requested": "pcc", "morph": None if reach is None else reach.as_dict(), "linear_morph": None,
+            "choice": reason, "warning": warning, "design_breaks": design["breaks"]}
+
+
 def describe_choice(summary: dict[str, Any]) -> list[str]:
     """The blend stage's line on the chosen blend (summaries of builds before ``choice`` existed have none)."""
     if "choice" not in summary:
@@ -113,4 +135,5 @@ def _final_fold_message(reach: MorphReach, final: SmoothCurve) -> str:
         "(1 - rho * kappa_n > 0)"
     )
 
-__all__ = ["MORPH_REACH_LIMIT", "BlendChoice", "choose_blend", "describe_choice"]
+
+__all__ = ["MORPH_REACH_LIMIT", "BlendChoice", "choose_blend", "describe_choice", "pcc_choice"]

@@ -22,6 +22,10 @@ INGEST_INITIAL_SURFACE = "ingest/initial_surface.npz"
 INGEST_SUMMARY = "ingest/summary.json"
 #: The centerline extracted from the surface (``final.centerline: auto``), VMTK's layout, in the case's units.
 INGEST_CENTERLINE = "ingest/centerline.vtp"
+#: The composed-chain design (issue 30): its document (``softdesign design --json`` prints the same) and the
+#: deviation along the target and the chain's points, for the report.
+DESIGN_SUMMARY = "design/summary.json"
+DESIGN_PROFILE = "design/profile.npz"
 BLEND_CURVES = "blend/curves.npz"
 BLEND_SUMMARY = "blend/summary.json"
 LINKS = "links/links.json"

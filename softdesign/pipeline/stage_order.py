@@ -14,6 +14,7 @@ from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages import (
     actuation,
     blend,
+    design,
     export,
     feasibility,
     fit,
@@ -26,9 +27,8 @@ from softdesign.pipeline.stages import (
 
 #: Every stage, in build order.
 STAGES: list[Stage] = [
-    ingest.STAGE, blend.STAGE, links.STAGE, kinematics.STAGE, fit.STAGE, actuation.STAGE, export.STAGE, mould.STAGE,
-    volume_mesh.STAGE,
-    feasibility.STAGE,
+    ingest.STAGE, design.STAGE, blend.STAGE, links.STAGE, kinematics.STAGE, fit.STAGE, actuation.STAGE,
+    export.STAGE, mould.STAGE, volume_mesh.STAGE, feasibility.STAGE,
 ]
 
 

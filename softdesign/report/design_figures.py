@@ -1,4 +1,9 @@
-"""The design panel (issue 14, item 3): the q = 1 centerline, one constant-curvature arc per link, their error.
+"""The design panel: the composed chain of a ``design:`` (issue 30), else one arc per link (issue 14, item 3).
+
+With a design (``design/summary.json``): the chain of constant-curvature
+sections composed from the base frame (each section its colour) over the q = 1
+centerline, and along l each centerline sample's true distance to the chain
+against the tolerance; the tip error in the title.  Without one, as below.
 
 Left: the centerline at q = 1 (grey) in its principal view, each link's best
 arc drawn from the link's own start frame (the link's colour, dashed), and the
@@ -9,6 +14,9 @@ stated tolerance (``arc_check.ARC_TOLERANCE_MM``).
 """
 
 from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -91,3 +99,61 @@ def design_picture(chain: LinkChain) -> Picture:
         "`softdesign design CASE --tolerance-mm T` chooses the fewest links within T."
     )
     return picture("design.png", figure, SIZE_IN, "Link design: one constant-curvature arc per link", caption)
+
+
+def panel_title(build_dir: Path) -> str:
+    """The report section's title: the composed design's when the build has one."""
+    from softdesign.pipeline.stages.design import load_design
+
+    if load_design(build_dir) is None:
+        return "Link design: one constant-curvature arc per link"
+    return "Design: constant-curvature sections composed from the base"
+
+
+def panel_picture(chain: LinkChain, build_dir: Path) -> Picture:
+    """The composed design's figure when the build has a design, else :func:`design_picture`."""
+    from softdesign.pipeline.stages.design import load_design
+
+    design = load_design(build_dir)
+    return design_picture(chain) if design is None else chain_picture(design.document, design.profile)
+
+
+def chain_picture(document: dict[str, Any], profile: dict[str, np.ndarray]) -> Picture:
+    """The composed chain over the target, and the deviation along l against the tolerance (issue 30)."""
+    target, points, s = profile["target_points"], profile["chain_points"], profile["chain_s"]
+    joints = np.concatenate([[0.0], np.cumsum([k["length"] for k in document["links"]])])
+    colours = link_colours(len(document["links"]))
+    view = principal_view(target, target[-1] - target[-2 if len(target) > 1 else 0])
+    length = float(np.sum(np.linalg.norm(np.diff(target, axis=0), axis=1)))
+    with styled():
+        figure = fixed_figure(SIZE_IN, MARGINS_IN, (GAP_IN, 0.0), (1, 2))
+        left, right = figure.subplots(1, 2, width_ratios=[1.3, 1.0])
+        xy = view.project(target)
+        left.plot(xy[:, 0], xy[:, 1], color="0.6", lw=3.0, label="centerline, q = 1")
+        for j in range(len(document["links"])):
+            inside = (s >= joints[j]) & (s <= joints[j + 1])
+            a = view.project(points[inside])
+            left.plot(a[:, 0], a[:, 1], color=colours[j], lw=1.4, label=f"section {j}")
+        base = view.project(np.array(document["base_frame"])[None, :3, 3])
+        left.plot(base[:, 0], base[:, 1], "ko", ms=4, label="base frame")
+        left.set(aspect="equal", xlabel=view.labels[0], ylabel=view.labels[1], title="chain composed from the base")
+        left.legend(loc="best", fontsize=7)
+        right.plot(profile["l"] * length, profile["deviation_mm"], color="k", lw=1.2, label="centerline to chain")
+        for j, link in enumerate(document["links"]):
+            right.axvspan(link["l_start"] * length, link["l_end"] * length, color=colours[j], alpha=0.12, lw=0)
+        right.axhline(document["tolerance_mm"], color="k", lw=0.8, ls="--",
+                      label=f"tolerance {document['tolerance_mm']:g} mm")
+        right.set(xlabel="arc length of the centerline (mm)", ylabel="distance to the composed chain (mm)",
+                  title=f"tip off by {document['tip_error_mm']:.3g} mm, {document['tip_error_deg']:.3g} deg",
+                  ylim=(0.0, None))
+        right.legend(loc="best", fontsize=7)
+    verdict = "within" if document["meets_tolerance"] else "NOT within"
+    caption = (
+        f"{len(document['links'])} constant-curvature sections (seed 003), section 1 on the centerline's base frame "
+        "and each next one on the previous tip, over the q = 1 centerline. Right: each centerline sample's true "
+        f"distance to the chain (shaded: the sections' l ranges); both ways the chain is at most "
+        f"{document['chain_max_deviation_mm']:.3g} mm from the centerline, {verdict} the tolerance; the tip is "
+        f"{document['tip_error_mm']:.3g} mm and {document['tip_error_deg']:.3g} deg off (design/summary.json)."
+    )
+    return picture("design.png", figure, SIZE_IN, "Design: constant-curvature sections composed from the base",
+                   caption)

@@ -93,7 +93,7 @@ def true_distances(data: BuildData) -> FloatArray:
         data.ingest.vertices[keep], points["l"][keep], points["angle"][keep], points["rho"][keep],
         np.zeros(int(keep.sum()), np.int8),
     )
-    curve = data.kinematics.chain.shape.curve_at(1.0)
+    curve = data.kinematics.chain.shape.target_curve()  # the wall is fitted around it (blend: pcc: the vessel's)
     return closest_surface_points(curve, _FieldAtQ(fit.field, 1.0), polar)[0]
 
 

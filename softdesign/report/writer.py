@@ -276,8 +276,8 @@ def report_sections(
         notes.append(NO_EXPORT)
         tables.notes.append(NO_EXPORT)
     design = Section(
-        "design", "Link design: one constant-curvature arc per link",
-        pictures=[run("design.png", lambda: design_figures.design_picture(data.kinematics.chain))],
+        "design", design_figures.panel_title(data.build_dir),
+        pictures=[run("design.png", lambda: design_figures.panel_picture(data.kinematics.chain, data.build_dir))],
     )
     sections = [
         view, morph, surfaces, fit, kinematics, design, tables,
@@ -311,7 +311,7 @@ def _slow_parts(data: BuildData, options: ReportOptions) -> dict[str, Callable[[
         parts["fit_distances.png"] = lambda: _distance_picture(data)
         parts["fit_residuals.png"] = lambda: fit_figures.residual_picture(data)
         parts[profile_figures.NAME] = lambda: profile_figures.profile_picture(data)
-    parts["design.png"] = lambda: design_figures.design_picture(data.kinematics.chain)
+    parts["design.png"] = lambda: design_figures.panel_picture(data.kinematics.chain, data.build_dir)
     parts[mould_figures.NAME] = lambda: mould_figures.mould_picture(data)
     return parts
 

@@ -21,9 +21,8 @@ from tests.helpers.paths import REPO
 
 runner = CliRunner()
 DEMO = REPO / "configs" / "demo.yaml"
-#: The design's breaks are written with six decimals of l: the build's link ends move by at most 5e-7 of the
-#: 104 mm path (5e-5 mm), and a link's deviation with them by about as much.
-BREAK_ROUNDING_MM = 1e-3
+#: blend: pcc's links against their best arcs at q = 1 (see the designed-demo test).
+PCC_ARC_CHECK_MM = 0.1
 FIGURE = re.compile(r"link (\d+): at q = 1 its centerline is up to ([0-9.]+) mm")
 
 
@@ -54,8 +53,12 @@ def test_the_designed_demo_builds_without_a_warning_and_with_the_designs_figures
     assert "warning" not in result.stderr
     check = json.loads((tmp_path / "designed" / "manifest.json").read_text())["metrics"]["kinematics"]["arc_check"]
     assert check["warnings"] == []
-    np.testing.assert_allclose(check["max_deviation_mm"], [k["max_deviation_mm"] for k in links], rtol=0,
-                               atol=BREAK_ROUNDING_MM)
+    # issue 30: the designed case builds blend: pcc, one link per section, each link at q = 1 one arc of the chain.
+    # The check starts each arc on the spline's frame at the link's start; the quintic through the chain's samples
+    # is within 1e-3 mm of the chain but its tangent at a joint, where the curvature jumps, is off by ~2e-3 rad, and
+    # an arc started there drifts by that times the link's length (measured: 0.056 mm on the demo's 30 mm section)
+    assert len(check["max_deviation_mm"]) == len(links)
+    np.testing.assert_allclose(check["max_deviation_mm"], 0.0, rtol=0, atol=PCC_ARC_CHECK_MM)
 
 
 def test_pcc_design_warns_above_warn_mm_only(tmp_path):

@@ -26,7 +26,7 @@ BREAKS_TOL = 5e-7
 
 def comparable(case) -> dict:
     """The case without its links, input paths resolved (the designed file may name them from another folder)."""
-    dump = case.model_dump(exclude={"links"})
+    dump = case.model_dump(exclude={"links", "blend", "design"})
     dump["final"] = {k: v.resolve() if isinstance(v, Path) else v for k, v in dump["final"].items()}
     return dump
 
@@ -40,13 +40,13 @@ def test_demo_design_meets_the_tolerance_and_its_case_file_differs_only_in_the_l
     build, output = tmp_path / "build", tmp_path / "designed.yaml"
     code, doc, err = design_json(DEMO, build, output, "--tolerance-mm", "1", "--d", "3")
     assert code == 0, err
-    assert list(doc)[:4] == ["tolerance_mm", "meets_tolerance", "worst_deviation_mm", "links"]
-    assert {"breaks", "tip_error_mm", "tip_error_rad"} <= set(doc)
+    assert {"base_frame", "links", "chain_max_deviation_mm", "tip_error_mm", "tip_error_deg", "meets_tolerance",
+            "method", "convention", "breaks"} <= set(doc)
     assert doc["meets_tolerance"] and doc["tolerance_mm"] == 1.0
     links = doc["links"]
     assert [k["index"] for k in links] == list(range(len(links)))
     assert all(k["max_deviation_mm"] <= 1.0 for k in links)
-    assert doc["worst_deviation_mm"] == max(k["max_deviation_mm"] for k in links)
+    assert doc["chain_max_deviation_mm"] == max(k["max_deviation_mm"] for k in links)
     np.testing.assert_allclose(doc["breaks"], [links[0]["l_start"]] + [k["l_end"] for k in links], rtol=0,
                                atol=BREAKS_TOL)
     assert doc["breaks"][0] == 0.0 and doc["breaks"][-1] == 1.0
@@ -55,10 +55,11 @@ def test_demo_design_meets_the_tolerance_and_its_case_file_differs_only_in_the_l
                                    rtol=0, atol=JSON_TOL)
         assert k["theta"] == pytest.approx(k["kappa"] * k["length"], abs=JSON_TOL)
     designed, original = load_case(output), load_case(DEMO)
-    assert designed.links.breaks == doc["breaks"]
+    assert designed.links.breaks == [round(b, 6) for b in doc["breaks"]]
+    assert designed.blend == "pcc" and designed.design is not None and designed.design.tolerance_mm == 1.0
     assert comparable(designed) == comparable(original)
     assert "# the main vessel; path 1 follows the side branch" in output.read_text()  # the user's comments stay
-    # the designed case's links stage takes exactly these breaks
+    # the designed case's links stage takes exactly the design's breaks (blend: pcc: one link per section)
     result = runner.invoke(app, ["links", str(output), "--out", str(tmp_path / "build-designed")])
     assert result.exit_code == 0, result.output
     written = json.loads((tmp_path / "build-designed" / "links" / "links.json").read_text())
@@ -89,8 +90,8 @@ def test_no_design_within_max_links_exits_1_with_the_best_and_writes_nothing(tmp
     output = tmp_path / "designed.yaml"
     code, doc, err = design_json(DEMO, tmp_path / "build", output, "--tolerance-mm", "0.05", "--max-links", "2")
     assert code == 1
-    assert not doc["meets_tolerance"] and len(doc["links"]) <= 2 and doc["worst_deviation_mm"] > 0.05
-    assert "no segmentation into at most 2 link(s)" in err and "nothing written" in err
+    assert not doc["meets_tolerance"] and len(doc["links"]) <= 2 and doc["chain_max_deviation_mm"] > 0.05
+    assert "the design misses its bounds" in err and "nothing written" in err
     assert not output.exists()
 
 
@@ -99,7 +100,7 @@ def test_no_design_within_max_links_exits_1_with_the_best_and_writes_nothing(tmp
     [
         (["--tolerance-mm", "0"], "--tolerance-mm must be a finite number > 0 mm, got 0"),
         (["--tolerance-mm", "-1"], "--tolerance-mm must be a finite number > 0 mm, got -1"),
-        (["--tolerance-mm", "1", "--max-links", "0"], "--max-links must be 1 to 200, got 0"),
+        (["--tolerance-mm", "1", "--max-links", "0"], "--max-links must be 1 to 40, got 0"),
         (["--tolerance-mm", "1", "--min-link-mm", "0"], "--min-link-mm must be a finite number > 0 mm"),
         (["--tolerance-mm", "1", "--min-link-mm", "5000"], "longer than the centerline"),
         (["--tolerance-mm", "1", "--d", "x"], "--d value 1: 'x' is not a number"),
@@ -121,7 +122,8 @@ def test_output_into_a_missing_folder_or_onto_the_case_exits_2(tmp_path):
 def test_help_names_the_json_keys():
     result = runner.invoke(app, ["design", "--help"])
     assert result.exit_code == 0
-    for key in ("tolerance_mm", "max_deviation_mm", "chamber_lengths", "tip_error_rad", "--max-links"):
+    for key in ("tolerance_mm", "max_deviation_mm", "chamber_lengths", "tip_error_deg", "base_frame", "tip_frame",
+                "--max-links", "--tip-tolerance-mm", "--tip-tolerance-deg"):
         assert key in result.output
 
 
@@ -184,6 +186,8 @@ def test_a_straight_vessel_is_one_straight_link_and_without_radii_needs_min_link
     assert code == 0, err
     (link,) = doc["links"]
     assert (link["kappa"], link["phi"], link["theta"]) == (0.0, 0.0, 0.0) and doc["breaks"] == [0.0, 1.0]
-    np.testing.assert_allclose([link["length"], link["max_deviation_mm"], doc["tip_error_mm"], doc["tip_error_rad"]],
-                               [40.0, 0.0, 0.0, 0.0], rtol=0, atol=1e-9)
-    assert (tmp_path / "d.yaml").read_text() == "final: {centerline: line.csv}\nlinks: {breaks: [0.0, 1.0]}\n"
+    np.testing.assert_allclose([link["length"], link["max_deviation_mm"], doc["tip_error_mm"], doc["tip_error_deg"]],
+                               [40.0, 0.0, 0.0, 0.0], rtol=0, atol=1e-6)
+    assert (tmp_path / "d.yaml").read_text() == (
+        "final: {centerline: line.csv}\ndesign: {tolerance_mm: 0.1, max_links: 20, min_link_mm: 5.0}\nblend: pcc\n"
+        "links: {breaks: [0.0, 1.0]}\n")

@@ -233,3 +233,18 @@ def test_a_broken_case_fails_its_row_and_the_others_still_build(tmp_path):
         assert json.loads((build / f"{name}.status.json").read_text())["exit_code"] == 2
     # the failed cases are tried again next time; the good ones are left alone
     assert builds_in(make("-n", "cohort", cohort_dir=cases, build=build).stdout, build) == {"broken", "missing"}
+
+
+def test_a_designed_case_row_carries_the_chain_deviation_and_tip_error(tmp_path):
+    # issue 30: the design stage's manifest figures reach the cohort summary; a case without a design leaves them blank
+    design = {"designed": True, "links": 5, "meets_tolerance": True, "chain_max_deviation_mm": 0.47,
+              "tip_error_mm": 0.12, "tip_error_deg": 4.1, "breaks": [0.0, 1.0]}
+    for name, metrics in (("designed", {"design": design}), ("plain", {"design": {"designed": False}})):
+        (tmp_path / name).mkdir()
+        manifest = {"metrics": metrics, "outputs": [], "case": {"export": {}}}
+        (tmp_path / name / "manifest.json").write_text(json.dumps(manifest))
+    designed = cohort.manifest_figures(tmp_path / "designed")
+    assert (designed["chain_deviation_mm"], designed["tip_error_mm"], designed["tip_error_deg"]) == (0.47, 0.12, 4.1)
+    plain = cohort.manifest_figures(tmp_path / "plain")
+    assert (plain["chain_deviation_mm"], plain["tip_error_mm"], plain["tip_error_deg"]) == ("", "", "")
+    assert {"chain_deviation_mm", "tip_error_mm", "tip_error_deg"} <= set(cohort.SUMMARY_COLUMNS)

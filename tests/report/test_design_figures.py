@@ -40,3 +40,32 @@ def test_the_panel_draws_the_manifests_deviations_and_the_chained_tip(tmp_path):
     path.write_bytes(picture.data)
     with Image.open(path) as image:
         assert image.size == EXPECTED_SIZES["design.png"]
+
+
+def test_with_a_design_the_panel_draws_the_composed_chain_and_its_figures(tmp_path):
+    # issue 30: a build with a design: block shows the chain composed from the base, its deviation and tip error
+    import yaml
+
+    from softdesign.pipeline.stages.design import load_design
+    from softdesign.report.design_figures import panel_picture, panel_title
+
+    demo = REPO / "configs" / "demo.yaml"
+    case = yaml.safe_load(demo.read_text())
+    for key in ("centerline", "surface"):
+        case["final"][key] = str((demo.parent / case["final"][key]).resolve())
+    case.update(design={"tolerance_mm": 1.0}, blend="pcc")
+    case_file = tmp_path / "demo.yaml"
+    case_file.write_text(yaml.safe_dump(case))
+    outcome = build_through(case_file, tmp_path / "build", target="kinematics")
+    design = load_design(tmp_path / "build")
+    assert design is not None and panel_title(tmp_path / "build").startswith("Design: constant-curvature sections")
+    picture = panel_picture(outcome.results["kinematics"].chain, tmp_path / "build")
+    document = design.document
+    for figure in (document["chain_max_deviation_mm"], document["tip_error_mm"], document["tip_error_deg"]):
+        assert f"{figure:.3g}" in picture.caption
+    path = tmp_path / picture.name
+    path.write_bytes(picture.data)
+    with Image.open(path) as image:
+        assert image.size == EXPECTED_SIZES["design.png"]
+    # the profile drawn is each target sample's distance to the chain, at most the chain's two-way deviation
+    assert 0.0 < design.profile["deviation_mm"].max() <= document["chain_max_deviation_mm"]

@@ -15,9 +15,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softdesign.geometry.blend import BlendedShape, BlendMode, Shortening, blend_shapes
+from softdesign.errors import ConfigError
+from softdesign.geometry.blend import BlendedShape, BlendMode, Shortening, blend_shapes, sampled_shape
 from softdesign.geometry.curves import (
     TORSION_KAPPA_FLOOR,
+    SmoothCurve,
     smooth_curve_from_polyline,
     smooth_curve_from_samples,
 )
@@ -25,8 +27,9 @@ from softdesign.geometry.frames import FrameMode
 from softdesign.geometry.initial import InitialSpec, build_initial_shape, initial_shape_from_polyline
 from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import curve_options
-from softdesign.pipeline.blend_choice import choose_blend, describe_choice
+from softdesign.pipeline.blend_choice import choose_blend, describe_choice, pcc_choice
 from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.design import DesignResult, load_design
 from softdesign.pipeline.stages.ingest import IngestResult
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 
@@ -36,7 +39,8 @@ if TYPE_CHECKING:  # only annotations: the report loads stage results without th
 #: 2: the final path's torsion only where curvature >= TORSION_KAPPA_FLOOR (null when nowhere), with the
 #: fraction of the path where it is defined and the floor.
 #: 3: the morph's reach r * kappa over q (``morph``), ``blend: auto`` and the blend it chose.
-VERSION = 3
+#: 4: ``blend: pcc`` (the designed chain, each section's curvature q * kappa at constant length).
+VERSION = 4
 
 
 @dataclass(frozen=True)
@@ -48,9 +52,16 @@ class BlendResult:
     samples: tuple[np.ndarray, ...]
 
 
-def run_blend(case: Case, ingest: IngestResult) -> BlendResult:
-    """Build c(q, l) for the case from the ingested paths."""
+def run_blend(case: Case, ingest: IngestResult, design: DesignResult | None = None) -> BlendResult:
+    """Build c(q, l) for the case from the ingested paths (``blend: pcc``: from the design's chain)."""
     final = smooth_curve_from_polyline(ingest.path.points, curve_options(case))
+    if case.blend == "pcc":
+        if design is None:  # the case file's check refuses blend: pcc without a design: block
+            raise RuntimeError("blend: pcc without a design")
+        final = smooth_curve_from_samples(final.points(final.l_grid))  # as the design stage and load_blend build it
+        shape = pcc_shape(final, design, case.frames)
+        figures = pcc_choice(shape, ingest.path, design.document)
+        return BlendResult(shape, {**_summary(case, shape), **figures}, (final.points(final.l_grid),))
     same_grid = curve_options(case, count=len(final.l_grid))
     spec = InitialSpec(
         kind=case.initial.kind,
@@ -73,6 +84,23 @@ def run_blend(case: Case, ingest: IngestResult) -> BlendResult:
     samples = tuple(curve.points(curve.l_grid) for curve in choice.shape.keys)
     shape = _shape_from_samples(choice.shape.key_q, samples, choice.shape.mode, choice.shape.frames)
     return BlendResult(shape, {**_summary(case, shape), **choice.summary()}, samples)
+
+
+def pcc_shape(final: SmoothCurve, design: DesignResult, frames: FrameMode) -> BlendedShape:
+    """c(q, .): each designed section an arc of its own length, curvature q * kappa, plane phi, composed from the base.
+
+    The target's l maps onto the chain by arc-length fraction (the design's breaks are the joints' fractions), so
+    c(q, l) is the chain's point at arc length ``l * sum(L)``.
+    """
+    from softdesign.kinematics.pcc_chain import chain_points_at
+
+    base, w, lengths = design.base2world, design.w, design.lengths
+    s = final.l_grid * float(np.sum(lengths))
+
+    def sampler(q: float) -> np.ndarray:
+        return chain_points_at(base, q * w, lengths, s)
+
+    return sampled_shape(final, sampler, "pcc", frames)
 
 
 def _shape_from_samples(
@@ -111,9 +139,10 @@ def _summary(case: Case, shape: BlendedShape) -> dict[str, Any]:
 
 
 def write_blend(result: BlendResult, staging: Staging) -> None:
-    """Keep the key shapes' samples and the figures."""
+    """Keep the key shapes' samples (``pcc``: the final shape's; the chain is the design's) and the figures."""
     samples = {f"key_{k}": points for k, points in enumerate(result.samples)}
-    staging.write_bytes(layout.BLEND_CURVES, npz_bytes(key_q=result.shape.key_q, **samples))
+    key_q = result.shape.key_q if result.shape.mode != "pcc" else np.array([1.0])
+    staging.write_bytes(layout.BLEND_CURVES, npz_bytes(key_q=key_q, **samples))
     staging.write_json(layout.BLEND_SUMMARY, result.summary)
 
 
@@ -122,6 +151,13 @@ def load_blend(build_dir: Path) -> BlendResult:
     data = load_npz(Path(build_dir) / layout.BLEND_CURVES)
     summary = json.loads((Path(build_dir) / layout.BLEND_SUMMARY).read_text(encoding="utf-8"))
     samples = tuple(data[f"key_{k}"] for k in range(len(data["key_q"])))
+    if summary["mode"] == "pcc":
+        design = load_design(build_dir)
+        if design is None:
+            raise ConfigError(f"{build_dir}: blend: pcc was built from a design, but design/summary.json is missing; "
+                              "run `softdesign build` again")
+        return BlendResult(pcc_shape(smooth_curve_from_samples(samples[0]), design, summary["frames"]), summary,
+                           samples)
     shape = _shape_from_samples(data["key_q"], samples, summary["mode"], summary["frames"])
     return BlendResult(shape, summary, samples)
 
@@ -162,8 +198,8 @@ STAGE = Stage(
     name="blend",
     version=VERSION,
     reads=("initial", "resample", "frames", "blend"),
-    upstream=("ingest",),
-    compute=lambda case, results: run_blend(case, results["ingest"]),
+    upstream=("ingest", "design"),
+    compute=lambda case, results: run_blend(case, results["ingest"], results.get("design")),
     write=write_blend,
     load=lambda build_dir, results: load_blend(build_dir),
     describe=describe_blend,

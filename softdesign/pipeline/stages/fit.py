@@ -86,7 +86,7 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     if len(ingest.faces) == 0:
         raise ConfigError("final.surface is required to fit the actuator's surface; add it to the case file")
     chain = links.chain
-    curve = chain.shape.curve_at(1.0)
+    curve = chain.shape.target_curve()  # the vessel's centerline (blend: pcc carries the wall onto the chain)
     path = ingest.path
     inscribed = (None, None) if path.radius is None else inscribed_profile(curve, path.points, path.radius)
     network = NetworkContext(path.points, tuple(p.points for p in ingest.others), *inscribed)
@@ -130,6 +130,8 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     summary["morph_fold"] = morph.as_dict()
     if morph.warning() is not None:
         summary["warnings"] = [*summary.get("warnings", []), morph.warning()]
+    if chain.shape.mode == "pcc":
+        summary["pcc"] = _carried_to_chain(chain, curve)
     # the end prior can hold the ends a straying centerline leaves one-sided: the fit then succeeds, so say it
     stray = centerline_stray(case, curve.curve, path)
     if stray is not None:
@@ -144,6 +146,21 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
         "distance": wall.distance,
     }
     return FitResult(field, summary, points)
+
+
+def _carried_to_chain(chain: LinkChain, vessel: Any) -> dict[str, Any]:
+    """blend: pcc: how far the wall, fitted around the vessel's centerline, is carried to reach the chain at q = 1."""
+    l = chain.shape.keys[-1].dense_l()
+    moved = np.linalg.norm(chain.shape.smooth_curve_at(1.0).points(l) - vessel.points(l), axis=1)
+    worst = int(np.argmax(moved))
+    return {
+        "max_axis_shift_mm": float(moved[worst]),
+        "at_l": float(l[worst]),
+        "note": "the wall is fitted around the vessel's centerline and carried onto the designed chain by arc-length "
+                "fraction per section: at q = 1 each ring of the body sits on the chain's point at the same l, up to "
+                "max_axis_shift_mm from the vessel's (the chain's true distance to the centerline, "
+                "design/summary.json: chain_max_deviation_mm, is at most this)",
+    }
 
 
 def centerline_stray(case: Case, curve: SmoothCurve, path: SelectedPath) -> str | None:

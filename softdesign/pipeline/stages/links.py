@@ -39,12 +39,17 @@ def run_links(case: Case, blend: BlendResult) -> LinksResult:
     """Split the blended shape into the case's links (``links.count``, ``breaks`` or ``length_mm``)."""
     rule = case.links
     total = blend.shape.keys[-1].length
-    breaks = link_breaks(total, rule.count, rule.breaks, rule.length_mm)
+    if blend.shape.mode == "pcc":  # one link per designed section
+        breaks = np.array(blend.summary["design_breaks"], dtype=np.float64)
+    else:
+        breaks = link_breaks(total, rule.count, rule.breaks, rule.length_mm)
     document = {
         "breaks": breaks.tolist(),
         "lengths_mm": (np.diff(breaks) * total).tolist(),
         "units": {"breaks": "normalized arc length l of the final shape", "lengths_mm": "mm"},
     }
+    if blend.shape.mode == "pcc":
+        document["source"] = "design: one link per section (blend: pcc; the case's links: is not used)"
     return LinksResult(LinkChain(blend.shape, breaks), document)
 
 
