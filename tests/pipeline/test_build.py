@@ -69,33 +69,38 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     assert statuses(build(demo_case, out)) == dict.fromkeys(STAGES, "skipped")
     edit(demo_case, "fit", smoothing=2.0e-5)
     assert statuses(build(demo_case, out)) == {
-        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "ran",
+        "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
+        "fit": "ran",
         "actuation": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
     edit(demo_case, "export", q=[0, 0.5, 1])
     assert statuses(build(demo_case, out)) == {
-        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "ran", "fit": "skipped",
+        "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "ran",
+        "fit": "skipped",
         "actuation": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
     # The mesh formats are read by export (and the mould's formats): kinematics, the fit and the feasibility
     # figures stay cached.
     edit(demo_case, "export", formats=["stl", "ply"])
     assert statuses(build(demo_case, out)) == {
-        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "skipped",
+        "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
+        "fit": "skipped",
         "actuation": "skipped", "export": "ran", "mould": "ran", "volume_mesh": "skipped", "feasibility": "skipped",
     }
     # A mould is read by the mould stage and by the fit (which turns the end cuts into the mould's parting
     # plane): the fit and what follows it are redone; ingest, blend, links and kinematics stay.
     edit(demo_case, "export", mould={"margin_mm": 8})
     assert statuses(build(demo_case, out)) == {
-        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "ran",
+        "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
+        "fit": "ran",
         "actuation": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
     assert (out / "meshes" / "mould" / "half_a.ply").is_file()
     # New link breaks: the links, their kinematics and the per-link fit are redone; ingest and blend are not.
     edit(demo_case, "links", count=None, breaks=[0, 0.4, 1])
     assert statuses(build(demo_case, out)) == {
-        "ingest": "skipped", "blend": "skipped", "links": "ran", "kinematics": "ran", "fit": "ran", "actuation": "ran",
+        "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "ran", "kinematics": "ran",
+        "fit": "ran", "actuation": "ran",
         "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
     # A material is read by the verdicts alone (feasibility, the chambers' actuation, the volume mesh's 3D stress
@@ -121,7 +126,8 @@ def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tm
     # Nothing changed: the export on disk is what a build would make now, figures and metrics included.
     ran, manifest = run_fit()
     assert ran == {
-        "ingest": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped", "fit": "skipped",
+        "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
+        "fit": "skipped",
         "actuation": "kept", "export": "kept", "mould": "kept", "volume_mesh": "kept", "feasibility": "kept",
     }
     outputs = {o["path"]: o for o in manifest["outputs"]}
