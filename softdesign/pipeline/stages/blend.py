@@ -46,11 +46,14 @@ class BlendResult:
     shape: BlendedShape
     summary: dict[str, Any]
     samples: tuple[np.ndarray, ...]
+    #: samples where the curve keeps a corner (sharp joints at link breaks, geometry.curves)
+    joints: tuple[int, ...] = ()
 
 
 def run_blend(case: Case, ingest: IngestResult) -> BlendResult:
     """Build c(q, l) for the case from the ingested paths."""
-    final = smooth_curve_from_polyline(ingest.path.points, curve_options(case))
+    # explicit link breaks are where a designed case's sections meet: kept sharp where the path has a corner there
+    final = smooth_curve_from_polyline(ingest.path.points, curve_options(case), case.links.breaks or ())
     same_grid = curve_options(case, count=len(final.l_grid))
     spec = InitialSpec(
         kind=case.initial.kind,
@@ -71,14 +74,16 @@ def run_blend(case: Case, ingest: IngestResult) -> BlendResult:
     # the smoothed ones to round-off (1e-13 mm), not to the bit, and the stages after this one must get the same
     # shape whether the blend ran now or was loaded, or a stage re-run on cached results writes other bytes
     samples = tuple(curve.points(curve.l_grid) for curve in choice.shape.keys)
-    shape = _shape_from_samples(choice.shape.key_q, samples, choice.shape.mode, choice.shape.frames)
-    return BlendResult(shape, {**_summary(case, shape), **choice.summary()}, samples)
+    joints = final.joints
+    shape = _shape_from_samples(choice.shape.key_q, samples, choice.shape.mode, choice.shape.frames, joints)
+    return BlendResult(shape, {**_summary(case, shape), **choice.summary()}, samples, joints)
 
 
 def _shape_from_samples(
-    key_q: np.ndarray, samples: tuple[np.ndarray, ...], mode: BlendMode, frames: FrameMode
+    key_q: np.ndarray, samples: tuple[np.ndarray, ...], mode: BlendMode, frames: FrameMode,
+    joints: tuple[int, ...] = (),
 ) -> BlendedShape:
-    keys = [smooth_curve_from_samples(points) for points in samples]
+    keys = [smooth_curve_from_samples(points, joints) for points in samples]
     keyframes = tuple(zip(np.asarray(key_q)[1:-1].tolist(), keys[1:-1], strict=True))
     return blend_shapes(keys[0], keys[-1], keyframes, mode, frames)
 
@@ -113,7 +118,8 @@ def _summary(case: Case, shape: BlendedShape) -> dict[str, Any]:
 def write_blend(result: BlendResult, staging: Staging) -> None:
     """Keep the key shapes' samples and the figures."""
     samples = {f"key_{k}": points for k, points in enumerate(result.samples)}
-    staging.write_bytes(layout.BLEND_CURVES, npz_bytes(key_q=result.shape.key_q, **samples))
+    joints = {"joints": np.asarray(result.joints, np.int64)} if result.joints else {}  # none: the bytes of before
+    staging.write_bytes(layout.BLEND_CURVES, npz_bytes(key_q=result.shape.key_q, **samples, **joints))
     staging.write_json(layout.BLEND_SUMMARY, result.summary)
 
 
@@ -122,8 +128,9 @@ def load_blend(build_dir: Path) -> BlendResult:
     data = load_npz(Path(build_dir) / layout.BLEND_CURVES)
     summary = json.loads((Path(build_dir) / layout.BLEND_SUMMARY).read_text(encoding="utf-8"))
     samples = tuple(data[f"key_{k}"] for k in range(len(data["key_q"])))
-    shape = _shape_from_samples(data["key_q"], samples, summary["mode"], summary["frames"])
-    return BlendResult(shape, summary, samples)
+    joints = tuple(int(j) for j in data.get("joints", np.zeros(0, np.int64)))
+    shape = _shape_from_samples(data["key_q"], samples, summary["mode"], summary["frames"], joints)
+    return BlendResult(shape, summary, samples, joints)
 
 
 def torsion_text(path: dict[str, Any]) -> str:
@@ -161,7 +168,7 @@ def describe_blend(result: BlendResult) -> list[str]:
 STAGE = Stage(
     name="blend",
     version=VERSION,
-    reads=("initial", "resample", "frames", "blend"),
+    reads=("initial", "resample", "frames", "blend", "links.breaks"),
     upstream=("ingest",),
     compute=lambda case, results: run_blend(case, results["ingest"]),
     write=write_blend,
