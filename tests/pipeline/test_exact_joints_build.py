@@ -20,6 +20,7 @@ from softdesign.geometry.se3 import rotvec_from_rotation
 from softdesign.io.centerline_vtp import write_centerlines_vtp
 from softdesign.pipeline.api import build_through
 from softdesign.pipeline.layout import KINEMATICS
+from softdesign.pipeline.stages.blend import describe_blend
 from tests.helpers.seed_transforms import seed_chain, trans_z
 
 #: (kappa 1/mm, phi rad, L mm); joints at 20, 32.5 and 47.5 mm of 70: samples of a 0.5 mm grid.
@@ -48,7 +49,10 @@ def test_link_transforms_of_a_case_broken_at_its_joints_are_the_sections(tmp_pat
             "resample": {"spacing_mm": SPACING_MM, "smoothing_mm": 0.0, "end_straight_mm": 0.0},
             "links": {"breaks": breaks}, "export": {"q": [0, 1]}}
     (tmp_path / "arcs.yaml").write_text(yaml.safe_dump(case), encoding="utf-8")
-    build_through(tmp_path / "arcs.yaml", tmp_path / "build", target="kinematics")
+    outcome = build_through(tmp_path / "arcs.yaml", tmp_path / "build", target="kinematics")
+    assert outcome.results["blend"].joints == (40, 65, 95)
+    assert "sharp joints (link breaks at a corner of the path, not smoothed over) at l = 0.2857, 0.4643, 0.6786" in (
+        describe_blend(outcome.results["blend"]))
     document = json.loads((tmp_path / "build" / KINEMATICS).read_text(encoding="utf-8"))
     final = next(p for p in document["poses"] if p["q"] == [1.0] * len(ARCS))
     for link, (kappa, phi, length) in zip(final["links"], ARCS, strict=True):

@@ -162,6 +162,10 @@ def describe_blend(result: BlendResult) -> list[str]:
             f"no intermediate shape is shorter than both end shapes (q = 0: {s['initial_length_mm']:.2f} mm, "
             f"q = 1: {f['length_mm']:.2f} mm)"
         )
+    if result.joints:
+        grid = result.shape.keys[-1].l_grid
+        at = ", ".join(f"{grid[j]:.4f}" for j in result.joints)
+        lines.append(f"sharp joints (link breaks at a corner of the path, not smoothed over) at l = {at}")
     return lines + describe_choice(s)
 
 
