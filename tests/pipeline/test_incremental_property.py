@@ -114,3 +114,26 @@ def test_rebuilds_after_any_edits_give_a_fresh_builds_bytes(first_build, edits):
         differing = sorted(name for name in one if one[name] != two[name] and name != "manifest.json")
         assert differing == [], f"after {edits}: {differing}"
         assert without_run_record(incremental / "manifest.json") == without_run_record(fresh / "manifest.json")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["kinematics", "fit", "export", "feasibility"])
+def test_a_stage_recomputed_on_results_loaded_from_the_folder_writes_the_kept_bytes(first_build, name, tmp_path):
+    """The issue's other half: every stage before ``name`` loaded from the build folder, ``name`` computed again."""
+    from softdesign.config import load_case
+    from softdesign.pipeline.stage_order import STAGES
+    from softdesign.pipeline.store import Staging
+
+    case_file = tmp_path / "case.yaml"
+    case_file.write_text(yaml.safe_dump(BASE, sort_keys=False), encoding="utf-8")
+    case = load_case(case_file)
+    results: dict[str, Any] = {}
+    for stage in STAGES:
+        if stage.name == name:
+            break
+        results[stage.name] = stage.load(first_build, results)
+    stage = next(s for s in STAGES if s.name == name)
+    kept = json.loads((first_build / name / "stage.json").read_text(encoding="utf-8"))["outputs"]
+    with Staging(tmp_path / "again") as staging:
+        stage.write(stage.compute(case, results), staging)
+        assert staging.written == kept
