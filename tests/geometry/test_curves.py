@@ -244,3 +244,9 @@ def test_samples_rebuilt_with_their_joints_give_the_same_spline():
     assert np.array_equal(again.spline.t, curve.spline.t)
     with pytest.raises(GeometryError, match="fewer than 6 samples"):
         smooth_curve_from_samples(curve.points(curve.l_grid), (3,))
+
+
+def test_a_smoothed_path_makes_no_joint_its_smoothing_moved_the_vertex_off_the_break():
+    points, corner = corner_points()
+    options = CurveOptions(spacing_mm=0.5, smoothing_mm=0.05, end_straight_mm=0.0)
+    assert smooth_curve_from_polyline(points, options, [corner]).joints == ()
