@@ -52,11 +52,13 @@ def forward_payload(lengths: np.ndarray, d: np.ndarray) -> dict:
             "length": float(arcs.length[i]),
             "theta": float(arcs.theta[i]),
             "transform": (section2prev[i] + 0.0).tolist(),  # + 0.0 turns -0.0 into 0.0
+            "dh": pcc.dh_rows(float(arcs.kappa[i]), float(arcs.phi[i]), float(arcs.length[i])),
         }
         for i in range(len(lengths))
     ]
     tip2base = tip2base + 0.0
-    return {"sections": sections, "tip": tip2base[:3, 3].tolist(), "transform": tip2base.tolist()}
+    return {"sections": sections, "tip": tip2base[:3, 3].tolist(), "transform": tip2base.tolist(),
+            "dh_convention": pcc.DH_CONVENTION}
 
 
 def _print_forward(payload: dict) -> None:
@@ -85,7 +87,9 @@ def forward(
     """Shape of a chain of sections from encoder lengths: kappa, phi, L, theta per section, and the tip pose.
 
     JSON: {"sections": [{"kappa" (1/mm), "phi" (rad), "length" (mm), "theta" (rad),
-    "transform" (4x4, section tip to previous tip)}], "tip" [x, y, z] (mm), "transform" (4x4, tip to base)}.
+    "transform" (4x4, section tip to previous tip), "dh" (seed 003's Table 1: five rows {"theta", "d", "a",
+    "alpha"}, rad and mm, whose D-H links Rz Tz Tx Rx multiply to "transform")}], "tip" [x, y, z] (mm),
+    "transform" (4x4, tip to base), "dh_convention"}.
     """
 
     def action() -> None:

@@ -266,7 +266,7 @@ def _check_common_grid(keys: tuple[SmoothCurve, ...], key_q: FloatArray) -> None
 
 def _linear(a: SmoothCurve, b: SmoothCurve, w: float) -> SmoothCurve:
     samples = (1.0 - w) * a.points(a.l_grid) + w * b.points(b.l_grid)
-    return smooth_curve_from_samples(samples)
+    return smooth_curve_from_samples(samples, b.joints)
 
 
 def _prepare_intrinsic(keys: tuple[SmoothCurve, ...], base_normal: FloatArray) -> _Intrinsic:
@@ -300,7 +300,7 @@ def _integrate_intrinsic(final_like: SmoothCurve, data: _Intrinsic, a: int, w: f
     s = np.linspace(0.0, length, intervals + 1)
     positions = make_interp_spline(s, tangents, k=5).antiderivative()(s) + base[:3, 3]
     per_sample = intervals // (len(final_like.l_grid) - 1)
-    return smooth_curve_from_samples(positions[::per_sample])
+    return smooth_curve_from_samples(positions[::per_sample], final_like.joints)
 
 
 def _blend_pose(a: FloatArray, b: FloatArray, w: float) -> FloatArray:

@@ -16,6 +16,10 @@ A polyline (mm, proximal first) becomes a :class:`SmoothCurve` in four steps:
 Step 4 gives every curve resampled with the same count the same knot vector,
 so blends of shapes are exact on the spline coefficients, and curvature and
 torsion come from analytic derivatives, not finite differences.
+
+Joints: link breaks where the curvature jumps (seed 003's sections meet) are
+kept sharp when asked: each piece between them is smoothed and resampled on
+its own (:mod:`softdesign.geometry.curve_joints` says when a break is one).
 """
 
 from __future__ import annotations
@@ -28,6 +32,7 @@ import numpy.typing as npt
 from scipy.interpolate import BSpline, PPoly, make_interp_spline, splprep
 
 from softdesign.errors import ConfigError, GeometryError
+from softdesign.geometry.curve_joints import joint_cuts, pieces_spline
 from softdesign.types import POINT_TOL_MM, FloatArray, Points
 
 #: Degree of the spline in l (5: torsion, a third derivative, is still C2).
@@ -99,11 +104,13 @@ class SmoothCurve:
     spline : scipy BSpline in l, values (3,) mm
     length : arc length of the spline, mm
     l_grid : (m,) uniform sample parameters, l_grid[0] = 0, l_grid[-1] = 1
+    joints : indices into ``l_grid`` of the sharp joints: knots of full multiplicity, nothing smoothed across
     """
 
     spline: BSpline
     length: float
     l_grid: FloatArray
+    joints: tuple[int, ...] = ()
 
     @cached_property
     def pieces(self) -> PPoly:
@@ -222,14 +229,16 @@ def checked_l(l: npt.ArrayLike) -> FloatArray:
     return np.clip(l, 0.0, 1.0)
 
 
-def smooth_curve_from_samples(samples: npt.ArrayLike) -> SmoothCurve:
+def smooth_curve_from_samples(samples: npt.ArrayLike, joints: tuple[int, ...] = ()) -> SmoothCurve:
     """Quintic interpolating spline through samples taken at equal arc length.
 
     Parameters
     ----------
     samples : (m, 3) float, mm, m >= 6, at l = linspace(0, 1, m)
+    joints : increasing indices of samples where the curve may turn its curvature sharply: the spline is
+        a separate interpolant on each piece between them (>= 6 samples each), joined at the shared sample
 
-    Every call with the same m gives the same knot vector, so spline
+    Every call with the same m and joints gives the same knot vector, so spline
     coefficients of such curves blend exactly.
     """
     samples = np.asarray(samples, float)
@@ -239,18 +248,25 @@ def smooth_curve_from_samples(samples: npt.ArrayLike) -> SmoothCurve:
             "resample with more points (resample.count or a smaller resample.spacing_mm)"
         )
     l_grid = np.linspace(0.0, 1.0, len(samples))
-    spline = make_interp_spline(l_grid, samples, k=DEGREE)
+    if joints:
+        spline = pieces_spline(l_grid, samples, joints, DEGREE)
+    else:
+        spline = make_interp_spline(l_grid, samples, k=DEGREE)
     length = float(_arc_length_table(spline, l_grid)[-1])
-    return SmoothCurve(spline, length, l_grid)
+    return SmoothCurve(spline, length, l_grid, tuple(int(j) for j in joints))
 
 
-def smooth_curve_from_polyline(points: npt.ArrayLike, options: CurveOptions = CurveOptions()) -> SmoothCurve:
+def smooth_curve_from_polyline(
+    points: npt.ArrayLike, options: CurveOptions = CurveOptions(), joints: npt.ArrayLike = ()
+) -> SmoothCurve:
     """Smooth, end-trim and resample a polyline by arc length (see the module docstring).
 
     Parameters
     ----------
     points : (n, 3) float, mm, proximal first; consecutive duplicates are skipped
     options : spacing or count, smoothing and end handling, mm
+    joints : (k,) normalized l of link breaks to keep sharp where the polyline has a vertex on a grid
+        sample (see the module docstring); the others are smoothed over
 
     Raises
     ------
@@ -272,9 +288,41 @@ def smooth_curve_from_polyline(points: npt.ArrayLike, options: CurveOptions = Cu
         )
     count = options.count if options.count is not None else int(np.ceil(total / options.spacing_mm - 1e-9)) + 1
     count = max(count, DEGREE + 1)
+    cuts = joint_cuts(table, count, np.asarray(joints, float).ravel())
+    if cuts:
+        pieced = _samples_by_piece(points, options.smoothing_mm, cuts, count, end)
+        if pieced is not None:
+            return smooth_curve_from_samples(pieced, tuple(grid for _, grid in cuts))
     s_target = np.linspace(0.0, total, count)
     samples = _points_at_arc_length(spline, u, table, s_target, end)
     return smooth_curve_from_samples(samples)
+
+
+def _samples_by_piece(
+    points: Points, smoothing_mm: float, cuts: list[tuple[int, int]], count: int, end_mm: float
+) -> Points | None:
+    """Samples (count, 3) with each piece between joints smoothed and resampled on its own; None if one is too short.
+
+    A piece from vertex a to vertex b fills grid samples g_a..g_b at equal arc length of its own spline; the
+    straight ends apply to the first piece's start and the last one's end.  Where two smoothing pieces end a
+    little apart, the joint's sample is their midpoint.
+    """
+    vertices = [0, *(v for v, _ in cuts), len(points) - 1]
+    grids = [0, *(g for _, g in cuts), count - 1]
+    pieces = []
+    for i in range(len(vertices) - 1):
+        va, vb, ga, gb = vertices[i], vertices[i + 1], grids[i], grids[i + 1]
+        if vb - va + 1 < MIN_POLYLINE_POINTS or gb - ga < DEGREE:
+            return None
+        spline, u = _chord_spline(points[va : vb + 1], smoothing_mm)
+        table = _arc_length_table(spline, u)
+        start, stop = (end_mm if i == 0 else 0.0), (end_mm if i == len(vertices) - 2 else 0.0)
+        if start + stop >= table[-1]:
+            return None
+        pieces.append(_points_at_arc_length(spline, u, table, np.linspace(0.0, table[-1], gb - ga + 1), start, stop))
+    for left, right in zip(pieces[:-1], pieces[1:], strict=True):
+        right[0] = 0.5 * (left[-1] + right[0])
+    return np.concatenate([pieces[0]] + [piece[1:] for piece in pieces[1:]])
 
 
 def l_from_points(curve: SmoothCurve, points: npt.ArrayLike) -> FloatArray:
@@ -375,14 +423,16 @@ def _u_at_arc_length(spline: BSpline, u: FloatArray, table: FloatArray, s: Float
 
 
 def _points_at_arc_length(
-    spline: BSpline, u: FloatArray, table: FloatArray, s: FloatArray, end_mm: float
+    spline: BSpline, u: FloatArray, table: FloatArray, s: FloatArray, end_mm: float, stop_mm: float | None = None
 ) -> Points:
-    """Points at arc lengths s; within end_mm of either end, a straight extension of the tangent there."""
+    """Points at arc lengths s; within end_mm of the start (stop_mm of the end, default end_mm), a straight
+    extension of the tangent there."""
     total = table[-1]
-    inner = np.clip(s, end_mm, total - end_mm)
+    stop_mm = end_mm if stop_mm is None else stop_mm
+    inner = np.clip(s, end_mm, total - stop_mm)
     ut = _u_at_arc_length(spline, u, table, inner)
     out = spline(ut)
-    if end_mm > 0.0:
+    if end_mm > 0.0 or stop_mm > 0.0:
         tangent = spline(ut, nu=1)
         tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
         out = out + (s - inner)[:, None] * tangent

@@ -100,7 +100,7 @@ def straight_initial_shape(final: SmoothCurve, length_mm: float | None = None) -
     """A straight line from c_f(0) along T_f(0), ``length_mm`` long (default final's length)."""
     length = _checked_length(final, length_mm)
     base, tangent = final.points([0.0])[0], final.tangents([0.0])[0]
-    return smooth_curve_from_samples(base + np.outer(final.l_grid * length, tangent))
+    return smooth_curve_from_samples(base + np.outer(final.l_grid * length, tangent), final.joints)
 
 
 def arc_initial_shape(
@@ -136,7 +136,7 @@ def arc_initial_shape(
     # 1 - cos written as 2 sin^2(x/2) to keep it exact for small angles
     along = bend_radius_mm * np.sin(angle)
     across = 2.0 * bend_radius_mm * np.sin(0.5 * angle) ** 2
-    return smooth_curve_from_samples(base + np.outer(along, tangent) + np.outer(across, towards))
+    return smooth_curve_from_samples(base + np.outer(along, tangent) + np.outer(across, towards), final.joints)
 
 
 def initial_shape_from_polyline(
@@ -152,6 +152,8 @@ def initial_shape_from_polyline(
     """
     count_options = CurveOptions(options.spacing_mm, len(final.l_grid), options.smoothing_mm, options.end_straight_mm)
     shape = smooth_curve_from_polyline(points, count_options)
+    if final.joints:  # on final's knots, so that the shapes blend on their coefficients
+        shape = smooth_curve_from_samples(shape.points(shape.l_grid), final.joints)
     if not align_base:
         return shape
     return register_to_base(shape, final.points([0.0])[0], final.tangents([0.0])[0], roll_rad)
@@ -171,7 +173,7 @@ def register_to_base(
     rotation = rotation_from_rotvec(roll_rad * target) @ _smallest_rotation(curve.tangents([0.0])[0], target)
     origin = curve.points([0.0])[0]
     samples = (curve.points(curve.l_grid) - origin) @ rotation.T + np.asarray(base_point, float).reshape(3)
-    return smooth_curve_from_samples(samples)
+    return smooth_curve_from_samples(samples, curve.joints)
 
 
 def _smallest_rotation(a: FloatArray, b: FloatArray) -> FloatArray:

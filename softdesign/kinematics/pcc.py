@@ -234,6 +234,22 @@ def dh_table_from_arc(kappa: npt.ArrayLike, phi: npt.ArrayLike, length: npt.Arra
     return np.stack([np.stack(row, axis=-1) for row in rows], axis=-2)
 
 
+#: The columns of :func:`dh_table_from_arc`, as seed 003's Table 1 orders them.
+DH_COLUMNS = ("theta", "d", "a", "alpha")
+#: How the rows compose, for JSON documents that carry them.
+DH_CONVENTION = ("improved D-H rows of seed 003 (Table 1), standard D-H links Rz(theta) Tz(d) Tx(a) Rx(alpha), "
+                 "multiplied in row order: the product is the section's transform (rad, mm)")
+
+
+def dh_rows(kappa: float, phi: float, length: float) -> list[dict[str, float]]:
+    """Seed 003's five D-H rows of one section as ``{"theta", "d", "a", "alpha"}`` (rad, mm, mm, rad).
+
+    ``+ 0.0`` writes -0.0 (e.g. ``-phi`` at phi = 0) as 0.0.
+    """
+    table = dh_table_from_arc(kappa, phi, length) + 0.0
+    return [{name: float(value) for name, value in zip(DH_COLUMNS, row, strict=True)} for row in table]
+
+
 def transform_from_dh(theta: npt.ArrayLike, d: npt.ArrayLike, a: npt.ArrayLike, alpha: npt.ArrayLike) -> Pose:
     """One standard D-H link, ``Rz(theta) Tz(d) Tx(a) Rx(alpha)``.
 

@@ -342,6 +342,7 @@ def link_dict(link: LinkDesign) -> dict:
         "phi": a.phi,
         "length": a.length,
         "theta": a.theta,
+        "dh": pcc.dh_rows(a.kappa, a.phi, a.length),
         "chamber_lengths": link.chamber_lengths.tolist(),
         "chamber_strain": link.chamber_strain.tolist(),
         "backbone_max_mm": a.backbone_max_mm,

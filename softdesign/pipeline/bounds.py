@@ -23,6 +23,7 @@ from softdesign.limits import (
     MAX_MESH_VERTICES,
     MEMORY_BUDGET_TEXT,
 )
+from softdesign.pipeline.offset_bound import check_offset
 
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
@@ -86,6 +87,7 @@ def check_sizes(case: Case, ingest: IngestResult) -> None:
             f"use fit.end_margin_mm <= {END_MARGIN_SHARE * final:.3g}"
         )
     _check_meshes(case, longest)
+    check_offset(case, ingest)  # before the fit: an offset the vessel's radius cannot take
 
 
 _BUDGET = f"softdesign/limits.py, which keeps a build within {MEMORY_BUDGET_TEXT} of memory"

@@ -1,4 +1,4 @@
-"""One whole check of a build folder against a reference: meshes, then kinematics, then fit metrics.
+"""One whole check of a build folder against a reference: meshes, kinematics, then the manifests' stage figures.
 
 Both folders must be build folders (a ``manifest.json``); the fit metrics are
 compared here because they live in that manifest (``metrics.fit.*_mm``), and
@@ -14,12 +14,28 @@ from pathlib import Path
 from softdesign.errors import ConfigError, InputDataError
 from softdesign.pipeline.layout import MANIFEST
 from softdesign.regression.feasibility import compare_feasibility
-from softdesign.regression.figures import CheckOptions, CheckReport, Figure, missing_figure, read_json, scalar_figure
+from softdesign.regression.figures import (
+    CheckOptions,
+    CheckReport,
+    Figure,
+    is_number,
+    missing_figure,
+    read_json,
+    scalar_figure,
+)
 from softdesign.regression.kinematics import compare_kinematics_files
 from softdesign.regression.meshes import compare_mesh_folders, read_golden
+from softdesign.regression.sections import compare_sections
 
 #: Fit metrics compared first, in this order; other ``*_mm`` keys of metrics.fit follow, sorted.
 FIT_KEYS = ("rms_mm", "p95_mm", "p99_mm", "max_mm", "holdout_rms_mm")
+
+#: Fit metrics agree within check's relative tolerance of the reference plus this, mm: far above the round-off of
+#: a fit (1e-13 mm), far below any change of a fit that matters.
+FIT_FLOOR_MM = 1e-6
+
+#: A comparison of the two manifests: (build's, reference's, tolerances, notes to add to) -> figures.
+ManifestComparison = Callable[[dict, dict, CheckOptions, list[str]], list[Figure]]
 
 
 def check_build(
@@ -52,10 +68,20 @@ def check_build(
     if not figures:
         notes.append("no mesh files under meshes/ on either side")
     figures += compare_kinematics_files(build_dir, reference_dir, options, notes)
-    figures += compare_fit(build_manifest, ref_manifest, options.distance_mm, notes)
-    figures += compare_feasibility(build_manifest, ref_manifest, options.distance_mm, notes)
+    for _, compare in MANIFEST_COMPARISONS:
+        figures += compare(build_manifest, ref_manifest, options, notes)
     warnings = tuple(case_warnings(build_manifest, ref_manifest))
     return CheckReport(build_dir, reference_dir, options, tuple(figures), tuple(notes), warnings)
+
+
+#: What check compares in the manifests, in order, after the meshes and kinematics.json: the fit and the
+#: feasibility by their own code, then every section of :data:`softdesign.regression.sections.SECTIONS` (links,
+#: blend, design, mould, volume mesh).  A new stage's figures are a row of that table, or a line here.
+MANIFEST_COMPARISONS: tuple[tuple[str, ManifestComparison], ...] = (
+    ("fit", lambda build, ref, options, notes: compare_fit(build, ref, options.distance_mm, notes, options.rtol)),
+    ("feasibility", lambda build, ref, options, notes: compare_feasibility(build, ref, options.distance_mm, notes)),
+    ("sections", compare_sections),
+)
 
 
 def case_warnings(build_manifest: dict, ref_manifest: dict) -> list[str]:
@@ -93,8 +119,15 @@ def _changed_inputs(ours: object, theirs: object) -> list[str]:
     return changed + [f"{e.get('path')} (reference)" for e in theirs if e.get("sha256") not in ours_hashes]
 
 
-def compare_fit(build_manifest: dict, ref_manifest: dict, tolerance_mm: float, notes: list[str]) -> list[Figure]:
-    """Figures of ``metrics.fit.*_mm``: build minus reference, within ``tolerance_mm``."""
+def compare_fit(
+    build_manifest: dict, ref_manifest: dict, tolerance_mm: float, notes: list[str], rtol: float | None = None
+) -> list[Figure]:
+    """Figures of ``metrics.fit.*_mm``: build minus reference, within ``tolerance_mm``.
+
+    With ``rtol``, within the smaller of ``tolerance_mm`` and ``rtol`` of the reference plus FIT_FLOOR_MM: fit
+    errors are often far below the distance tolerance (1e-4 mm on a synthetic vessel), where a change of a
+    percent of them would pass an absolute tolerance unseen.
+    """
     ours = _fit_metrics(build_manifest, "build " + MANIFEST)
     theirs = _fit_metrics(ref_manifest, "reference " + MANIFEST)
     if ours is None and theirs is None:
@@ -104,7 +137,16 @@ def compare_fit(build_manifest: dict, ref_manifest: dict, tolerance_mm: float, n
         return [missing_figure("fit", "metrics.fit", in_build=ours is not None)]
     keys = [k for k in FIT_KEYS if k in ours or k in theirs]
     keys += sorted(k for k in set(ours) | set(theirs) if k.endswith("_mm") and k not in FIT_KEYS)
-    return [scalar_figure("fit", key, ours.get(key), theirs.get(key), tolerance_mm) for key in keys]
+    return [
+        scalar_figure("fit", key, ours.get(key), theirs.get(key), _fit_tolerance(theirs.get(key), tolerance_mm, rtol))
+        for key in keys
+    ]
+
+
+def _fit_tolerance(reference: object, tolerance_mm: float, rtol: float | None) -> float:
+    if rtol is None or not is_number(reference):
+        return tolerance_mm
+    return min(tolerance_mm, rtol * abs(float(reference)) + FIT_FLOOR_MM)
 
 
 def _fit_metrics(manifest: dict, where: str) -> dict | None:

@@ -132,8 +132,6 @@ def key_figures(manifest: dict[str, Any]) -> list[KeyFigure]:
         if "volume_mm3" in entry:
             for key, label, unit in MESH_FIGURES:
                 rows.append(_figure(manifest, f"/outputs/{i}/{key}", f"{entry['path']}: {label}", unit))
-    for name in manifest.get("timing_s", {}):
-        rows.append(_figure(manifest, f"/timing_s/{name}", f"time of stage {name} (last run)", "s"))
     return [row for row in rows if row is not None]
 
 

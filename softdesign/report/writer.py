@@ -68,6 +68,9 @@ from softdesign.report.volume_mesh_tables import volume_mesh_checks, volume_mesh
 T = TypeVar("T")
 
 PAGE = "index.html"
+#: What differs from run to run or folder to folder (the build folder's path, the build's and the report's times):
+#: kept out of the page, which is the same bytes for the same build wherever it is, and written here.
+LOG = "report.log"
 TEMP_PREFIX = ".report-"
 NO_FIT = (
     "no fit in this build folder (built only through kinematics): surfaces and fit quality are left out; "
@@ -232,6 +235,7 @@ def write_report(
     files[PAGE] = page.encode("utf-8")
     if any(interactive.JS_NAME in embed for s in sections for embed in s.embeds):
         files[interactive.JS_NAME] = interactive.plotly_js()
+    files[LOG] = run_log(data, timer.seconds)
     missing = sorted(set(referenced_files(page)) - set(files))
     if missing:
         raise RuntimeError(f"report page links to files it does not write: {missing}")  # a bug, not a user error
@@ -392,14 +396,14 @@ def _tables_section(data: BuildData) -> tuple[Section, list[Check]]:
     checks = mesh_checks(data.export_summary) + fit_checks(data.fit.summary if data.fit else None)
     checks += volume_mesh_checks(_volume_summary(data))
     checks += output_checks(data.build_dir, data.manifest)
-    stages = [(s["name"], s["status"], f"{data.manifest.get('timing_s', {}).get(s['name'], 0.0):.3f}")
-              for s in data.manifest.get("stages", [])]
+    # no times: they differ run to run, and the page is the same bytes for the same build (the times: LOG)
+    stages = [(s["name"], s["status"]) for s in data.manifest.get("stages", [])]
     tables = [
         key_figure_table(key_figures(data.manifest)),
         plain_table("Inputs", ("file (as the case names it)", "sha256", "bytes"), input_rows(data.manifest),
                     ("", "hash", "num")),
         plain_table("Software", ("package", "build (manifest.json)", "this report"), software_rows(data.manifest)),
-        plain_table("Stages of the last run", ("stage", "status", "time (s)"), stages, ("", "", "num")),
+        plain_table("Stages of the last run", ("stage", "status"), stages, ("", "")),
         *compact_check_tables(checks),
     ]
     notes = [f"ingest: {n}" for n in data.ingest.notes]
@@ -414,8 +418,16 @@ def _summary(data: BuildData) -> list[str]:
     q_text = ", ".join(f"{q:g}" for q in data.export_q)
     return [
         f"Case {data.name}: {data.link_count} link(s), {blend['mode']} blend, {blend['frames']} frames, "
-        f"export q = {q_text}. Build folder: {data.build_dir.name}.",
+        f"export q = {q_text}.",
     ]
+
+
+def run_log(data: BuildData, seconds: dict[str, float]) -> bytes:
+    """:data:`LOG`: the build folder's path, each stage's time in its last run and each report part's, s."""
+    lines = [f"build folder: {Path(os.path.realpath(data.build_dir)).as_posix()}"]
+    lines += [f"stage {name}: {value:.3f} s (last run)" for name, value in data.manifest.get("timing_s", {}).items()]
+    lines += [f"report part {name}: {value:.3f} s" for name, value in seconds.items()]
+    return ("\n".join(lines) + "\n").encode("utf-8")
 
 
 def commit_folder(target: Path, files: dict[str, bytes]) -> None:

@@ -39,7 +39,7 @@ def test_a_too_negative_offset_is_told_to_come_closer_to_zero_not_to_get_smaller
     radius = json.loads((out / "ingest" / "summary.json").read_text())["centerline"]["radius_range_mm"][0]
     case = demo_case(tmp_path, export={"offset_mm": -(radius + 0.5)})  # deeper than the thinnest radius
     result = runner.invoke(app, ["export", str(case), "--out", str(out)])
-    assert result.exit_code != 0
+    assert result.exit_code == 2  # refused after ingest, before the fit (issue 35 item 5)
     assert "Traceback" not in result.output
     assert "offset_mm" in result.output and "make offset_mm closer to 0 (less negative)" in result.output
     assert "make offset_mm smaller" not in result.output

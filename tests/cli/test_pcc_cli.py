@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 
 import numpy as np
 import pytest
@@ -14,6 +15,7 @@ from softdesign.errors import InputDataError
 from softdesign.io.polylines_vtp import write_polylines_vtp
 from softdesign.io.vtk_polydata import polydata_arrays, read_polydata
 from softdesign.kinematics import pcc
+from tests.helpers.seed_transforms import rot_z, seed_chain, trans_z
 
 runner = CliRunner()
 
@@ -43,8 +45,8 @@ def library_forward(lengths, d) -> tuple:
 @pytest.mark.parametrize("d_text, d", [("15", 15.0), ("15,14,13", np.array([15.0, 14.0, 13.0]))])
 def test_forward_json_equals_the_library(d_text, d):
     payload = forward_json("--lengths", BENDING, "--d", d_text)
-    assert list(payload) == ["sections", "tip", "transform"]
-    assert [list(s) for s in payload["sections"]] == [["kappa", "phi", "length", "theta", "transform"]] * 3
+    assert list(payload) == ["sections", "tip", "transform", "dh_convention"]
+    assert [list(s) for s in payload["sections"]] == [["kappa", "phi", "length", "theta", "transform", "dh"]] * 3
     lengths = np.array([[121, 123, 125], [236, 187, 269], [236, 186, 268]], float)
     arcs, section2prev, tip2base = library_forward(lengths, d)
     for name in ("kappa", "phi", "length", "theta"):
@@ -58,6 +60,48 @@ def test_forward_straight_section_prints_a_pure_translation():
     payload = forward_json("--lengths", "50, 50, 50", "--d", "10")
     np.testing.assert_array_equal(payload["tip"], [0.0, 0.0, 50.0])
     assert payload["sections"][0]["kappa"] == 0.0
+
+
+def _dh_link(theta: float, d: float, a: float, alpha: float) -> np.ndarray:
+    """A standard D-H link Rz(theta) Tz(d) Tx(a) Rx(alpha), from elementary matrices."""
+    ca, sa = np.cos(alpha), np.sin(alpha)
+    rot_x = np.array([[1, 0, 0, 0], [0, ca, -sa, 0], [0, sa, ca, 0], [0, 0, 0, 1.0]])
+    trans_x = np.eye(4)
+    trans_x[0, 3] = a
+    return rot_z(theta) @ trans_z(d) @ trans_x @ rot_x
+
+
+def test_forward_json_gives_seed_003s_table_1_for_the_first_section_and_rows_that_multiply_to_each_htm():
+    payload = forward_json("--lengths", BENDING, "--d", "15")
+    first = payload["sections"][0]
+    # the section's arc from its lengths, seed eqs. 3-5 written out (d = 15 mm)
+    l1, l2, l3 = 121.0, 123.0, 125.0
+    length = (l1 + l2 + l3) / 3
+    kappa = 2 * math.sqrt(l1**2 + l2**2 + l3**2 - l1 * l2 - l1 * l3 - l2 * l3) / (15.0 * (l1 + l2 + l3))
+    assert first["length"] == pytest.approx(length, rel=0, abs=EXACT_TOL * length)
+    assert first["kappa"] == pytest.approx(kappa, rel=0, abs=EXACT_TOL)
+    assert math.tan(first["phi"]) == pytest.approx(math.sqrt(3) * (l2 + l3 - 2 * l1) / (3 * (l2 - l3)), rel=1e-12)
+    # Table 1: (theta, d, a, alpha) of the five steps, with theta_1 = kappa L and r_1 = 1 / kappa
+    phi, theta, r = first["phi"], first["kappa"] * first["length"], 1.0 / first["kappa"]
+    table_1 = [
+        (phi, 0.0, 0.0, -math.pi / 2),
+        (theta / 2, 0.0, 0.0, math.pi / 2),
+        (0.0, 2 * r * math.sin(theta / 2), 0.0, -math.pi / 2),
+        (theta / 2, 0.0, 0.0, math.pi / 2),
+        (-phi, 0.0, 0.0, 0.0),
+    ]
+    assert [list(row) for row in first["dh"]] == [["theta", "d", "a", "alpha"]] * 5
+    got = [[row[c] for c in ("theta", "d", "a", "alpha")] for row in first["dh"]]
+    np.testing.assert_allclose(got, table_1, rtol=0, atol=EXACT_TOL * length)
+    # every section: the rows' D-H links multiply to its HTM (seed eq. 8), and to the five steps of section 3.2
+    for section in payload["sections"]:
+        product = np.eye(4)
+        for row in section["dh"]:
+            product = product @ _dh_link(row["theta"], row["d"], row["a"], row["alpha"])
+        np.testing.assert_allclose(product, section["transform"], rtol=0, atol=EXACT_TOL * section["length"])
+        steps = seed_chain(section["kappa"], section["phi"], section["length"])
+        np.testing.assert_allclose(product, steps, rtol=0, atol=EXACT_TOL * section["length"])
+    assert "Rz(theta) Tz(d) Tx(a) Rx(alpha)" in payload["dh_convention"]
 
 
 def test_forward_table_shows_each_section_and_the_tip():

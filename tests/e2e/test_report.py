@@ -25,7 +25,15 @@ from typer.testing import CliRunner
 
 from softdesign.pipeline.api import build_through
 from softdesign.report.interactive import DISPLAY_TOLERANCE_MM, DIV_ID, JS_NAME
-from softdesign.report.writer import EXPECTED_SIZES, PAGE, REPORT_DIR, ReportOptions, commit_folder, write_report
+from softdesign.report.writer import (
+    EXPECTED_SIZES,
+    LOG,
+    PAGE,
+    REPORT_DIR,
+    ReportOptions,
+    commit_folder,
+    write_report,
+)
 from softdesign.versions import software_versions
 from tests.helpers.cases import write_case
 from tests.helpers.paths import REPO
@@ -153,7 +161,8 @@ def test_the_page_links_only_to_files_beside_it_and_every_file_is_linked(built):
     for link in files:
         assert "://" not in link and not link.startswith("/") and ".." not in link, link  # no network, no escape
         assert (report_dir / link).is_file(), link
-    assert sorted(set(files) | {PAGE}) == sorted(p.name for p in report_dir.iterdir()) == sorted(result.files)
+    # and report.log beside it: the folder's path and the times, which the page leaves out
+    assert sorted(set(files) | {PAGE, LOG}) == sorted(p.name for p in report_dir.iterdir()) == sorted(result.files)
     anchors = {link[1:] for link in page.links if link.startswith("#")}
     text = (report_dir / PAGE).read_text(encoding="utf-8")
     assert all(f'id="{anchor}"' in text for anchor in anchors)
@@ -291,11 +300,13 @@ def test_a_drawn_plot_is_not_blank_and_an_empty_one_is(demo):
 def test_same_build_gives_the_same_report_bytes(demo, tmp_path):
     build_dir, _ = demo
     before = tree_hashes(build_dir / REPORT_DIR)
-    copy = tmp_path / build_dir.name  # the page names the build folder (not its path)
+    copy = tmp_path / "another-name"  # the page names no folder: report.log does, with the times
     shutil.copytree(build_dir, copy)
     shutil.rmtree(copy / REPORT_DIR)
     write_report(copy, ReportOptions(pcc_d=(DEMO_PCC_D,)))
-    assert tree_hashes(copy / REPORT_DIR) == before
+    after = tree_hashes(copy / REPORT_DIR)
+    assert after.keys() == before.keys() and LOG in after
+    assert [name for name in after if after[name] != before[name] and name != LOG] == []
 
 
 def test_tampered_outputs_fail_their_checks(demo, tmp_path):

@@ -191,3 +191,62 @@ def test_l_outside_unit_interval_is_refused():
     curve = smooth_curve_from_polyline(circle_points(12.0, 30.0, 61), CurveOptions(smoothing_mm=0.0))
     with pytest.raises(ConfigError, match=r"in \[0, 1\].*1\.5"):
         curve.points([0.2, 1.5])
+
+
+# -- joints: a link break at a curvature jump (issue 35 item 4) ---------------------------------------------
+def corner_points(spacing: float = 0.5) -> tuple[np.ndarray, float]:
+    """A 20 mm straight run, then a quarter of a 10 mm circle in the x-z plane: curvature 0 -> 0.1 /mm at z = 20.
+
+    Returns the vertices (every ``spacing`` mm of arc, the corner among them) and the corner's l.
+    """
+    line = np.column_stack([np.zeros(40), np.zeros(40), np.arange(40) * spacing])
+    angle = np.arange(0, int(round(5 * np.pi / spacing)) + 1) * spacing / 10.0
+    arc = np.column_stack([10.0 * (1 - np.cos(angle)), np.zeros_like(angle), 20.0 + 10.0 * np.sin(angle)])
+    return np.concatenate([line, arc]), 20.0 / (20.0 + angle[-1] * 10.0)
+
+
+def test_a_joint_is_a_knot_of_full_multiplicity_and_each_side_keeps_its_own_curvature():
+    points, corner = corner_points()
+    length = 20.0 + 10.0 * (len(points) - 41) * 0.05
+    options = CurveOptions(spacing_mm=length / (len(points) - 1), smoothing_mm=0.0, end_straight_mm=0.0)
+    curve = smooth_curve_from_polyline(points, options, [0.0, corner, 1.0])
+    assert curve.joints == (40,)
+    l_joint = curve.l_grid[40]
+    assert np.count_nonzero(curve.spline.t == l_joint) == curve.spline.k + 1
+    np.testing.assert_allclose(curve.points([l_joint])[0], [0.0, 0.0, 20.0], rtol=0, atol=EXACT_MM)
+    step = 1e-9
+    before, after = curve.curvature([l_joint - step, l_joint + step])
+    assert before <= 1e-6 and abs(after - 0.1) <= 1e-6  # the jump is kept, not smoothed over
+    # the tangent is continuous at the joint (both sides interpolate their own exact data)
+    t_before, t_after = curve.tangents([l_joint - step, l_joint + step])
+    assert np.linalg.norm(t_before - t_after) <= 1e-6
+    smoothed = smooth_curve_from_polyline(points, options)
+    assert smoothed.joints == () and smoothed.curvature([l_joint - step])[0] > 1e-3  # what it was
+
+
+def test_a_break_off_every_vertex_or_off_the_grid_is_smoothed_over_as_before():
+    points, corner = corner_points()
+    options = CurveOptions(spacing_mm=0.5, smoothing_mm=0.0, end_straight_mm=0.0)
+    plain = smooth_curve_from_polyline(points, options)
+    for breaks in ([0.0, 0.3, 1.0], [0.0, corner + 1e-3, 1.0]):
+        curve = smooth_curve_from_polyline(points, options, breaks)
+        assert curve.joints == ()
+        assert np.array_equal(curve.spline.c, plain.spline.c) and np.array_equal(curve.spline.t, plain.spline.t)
+
+
+def test_samples_rebuilt_with_their_joints_give_the_same_spline():
+    points, corner = corner_points()
+    length = 20.0 + 10.0 * (len(points) - 41) * 0.05
+    options = CurveOptions(spacing_mm=length / (len(points) - 1), smoothing_mm=0.0, end_straight_mm=0.0)
+    curve = smooth_curve_from_polyline(points, options, [corner])
+    again = smooth_curve_from_samples(curve.points(curve.l_grid), curve.joints)
+    np.testing.assert_allclose(again.spline.c, curve.spline.c, rtol=0, atol=1e-12)
+    assert np.array_equal(again.spline.t, curve.spline.t)
+    with pytest.raises(GeometryError, match="fewer than 6 samples"):
+        smooth_curve_from_samples(curve.points(curve.l_grid), (3,))
+
+
+def test_a_smoothed_path_makes_no_joint_its_smoothing_moved_the_vertex_off_the_break():
+    points, corner = corner_points()
+    options = CurveOptions(spacing_mm=0.5, smoothing_mm=0.05, end_straight_mm=0.0)
+    assert smooth_curve_from_polyline(points, options, [corner]).joints == ()

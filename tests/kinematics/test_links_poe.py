@@ -13,7 +13,7 @@ from softdesign.geometry.initial import arc_initial_shape, straight_initial_shap
 from softdesign.geometry.se3 import inverse_pose, pose_from_twist, rotation_from_rotvec, rotvec_from_rotation
 from softdesign.kinematics.links import LinkChain, link_breaks, link_transforms
 from softdesign.kinematics.poe import PoeSplit, poe_from_pose, pose_from_poe
-from tests.helpers.seed_transforms import seed_chain
+from tests.helpers.seed_transforms import seed_chain, trans_z
 
 #: The issue's bound on reproducing S_T_E from its POE split (we reach rounding).
 POE_TOL = 1e-9
@@ -243,3 +243,71 @@ def test_straight_initial_shape_at_q0_works_in_rmf_and_fails_clearly_in_frenet(c
         LinkChain(frenet, chain.breaks).transforms(0.0)
     message = str(caught.value)
     assert "frenet, q = 0" in message and "l in [0.0000, 1.0000]" in message and "use frames: rmf" in message
+
+
+# --- exact joints: a break at a curvature jump is a knot the smoothing does not cross (issue 35 item 4) -------
+#: The issue's bound at every joint, for the link transforms (D-H / POE) and the frames in the world.
+JOINT_ANGLE_TOL = 1e-4  # rad
+JOINT_MM_TOL = 1e-4
+#: Arcs of different planes, one straight, at the project's default sample spacing (100 x the test above's).
+JOINT_ARCS = ((0.05, 0.4, 20.0), (0.0, 0.0, 12.5), (0.07, 2.0, 15.0), (0.03, -1.5, 22.5))
+JOINT_SPACING_MM = 0.5
+
+
+def _section(kappa: float, phi: float, length: float) -> np.ndarray:
+    """Seed 003's section transform; a straight one (kappa = 0, where its chord formula divides by zero) is Tz(L)."""
+    return seed_chain(kappa, phi, length) if kappa > 0.0 else trans_z(length)
+
+
+def _joint_case(joints: bool):
+    """Framed curve of the arcs' vertices (every joint a vertex), resampled with or without joints; the poses."""
+    rng = np.random.default_rng(35)
+    base = np.eye(4)
+    base[:3, :3] = rotation_from_rotvec(rng.normal(size=3))
+    base[:3, 3] = rng.normal(scale=50, size=3)
+    pose, points, poses = base, [], [base]
+    for kappa, phi, length in JOINT_ARCS:
+        for si in np.arange(0.0, length - 1e-9, JOINT_SPACING_MM):
+            points.append((pose @ _section(kappa, phi, si))[:3, 3] if si > 0 else pose[:3, 3])
+        pose = pose @ _section(kappa, phi, length)
+        poses.append(pose)
+    points.append(pose[:3, 3])
+    breaks = np.concatenate([[0.0], np.cumsum([a[2] for a in JOINT_ARCS])]) / sum(a[2] for a in JOINT_ARCS)
+    options = CurveOptions(spacing_mm=JOINT_SPACING_MM, smoothing_mm=0.0, end_straight_mm=0.0)
+    curve = smooth_curve_from_polyline(np.array(points), options, breaks if joints else ())
+    return framed_curve(curve, "rmf", base_normal=base[:3, 0]), breaks, np.array(poses)
+
+
+def _errors(framed, breaks, poses):
+    """Largest angle (rad) and distance (mm) of each link's S_T_E and each joint's world frame from the chain."""
+    transforms, world = link_transforms(framed, breaks), framed.poses(breaks)
+    angles, distances = [], []
+    for j in range(len(JOINT_ARCS)):
+        expected = inverse_pose(poses[j]) @ poses[j + 1]
+        angles.append(np.linalg.norm(rotvec_from_rotation(expected[:3, :3].T @ transforms[j][:3, :3])))
+        distances.append(np.linalg.norm(transforms[j][:3, 3] - expected[:3, 3]))
+    for j in range(len(poses)):
+        angles.append(np.linalg.norm(rotvec_from_rotation(poses[j][:3, :3].T @ world[j][:3, :3])))
+        distances.append(np.linalg.norm(world[j][:3, 3] - poses[j][:3, 3]))
+    return max(angles), max(distances)
+
+
+def test_breaks_at_the_joints_keep_every_joint_exact():
+    framed, breaks, poses = _joint_case(joints=True)
+    assert framed.curve.joints == (40, 65, 95)  # 20, 32.5 and 47.5 mm of 70 at 0.5 mm
+    angle, distance = _errors(framed, breaks, poses)
+    assert angle <= JOINT_ANGLE_TOL and distance <= JOINT_MM_TOL, (angle, distance)
+    # and the POE split of each link is its arc: theta2 = kappa L (the straight link: no rotation)
+    for transform, (kappa, _, length) in zip(link_transforms(framed, breaks), JOINT_ARCS, strict=True):
+        assert abs(poe_from_pose(transform).theta2 - kappa * length) <= JOINT_ANGLE_TOL
+
+
+def test_without_joints_the_smoothing_rounds_the_corners():
+    # the issue's starting point (1.9e-3 rad on its centerline): the quintic through every sample crosses the jumps
+    angle, _ = _joint_case_errors(joints=False)
+    assert angle > 10 * JOINT_ANGLE_TOL
+
+
+def _joint_case_errors(joints: bool):
+    framed, breaks, poses = _joint_case(joints)
+    return _errors(framed, breaks, poses)

@@ -261,14 +261,19 @@ def test_demo_case_reports_finite_figures(tmp_path):
     assert list(payload) == ["d", "poses", "convention", "warnings"]
     assert [pose["q"] for pose in payload["poses"]] == [0.0, 0.5, 1.0]
     keys = [
-        "index", "l_start", "l_end", "kappa", "phi", "length", "theta", "chamber_lengths", "chamber_strain",
+        "index", "l_start", "l_end", "kappa", "phi", "length", "theta", "dh", "chamber_lengths", "chamber_strain",
         *ERROR_KEYS,
     ]
     for pose in payload["poses"]:
         assert list(pose) == ["q", "links", "worst"] and len(pose["links"]) == 4
         for link in pose["links"]:
             assert list(link) == keys
-            values = [v for k in keys for v in np.atleast_1d(link[k])]
+            # the D-H rows multiply to the link's arc (seed 003's HTM)
+            rows = [[row[c] for c in ("theta", "d", "a", "alpha")] for row in link["dh"]]
+            np.testing.assert_allclose(pcc.transform_from_dh_table(rows),
+                                       pcc.transform_from_arc(link["kappa"], link["phi"], link["length"]),
+                                       rtol=0, atol=1e-12 * max(1.0, link["length"]))
+            values = [v for k in keys if k != "dh" for v in np.atleast_1d(link[k])]
             assert all(math.isfinite(v) for v in values) and link["kappa"] >= 0.0
         worst = max(pose["links"], key=lambda link: link["backbone_max_mm"])
         assert pose["worst"] == {"index": worst["index"], **{k: worst[k] for k in ERROR_KEYS}}

@@ -40,7 +40,8 @@ if TYPE_CHECKING:  # only annotations: the report loads stage results without th
 #: fraction of the path where it is defined and the floor.
 #: 3: the morph's reach r * kappa over q (``morph``), ``blend: auto`` and the blend it chose.
 #: 4: ``blend: pcc`` (the designed chain, each section's curvature q * kappa at constant length).
-VERSION = 4
+#: 5: sharp joints at explicit link breaks (``joints`` in blend/curves.npz when there are any).
+VERSION = 5
 
 
 @dataclass(frozen=True)
@@ -50,11 +51,14 @@ class BlendResult:
     shape: BlendedShape
     summary: dict[str, Any]
     samples: tuple[np.ndarray, ...]
+    #: samples where the curve keeps a corner (sharp joints at link breaks, geometry.curves)
+    joints: tuple[int, ...] = ()
 
 
 def run_blend(case: Case, ingest: IngestResult, design: DesignResult | None = None) -> BlendResult:
     """Build c(q, l) for the case from the ingested paths (``blend: pcc``: from the design's chain)."""
-    final = smooth_curve_from_polyline(ingest.path.points, curve_options(case))
+    # explicit link breaks are where a designed case's sections meet: kept sharp where the path has a corner there
+    final = smooth_curve_from_polyline(ingest.path.points, curve_options(case), case.links.breaks or ())
     if case.blend == "pcc":
         if design is None:  # the case file's check refuses blend: pcc without a design: block
             raise RuntimeError("blend: pcc without a design")
@@ -82,8 +86,9 @@ def run_blend(case: Case, ingest: IngestResult, design: DesignResult | None = No
     # the smoothed ones to round-off (1e-13 mm), not to the bit, and the stages after this one must get the same
     # shape whether the blend ran now or was loaded, or a stage re-run on cached results writes other bytes
     samples = tuple(curve.points(curve.l_grid) for curve in choice.shape.keys)
-    shape = _shape_from_samples(choice.shape.key_q, samples, choice.shape.mode, choice.shape.frames)
-    return BlendResult(shape, {**_summary(case, shape), **choice.summary()}, samples)
+    joints = final.joints
+    shape = _shape_from_samples(choice.shape.key_q, samples, choice.shape.mode, choice.shape.frames, joints)
+    return BlendResult(shape, {**_summary(case, shape), **choice.summary()}, samples, joints)
 
 
 def pcc_shape(final: SmoothCurve, design: DesignResult, frames: FrameMode) -> BlendedShape:
@@ -104,9 +109,10 @@ def pcc_shape(final: SmoothCurve, design: DesignResult, frames: FrameMode) -> Bl
 
 
 def _shape_from_samples(
-    key_q: np.ndarray, samples: tuple[np.ndarray, ...], mode: BlendMode, frames: FrameMode
+    key_q: np.ndarray, samples: tuple[np.ndarray, ...], mode: BlendMode, frames: FrameMode,
+    joints: tuple[int, ...] = (),
 ) -> BlendedShape:
-    keys = [smooth_curve_from_samples(points) for points in samples]
+    keys = [smooth_curve_from_samples(points, joints) for points in samples]
     keyframes = tuple(zip(np.asarray(key_q)[1:-1].tolist(), keys[1:-1], strict=True))
     return blend_shapes(keys[0], keys[-1], keyframes, mode, frames)
 
@@ -142,7 +148,8 @@ def write_blend(result: BlendResult, staging: Staging) -> None:
     """Keep the key shapes' samples (``pcc``: the final shape's; the chain is the design's) and the figures."""
     samples = {f"key_{k}": points for k, points in enumerate(result.samples)}
     key_q = result.shape.key_q if result.shape.mode != "pcc" else np.array([1.0])
-    staging.write_bytes(layout.BLEND_CURVES, npz_bytes(key_q=key_q, **samples))
+    joints = {"joints": np.asarray(result.joints, np.int64)} if result.joints else {}  # none: the bytes of before
+    staging.write_bytes(layout.BLEND_CURVES, npz_bytes(key_q=key_q, **samples, **joints))
     staging.write_json(layout.BLEND_SUMMARY, result.summary)
 
 
@@ -158,8 +165,9 @@ def load_blend(build_dir: Path) -> BlendResult:
                               "run `softdesign build` again")
         return BlendResult(pcc_shape(smooth_curve_from_samples(samples[0]), design, summary["frames"]), summary,
                            samples)
-    shape = _shape_from_samples(data["key_q"], samples, summary["mode"], summary["frames"])
-    return BlendResult(shape, summary, samples)
+    joints = tuple(int(j) for j in data.get("joints", np.zeros(0, np.int64)))
+    shape = _shape_from_samples(data["key_q"], samples, summary["mode"], summary["frames"], joints)
+    return BlendResult(shape, summary, samples, joints)
 
 
 def torsion_text(path: dict[str, Any]) -> str:
@@ -191,13 +199,17 @@ def describe_blend(result: BlendResult) -> list[str]:
             f"no intermediate shape is shorter than both end shapes (q = 0: {s['initial_length_mm']:.2f} mm, "
             f"q = 1: {f['length_mm']:.2f} mm)"
         )
+    if result.joints:
+        grid = result.shape.keys[-1].l_grid
+        at = ", ".join(f"{grid[j]:.4f}" for j in result.joints)
+        lines.append(f"sharp joints (link breaks at a corner of the path, not smoothed over) at l = {at}")
     return lines + describe_choice(s)
 
 
 STAGE = Stage(
     name="blend",
     version=VERSION,
-    reads=("initial", "resample", "frames", "blend"),
+    reads=("initial", "resample", "frames", "blend", "links.breaks"),
     upstream=("ingest", "design"),
     compute=lambda case, results: run_blend(case, results["ingest"], results.get("design")),
     write=write_blend,

@@ -1,0 +1,43 @@
+"""The report of a build is the same bytes wherever the build folder is (issue 35 item 1).
+
+The page once named the folder and showed each stage's time, so two identical
+builds in different folders gave pages a few bytes apart; those now go only
+into ``report/report.log``.
+"""
+
+from __future__ import annotations
+
+import shutil
+
+import pytest
+from typer.testing import CliRunner
+
+from softdesign.cli import app
+from softdesign.pipeline.api import build_through
+from softdesign.pipeline.layout import REPORT_DIR
+from softdesign.report.writer import LOG
+from tests.helpers.paths import REPO
+
+runner = CliRunner()
+
+
+@pytest.mark.slow
+def test_identical_builds_in_other_folders_give_the_same_report_bytes(tmp_path):
+    first = tmp_path / "folder-alpha"
+    build_through(REPO / "configs" / "demo.yaml", first)
+    second = tmp_path / "elsewhere" / "folder-beta"
+    shutil.copytree(first, second)  # the same build, in a folder of another name and depth
+    drawn = {}
+    for folder in (first, second):
+        result = runner.invoke(app, ["report", str(folder), "--jobs", "1"])
+        assert result.exit_code == 0, result.output
+        drawn[folder] = {p.name: p.read_bytes() for p in sorted((folder / REPORT_DIR).iterdir())}
+    one, two = drawn[first], drawn[second]
+    assert sorted(one) == sorted(two) and "index.html" in one
+    assert [name for name in one if one[name] != two[name] and name != LOG] == []
+    page = one["index.html"].decode("utf-8")
+    assert "folder-alpha" not in page and "time (s)" not in page and "/timing_s/" not in page
+    # the log has what the page leaves out: the folder and the times
+    log = two[LOG].decode("utf-8")
+    assert f"build folder: {second.resolve().as_posix()}\n" in log
+    assert "stage fit: " in log and "report part load the build: " in log

@@ -1,0 +1,139 @@
+"""A build is a function of its inputs (issue 35 item 1), as a property.
+
+Random sequences of 3-5 edits to the demo case (resample, links, export.q,
+export formats, fit keys, material), each followed by a rebuild into the same
+folder (unchanged stages loaded from it, the rest recomputed on what was
+loaded), then a fresh build of the final case: the two folders hold the same
+files, byte for byte.  The manifest records the run as well as the build
+(each stage's status, ran or skipped, and its time, DESIGN.md's "per-stage
+time"), so it is compared with those two removed; every other byte of it must
+agree.
+
+Coarse settings keep a build to about a second: the property is about caching, not resolution.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+from hypothesis import HealthCheck, Phase, given, settings
+from hypothesis import strategies as st
+
+from softdesign.pipeline.api import build_through
+from tests.helpers.folders import snapshot
+from tests.helpers.paths import REPO
+
+#: The demo case at coarse settings (1 mm samples and rings, 3 mm x 12 fit knots, 40 vertices around).
+BASE: dict[str, Any] = {
+    "name": "demo",
+    "units": "mm",
+    "final": {"centerline": str(REPO / "data" / "demo" / "centerline.vtp"),
+              "surface": str(REPO / "data" / "demo" / "surface.stl"), "path": 0},
+    "initial": {"kind": "straight"},
+    "resample": {"spacing_mm": 1.0, "smoothing_mm": 0.05, "end_straight_mm": 0.0},
+    "frames": "rmf",
+    "blend": "linear",
+    "links": {"count": 4},
+    "fit": {"knot_spacing_mm": 3.0, "angular_intervals": 12, "smoothing": 1.0e-5},
+    "export": {"q": [0, 1], "formats": ["stl"], "spacing_mm": 1.0, "angular_count": 40},
+}
+
+#: One edit: (where, value); "material" replaces the block (None removes it), the others set one key.
+EDITS = st.one_of(
+    st.tuples(st.just("resample.spacing_mm"), st.sampled_from([1.0, 1.25])),
+    st.tuples(st.just("resample.smoothing_mm"), st.sampled_from([0.05, 0.1])),
+    st.tuples(st.just("links"), st.sampled_from([{"count": 4}, {"count": 3}, {"length_mm": 25.0},
+                                                 {"breaks": [0.0, 0.4, 1.0]}])),
+    st.tuples(st.just("export.q"), st.sampled_from([[0, 1], [0, 0.5, 1], [0.25, 1]])),
+    st.tuples(st.just("export.formats"), st.sampled_from([["stl"], ["stl", "ply"], ["obj"], ["vtp"]])),
+    st.tuples(st.just("fit.knot_spacing_mm"), st.sampled_from([3.0, 4.0])),
+    st.tuples(st.just("fit.angular_intervals"), st.sampled_from([12, 16])),
+    st.tuples(st.just("fit.smoothing"), st.sampled_from([1.0e-5, 3.0e-5])),
+    st.tuples(st.just("material"), st.sampled_from([None, {"name": "ecoflex-00-30"}, {"name": "dragon-skin-30"}])),
+)
+
+
+def apply(case: dict[str, Any], where: str, value: Any) -> None:
+    """Set the dotted key ``where`` of ``case`` to ``value`` (a top-level None removes the key)."""
+    *parents, key = where.split(".")
+    node = case
+    for part in parents:
+        node = node[part]
+    if value is None:
+        node.pop(key, None)
+    else:
+        node[key] = copy.deepcopy(value)
+
+
+def build(case: dict[str, Any], case_file: Path, out: Path) -> None:
+    case_file.write_text(yaml.safe_dump(case, sort_keys=False), encoding="utf-8")
+    build_through(case_file, out)
+
+
+def without_run_record(manifest_file: Path) -> dict[str, Any]:
+    """The manifest less what records the run rather than the build: stage times and statuses."""
+    manifest = json.loads(manifest_file.read_text(encoding="utf-8"))
+    manifest.pop("timing_s")
+    for stage in manifest["stages"]:
+        stage.pop("status")
+    return manifest
+
+
+@pytest.fixture(scope="module")
+def first_build(tmp_path_factory) -> Path:
+    """The base case built once; each example starts from a copy of it."""
+    root = tmp_path_factory.mktemp("first")
+    build(BASE, root / "case.yaml", root / "build")
+    return root / "build"
+
+
+@pytest.mark.slow
+@settings(max_examples=20, deadline=None, phases=(Phase.explicit, Phase.reuse, Phase.generate),
+          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@given(edits=st.lists(EDITS, min_size=3, max_size=5))
+def test_rebuilds_after_any_edits_give_a_fresh_builds_bytes(first_build, edits):
+    # no shrinking phase: each step is a build; a failure prints its edits as drawn
+    with tempfile.TemporaryDirectory(prefix="incremental-") as scratch:
+        root = Path(scratch)
+        incremental, fresh = root / "incremental", root / "fresh"
+        shutil.copytree(first_build, incremental)
+        case = copy.deepcopy(BASE)
+        for where, value in edits:
+            apply(case, where, value)
+            build(case, root / "case.yaml", incremental)
+        build(case, root / "case.yaml", fresh)
+        one, two = snapshot(incremental), snapshot(fresh)
+        assert one.keys() == two.keys()
+        differing = sorted(name for name in one if one[name] != two[name] and name != "manifest.json")
+        assert differing == [], f"after {edits}: {differing}"
+        assert without_run_record(incremental / "manifest.json") == without_run_record(fresh / "manifest.json")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["kinematics", "fit", "export", "feasibility"])
+def test_a_stage_recomputed_on_results_loaded_from_the_folder_writes_the_kept_bytes(first_build, name, tmp_path):
+    """The issue's other half: every stage before ``name`` loaded from the build folder, ``name`` computed again."""
+    from softdesign.config import load_case
+    from softdesign.pipeline.stage_order import STAGES
+    from softdesign.pipeline.store import Staging
+
+    case_file = tmp_path / "case.yaml"
+    case_file.write_text(yaml.safe_dump(BASE, sort_keys=False), encoding="utf-8")
+    case = load_case(case_file)
+    results: dict[str, Any] = {}
+    for stage in STAGES:
+        if stage.name == name:
+            break
+        results[stage.name] = stage.load(first_build, results)
+    stage = next(s for s in STAGES if s.name == name)
+    kept = json.loads((first_build / name / "stage.json").read_text(encoding="utf-8"))["outputs"]
+    with Staging(tmp_path / "again") as staging:
+        stage.write(stage.compute(case, results), staging)
+        assert staging.written == kept
