@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from softdesign.cli.common import CaseArg, JsonOpt, OutOpt, emit_json, note, run_guarded
+from softdesign.cli.common import TEXT_ANGLES, CaseArg, JsonOpt, OutOpt, emit_json, note, run_guarded
 from softdesign.design_config import MAX_DESIGN_LINKS
 from softdesign.errors import ConfigError, SoftdesignError
 
@@ -70,16 +70,16 @@ def _print(document: dict[str, Any], case_file: Path, chambers: np.ndarray | Non
                f"chain {document['chain_max_deviation_mm']:.4g} mm from the centerline (tolerance "
                f"{document['tolerance_mm']:g} mm), tip {document['tip_error_mm']:.4g} mm (tolerance "
                f"{document['tip_tolerance_mm']:g} mm) and {document['tip_error_deg']:.4g} deg")
-    typer.echo(f"{'link':>4}  {'l range':>13}  {'kappa [1/mm]':>12}  {'phi [rad]':>9}  {'L [mm]':>8}  "
-               f"{'theta [rad]':>11}  {'max dev [mm]':>12}  {'chambers l1 l2 l3 [mm]':>24}")
+    typer.echo(f"{'link':>4}  {'l range':>13}  {'kappa [1/mm]':>12}  {'phi [deg]':>9}  {'L [mm]':>8}  "
+               f"{'theta [deg]':>11}  {'max dev [mm]':>12}  {'chambers l1 l2 l3 [mm]':>24}")
     for j, k in enumerate(document["links"]):
         cells = "-" if chambers is None else " ".join(f"{v:7.3f}" for v in chambers[j])
         typer.echo(f"{k['index']:>4}  {k['l_start']:6.4f}-{k['l_end']:6.4f}  {k['kappa']:12.6f}  "
-                   f"{k['phi']:9.4f}  {k['length']:8.3f}  {k['theta']:11.4f}  {k['max_deviation_mm']:12.4g}  "
+                   f"{math.degrees(k['phi']):9.3f}  {k['length']:8.3f}  {math.degrees(k['theta']):11.3f}  "
+                   f"{k['max_deviation_mm']:12.4g}  "
                    f"{cells:>24}")
     typer.echo(f"breaks l = {[round(b, 6) for b in document['breaks']]}")
-    typer.echo("angles in radians (phi from the section's base N towards B), the tip angle in degrees; "
-               + document["method"])
+    typer.echo(f"{TEXT_ANGLES}; phi from the section's base N towards B; " + document["method"])
 
 
 def design(
