@@ -8,7 +8,7 @@ from typing import Annotated, Any, Literal
 
 import typer
 
-from softdesign.cli.common import JsonOpt, emit_json, note, point_from_text, run_guarded
+from softdesign.cli.common import JsonOpt, emit_json, note, point_from_text, refuse_overwriting_inputs, run_guarded
 from softdesign.errors import ConfigError
 
 SurfaceArg = Annotated[
@@ -56,6 +56,7 @@ def centerline(
                               f"'{output.suffix or '(no suffix)'}'")
         if not output.parent.is_dir():
             raise ConfigError(f"--output {output}: the folder {output.parent} does not exist; create it first")
+        refuse_overwriting_inputs("--output", output, [surface])
         scale = UNIT_SCALE_TO_MM[units]
         options = CenterlineOptions(
             inlet=None if inlet is None else _mm(point_from_text(inlet, "--inlet"), scale),

@@ -13,7 +13,16 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from softdesign.cli.common import CaseArg, JsonOpt, OutOpt, emit_json, note, run_guarded
+from softdesign.cli.common import (
+    CaseArg,
+    JsonOpt,
+    OutOpt,
+    case_inputs,
+    emit_json,
+    note,
+    refuse_overwriting_inputs,
+    run_guarded,
+)
 from softdesign.errors import ConfigError, SoftdesignError, errors_named_for
 
 if TYPE_CHECKING:  # numpy is imported where it is used: `softdesign --help` starts without it
@@ -147,6 +156,7 @@ def design(
             raise ConfigError(f"--output {target}: the folder {target.parent} does not exist; create it first")
         if target.resolve() == case_file.resolve():
             raise ConfigError(f"--output {target}: is the case file itself; write the design to another file")
+        refuse_overwriting_inputs("--output", target, case_inputs(case_file))
         outcome = build_through(case_file, out, target="blend", progress=note)
         shape = outcome.results["blend"].shape
         curve = final_shape_rmf(shape)

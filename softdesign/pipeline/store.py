@@ -76,9 +76,10 @@ def read_record(file: Path) -> dict[str, Any] | None:
     if not file.is_file():
         return None
     try:
-        return json.loads(file.read_text(encoding="utf-8"))
-    except (OSError, json.JSONDecodeError):
+        payload = json.loads(file.read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):  # RecursionError: nested too deep to be one of ours
         return None
+    return payload if isinstance(payload, dict) else None
 
 
 def process_alive(pid: str) -> bool:

@@ -11,9 +11,7 @@ from __future__ import annotations
 
 import gc
 import os
-import shutil
 import time
-import uuid
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -25,7 +23,6 @@ from softdesign.pipeline.layout import REPORT_DIR
 from softdesign.pipeline.lock import BuildLock
 from softdesign.pipeline.out_folder import folder_errors
 from softdesign.pipeline.parallel import jobs_for_build, map_items
-from softdesign.pipeline.store import process_alive
 from softdesign.report import (
     animation,
     design_figures,
@@ -39,7 +36,8 @@ from softdesign.report import (
     stretch_figures,
     surface_figures,
 )
-from softdesign.report.build_folder import BuildData, load_build
+from softdesign.report.build_folder import BuildData, load_build, require_build
+from softdesign.report.commit import commit_folder
 from softdesign.report.html_page import (
     Section,
     banner_html,
@@ -66,7 +64,6 @@ from softdesign.report.volume_mesh_tables import volume_mesh_checks, volume_mesh
 T = TypeVar("T")
 
 PAGE = "index.html"
-TEMP_PREFIX = ".report-"
 NO_FIT = (
     "no fit in this build folder (built only through kinematics): surfaces and fit quality are left out; "
     "run softdesign build"
@@ -214,6 +211,16 @@ def write_report(
     SoftdesignError
         A PCC design fails (e.g. a bad ``pcc_d``).
     """
+    # under the build's lock from the first read to the last write: a build cannot change the folder meanwhile, so
+    # the page shows one build; OSErrors name the folder, exit 2
+    require_build(Path(build_dir))  # before the lock: a folder that is not a build gets no lock file beside it
+    with folder_errors(Path(build_dir)), BuildLock(Path(os.path.realpath(build_dir))) as lock:
+        result = _write_report(Path(build_dir), options, progress, jobs)
+    result.notes[:0] = lock.notes
+    return result
+
+
+def _write_report(build_dir: Path, options: ReportOptions, progress: Progress | None, jobs: int) -> ReportResult:
     timer = _Timer(progress, jobs)
     data = timer("load the build", lambda: load_build(build_dir))
     with _collector_for_figures():
@@ -230,10 +237,8 @@ def write_report(
     missing = sorted(set(referenced_files(page)) - set(files))
     if missing:
         raise RuntimeError(f"report page links to files it does not write: {missing}")  # a bug, not a user error
-    target = Path(build_dir) / REPORT_DIR
-    # under the build's lock, so a build cannot swap the folder away mid-commit; OSErrors name the folder, exit 2
-    with folder_errors(Path(build_dir)), BuildLock(Path(os.path.realpath(build_dir))):
-        timer("write the files", lambda: commit_folder(target, files))
+    target = build_dir / REPORT_DIR
+    timer("write the files", lambda: commit_folder(target, files))
     return ReportResult(target / PAGE, {k: len(v) for k, v in sorted(files.items())}, passed, len(checks), notes,
                         timer.seconds, warnings)
 
@@ -409,30 +414,3 @@ def _summary(data: BuildData, passed: int, total: int) -> list[str]:
         f"export q = {q_text}. Build folder: {data.build_dir.name}.",
         f"Checks: {passed} of {total} passed.",
     ]
-
-
-def commit_folder(target: Path, files: dict[str, bytes]) -> None:
-    """Write ``files`` into a temporary folder beside ``target``, then swap it in for ``target``.
-
-    Temporary folders are named ``.report-<pid>-<random>``; one whose process
-    is gone is a killed run's leftover and is removed.
-    """
-    parent = target.parent
-    for stale in parent.glob(TEMP_PREFIX + "*"):
-        if not process_alive(stale.name.removeprefix(TEMP_PREFIX).split("-", 1)[0]):
-            shutil.rmtree(stale, ignore_errors=True)
-    temp = parent / f"{TEMP_PREFIX}{os.getpid()}-{uuid.uuid4().hex[:12]}"
-    temp.mkdir()  # unlike mkdtemp, honours the umask: the report is as readable as the rest of the build
-    old = temp.with_name(temp.name + "-old")
-    try:
-        for name, data in sorted(files.items()):
-            (temp / name).write_bytes(data)
-        if target.exists():
-            os.rename(target, old)
-        os.rename(temp, target)
-    except BaseException:
-        if old.exists() and not target.exists():
-            os.rename(old, target)
-        shutil.rmtree(temp, ignore_errors=True)
-        raise
-    shutil.rmtree(old, ignore_errors=True)
