@@ -116,6 +116,12 @@ class Resample(_Section):
     smoothing_mm: FiniteFloat = Field(0.1, ge=0.0)
     end_straight_mm: FiniteFloat = Field(2.0, ge=0.0)
 
+    @model_validator(mode="after")
+    def _one_rule(self) -> Resample:
+        if self.count is not None and "spacing_mm" in self.model_fields_set:  # count would win silently
+            raise ValueError("give one of count, spacing_mm; got both")
+        return self
+
 
 class Links(_Section):
     """How the actuator is split into links: exactly one of the three keys."""
@@ -239,7 +245,7 @@ class Export(_Section):
     wall_mm: FiniteFloat | None = Field(None, gt=0.0)
     port_mm: FiniteFloat | None = Field(None, gt=0.0)
     # the names come from io.formats' registry (one list); mypy cannot read a Literal built from a tuple at run time
-    formats: list[Literal[MESH_FORMATS]] = ["stl"]  # type: ignore[valid-type]
+    formats: list[Literal[MESH_FORMATS]] = Field(["stl"], min_length=1)  # type: ignore[valid-type]
     spacing_mm: FiniteFloat = Field(0.5, gt=0.0)
     angular_count: Integer = Field(64, ge=MIN_ANGULAR_COUNT, le=MAX_ANGULAR_COUNT)
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...

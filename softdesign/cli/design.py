@@ -154,6 +154,9 @@ def design(
         target = output if output is not None else case_file.with_name(f"{case_file.stem}-designed.yaml")
         if not target.parent.is_dir():
             raise ConfigError(f"--output {target}: the folder {target.parent} does not exist; create it first")
+        if target.is_dir():
+            raise ConfigError(f"--output {target}: is a folder, expected the case file to write; name a file in it, "
+                              f"e.g. {target / (case_file.stem + '-designed.yaml')}")
         if target.resolve() == case_file.resolve():
             raise ConfigError(f"--output {target}: is the case file itself; write the design to another file")
         refuse_overwriting_inputs("--output", target, case_inputs(case_file))
@@ -208,7 +211,11 @@ def _write_case(case_file: Path, target: Path, breaks: list[float], name: str) -
 
     text = case_file.read_text(encoding="utf-8")
     new_text, kept = case_text_with_breaks(text, breaks, case_file.parent, target.parent)
-    write_bytes_atomically(target, new_text.encode("utf-8"))
+    try:
+        write_bytes_atomically(target, new_text.encode("utf-8"))
+    except OSError as err:
+        raise ConfigError(f"--output {target}: cannot write it ({err.strerror or err}); choose a writable path"
+                          ) from None
     note(f"wrote {target} (links: breaks of the design)")
     if not kept:
         note(f"note: {target} was written whole from the parsed case (its comments are not kept): the text "

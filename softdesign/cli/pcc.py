@@ -18,6 +18,14 @@ from typing import TYPE_CHECKING, Annotated, Any, NamedTuple
 import typer
 
 from softdesign.cli.common import JsonOpt, emit_json, note, run_guarded
+from softdesign.cli.pcc_bounds import (
+    MAX_LENGTH_MM,
+    MAX_POINTS_PER_SECTION,
+    MAX_SECTIONS,
+    check_backbone_points,
+    check_readings_file,
+    check_shapes_dir,
+)
 from softdesign.cli.pcc_design import design
 from softdesign.cli.pcc_options import DOpt, LengthsOpt, lengths_from_text, spacing_from_text
 from softdesign.errors import ConfigError, InputDataError
@@ -115,6 +123,9 @@ def _header_sections(path: Path, header: list[str]) -> int:
     count = len(header)
     if count < 4 or (count - 1) % 3:
         raise InputDataError(f"{path} line 1: the header has {count} column(s); {fix}")
+    if (count - 1) // 3 > MAX_SECTIONS:
+        raise InputDataError(f"{path} line 1: the header names {(count - 1) // 3} sections, above the bound of "
+                             f"{MAX_SECTIONS}; {fix}")
     try:
         float(header[0])
     except ValueError:
@@ -142,8 +153,9 @@ def _parse_row(values: list[str], sections: int) -> tuple[float | None, np.ndarr
         except ValueError:
             reasons.append(f"section {section + 1} cable {cable + 1}: '{text.strip()}' is not a number")
             continue
-        if not (math.isfinite(value) and value > 0):
-            reasons.append(f"section {section + 1} cable {cable + 1}: length {value:g} mm is not > 0")
+        if not (math.isfinite(value) and 0 < value <= MAX_LENGTH_MM):
+            reasons.append(f"section {section + 1} cable {cable + 1}: length {value:g} mm is not > 0 and "
+                           f"<= {MAX_LENGTH_MM:g}")
         lengths[section, cable] = value
     return time, (None if reasons else lengths), reasons
 
@@ -181,8 +193,7 @@ def read_readings(path: Path, max_rate: float | None = None) -> Readings:
     """
     import numpy as np
 
-    if not path.is_file():
-        raise InputDataError(f"{path}: readings file not found; check the path")
+    check_readings_file(path)
     try:
         rows = [(n, row) for n, row in enumerate(csv.reader(io.StringIO(path.read_text())), start=1) if row]
     except (OSError, UnicodeDecodeError, csv.Error) as err:
@@ -279,7 +290,7 @@ def reconstruct(
         float | None, typer.Option("--max-rate", help="Reject a row whose length changes faster than this, mm/s.")
     ] = None,
     points_per_section: Annotated[
-        int, typer.Option("--points-per-section", min=2, help="Backbone samples per arc.")
+        int, typer.Option("--points-per-section", min=2, max=MAX_POINTS_PER_SECTION, help="Backbone samples per arc.")
     ] = 21,
 ) -> None:
     """Backbone and tip pose for every row of an encoder-readings CSV.
@@ -305,9 +316,10 @@ def reconstruct(
             )
         readings = read_readings(readings_csv, max_rate)
         spacing = spacing_from_text(d, readings.lengths.shape[1], where=str(readings_csv))
+        check_backbone_points(str(readings_csv), len(readings.times), readings.lengths.shape[1], points_per_section)
         for line, time, reason in readings.rejected:
             note(f"{readings_csv} line {line} (time {time}): rejected: {reason}")
-        out_dir.mkdir(parents=True, exist_ok=True)
+        check_shapes_dir(out_dir)
         arcs = pcc.arcs_from_lengths(readings.lengths, spacing)
         tip2base = pcc.chain_transforms(pcc.transform_from_arc(arcs.kappa, arcs.phi, arcs.length))[:, -1]
         written = [

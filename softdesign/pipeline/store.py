@@ -52,8 +52,11 @@ def sha256_file(path: Path) -> str:
     """Hex sha256 of a file's contents, read in chunks."""
     digest = hashlib.sha256()
     with Path(path).open("rb") as handle:
-        for chunk in iter(lambda: handle.read(1 << 20), b""):
-            digest.update(chunk)
+        try:
+            for chunk in iter(lambda: handle.read(1 << 20), b""):
+                digest.update(chunk)
+        except OSError as err:  # a failed read names no file (EIO from /proc/self/mem): name it, so callers can
+            raise OSError(err.errno, err.strerror, str(path)) from err
     return digest.hexdigest()
 
 

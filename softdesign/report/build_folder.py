@@ -24,6 +24,7 @@ from softdesign.pipeline.stages.fit import FitResult, load_fit
 from softdesign.pipeline.stages.ingest import IngestResult, load_ingest
 from softdesign.pipeline.stages.kinematics import KinematicsResult, load_kinematics
 from softdesign.pipeline.stages.links import load_links
+from softdesign.report.build_check import check_files_as_built, check_manifest
 
 
 @dataclass(frozen=True)
@@ -98,6 +99,8 @@ def load_build(build_dir: str | Path) -> BuildData:
         raise InputDataError(f"{root / MANIFEST}: unreadable ({type(err).__name__}: {err}); {fix}") from err
     required = (layout.INGEST_SUMMARY, layout.INGEST_PATH, layout.BLEND_CURVES, layout.BLEND_SUMMARY, layout.LINKS,
                 layout.KINEMATICS)
+    check_manifest(root, manifest, fix)
+    check_files_as_built(root, manifest, fix)
     missing = [rel for rel in required if not (root / rel).is_file()]
     if missing:
         raise InputDataError(
