@@ -43,6 +43,13 @@ from softdesign.limits import (
     MAX_LINKS,
     MEMORY_BUDGET_TEXT,
 )
+from softdesign.limits_shape import (
+    MAX_INITIAL_LENGTH_MM,
+    MAX_INITIAL_RADIUS_MM,
+    MAX_OFFSET_MM,
+    MIN_INITIAL_LENGTH_MM,
+    MIN_INITIAL_RADIUS_MM,
+)
 from softdesign.limits_volume import MAX_MESHER_SECONDS, MAX_VOLUME_MESHES, MIN_TET_SIZE_MM
 from softdesign.materials import MaterialLimits, PresetName, resolve_material
 from softdesign.meshing.mould_spec import MIN_MOULD_WALL_MM
@@ -88,8 +95,8 @@ class InitialShape(_Section):
     """The insertion shape, q = 0, and the body radius there."""
 
     kind: Literal["straight", "arc", "file"] = "straight"
-    length_mm: FiniteFloat | None = Field(None, gt=0.0)
-    radius_mm: FiniteFloat | None = Field(None, gt=0.0)
+    length_mm: FiniteFloat | None = Field(None, ge=MIN_INITIAL_LENGTH_MM, le=MAX_INITIAL_LENGTH_MM)
+    radius_mm: FiniteFloat | None = Field(None, ge=MIN_INITIAL_RADIUS_MM, le=MAX_INITIAL_RADIUS_MM)
     surface: Path | None = None
     bend_radius_mm: FiniteFloat | None = Field(None, gt=0.0)
     bend_plane_deg: FiniteFloat = 0.0
@@ -241,7 +248,7 @@ class Export(_Section):
 
     q: list[FiniteFloat] | None = Field(None, max_length=MAX_EXPORT_Q)
     frames: Integer | None = Field(None, ge=2, le=MAX_EXPORT_Q)
-    offset_mm: FiniteFloat = 0.0
+    offset_mm: FiniteFloat = Field(0.0, ge=-MAX_OFFSET_MM, le=MAX_OFFSET_MM)
     wall_mm: FiniteFloat | None = Field(None, gt=0.0)
     port_mm: FiniteFloat | None = Field(None, gt=0.0)
     # the names come from io.formats' registry (one list); mypy cannot read a Literal built from a tuple at run time
