@@ -45,6 +45,7 @@ def centerline(
 
     def action() -> None:
         from softdesign.centerline.extract import CenterlineOptions, extract_centerlines
+        from softdesign.centerline.result_checks import check_centerlines
         from softdesign.io.centerline_vtp import read_face_regions, write_centerlines_vtp
         from softdesign.io.surface import read_surface
         from softdesign.types import UNIT_SCALE_TO_MM
@@ -66,6 +67,7 @@ def centerline(
         start = time.perf_counter()
         vertices, faces = read_surface(surface, scale)
         result = extract_centerlines(vertices, faces, options, str(surface))
+        check_centerlines(result.paths, result.radii, vertices, faces, str(surface))  # nothing written if meaningless
         try:
             write_centerlines_vtp(output, result, 1.0 / scale)
         except OSError as err:
