@@ -58,6 +58,21 @@ def report_marker_files(folder: Path) -> list[str] | None:
     return [REPORT_MARKER, *files]
 
 
+#: What a report of a version before the marker wrote into report/: its page, images, animation and scripts.
+LEGACY_REPORT_SUFFIXES = (".html", ".png", ".gif", ".js")
+
+
+def legacy_report_files(folder: Path) -> list[str]:
+    """The files of a report without a marker (an older version's), when report/ holds nothing else; else none."""
+    report = folder / REPORT_DIR
+    if report.is_symlink() or not report.is_dir():
+        return []
+    entries = list(report.iterdir())
+    if any(e.is_symlink() or not e.is_file() or not e.name.endswith(LEGACY_REPORT_SUFFIXES) for e in entries):
+        return []
+    return [e.name for e in entries] if any(e.name == "index.html" for e in entries) else []
+
+
 def owned_files(folder: Path) -> set[str]:
     """The paths (POSIX, relative to ``folder``) of the files softdesign wrote in build folder ``folder``."""
     manifest = _json(folder / MANIFEST)
@@ -73,7 +88,7 @@ def owned_files(folder: Path) -> set[str]:
         own.add(f"{stage}/{STAGE_RECORD}")
         outputs = _json(record).get("outputs")
         own |= {str(p) for p in (outputs if isinstance(outputs, dict) else {}) if safe_relative(p)}
-    own |= {f"{REPORT_DIR}/{name}" for name in report_marker_files(folder / REPORT_DIR) or []}
+    own |= {f"{REPORT_DIR}/{name}" for name in report_marker_files(folder / REPORT_DIR) or legacy_report_files(folder)}
     for temp in folder.iterdir():
         if REPORT_TEMP.fullmatch(temp.name) and not temp.is_symlink() and temp.is_dir():
             own |= {f"{temp.name}/{name}" for name in report_marker_files(temp) or []}

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from softdesign.errors import ConfigError
 from softdesign.pipeline.layout import REPORT_DIR
-from softdesign.pipeline.owned import REPORT_MARKER, REPORT_TEMP, report_marker_files
+from softdesign.pipeline.owned import REPORT_MARKER, REPORT_TEMP, legacy_report_files, report_marker_files
 from softdesign.pipeline.store import canonical_json, process_alive, sha256_bytes
 
 TEMP_PREFIX = ".report-"
@@ -71,7 +71,7 @@ def _check_report_folder(target: Path) -> None:
         return
     if not target.is_dir():
         raise ConfigError(f"{target}: is a file, expected the report's folder; {fix}")
-    own = set(report_marker_files(target) or [])
+    own = set(report_marker_files(target) or legacy_report_files(target.parent))
     foreign = sorted(p.name + ("/" if p.is_dir() and not p.is_symlink() else "") for p in target.iterdir()
                      if p.name not in own or p.is_symlink() or not p.is_file())
     if foreign:

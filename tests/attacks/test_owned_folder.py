@@ -114,3 +114,16 @@ def test_pose_output_never_overwrites_the_cases_surface(tmp_path):
     assert_refused(result, "an input of this case", "write to another file")
     assert surface.read_bytes() == before
     assert not os.path.exists(tmp_path / "build")  # refused before the build
+
+
+def test_a_report_of_an_older_version_without_marker_is_still_ours(out, tmp_path):
+    report = out / REPORT_DIR
+    report.mkdir()
+    (report / PAGE).write_text("<html>an older report</html>")
+    (report / "morph.png").write_bytes(b"png")
+    result = runner.invoke(app, ["build", str(demo_case(tmp_path)), "--out", str(out)])
+    assert result.exit_code == 0, result.output  # rebuilt: the old report goes with the old folder, as before
+    report.mkdir()
+    (report / PAGE).write_text("<html>an older report</html>")
+    commit_folder(report, {PAGE: b"new page"})  # and a new report replaces it
+    assert (report / PAGE).read_bytes() == b"new page"
