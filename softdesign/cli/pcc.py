@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Annotated, Any, NamedTuple
 
 import typer
 
-from softdesign.cli.common import JsonOpt, emit_json, note, run_guarded
+from softdesign.cli.common import JsonOpt, emit_json, note, refuse_overwriting_inputs, run_guarded
 from softdesign.cli.pcc_bounds import (
     MAX_LENGTH_MM,
     MAX_POINTS_PER_SECTION,
@@ -319,6 +319,8 @@ def reconstruct(
         check_backbone_points(str(readings_csv), len(readings.times), readings.lengths.shape[1], points_per_section)
         for line, time, reason in readings.rejected:
             note(f"{readings_csv} line {line} (time {time}): rejected: {reason}")
+        for name in ("tips.csv", "backbones.vtp", "rejected.csv"):  # never over the readings themselves
+            refuse_overwriting_inputs("--shapes-dir", out_dir / name, [readings_csv])
         check_shapes_dir(out_dir)
         arcs = pcc.arcs_from_lengths(readings.lengths, spacing)
         tip2base = pcc.chain_transforms(pcc.transform_from_arc(arcs.kappa, arcs.phi, arcs.length))[:, -1]

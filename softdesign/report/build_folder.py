@@ -24,7 +24,7 @@ from softdesign.pipeline.stages.fit import FitResult, load_fit
 from softdesign.pipeline.stages.ingest import IngestResult, load_ingest
 from softdesign.pipeline.stages.kinematics import KinematicsResult, load_kinematics
 from softdesign.pipeline.stages.links import load_links
-from softdesign.report.build_check import check_files_as_built, check_manifest
+from softdesign.report.build_check import check_manifest
 
 
 @dataclass(frozen=True)
@@ -100,7 +100,6 @@ def load_build(build_dir: str | Path) -> BuildData:
     required = (layout.INGEST_SUMMARY, layout.INGEST_PATH, layout.BLEND_CURVES, layout.BLEND_SUMMARY, layout.LINKS,
                 layout.KINEMATICS)
     check_manifest(root, manifest, fix)
-    check_files_as_built(root, manifest, fix)
     missing = [rel for rel in required if not (root / rel).is_file()]
     if missing:
         raise InputDataError(

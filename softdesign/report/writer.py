@@ -10,6 +10,7 @@ manifest are only read.
 from __future__ import annotations
 
 import gc
+import json
 import os
 import time
 from collections.abc import Callable, Iterator
@@ -19,7 +20,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from softdesign.errors import ConfigError
-from softdesign.pipeline.layout import REPORT_DIR
+from softdesign.pipeline.layout import MANIFEST, REPORT_DIR
 from softdesign.pipeline.lock import BuildLock
 from softdesign.pipeline.out_folder import folder_errors
 from softdesign.pipeline.parallel import jobs_for_build, map_items
@@ -36,6 +37,7 @@ from softdesign.report import (
     stretch_figures,
     surface_figures,
 )
+from softdesign.report.build_check import changed_since_build, unreadable_build
 from softdesign.report.build_folder import BuildData, load_build, require_build
 from softdesign.report.commit import commit_folder
 from softdesign.report.html_page import (
@@ -215,7 +217,11 @@ def write_report(
     # the page shows one build; OSErrors name the folder, exit 2
     require_build(Path(build_dir))  # before the lock: a folder that is not a build gets no lock file beside it
     with folder_errors(Path(build_dir)), BuildLock(Path(os.path.realpath(build_dir))) as lock:
-        result = _write_report(Path(build_dir), options, progress, jobs)
+        try:
+            result = _write_report(Path(build_dir), options, progress, jobs)
+        except (KeyError, TypeError, IndexError, ValueError, AttributeError) as err:  # the build's files lack a key
+            manifest = json.loads((Path(build_dir) / MANIFEST).read_text(encoding="utf-8"))
+            raise unreadable_build(Path(build_dir), changed_since_build(Path(build_dir), manifest), err) from err
     result.notes[:0] = lock.notes
     return result
 

@@ -127,3 +127,12 @@ def test_a_report_of_an_older_version_without_marker_is_still_ours(out, tmp_path
     (report / PAGE).write_text("<html>an older report</html>")
     commit_folder(report, {PAGE: b"new page"})  # and a new report replaces it
     assert (report / PAGE).read_bytes() == b"new page"
+
+
+def test_pcc_reconstruct_never_writes_over_its_readings(tmp_path):
+    readings = tmp_path / "tips.csv"
+    readings.write_text("t,a,b,c\n0,100,100,100\n1,100,101,99\n")
+    before = readings.read_bytes()
+    result = runner.invoke(app, ["pcc", "reconstruct", str(readings), "--d", "5", "--shapes-dir", str(tmp_path)])
+    assert_refused(result, "--shapes-dir", "an input of this case")
+    assert readings.read_bytes() == before
