@@ -49,6 +49,7 @@ from softdesign.limits_shape import (
     MAX_OFFSET_MM,
     MIN_INITIAL_LENGTH_MM,
     MIN_INITIAL_RADIUS_MM,
+    size_bound,
 )
 from softdesign.limits_volume import MAX_MESHER_SECONDS, MAX_VOLUME_MESHES, MIN_TET_SIZE_MM
 from softdesign.materials import MaterialLimits, PresetName, resolve_material
@@ -95,14 +96,18 @@ class InitialShape(_Section):
     """The insertion shape, q = 0, and the body radius there."""
 
     kind: Literal["straight", "arc", "file"] = "straight"
-    length_mm: FiniteFloat | None = Field(None, ge=MIN_INITIAL_LENGTH_MM, le=MAX_INITIAL_LENGTH_MM)
-    radius_mm: FiniteFloat | None = Field(None, ge=MIN_INITIAL_RADIUS_MM, le=MAX_INITIAL_RADIUS_MM)
+    length_mm: FiniteFloat | None = Field(None, gt=0.0)
+    radius_mm: FiniteFloat | None = Field(None, gt=0.0)
     surface: Path | None = None
     bend_radius_mm: FiniteFloat | None = Field(None, gt=0.0)
     bend_plane_deg: FiniteFloat = 0.0
     centerline: Path | None = None
     path: Integer = Field(0, ge=0)
     align_base: bool = True
+
+    # after FiniteFloat's own check, so that a nan is called not finite rather than out of range
+    _length_bound = field_validator("length_mm")(size_bound(MIN_INITIAL_LENGTH_MM, MAX_INITIAL_LENGTH_MM))
+    _radius_bound = field_validator("radius_mm")(size_bound(MIN_INITIAL_RADIUS_MM, MAX_INITIAL_RADIUS_MM))
 
     @model_validator(mode="after")
     def _kind_needs(self) -> InitialShape:
@@ -248,12 +253,13 @@ class Export(_Section):
 
     q: list[FiniteFloat] | None = Field(None, max_length=MAX_EXPORT_Q)
     frames: Integer | None = Field(None, ge=2, le=MAX_EXPORT_Q)
-    offset_mm: FiniteFloat = Field(0.0, ge=-MAX_OFFSET_MM, le=MAX_OFFSET_MM)
+    offset_mm: FiniteFloat = 0.0
     wall_mm: FiniteFloat | None = Field(None, gt=0.0)
     port_mm: FiniteFloat | None = Field(None, gt=0.0)
     # the names come from io.formats' registry (one list); mypy cannot read a Literal built from a tuple at run time
     formats: list[Literal[MESH_FORMATS]] = Field(["stl"], min_length=1)  # type: ignore[valid-type]
     spacing_mm: FiniteFloat = Field(0.5, gt=0.0)
+    _offset_bound = field_validator("offset_mm")(size_bound(-MAX_OFFSET_MM, MAX_OFFSET_MM))
     angular_count: Integer = Field(64, ge=MIN_ANGULAR_COUNT, le=MAX_ANGULAR_COUNT)
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...
     split_regions: bool = False

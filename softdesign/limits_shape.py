@@ -18,8 +18,21 @@ fit.end_cut); the schema now refuses them, naming the bound.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 MIN_INITIAL_RADIUS_MM = 0.03
 MAX_INITIAL_RADIUS_MM = 100.0
 MIN_INITIAL_LENGTH_MM = 5.0
 MAX_INITIAL_LENGTH_MM = 2000.0
 MAX_OFFSET_MM = 20.0
+
+
+def size_bound(lowest: float, highest: float) -> Callable[[type, float | None], float | None]:
+    """A pydantic field validator (classmethod body) refusing a size outside [lowest, highest] mm, naming both."""
+
+    def check(cls: type, value: float | None) -> float | None:  # noqa: ARG001 - pydantic's validator signature
+        if value is not None and not lowest <= value <= highest:
+            raise ValueError(f"must be {lowest:g} to {highest:g} mm, got {value:g}")
+        return value
+
+    return check
