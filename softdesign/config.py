@@ -47,6 +47,14 @@ from softdesign.limits import (
     MAX_LINKS,
     MEMORY_BUDGET_TEXT,
 )
+from softdesign.limits_shape import (
+    MAX_INITIAL_LENGTH_MM,
+    MAX_INITIAL_RADIUS_MM,
+    MAX_OFFSET_MM,
+    MIN_INITIAL_LENGTH_MM,
+    MIN_INITIAL_RADIUS_MM,
+    size_bound,
+)
 from softdesign.limits_volume import MAX_MESHER_SECONDS, MAX_VOLUME_MESHES, MIN_TET_SIZE_MM
 from softdesign.materials import MaterialLimits, PresetName, resolve_material
 from softdesign.meshing.mould_spec import MIN_MOULD_WALL_MM
@@ -101,6 +109,10 @@ class InitialShape(_Section):
     path: Integer = Field(0, ge=0)
     align_base: bool = True
 
+    # after FiniteFloat's own check, so that a nan is called not finite rather than out of range
+    _length_bound = field_validator("length_mm")(size_bound(MIN_INITIAL_LENGTH_MM, MAX_INITIAL_LENGTH_MM))
+    _radius_bound = field_validator("radius_mm")(size_bound(MIN_INITIAL_RADIUS_MM, MAX_INITIAL_RADIUS_MM))
+
     @model_validator(mode="after")
     def _kind_needs(self) -> InitialShape:
         if self.kind == "arc" and self.bend_radius_mm is None:
@@ -119,6 +131,12 @@ class Resample(_Section):
     count: Integer | None = Field(None, ge=4, le=MAX_CURVE_SAMPLES)
     smoothing_mm: FiniteFloat = Field(0.1, ge=0.0)
     end_straight_mm: FiniteFloat = Field(2.0, ge=0.0)
+
+    @model_validator(mode="after")
+    def _one_rule(self) -> Resample:
+        if self.count is not None and "spacing_mm" in self.model_fields_set:  # count would win silently
+            raise ValueError("give one of count, spacing_mm; got both")
+        return self
 
 
 class Links(_Section):
@@ -250,8 +268,9 @@ class Export(_Section):
     wall_mm: FiniteFloat | None = Field(None, gt=0.0)
     port_mm: FiniteFloat | None = Field(None, gt=0.0)
     # the names come from io.formats' registry (one list); mypy cannot read a Literal built from a tuple at run time
-    formats: list[Literal[MESH_FORMATS]] = ["stl"]  # type: ignore[valid-type]
+    formats: list[Literal[MESH_FORMATS]] = Field(["stl"], min_length=1)  # type: ignore[valid-type]
     spacing_mm: FiniteFloat = Field(0.5, gt=0.0)
+    _offset_bound = field_validator("offset_mm")(size_bound(-MAX_OFFSET_MM, MAX_OFFSET_MM))
     angular_count: Integer = Field(64, ge=MIN_ANGULAR_COUNT, le=MAX_ANGULAR_COUNT)
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...
     split_regions: bool = False

@@ -8,7 +8,7 @@ from typing import Annotated, Any, Literal
 
 import typer
 
-from softdesign.cli.common import JsonOpt, emit_json, note, point_from_text, run_guarded
+from softdesign.cli.common import JsonOpt, emit_json, note, point_from_text, refuse_overwriting_inputs, run_guarded
 from softdesign.errors import ConfigError
 
 SurfaceArg = Annotated[
@@ -45,6 +45,7 @@ def centerline(
 
     def action() -> None:
         from softdesign.centerline.extract import CenterlineOptions, extract_centerlines
+        from softdesign.centerline.result_checks import check_centerlines
         from softdesign.io.centerline_vtp import read_face_regions, write_centerlines_vtp
         from softdesign.io.surface import read_surface
         from softdesign.types import UNIT_SCALE_TO_MM
@@ -56,6 +57,7 @@ def centerline(
                               f"'{output.suffix or '(no suffix)'}'")
         if not output.parent.is_dir():
             raise ConfigError(f"--output {output}: the folder {output.parent} does not exist; create it first")
+        refuse_overwriting_inputs("--output", output, [surface])
         scale = UNIT_SCALE_TO_MM[units]
         options = CenterlineOptions(
             inlet=None if inlet is None else _mm(point_from_text(inlet, "--inlet"), scale),
@@ -65,6 +67,7 @@ def centerline(
         start = time.perf_counter()
         vertices, faces = read_surface(surface, scale)
         result = extract_centerlines(vertices, faces, options, str(surface))
+        check_centerlines(result.paths, result.radii, vertices, faces, str(surface))  # nothing written if meaningless
         try:
             write_centerlines_vtp(output, result, 1.0 / scale)
         except OSError as err:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import inspect
 import json
 import math
+import os
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -197,3 +198,26 @@ class StageProgress:
         end = "\n" if int(done) == int(total) and not message.endswith("running") else ""
         self.stream.write(f"\r[{bar}] {done}/{total} {message:<60.60}{end}")
         self.stream.flush()
+
+
+def refuse_overwriting_inputs(option: str, target: Path, inputs: list[Path]) -> None:
+    """ConfigError when ``target`` (a file a command writes) is one of ``inputs`` (the case file, its input files).
+
+    The same file by any name counts (a link, ``./``, another spelling): compared by real path and by identity.
+    """
+    real = Path(os.path.realpath(target))
+    for item in inputs:
+        same = real == Path(os.path.realpath(item))
+        if not same and target.exists() and item.exists():
+            same = os.path.samefile(target, item)
+        if same:
+            raise ConfigError(f"{option} {target}: is {item}, an input of this case, which writing would overwrite; "
+                              "write to another file")
+
+
+def case_inputs(case_file: Path) -> list[Path]:
+    """The case file and every file its build reads (for :func:`refuse_overwriting_inputs`); the case is checked."""
+    from softdesign.config import load_case
+    from softdesign.pipeline.inputs import input_fields
+
+    return [case_file, *(path for _, path in input_fields(load_case(case_file)))]

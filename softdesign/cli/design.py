@@ -16,7 +16,17 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from softdesign.cli.common import TEXT_ANGLES, CaseArg, JsonOpt, OutOpt, emit_json, note, run_guarded
+from softdesign.cli.common import (
+    TEXT_ANGLES,
+    CaseArg,
+    JsonOpt,
+    OutOpt,
+    case_inputs,
+    emit_json,
+    note,
+    refuse_overwriting_inputs,
+    run_guarded,
+)
 from softdesign.design_config import MAX_DESIGN_LINKS
 from softdesign.errors import ConfigError, SoftdesignError
 
@@ -131,8 +141,12 @@ def design(
         target = output if output is not None else case_file.with_name(f"{case_file.stem}-designed.yaml")
         if not target.parent.is_dir():
             raise ConfigError(f"--output {target}: the folder {target.parent} does not exist; create it first")
+        if target.is_dir():
+            raise ConfigError(f"--output {target}: is a folder, expected the case file to write; name a file in it, "
+                              f"e.g. {target / (case_file.stem + '-designed.yaml')}")
         if target.resolve() == case_file.resolve():
             raise ConfigError(f"--output {target}: is the case file itself; write the design to another file")
+        refuse_overwriting_inputs("--output", target, case_inputs(case_file))
         case = _case_with_design(case_file, {
             "tolerance_mm": tolerance_mm, "tip_tolerance_mm": tip_tolerance_mm,
             "tip_tolerance_deg": tip_tolerance_deg, "max_links": max_links, "min_link_mm": min_link_mm})
@@ -189,7 +203,11 @@ def _write_case(case_file: Path, target: Path, breaks: list[float], case: Case, 
         note(f"note: {target} keeps blend: {case.blend}: " + "; ".join(problems))
     text = case_file.read_text(encoding="utf-8")
     new_text, kept = case_text_with_keys(text, updates, case_file.parent, target.parent)
-    write_bytes_atomically(target, new_text.encode("utf-8"))
+    try:
+        write_bytes_atomically(target, new_text.encode("utf-8"))
+    except OSError as err:
+        raise ConfigError(f"--output {target}: cannot write it ({err.strerror or err}); choose a writable path"
+                          ) from None
     blend = "blend: pcc, " if "blend" in updates else ""
     note(f"wrote {target} (design: {flow}, {blend}links: the design's breaks)")
     if not kept:

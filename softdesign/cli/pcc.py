@@ -17,7 +17,15 @@ from typing import TYPE_CHECKING, Annotated, Any, NamedTuple
 
 import typer
 
-from softdesign.cli.common import TEXT_ANGLES, JsonOpt, emit_json, note, run_guarded
+from softdesign.cli.common import TEXT_ANGLES, JsonOpt, emit_json, note, refuse_overwriting_inputs, run_guarded
+from softdesign.cli.pcc_bounds import (
+    MAX_LENGTH_MM,
+    MAX_POINTS_PER_SECTION,
+    MAX_SECTIONS,
+    check_backbone_points,
+    check_readings_file,
+    check_shapes_dir,
+)
 from softdesign.cli.pcc_design import design
 from softdesign.cli.pcc_options import DOpt, LengthsOpt, lengths_from_text, spacing_from_text
 from softdesign.errors import ConfigError, InputDataError
@@ -118,6 +126,9 @@ def _header_sections(path: Path, header: list[str]) -> int:
     count = len(header)
     if count < 4 or (count - 1) % 3:
         raise InputDataError(f"{path} line 1: the header has {count} column(s); {fix}")
+    if (count - 1) // 3 > MAX_SECTIONS:
+        raise InputDataError(f"{path} line 1: the header names {(count - 1) // 3} sections, above the bound of "
+                             f"{MAX_SECTIONS}; {fix}")
     try:
         float(header[0])
     except ValueError:
@@ -145,8 +156,9 @@ def _parse_row(values: list[str], sections: int) -> tuple[float | None, np.ndarr
         except ValueError:
             reasons.append(f"section {section + 1} cable {cable + 1}: '{text.strip()}' is not a number")
             continue
-        if not (math.isfinite(value) and value > 0):
-            reasons.append(f"section {section + 1} cable {cable + 1}: length {value:g} mm is not > 0")
+        if not (math.isfinite(value) and 0 < value <= MAX_LENGTH_MM):
+            reasons.append(f"section {section + 1} cable {cable + 1}: length {value:g} mm is not > 0 and "
+                           f"<= {MAX_LENGTH_MM:g}")
         lengths[section, cable] = value
     return time, (None if reasons else lengths), reasons
 
@@ -184,8 +196,7 @@ def read_readings(path: Path, max_rate: float | None = None) -> Readings:
     """
     import numpy as np
 
-    if not path.is_file():
-        raise InputDataError(f"{path}: readings file not found; check the path")
+    check_readings_file(path)
     try:
         rows = [(n, row) for n, row in enumerate(csv.reader(io.StringIO(path.read_text())), start=1) if row]
     except (OSError, UnicodeDecodeError, csv.Error) as err:
@@ -277,6 +288,7 @@ def _readings_and_arcs(path: Path, d: str | None, max_rate: float | None) -> tup
     from softdesign.kinematics import pcc
     from softdesign.kinematics.chamber_lengths import arcs_from_chamber_lengths
 
+    check_readings_file(path)  # the size bound, before either reader
     if is_actuation_header(first_row(path)):
         table = read_actuation_table(path)
         if d is not None:
@@ -306,7 +318,7 @@ def reconstruct(
         float | None, typer.Option("--max-rate", help="Reject a row whose length changes faster than this, mm/s.")
     ] = None,
     points_per_section: Annotated[
-        int, typer.Option("--points-per-section", min=2, help="Backbone samples per arc.")
+        int, typer.Option("--points-per-section", min=2, max=MAX_POINTS_PER_SECTION, help="Backbone samples per arc.")
     ] = 21,
     d: Annotated[
         str | None,
@@ -341,9 +353,12 @@ def reconstruct(
                 f"--max-rate must be a finite number > 0 mm/s, got {max_rate:g}; omit it to skip the check"
             )
         readings, arcs, first = _readings_and_arcs(readings_csv, d, max_rate)
+        check_backbone_points(str(readings_csv), len(readings.times), readings.lengths.shape[1], points_per_section)
         for line, time, reason in readings.rejected:
             note(f"{readings_csv} line {line} (time {time}): rejected: {reason}")
-        out_dir.mkdir(parents=True, exist_ok=True)
+        for name in ("tips.csv", "backbones.vtp", "rejected.csv"):  # never over the readings themselves
+            refuse_overwriting_inputs("--shapes-dir", out_dir / name, [readings_csv])
+        check_shapes_dir(out_dir)
         tip2base = pcc.chain_transforms(pcc.transform_from_arc(arcs.kappa, arcs.phi, arcs.length))[:, -1]
         written = [
             _write_text_atomically(out_dir / "tips.csv", _tips_csv(readings, arcs, tip2base, first)),

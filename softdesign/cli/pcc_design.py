@@ -13,6 +13,7 @@ from typing import Annotated
 import typer
 
 from softdesign.cli.common import TEXT_ANGLES, CaseArg, JsonOpt, OutOpt, emit_json, note, run_guarded
+from softdesign.cli.pcc_bounds import MAX_DESIGN_SAMPLES
 from softdesign.cli.pcc_options import spacing_from_text
 from softdesign.errors import ConfigError, errors_named_for
 from softdesign.kinematics.arc_tolerance import ARC_TOLERANCE_MM
@@ -69,7 +70,8 @@ def design(
     ],
     json_out: JsonOpt = False,
     out: OutOpt = None,
-    samples: Annotated[int, typer.Option("--samples", min=3, help="Backbone samples per link for the fit.")] = 201,
+    samples: Annotated[int, typer.Option("--samples", min=3, max=MAX_DESIGN_SAMPLES,
+                                         help="Backbone samples per link for the fit.")] = 201,
     warn_mm: Annotated[float, typer.Option(
         "--warn-mm", help="Warn when a link's arc misses its backbone by more than this, mm.")] = ARC_TOLERANCE_MM,
 ) -> None:

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from softdesign.cli.common import distances_from_text, finite_number
+from softdesign.cli.pcc_bounds import MAX_LENGTH_MM, MAX_SECTIONS
 from softdesign.errors import ConfigError
 
 if TYPE_CHECKING:  # numpy is imported where it is used: `softdesign --help` starts without it
@@ -40,6 +41,8 @@ def lengths_from_text(text: str) -> np.ndarray:
     sections = [part for part in text.split(";") if part.strip()]
     if not sections:
         raise ConfigError(f"--lengths: no lengths given; {fix}")
+    if len(sections) > MAX_SECTIONS:
+        raise ConfigError(f"--lengths: {len(sections)} sections, above the bound of {MAX_SECTIONS}; {fix}")
     rows = []
     for i, part in enumerate(sections, start=1):
         values = part.split(",")
@@ -49,8 +52,9 @@ def lengths_from_text(text: str) -> np.ndarray:
             )
         row = [finite_number(v, f"--lengths: section {i} cable {j}", fix) for j, v in enumerate(values, start=1)]
         for j, value in enumerate(row, start=1):
-            if value <= 0:
-                raise ConfigError(f"--lengths: section {i} cable {j} is {value:g} mm, expected > 0; {fix}")
+            if not 0 < value <= MAX_LENGTH_MM:
+                raise ConfigError(f"--lengths: section {i} cable {j} is {value:g} mm, expected > 0 and "
+                                  f"<= {MAX_LENGTH_MM:g}; {fix}")
         rows.append(row)
     return np.array(rows, dtype=np.float64)
 

@@ -20,9 +20,11 @@ from softdesign.cli.common import (
     JsonOpt,
     OutOpt,
     QOpt,
+    case_inputs,
     emit_json,
     note,
     q_values_from_text,
+    refuse_overwriting_inputs,
     run_guarded,
 )
 from softdesign.errors import ConfigError, errors_named_for
@@ -155,6 +157,7 @@ def pose(
         _check_build_folder_option(out)
         q_values = q_values_from_text(q)
         mesh_format_of(output)  # refuse an unknown suffix or folder before the build, not after
+        refuse_overwriting_inputs("--output", output, case_inputs(case_file))
         body = _make_pose(case_file, q_values, out, force)
         try:
             write_mesh(output, body.vertices, body.faces, body.regions)

@@ -18,6 +18,9 @@ from softdesign.types import UNIT_SCALE_TO_MM, FloatArray, Points
 INSIDE_FRACTION = 0.9
 #: Median centerline-to-wall distance over median inscribed radius must lie in this band.
 WALL_RATIO_BAND = (0.2, 5.0)
+#: The surface's extent over the centerline's for one vessel (the wall adds a diameter to the path's extent; a
+#: short wide vessel reaches a few times): the unit hint needs the rescaled surface within it.
+EXTENT_RATIO_BAND = (0.5, 10.0)
 #: Unit factors tried when the check fails, with what each would mean.
 UNIT_FACTORS = (
     (1000.0, "surface in m, centerline in mm"),
@@ -69,9 +72,13 @@ def check_surface_surrounds(
     """
     if surrounds(points, radius, vertices):
         return
-    hint = next((why for factor, why in UNIT_FACTORS if surrounds(points, radius, vertices * factor)), None)
     extent_c = float(np.ptp(points, axis=0).max())
     extent_s = float(np.ptp(vertices, axis=0).max())
+    # a units mismatch explains it only when the rescaled surface is the centerline's size and surrounds it: a
+    # surface 1000 times larger would contain a centerline that is merely elsewhere
+    hint = next((why for factor, why in UNIT_FACTORS
+                 if EXTENT_RATIO_BAND[0] <= extent_s * factor / max(extent_c, 1e-300) <= EXTENT_RATIO_BAND[1]
+                 and surrounds(points, radius, vertices * factor)), None)
     message = (
         f"{where}: the surface does not surround the centerline (centerline extent {extent_c:.4g}, "
         f"surface extent {extent_s:.4g}, in the case's units converted to mm)"

@@ -6,8 +6,12 @@ before it can hang or fill memory: a FIFO (reading it would wait forever),
 :data:`MAX_CASE_BYTES`; YAML nested deeper than :data:`MAX_NESTING` (PyYAML's
 composer recurses and would end in a RecursionError) or whose aliases expand
 to more than :data:`MAX_NODES` nodes (a "billion laughs" file of 714 bytes
-expands to gigabytes); and a key given twice in one mapping (YAML would keep
-the last silently).
+expands to gigabytes), or that holds more values written out (refused from the
+event stream, in a second); an alias inside itself; a merge key ``<<`` (it
+copies keys unseen, so a key given twice would pass); an integer longer than
+:data:`MAX_INTEGER_DIGITS`; and a key given twice in one mapping (YAML would
+keep the last silently).  YAML 1.1's base-60 numbers (``1:30`` read as 90)
+are kept as text, which the schema then refuses as a number.
 """
 
 from __future__ import annotations
@@ -25,8 +29,15 @@ from softdesign.errors import ConfigError
 MAX_CASE_BYTES = 1_000_000
 #: Deepest nesting of mappings and lists: a case is 3 levels deep (export.q is a list in a mapping in the file).
 MAX_NESTING = 32
-#: Most nodes the document may have with every alias expanded (a 1 MB file of plain keys has fewer).
+#: Most nodes the document may have, written out or with every alias expanded (a case has a few dozen).
 MAX_NODES = 100_000
+#: Longest integer a case may write, characters: Python refuses to read one of more than 4300 digits, and no case
+#: value needs more than a few.
+MAX_INTEGER_DIGITS = 100
+#: libyaml's parser where PyYAML has it (10 to 100 times faster than the pure-Python one), else that one.
+_LOADER: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+_INT, _FLOAT, _STR = "tag:yaml.org,2002:int", "tag:yaml.org,2002:float", "tag:yaml.org,2002:str"
+_MERGE = "tag:yaml.org,2002:merge"
 
 
 def read_case_text(path: Path) -> str:
@@ -98,14 +109,15 @@ def parse_case_yaml(path: Path, text: str) -> tuple[Any, yaml.Node | None]:
     Raises
     ------
     ConfigError
-        Not valid YAML, too deep, too many nodes after alias expansion, or a key given twice.
+        Not valid YAML, too deep, too many values (written out or through aliases), an alias that contains
+        itself, a merge key, an integer of more than MAX_INTEGER_DIGITS digits, or a key given twice.
     """
     try:
-        _check_nesting(path, text)
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
+        _check_events(path, text)
+        root = yaml.compose(text, Loader=_LOADER)
         if root is not None:
             _check_nodes(path, root)
-        data = yaml.SafeLoader(text).construct_document(root) if root is not None else None
+        data = _LOADER(text).construct_document(root) if root is not None else None
     except yaml.YAMLError as err:
         mark = getattr(err, "problem_mark", None)
         where = f"{path}:{mark.line + 1}" if mark is not None else str(path)
@@ -114,49 +126,78 @@ def parse_case_yaml(path: Path, text: str) -> tuple[Any, yaml.Node | None]:
     return data, root
 
 
-def _check_nesting(path: Path, text: str) -> None:
-    """Refuse nesting deeper than MAX_NESTING from the event stream (the parser does not recurse)."""
-    depth = 0
-    for event in yaml.parse(text, Loader=yaml.SafeLoader):
+def _check_events(path: Path, text: str) -> None:
+    """Refuse nesting deeper than MAX_NESTING, or more than MAX_NODES values written out, from the event stream.
+
+    The parser does not recurse and holds one event at a time, so this is fast and small whatever the file.
+    """
+    depth = count = 0
+    for event in yaml.parse(text, Loader=_LOADER):
+        if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent, yaml.ScalarEvent)):
+            count += 1
+            if count > MAX_NODES:
+                raise ConfigError(
+                    f"{_where(path, event)}: the YAML holds more than {MAX_NODES} values (the limit); "
+                    "a case file needs a few dozen: the data stay in the files it names"
+                )
         if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
             depth += 1
             if depth > MAX_NESTING:
-                where = f"{path}:{event.start_mark.line + 1}" if event.start_mark is not None else str(path)
                 raise ConfigError(
-                    f"{where}: mappings and lists nested more than {MAX_NESTING} deep (the limit); "
+                    f"{_where(path, event)}: mappings and lists nested more than {MAX_NESTING} deep (the limit); "
                     "a case file is 3 levels deep, see configs/demo.yaml"
                 )
         elif isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
             depth -= 1
 
 
+def _where(path: Path, item: Any) -> str:
+    mark = getattr(item, "start_mark", None)
+    return f"{path}:{mark.line + 1}" if mark is not None else str(path)
+
+
 def _check_nodes(path: Path, root: yaml.Node) -> None:
-    """Refuse more than MAX_NODES nodes with aliases expanded, and a key given twice in one mapping.
+    """Refuse more than MAX_NODES nodes with aliases expanded, an alias inside itself, and what a scalar must not be.
 
     An alias is the same node object as its anchor, so each node's expanded
-    size is counted once (memoised) and the sum never expands anything.
+    size is counted once (memoised) and the sum never expands anything.  A
+    node met again while its own children are being walked contains itself
+    (``a: &a [*a]``), which no case value can.
     """
     sizes: dict[int, int] = {}
-    order: list[yaml.Node] = []
-    stack: list[yaml.Node] = [root]
-    seen: set[int] = set()
-    while stack:  # post-order without recursion: children before their parent
-        node = stack.pop()
-        if id(node) in seen:
+    stack: list[tuple[yaml.Node, bool]] = [(root, False)]
+    open_nodes: set[int] = set()
+    while stack:  # depth-first, children before their parent, without recursion
+        node, done = stack.pop()
+        if done:
+            open_nodes.discard(id(node))
+            sizes[id(node)] = 1 + sum(sizes[id(child)] for child in _children(node))
+            if sizes[id(node)] > MAX_NODES:
+                raise ConfigError(
+                    f"{_where(path, node)}: the YAML expands to more than {MAX_NODES} values (the limit) through its "
+                    "aliases (*name); write the values out, a case file needs a few dozen"
+                )
             continue
-        seen.add(id(node))
-        order.append(node)
-        stack.extend(_children(node))
-    for node in reversed(order):
-        if isinstance(node, yaml.MappingNode):
-            _no_duplicate_keys(path, node)
-        sizes[id(node)] = 1 + sum(sizes[id(child)] for child in _children(node))
-        if sizes[id(node)] > MAX_NODES:
-            line = node.start_mark.line + 1
-            raise ConfigError(
-                f"{path}:{line}: the YAML expands to more than {MAX_NODES} values (the limit) through its aliases "
-                "(*name); write the values out, a case file needs a few dozen"
-            )
+        if id(node) in open_nodes:
+            raise ConfigError(f"{_where(path, node)}: an alias (*name) refers to the list or mapping it is inside, "
+                              "which would make it contain itself; write the value out")
+        if id(node) in sizes:
+            continue
+        _check_node(path, node)
+        open_nodes.add(id(node))
+        stack.append((node, True))
+        stack.extend((child, False) for child in _children(node))
+
+
+def _check_node(path: Path, node: yaml.Node) -> None:
+    """One node's own rules: a mapping without merge keys or duplicates, a number a case can hold."""
+    if isinstance(node, yaml.MappingNode):
+        _no_duplicate_keys(path, node)
+    elif isinstance(node, yaml.ScalarNode) and node.tag == _INT and len(node.value) > MAX_INTEGER_DIGITS:
+        raise ConfigError(f"{_where(path, node)}: an integer of {len(node.value)} characters, more than the "
+                          f"{MAX_INTEGER_DIGITS} any case value needs; write the value a case expects")
+    elif isinstance(node, yaml.ScalarNode) and node.tag in (_INT, _FLOAT) and ":" in node.value:
+        node.tag = _STR  # YAML 1.1 reads 1:30 as 90 (base 60): keep the text, which the schema refuses as a number
 
 
 def _children(node: yaml.Node) -> list[yaml.Node]:
@@ -170,7 +211,12 @@ def _children(node: yaml.Node) -> list[yaml.Node]:
 def _no_duplicate_keys(path: Path, node: yaml.MappingNode) -> None:
     first: dict[str, int] = {}
     for key, _ in node.value:
-        if not isinstance(key, yaml.ScalarNode) or key.tag == "tag:yaml.org,2002:merge":
+        if isinstance(key, yaml.ScalarNode) and key.tag == _MERGE:
+            raise ConfigError(
+                f"{_where(path, key)}: a merge key (<<) copies keys from elsewhere, where a key given twice would "
+                "pass unseen; a case file writes its keys out: replace the << line with the keys it copies"
+            )
+        if not isinstance(key, yaml.ScalarNode):
             continue
         line = key.start_mark.line + 1
         if key.value in first:

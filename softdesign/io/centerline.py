@@ -114,8 +114,8 @@ def _read_csv(path: Path) -> list[Polyline]:
     try:
         with path.open(newline="", encoding="utf-8") as handle:
             rows = list(csv.reader(handle))
-    except (OSError, UnicodeDecodeError) as err:
-        raise InputDataError(f"{path}: cannot read the CSV centerline ({err})") from err
+    except (OSError, UnicodeDecodeError, csv.Error) as err:  # csv.Error: a field over 128 kB, a NUL byte
+        raise InputDataError(f"{path}: cannot read the CSV centerline ({err}); save it as plain CSV") from err
     if not rows:
         raise InputDataError(f"{path}: the CSV file is empty; expected a header row 'x,y,z[,radius]' and points")
     header = [h.strip().lower() for h in rows[0]]

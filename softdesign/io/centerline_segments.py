@@ -74,8 +74,10 @@ def read_line_cells(path: Path) -> LineCells:
     from vtkmodules.vtkIOLegacy import vtkUnstructuredGridReader
     from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
 
+    from softdesign.io.vtk_header_bounds import check_vtk_header
     from softdesign.io.vtk_polydata import _ErrorCatcher, _silence_vtk_log, polydata_arrays
 
+    check_vtk_header(path)  # before vtk allocates what the header declares
     _silence_vtk_log()
     xml = path.suffix.lower() == ".vtu"
     reader: Any = vtkXMLUnstructuredGridReader() if xml else vtkUnstructuredGridReader()

@@ -76,11 +76,13 @@ def _read_trimesh(path: Path) -> Mesh:
     if problem is not None:
         raise InputDataError(f"{path}: not an STL file: {problem}; re-export the mesh as STL")
     try:
-        mesh = _load_stl(path) if stl else trimesh.load(str(path), force="mesh", process=True)
+        mesh = _load_stl(path) if stl else trimesh.load(str(path), force="mesh", process=False)
     except Exception as err:  # trimesh raises many types for malformed files
         raise InputDataError(f"{path}: cannot read the mesh ({type(err).__name__}: {err}); re-export it") from err
     if not isinstance(mesh, trimesh.Trimesh):
         return np.zeros((0, 3)), np.zeros((0, 3), np.int64)
+    _refuse_non_finite(path, np.asarray(mesh.vertices))
+    mesh.process()  # after the check: trimesh's processing drops non-finite vertices, and their faces, silently
     return np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces, np.int64)
 
 
@@ -100,14 +102,25 @@ def _load_stl(path: Path) -> object:
         except HeaderError:  # not a binary STL: ASCII
             loaded = {}
     if "vertices" not in loaded or "faces" not in loaded:
-        return trimesh.load(str(path), force="mesh", process=True)
-    return trimesh.Trimesh(vertices=loaded["vertices"], faces=loaded["faces"], process=True)
+        return trimesh.load(str(path), force="mesh", process=False)
+    return trimesh.Trimesh(vertices=loaded["vertices"], faces=loaded["faces"], process=False)
+
+
+def _refuse_non_finite(path: Path, vertices: np.ndarray) -> None:
+    """InputDataError naming how many vertices have a NaN or infinite coordinate (the first one too)."""
+    bad = ~np.all(np.isfinite(vertices), axis=1) if len(vertices) else np.zeros(0, bool)
+    if bad.any():
+        raise InputDataError(f"{path}: {int(bad.sum())} of its {len(vertices)} vertices have NaN or infinite "
+                             f"coordinates (the first: vertex {int(np.argmax(bad))} as stored); expected finite "
+                             "coordinates: re-export the surface, or repair it (e.g. vmtksurfacecleaner)")
 
 
 def _read_vtk(path: Path) -> Mesh:
     from softdesign.io.vtk_polydata import read_polydata, triangles_from_polydata
 
-    return _merge_duplicate_vertices(*triangles_from_polydata(read_polydata(path)))
+    vertices, faces = triangles_from_polydata(read_polydata(path))
+    _refuse_non_finite(path, vertices)
+    return _merge_duplicate_vertices(vertices, faces)
 
 
 def _merge_duplicate_vertices(vertices: np.ndarray, faces: np.ndarray) -> Mesh:

@@ -43,6 +43,9 @@ def read_surface(path: str | Path, scale_to_mm: float = 1.0) -> Mesh:
             f"{path}: the surface is empty (0 triangles); expected the vessel wall from VMTK "
             "(e.g. vmtkmarchingcubes + vmtksurfacecapper output)"
         )
-    if not np.all(np.isfinite(vertices)):
-        raise InputDataError(f"{path}: the surface has NaN or infinite vertex coordinates; re-export it")
+    bad = ~np.all(np.isfinite(vertices), axis=1)
+    if bad.any():
+        raise InputDataError(f"{path}: {int(bad.sum())} of its {len(vertices)} vertices have NaN or infinite "
+                             f"coordinates (the first: vertex {int(np.argmax(bad))}); expected finite coordinates: "
+                             "re-export the surface, or repair it (e.g. vmtksurfacecleaner)")
     return vertices * scale_to_mm, faces

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from softdesign.errors import InputDataError
+from softdesign.io.vtk_header_bounds import check_cell_indices, check_vtk_header
 
 
 def read_polydata(path: Path):
@@ -28,6 +29,7 @@ def read_polydata(path: Path):
 
     if not path.is_file():
         raise InputDataError(f"{path}: file not found; check the path in the case file")
+    check_vtk_header(path)  # before vtk allocates what the header declares
     _silence_vtk_log()
     reader: Any  # VTK's stubs type AddObserver's event as an int id; vtk takes the event's name too
     if path.suffix.lower() == ".vtp":
@@ -42,6 +44,7 @@ def read_polydata(path: Path):
     if errors.messages or poly is None or (path.suffix.lower() == ".vtk" and not reader.IsFilePolyData()):
         detail = errors.messages[0] if errors.messages else "not VTK PolyData"
         raise InputDataError(f"{path}: cannot read it as VTK PolyData ({detail}); re-export it from VMTK or ParaView")
+    check_cell_indices(poly, path)
     return poly
 
 

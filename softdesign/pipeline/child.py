@@ -27,12 +27,16 @@ from multiprocessing.connection import Connection
 from typing import Any
 
 from softdesign.errors import MeshError
+from softdesign.pipeline.parallel import die_with_parent
 
 #: How long a killed child may take to be reaped, s.
 _REAP_S = 10.0
 
 
-def _child_main(send: Connection, target: Callable[..., Any], args: tuple[Any, ...], memory_bytes: int | None) -> None:
+def _child_main(
+    send: Connection, target: Callable[..., Any], args: tuple[Any, ...], memory_bytes: int | None, parent: int
+) -> None:
+    die_with_parent(parent)  # a mesher left running after its build was killed would run on for nothing
     try:
         if memory_bytes is not None:
             # address space, not resident memory: what a native allocation (malloc, new) is refused beyond
@@ -91,7 +95,7 @@ def run_in_child(
         raise ValueError(f"timeout_s must be > 0, got {timeout_s}")
     context = multiprocessing.get_context("spawn")
     receive, send = context.Pipe(duplex=False)
-    process = context.Process(target=_child_main, args=(send, target, args, memory_bytes), daemon=True)
+    process = context.Process(target=_child_main, args=(send, target, args, memory_bytes, os.getpid()), daemon=True)
     process.start()
     send.close()  # the child holds the only writer: its death ends the pipe, and poll() sees it at once
     try:

@@ -6,18 +6,28 @@ are a mistake in the recipe that starts them (``make -j`` with a duplicated
 target, two cluster jobs), and waiting would repeat the work in silence or
 hang a CI job.  The lock file stays beside the folder (removing it would let
 a third run lock a new file while the second still waits on the old one);
-the kernel releases the lock when the process ends, killed or not.
+the kernel releases the lock when the process ends, killed or not (and the
+build's forked workers die with it: :mod:`softdesign.pipeline.parallel`).
+
+A run that ends clears the file; a later run that finds it still naming a
+process says that run was killed and proceeds.  The file is opened without
+following a symbolic link and must be a regular file of this user, so a link
+planted beside the build folder (in a shared /tmp) cannot make a run write
+outside it.
 """
 
 from __future__ import annotations
 
+import errno
 import os
 import platform
+import stat
 import sys
 from pathlib import Path
 
 from softdesign.errors import ConfigError
 from softdesign.pipeline.layout import lock_name
+from softdesign.pipeline.store import process_alive
 
 
 class BuildLock:
@@ -27,6 +37,8 @@ class BuildLock:
         self.build_dir = Path(build_dir)
         self.path = self.build_dir.parent / lock_name(self.build_dir.name)
         self._fd: int | None = None
+        #: what the run should be told (a previous run that was killed), filled on entry
+        self.notes: list[str] = []
 
     def __enter__(self) -> BuildLock:
         if sys.platform == "win32":  # no flock there; runs are not serialized
@@ -34,26 +46,65 @@ class BuildLock:
         import fcntl
 
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o666)
+        fd = self._open()
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             holder = os.read(fd, 200).decode("utf-8", "replace").strip() or "unknown"
             os.close(fd)
-            raise ConfigError(
-                f"{self.build_dir}: another softdesign run (pid {holder}) is writing this build folder "
-                f"(it holds {self.path}); expected no other run into the same folder: wait for that run to end, "
-                "or give this one another --out"
-            ) from None
+            raise ConfigError(self._held_message(holder)) from None
         except BaseException:
             os.close(fd)
             raise
+        previous = os.read(fd, 200).decode("utf-8", "replace").strip()
+        if previous:  # a run that ends clears the file: this one was killed, and the kernel released its lock
+            self.notes.append(f"{self.build_dir}: the previous run ({previous}) ended without finishing (killed?); "
+                              "its lock was released when it ended, and this run proceeds")
         os.ftruncate(fd, 0)
-        os.write(fd, f"{os.getpid()} on {platform.node() or 'this machine'}\n".encode("utf-8", "replace"))
+        os.pwrite(fd, f"{os.getpid()} on {_machine()}\n".encode("utf-8", "replace"), 0)
         self._fd = fd
         return self
 
+    def _open(self) -> int:
+        """The lock file, opened without following a link; refused unless a regular file of this user."""
+        flags = os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+        fix = f"remove {self.path} (softdesign makes it anew), or give --out another folder"
+        try:
+            fd = os.open(self.path, flags | getattr(os, "O_NONBLOCK", 0), 0o666)
+        except OSError as err:
+            if err.errno == errno.ELOOP or os.path.islink(self.path):
+                raise ConfigError(f"{self.build_dir}: its lock file {self.path} is a symbolic link (to "
+                                  f"{os.readlink(self.path)}); softdesign does not follow it, so that nothing outside "
+                                  f"the build folder is written; {fix}") from None
+            raise
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode) or info.st_uid != os.geteuid():
+            os.close(fd)
+            what = "not a regular file" if not stat.S_ISREG(info.st_mode) else f"owned by user id {info.st_uid}"
+            raise ConfigError(f"{self.build_dir}: its lock file {self.path} is {what}; expected a regular file of "
+                              f"this user (id {os.geteuid()}); {fix}")
+        return fd
+
+    def _held_message(self, holder: str) -> str:
+        pid, _, machine = holder.partition(" on ")
+        ended = machine == _machine() and pid.isdigit() and not process_alive(pid)
+        if ended:
+            who = (f"pid {pid}, which has ended; a process it started still holds {self.path} (list it with "
+                   f"`fuser {self.path}`)")
+            fix = "end that process, then run again"
+        else:
+            who, fix = f"pid {holder}", "wait for that run to end, or give this one another --out"
+        return (f"{self.build_dir}: another softdesign run ({who}) is writing this build folder "
+                f"(it holds {self.path}); expected no other run into the same folder: {fix}")
+
     def __exit__(self, *exc: object) -> None:
         if self._fd is not None:
-            os.close(self._fd)  # closing the only descriptor releases the flock
+            try:
+                os.ftruncate(self._fd, 0)  # ended, not killed: the next run finds the file empty
+            finally:
+                os.close(self._fd)  # closing the only descriptor releases the flock
             self._fd = None
+
+
+def _machine() -> str:
+    return platform.node() or "this machine"

@@ -17,7 +17,8 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from softdesign.errors import ConfigError
-from softdesign.pipeline.layout import MANIFEST, REPORT_DIR, STAGE_RECORD, lock_name, sibling_role
+from softdesign.pipeline.layout import MANIFEST, lock_name, sibling_role
+from softdesign.pipeline.owned import foreign_files
 
 _OTHER_OUT = "give --out another folder"
 _FIXES = {
@@ -63,7 +64,7 @@ def check_out_folder(build_dir: Path, inputs: list[Path]) -> None:
             "manifest.json, and a build replaces its whole folder; expected an empty folder or a softdesign build "
             f"folder: {_OTHER_OUT}"
         )
-    foreign = sorted(set(entries) - _own_entries(real))
+    foreign = foreign_files(real)
     if foreign:
         raise ConfigError(
             f"build folder {build_dir}: is a softdesign build folder that also holds files softdesign did not write "
@@ -79,7 +80,7 @@ def _listed(names: list[str]) -> str:
 def _manifest(folder: Path) -> dict | None:
     try:
         payload = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         return None
     return payload if isinstance(payload, dict) else None
 
@@ -87,14 +88,6 @@ def _manifest(folder: Path) -> dict | None:
 def _is_softdesign_build(folder: Path) -> bool:
     manifest = _manifest(folder)
     return manifest is not None and isinstance(manifest.get("software"), dict) and "softdesign" in manifest["software"]
-
-
-def _own_entries(folder: Path) -> set[str]:
-    """Top-level names a build (or ``softdesign report``) writes into ``folder``, from its manifest and stages."""
-    manifest = _manifest(folder) or {}
-    listed = [entry.get("path", "") for entry in manifest.get("outputs", []) + manifest.get("records", [])]
-    own = {MANIFEST, REPORT_DIR} | {path.split("/", 1)[0] for path in listed if isinstance(path, str)}
-    return own | {p.parent.name for p in folder.glob(f"*/{STAGE_RECORD}")}
 
 
 @contextmanager

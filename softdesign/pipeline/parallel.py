@@ -16,6 +16,10 @@ benchmark machine) and pickle the inputs to each.  Only a q goes to a worker
 and only its result comes back.  Where ``fork`` is not available (not Linux
 or macOS) the work runs in this process.
 
+Left running: none.  Each worker asks the kernel to kill it when the build's
+process ends (:func:`die_with_parent`), so a build killed mid-stage leaves no
+worker holding its memory or the build folder's lock.
+
 Same bytes: each q is computed by the same code on the same inputs wherever
 it runs, and the results come back in the order of the q values, so the
 outputs do not depend on ``jobs`` (``tests/pipeline/test_parallel.py``
@@ -24,8 +28,11 @@ builds with 1 and 2 jobs and compares every file).
 
 from __future__ import annotations
 
+import ctypes
 import multiprocessing
 import os
+import signal
+import sys
 from collections.abc import Callable, Iterator, MutableMapping, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
@@ -94,6 +101,27 @@ def current_jobs() -> int:
     return _JOBS.get()
 
 
+#: prctl's option asking the kernel to send a signal to this process when its parent ends (Linux).
+_PR_SET_PDEATHSIG = 1
+
+
+def die_with_parent(parent_pid: int) -> None:
+    """In a worker: be killed (SIGKILL) when the process that started it ends, killed or not; Linux only.
+
+    A worker of a killed build would otherwise live on, asleep on its pipe,
+    holding the memory it inherited and the build folder's lock, so that every
+    later build is refused.  Where prctl is missing (not Linux) nothing is asked.
+    """
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+        except (OSError, AttributeError):
+            return
+        if os.getppid() != parent_pid:  # the parent ended before the request was made: end now
+            os._exit(1)
+
+
 def _call(item: Any) -> Any:
     if _TASK is None:
         raise RuntimeError("a softdesign worker started without its task")
@@ -136,7 +164,8 @@ def map_items(
         return results
     _TASK = task
     try:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork")) as pool:
+        with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
+                                 initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
             results = []
             for item, result in zip(items, pool.map(_call, items), strict=True):
                 results.append(result)

@@ -23,6 +23,7 @@ from softdesign.pipeline.bounds import check_sizes
 from softdesign.pipeline.lock import BuildLock
 from softdesign.pipeline.manifest import build_manifest
 from softdesign.pipeline.out_folder import check_out_folder, folder_errors
+from softdesign.pipeline.owned import safe_relative
 from softdesign.pipeline.parallel import jobs_for_build
 from softdesign.pipeline.stage import Results, Stage, StageRun, Status, stage_key
 from softdesign.pipeline.store import Staging, read_record, sha256_file
@@ -35,9 +36,22 @@ def _intact(build_dir: Path, record: dict[str, Any]) -> bool:
     return all((build_dir / rel).is_file() and sha256_file(build_dir / rel) == sha for rel, sha in outputs.items())
 
 
+def _record(build_dir: Path, stage: Stage) -> dict[str, Any] | None:
+    """The stage's record in ``build_dir``, or None when missing, unreadable, or naming an output outside its folder.
+
+    A record is only trusted to name files inside the stage's own folder (or, for export, the meshes and series it
+    writes beside them): one naming ``../x`` or an absolute path is not ours, and its stage runs again.
+    """
+    record = read_record(build_dir / layout.stage_record(stage.name))
+    outputs = record.get("outputs") if isinstance(record, dict) else None
+    if not isinstance(outputs, dict) or not all(safe_relative(r) and isinstance(h, str) for r, h in outputs.items()):
+        return None
+    return record
+
+
 def _up_to_date(build_dir: Path, stage: Stage, key: str) -> dict[str, Any] | None:
     """The stage's record in ``build_dir`` when its key is ``key`` and its outputs are intact, else None."""
-    record = read_record(build_dir / layout.stage_record(stage.name))
+    record = _record(build_dir, stage)
     if record is None or record.get("key") != key or not _intact(build_dir, record):
         return None
     return record
@@ -80,8 +94,8 @@ def run_stages(
     target = Path(os.path.realpath(build_dir))
     with folder_errors(build_dir):
         check_out_folder(build_dir, inputs)  # before the lock: a refused --out gets no lock file beside it
-    with folder_errors(build_dir), BuildLock(target):
-        for line in repair(target):
+    with folder_errors(build_dir), BuildLock(target) as lock:
+        for line in lock.notes + repair(target):
             options.progress(line)
         with Staging(build_dir) as staging, jobs_for_build(options.jobs):
             results, runs = _run_all(case, staging, stages, input_hashes, options)
@@ -108,7 +122,7 @@ def _run_all(
         if stage.name == "ingest":  # the vessel is measured: refuse spacings it cannot afford before they run
             check_sizes(case, results["ingest"])
     for stage in options.later:
-        record = read_record(staging.target / layout.stage_record(stage.name))
+        record = _record(staging.target, stage)
         if record is not None and all(u in keys for u in stage.upstream):
             keys[stage.name] = stage_key(stage, case, [keys[u] for u in stage.upstream], [])
             runs.append(_kept_run(stage, record, keys[stage.name], results, staging))

@@ -52,8 +52,11 @@ def sha256_file(path: Path) -> str:
     """Hex sha256 of a file's contents, read in chunks."""
     digest = hashlib.sha256()
     with Path(path).open("rb") as handle:
-        for chunk in iter(lambda: handle.read(1 << 20), b""):
-            digest.update(chunk)
+        try:
+            for chunk in iter(lambda: handle.read(1 << 20), b""):
+                digest.update(chunk)
+        except OSError as err:  # a failed read names no file (EIO from /proc/self/mem): name it, so callers can
+            raise OSError(err.errno, err.strerror, str(path)) from err
     return digest.hexdigest()
 
 
@@ -76,9 +79,10 @@ def read_record(file: Path) -> dict[str, Any] | None:
     if not file.is_file():
         return None
     try:
-        return json.loads(file.read_text(encoding="utf-8"))
-    except (OSError, json.JSONDecodeError):
+        payload = json.loads(file.read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):  # RecursionError: nested too deep to be one of ours
         return None
+    return payload if isinstance(payload, dict) else None
 
 
 def process_alive(pid: str) -> bool:

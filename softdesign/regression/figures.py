@@ -129,6 +129,8 @@ def read_json(path: Path) -> dict:
         payload = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
         raise InputDataError(f"{path}: cannot read JSON ({err}); rebuild it") from err
+    except RecursionError:
+        raise InputDataError(f"{path}: its JSON is nested too deep to be a softdesign file; rebuild it") from None
     if not isinstance(payload, dict):
         raise InputDataError(f"{path}: expected a JSON object, got {type(payload).__name__}")
     return payload

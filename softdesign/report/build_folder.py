@@ -24,6 +24,7 @@ from softdesign.pipeline.stages.fit import FitResult, load_fit
 from softdesign.pipeline.stages.ingest import IngestResult, load_ingest
 from softdesign.pipeline.stages.kinematics import KinematicsResult, load_kinematics
 from softdesign.pipeline.stages.links import load_links
+from softdesign.report.build_check import check_manifest
 
 
 @dataclass(frozen=True)
@@ -91,14 +92,14 @@ def load_build(build_dir: str | Path) -> BuildData:
     """
     root = Path(build_dir)
     fix = f"build it first: softdesign build CASE.yaml --out {root}"
-    if not (root / MANIFEST).is_file():
-        raise InputDataError(f"{root}: not a build folder (no {MANIFEST}); {fix}")
+    require_build(root)
     try:
         manifest = json.loads((root / MANIFEST).read_text(encoding="utf-8"))
-    except (OSError, json.JSONDecodeError) as err:
-        raise InputDataError(f"{root / MANIFEST}: unreadable ({err}); {fix}") from err
+    except (OSError, ValueError, RecursionError) as err:
+        raise InputDataError(f"{root / MANIFEST}: unreadable ({type(err).__name__}: {err}); {fix}") from err
     required = (layout.INGEST_SUMMARY, layout.INGEST_PATH, layout.BLEND_CURVES, layout.BLEND_SUMMARY, layout.LINKS,
                 layout.KINEMATICS)
+    check_manifest(root, manifest, fix)
     missing = [rel for rel in required if not (root / rel).is_file()]
     if missing:
         raise InputDataError(
@@ -115,6 +116,13 @@ def load_build(build_dir: str | Path) -> BuildData:
             f"{root}: a stage's kept files are unreadable ({type(err).__name__}: {err}); {fix} --force"
         ) from err
     return BuildData(root, manifest, ingest, blend, kinematics, fit, export)
+
+
+def require_build(root: Path) -> None:
+    """InputDataError unless ``root`` holds a manifest (checked before the report takes the folder's lock)."""
+    if not (root / MANIFEST).is_file():
+        raise InputDataError(f"{root}: not a build folder (no {MANIFEST}); "
+                             f"build it first: softdesign build CASE.yaml --out {root}")
 
 
 def _has(root: Path, *relative: str) -> bool:

@@ -10,10 +10,9 @@ manifest are only read.
 from __future__ import annotations
 
 import gc
+import json
 import os
-import shutil
 import time
-import uuid
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -21,11 +20,10 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from softdesign.errors import ConfigError
-from softdesign.pipeline.layout import REPORT_DIR
+from softdesign.pipeline.layout import MANIFEST, REPORT_DIR
 from softdesign.pipeline.lock import BuildLock
 from softdesign.pipeline.out_folder import folder_errors
 from softdesign.pipeline.parallel import jobs_for_build, map_items
-from softdesign.pipeline.store import process_alive
 from softdesign.report import (
     actuation_figures,
     animation,
@@ -40,7 +38,9 @@ from softdesign.report import (
     stretch_figures,
     surface_figures,
 )
-from softdesign.report.build_folder import BuildData, load_build
+from softdesign.report.build_check import changed_since_build, unreadable_build
+from softdesign.report.build_folder import BuildData, load_build, require_build
+from softdesign.report.commit import commit_folder
 from softdesign.report.html_page import (
     Section,
     banner_html,
@@ -71,7 +71,6 @@ PAGE = "index.html"
 #: What differs from run to run or folder to folder (the build folder's path, the build's and the report's times):
 #: kept out of the page, which is the same bytes for the same build wherever it is, and written here.
 LOG = "report.log"
-TEMP_PREFIX = ".report-"
 NO_FIT = (
     "no fit in this build folder (built only through kinematics): surfaces and fit quality are left out; "
     "run softdesign build"
@@ -220,6 +219,20 @@ def write_report(
     SoftdesignError
         A PCC design fails (e.g. a bad ``pcc_d``).
     """
+    # under the build's lock from the first read to the last write: a build cannot change the folder meanwhile, so
+    # the page shows one build; OSErrors name the folder, exit 2
+    require_build(Path(build_dir))  # before the lock: a folder that is not a build gets no lock file beside it
+    with folder_errors(Path(build_dir)), BuildLock(Path(os.path.realpath(build_dir))) as lock:
+        try:
+            result = _write_report(Path(build_dir), options, progress, jobs)
+        except (KeyError, TypeError, IndexError, ValueError, AttributeError) as err:  # the build's files lack a key
+            manifest = json.loads((Path(build_dir) / MANIFEST).read_text(encoding="utf-8"))
+            raise unreadable_build(Path(build_dir), changed_since_build(Path(build_dir), manifest), err) from err
+    result.notes[:0] = lock.notes
+    return result
+
+
+def _write_report(build_dir: Path, options: ReportOptions, progress: Progress | None, jobs: int) -> ReportResult:
     timer = _Timer(progress, jobs)
     data = timer("load the build", lambda: load_build(build_dir))
     with _collector_for_figures():
@@ -239,10 +252,8 @@ def write_report(
     missing = sorted(set(referenced_files(page)) - set(files))
     if missing:
         raise RuntimeError(f"report page links to files it does not write: {missing}")  # a bug, not a user error
-    target = Path(build_dir) / REPORT_DIR
-    # under the build's lock, so a build cannot swap the folder away mid-commit; OSErrors name the folder, exit 2
-    with folder_errors(Path(build_dir)), BuildLock(Path(os.path.realpath(build_dir))):
-        timer("write the files", lambda: commit_folder(target, files))
+    target = build_dir / REPORT_DIR
+    timer("write the files", lambda: commit_folder(target, files))
     return ReportResult(target / PAGE, {k: len(v) for k, v in sorted(files.items())}, passed, len(checks), notes,
                         timer.seconds, warnings)
 
@@ -428,30 +439,3 @@ def run_log(data: BuildData, seconds: dict[str, float]) -> bytes:
     lines += [f"stage {name}: {value:.3f} s (last run)" for name, value in data.manifest.get("timing_s", {}).items()]
     lines += [f"report part {name}: {value:.3f} s" for name, value in seconds.items()]
     return ("\n".join(lines) + "\n").encode("utf-8")
-
-
-def commit_folder(target: Path, files: dict[str, bytes]) -> None:
-    """Write ``files`` into a temporary folder beside ``target``, then swap it in for ``target``.
-
-    Temporary folders are named ``.report-<pid>-<random>``; one whose process
-    is gone is a killed run's leftover and is removed.
-    """
-    parent = target.parent
-    for stale in parent.glob(TEMP_PREFIX + "*"):
-        if not process_alive(stale.name.removeprefix(TEMP_PREFIX).split("-", 1)[0]):
-            shutil.rmtree(stale, ignore_errors=True)
-    temp = parent / f"{TEMP_PREFIX}{os.getpid()}-{uuid.uuid4().hex[:12]}"
-    temp.mkdir()  # unlike mkdtemp, honours the umask: the report is as readable as the rest of the build
-    old = temp.with_name(temp.name + "-old")
-    try:
-        for name, data in sorted(files.items()):
-            (temp / name).write_bytes(data)
-        if target.exists():
-            os.rename(target, old)
-        os.rename(temp, target)
-    except BaseException:
-        if old.exists() and not target.exists():
-            os.rename(old, target)
-        shutil.rmtree(temp, ignore_errors=True)
-        raise
-    shutil.rmtree(old, ignore_errors=True)

@@ -24,6 +24,7 @@ from PIL import Image
 from typer.testing import CliRunner
 
 from softdesign.pipeline.api import build_through
+from softdesign.pipeline.owned import REPORT_MARKER
 from softdesign.report.interactive import DISPLAY_TOLERANCE_MM, DIV_ID, JS_NAME
 from softdesign.report.writer import (
     EXPECTED_SIZES,
@@ -106,7 +107,9 @@ def at_pointer(document, pointer: str):
 
 
 def tree_hashes(folder: Path) -> dict[str, str]:
-    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(folder.iterdir())}
+    """The report's files with their hashes (not its marker, which lists them: issue 36)."""
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(folder.iterdir())
+            if p.name != REPORT_MARKER}
 
 
 @pytest.fixture(scope="module")
@@ -162,7 +165,8 @@ def test_the_page_links_only_to_files_beside_it_and_every_file_is_linked(built):
         assert "://" not in link and not link.startswith("/") and ".." not in link, link  # no network, no escape
         assert (report_dir / link).is_file(), link
     # and report.log beside it: the folder's path and the times, which the page leaves out
-    assert sorted(set(files) | {PAGE, LOG}) == sorted(p.name for p in report_dir.iterdir()) == sorted(result.files)
+    written = sorted(p.name for p in report_dir.iterdir() if p.name != REPORT_MARKER)
+    assert sorted(set(files) | {PAGE, LOG}) == written == sorted(result.files)
     anchors = {link[1:] for link in page.links if link.startswith("#")}
     text = (report_dir / PAGE).read_text(encoding="utf-8")
     assert all(f'id="{anchor}"' in text for anchor in anchors)
@@ -464,10 +468,11 @@ def test_a_killed_runs_temporary_folder_is_removed_a_running_ones_kept(tmp_path)
     import sys
 
     finished = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
-    dead = tmp_path / f".report-{finished.stdout.strip()}-abc"  # that process has exited
-    alive = tmp_path / f".report-{__import__('os').getpid()}-def"  # this test's own process
+    dead = tmp_path / f".report-{finished.stdout.strip()}-0123456789ab"  # that process has exited
+    alive = tmp_path / f".report-{__import__('os').getpid()}-abcdef012345"  # this test's own process
     for folder in (dead, alive):
         folder.mkdir()
+        (folder / REPORT_MARKER).write_text('{"files": {"index.html": ""}}')  # a report writes its marker first
         (folder / PAGE).write_bytes(b"half written")
     commit_folder(tmp_path / REPORT_DIR, {PAGE: b"page"})
     assert not dead.exists() and alive.exists()
