@@ -4,13 +4,16 @@ A second run into the same folder is refused at once, naming the first
 run's process and machine, rather than waiting: two runs of one case at the same time
 are a mistake in the recipe that starts them (``make -j`` with a duplicated
 target, two cluster jobs), and waiting would repeat the work in silence or
-hang a CI job.  The lock file stays beside the folder (removing it would let
-a third run lock a new file while the second still waits on the old one);
-the kernel releases the lock when the process ends, killed or not (and the
-build's forked workers die with it: :mod:`softdesign.pipeline.parallel`).
+hang a CI job.  The kernel releases the lock when the process ends, killed
+or not (and the build's forked workers die with it:
+:mod:`softdesign.pipeline.parallel`).
 
-A run that ends clears the file; a later run that finds it still naming a
-process says that run was killed and proceeds.  The file is opened without
+A run that ends removes the file while it still holds the lock, so no lock
+file outlives its run; a run that locked a file removed under it (it opened
+the file just before) finds the path gone or another file there, and starts
+over on the path's file, so two runs never hold two different files.  A
+later run that finds the file of a killed run (still naming its process) says
+so and proceeds.  The file is opened without
 following a symbolic link and must be a regular file of this user, so a link
 planted beside the build folder (in a shared /tmp) cannot make a run write
 outside it.
@@ -29,6 +32,9 @@ from softdesign.errors import ConfigError
 from softdesign.pipeline.layout import lock_name
 from softdesign.pipeline.store import process_alive
 
+#: How many times a run starts over on a lock file removed under it before it gives up (each a few system calls).
+LOCK_ATTEMPTS = 20
+
 
 class BuildLock:
     """Hold the lock of build folder ``build_dir`` for a with-block (ConfigError when another run holds it)."""
@@ -46,16 +52,23 @@ class BuildLock:
         import fcntl
 
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd = self._open()
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            holder = os.read(fd, 200).decode("utf-8", "replace").strip() or "unknown"
-            os.close(fd)
-            raise ConfigError(self._held_message(holder)) from None
-        except BaseException:
-            os.close(fd)
-            raise
+        for _ in range(LOCK_ATTEMPTS):
+            fd = self._open()
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.read(fd, 200).decode("utf-8", "replace").strip() or "unknown"
+                os.close(fd)
+                raise ConfigError(self._held_message(holder)) from None
+            except BaseException:
+                os.close(fd)
+                raise
+            if self._still_the_path(fd):
+                break
+            os.close(fd)  # the run that held it removed it as it ended: lock the path's file instead
+        else:
+            raise ConfigError(f"{self.build_dir}: its lock file {self.path} was replaced {LOCK_ATTEMPTS} times while "
+                              "this run took it; expected one run at a time: run again")
         previous = os.read(fd, 200).decode("utf-8", "replace").strip()
         if previous:  # a run that ends clears the file: this one was killed, and the kernel released its lock
             self.notes.append(f"{self.build_dir}: the previous run ({previous}) ended without finishing (killed?); "
@@ -97,10 +110,22 @@ class BuildLock:
         return (f"{self.build_dir}: another softdesign run ({who}) is writing this build folder "
                 f"(it holds {self.path}); expected no other run into the same folder: {fix}")
 
+    def _still_the_path(self, fd: int) -> bool:
+        """Whether the locked file is still the one at :attr:`path` (not removed or replaced meanwhile)."""
+        try:
+            here = os.lstat(self.path)
+        except FileNotFoundError:
+            return False
+        mine = os.fstat(fd)
+        return (here.st_dev, here.st_ino) == (mine.st_dev, mine.st_ino)
+
     def __exit__(self, *exc: object) -> None:
         if self._fd is not None:
             try:
-                os.ftruncate(self._fd, 0)  # ended, not killed: the next run finds the file empty
+                if self._still_the_path(self._fd):
+                    os.unlink(self.path)  # while still held: no lock file outlives its run
+            except OSError:
+                os.ftruncate(self._fd, 0)  # cannot remove it: the next run finds it empty (ended, not killed)
             finally:
                 os.close(self._fd)  # closing the only descriptor releases the flock
             self._fd = None

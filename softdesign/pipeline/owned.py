@@ -59,7 +59,7 @@ def report_marker_files(folder: Path) -> list[str] | None:
 
 
 #: What a report of a version before the marker wrote into report/: its page, images, animation and scripts.
-LEGACY_REPORT_SUFFIXES = (".html", ".png", ".gif", ".js")
+LEGACY_REPORT_SUFFIXES = (".html", ".png", ".gif", ".js", ".log")
 
 
 def legacy_report_files(folder: Path) -> list[str]:

@@ -25,6 +25,7 @@ from softdesign.pipeline.manifest import build_manifest
 from softdesign.pipeline.out_folder import check_out_folder, folder_errors
 from softdesign.pipeline.owned import safe_relative
 from softdesign.pipeline.parallel import jobs_for_build
+from softdesign.pipeline.report_keep import carry_report
 from softdesign.pipeline.stage import Results, Stage, StageRun, Status, stage_key
 from softdesign.pipeline.store import Staging, read_record, sha256_file
 from softdesign.pipeline.swap import repair
@@ -103,7 +104,10 @@ def run_stages(
             manifest = build_manifest(case, staging.folder, stages_run, runs, results, inputs, input_hashes)
             staging.write_json(layout.MANIFEST, manifest)
             _check_listed(manifest, staging.written)
+            dropped = carry_report(staging, manifest)
             staging.commit()
+        if dropped is not None:
+            options.progress(dropped)
     return results, runs
 
 

@@ -59,11 +59,34 @@ def test_a_run_that_ends_releases_the_lock_and_a_killed_one_is_named_by_the_next
     build = tmp_path / "build"
     with BuildLock(build) as lock:
         assert lock.notes == []
-    assert (tmp_path / lock_name("build")).read_bytes() == b""  # ended: nothing left that claims the folder
+    assert not (tmp_path / lock_name("build")).exists()  # ended: no lock file outlives its run (issue 34)
     (tmp_path / lock_name("build")).write_text("999999999 on elsewhere\n")  # what a killed run leaves
     with BuildLock(build) as lock:
         assert len(lock.notes) == 1 and "999999999 on elsewhere" in lock.notes[0], lock.notes
         assert "ended without finishing" in lock.notes[0]
+    assert not (tmp_path / lock_name("build")).exists()
+
+
+def test_a_run_that_locked_a_file_removed_under_it_starts_over_on_the_paths_file(tmp_path, monkeypatch):
+    # the race removing the lock file opens: B opens the file, A (holding it) removes it and ends, B locks the
+    # removed file; B must not go on holding a file no other run can see
+    import fcntl
+
+    build = tmp_path / "build"
+    real_flock = fcntl.flock
+    removed = []
+
+    def flock_after_removal(fd, how):
+        if not removed:  # the first lock taken: its file is removed first, as an ending run does
+            removed.append(True)
+            (tmp_path / lock_name("build")).unlink()
+        return real_flock(fd, how)
+
+    monkeypatch.setattr(fcntl, "flock", flock_after_removal)
+    with BuildLock(build):
+        path = tmp_path / lock_name("build")
+        assert path.exists() and path.read_text().startswith(f"{__import__('os').getpid()} on ")
+    assert removed == [True] and not (tmp_path / lock_name("build")).exists()
 
 
 def test_report_removes_only_its_own_temporary_folders(tmp_path):
@@ -122,9 +145,8 @@ def test_a_report_of_an_older_version_without_marker_is_still_ours(out, tmp_path
     (report / PAGE).write_text("<html>an older report</html>")
     (report / "morph.png").write_bytes(b"png")
     result = runner.invoke(app, ["build", str(demo_case(tmp_path)), "--out", str(out)])
-    assert result.exit_code == 0, result.output  # rebuilt: the old report goes with the old folder, as before
-    report.mkdir()
-    (report / PAGE).write_text("<html>an older report</html>")
+    assert result.exit_code == 0, result.output  # rebuilt, outputs unchanged: the report is kept (issue 34)
+    assert (report / PAGE).read_text() == "<html>an older report</html>"
     commit_folder(report, {PAGE: b"new page"})  # and a new report replaces it
     assert (report / PAGE).read_bytes() == b"new page"
 
