@@ -63,7 +63,7 @@ from softdesign.pipeline.layout import q_label
 
 
 class _Section(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
 
 
 class FinalShape(_Section):
@@ -74,11 +74,19 @@ class FinalShape(_Section):
     """
 
     centerline: Literal["auto"] | Path
+    """The centerline file (.vtp .vtk .vtu .csv .npy), or auto to extract it from the surface at ingest."""
     surface: Path | None = None
+    """The vessel surface (.stl .vtp .ply .obj .vtk), capped or open."""
     path: Integer = Field(0, ge=0)
+    """Which path of the centerline network the actuator follows (a polyline index, or CenterlineIds when
+    branch-split).
+    """
     inlet: tuple[FiniteFloat, FiniteFloat, FiniteFloat] | None = None
+    """A point near the inlet: the path's end nearest it is l = 0, where the actuator is mounted."""
     reverse: bool = False
+    """Flip the path's orientation (when the inlet rule picks the wrong end)."""
     surface_units: Literal["mm", "cm", "m"] | None = None
+    """The surface file's unit when it differs from the case's units."""
 
     @model_validator(mode="after")
     def _auto_needs_surface(self) -> FinalShape:
@@ -91,23 +99,36 @@ class IntermediateShape(_Section):
     """A keyframe centerline reached at ``q`` (piecewise-linear in q between keyframes)."""
 
     q: FiniteFloat = Field(gt=0.0, lt=1.0)
+    """The q at which this keyframe is reached, strictly between 0 and 1."""
     centerline: Path
+    """The keyframe's centerline file."""
     path: Integer = Field(0, ge=0)
+    """Which path of the keyframe's centerline file."""
     reverse: bool = False
+    """Flip the keyframe path's orientation."""
 
 
 class InitialShape(_Section):
     """The insertion shape, q = 0, and the body radius there."""
 
     kind: Literal["straight", "arc", "file"] = "straight"
+    """The q = 0 shape: straight, an arc, or a file."""
     length_mm: FiniteFloat | None = Field(None, gt=0.0)
+    """Length of the q = 0 centerline, mm (default: the q = 1 centerline's)."""
     radius_mm: FiniteFloat | None = Field(None, gt=0.0)
+    """A constant body radius at q = 0, mm (default: the fitted wall's axially symmetric mean)."""
     surface: Path | None = None
+    """A surface for the q = 0 body instead of a constant radius."""
     bend_radius_mm: FiniteFloat | None = Field(None, gt=0.0)
+    """The arc's radius of curvature, mm (kind: arc)."""
     bend_plane_deg: FiniteFloat = 0.0
+    """The arc's bending plane about the base tangent, degrees from the base frame's N (kind: arc)."""
     centerline: Path | None = None
+    """The q = 0 centerline file (kind: file)."""
     path: Integer = Field(0, ge=0)
+    """Which path of the q = 0 centerline file (kind: file)."""
     align_base: bool = True
+    """Place the q = 0 shape's base on the q = 1 shape's base frame."""
 
     # after FiniteFloat's own check, so that a nan is called not finite rather than out of range
     _length_bound = field_validator("length_mm")(size_bound(MIN_INITIAL_LENGTH_MM, MAX_INITIAL_LENGTH_MM))
@@ -128,9 +149,13 @@ class Resample(_Section):
     """Arc-length resampling and smoothing of every centerline."""
 
     spacing_mm: FiniteFloat = Field(0.5, gt=0.0)
+    """Arc length between resampled points, mm."""
     count: Integer | None = Field(None, ge=4, le=MAX_CURVE_SAMPLES)
+    """A fixed number of resampled points instead of spacing_mm."""
     smoothing_mm: FiniteFloat = Field(0.1, ge=0.0)
+    """Smoothing of the centerline (Gaussian width along arc length), mm; 0 keeps it as it is."""
     end_straight_mm: FiniteFloat = Field(2.0, ge=0.0)
+    """Straighten this much of each end, mm (a centerline's last points bend towards the cap)."""
 
     @model_validator(mode="after")
     def _one_rule(self) -> Resample:
@@ -143,8 +168,11 @@ class Links(_Section):
     """How the actuator is split into links: exactly one of the three keys."""
 
     count: Integer | None = Field(None, ge=1, le=MAX_LINKS)
+    """The number of links of equal length."""
     breaks: list[FiniteFloat] | None = Field(None, max_length=MAX_LINKS + 1)
+    """Link breaks in normalized l, from 0 to 1, strictly increasing."""
     length_mm: FiniteFloat | None = Field(None, gt=0.0)
+    """Links of about this length, mm."""
 
     @model_validator(mode="after")
     def _one_rule(self) -> Links:
@@ -177,19 +205,31 @@ class Fit(_Section):
     # coefficient; 1e-5 is the least penalty that bridges the other iliac's opening; the aorta's
     # elliptical inlet wall reaches 1.79x the inscribed radius, so outliers start at 2x
     knot_spacing_mm: float | Literal["auto"] = 1.5
+    """Knot spacing of the spline along l, mm, or auto."""
     angular_intervals: Integer = Field(24, ge=4, le=MAX_ANGULAR_INTERVALS)
+    """Knot intervals of the spline around the body."""
     smoothing: FiniteFloat = Field(1.0e-5, ge=0.0)
+    """Weight of the smoothing penalty of the least-squares fit."""
     holdout_folds: Integer = Field(5, ge=2, le=MAX_HOLDOUT_FOLDS)
+    """Folds of the k-fold hold-out error of the fit."""
     outlier_factor: FiniteFloat = Field(2.0, gt=1.0)
+    """A wall point beyond this factor (or its inverse) of the reference radius is an outlier."""
     # wall points within this of either end are not fitted (a tilted cap's rim, one-sided ends); the end's
     # rings are then held at the inscribed radius by the end prior (fitting/end_prior.py)
     end_margin_mm: FiniteFloat = Field(0.0, ge=0.0, le=MAX_END_MARGIN_MM)
+    """Wall points within this of either end are not fitted; the end's rings are held at the inscribed radius, mm."""
     # where the body ends: at each end's detected cap plane or boundary loop (auto, cap_plane) or square to the
     # end tangent (normal); see geometry/end_cut.py
     end_cut: Literal["auto", "cap_plane", "normal"] = "auto"
+    """Where the body ends: auto (at a detected cap plane or open loop, else square), cap_plane, or normal (square to
+    the end tangent).
+    """
     # the body's radius is held at most this along the whole path (a thinner body makes a turn the vessel's
     # width cannot: a branch's take-off); a fold's message offers the value (fitting/radius_field.py)
     max_radius_mm: FiniteFloat | None = Field(None, gt=0.0)
+    """A cap on the fitted body's radius, mm: a thinner body that can make a turn tighter than the vessel is wide (the
+    fix a fold's message names).
+    """
 
     @field_validator("knot_spacing_mm", mode="before")
     @classmethod
@@ -209,13 +249,20 @@ class Mould(_Section):
     """A two-part casting mould around the body at q = 0 (and a core for a hollow body): every size in mm."""
 
     margin_mm: FiniteFloat = Field(10.0, gt=0.0, le=200.0)
+    """Mould material around the body, mm."""
     clearance_mm: FiniteFloat = Field(0.2, ge=0.0, le=5.0)
+    """Clearance of the keys and core prints, mm."""
     key_mm: FiniteFloat = Field(4.0, gt=0.0, le=100.0)
+    """Size of the registration keys between the halves, mm."""
     pour_mm: FiniteFloat = Field(4.0, gt=0.0, le=50.0)
+    """Diameter of the pour channel, mm."""
     vent_mm: FiniteFloat = Field(2.0, gt=0.0, le=50.0)
+    """Diameter of the vent, mm."""
     print_mm: FiniteFloat = Field(10.0, gt=0.0, le=200.0)
+    """Length of the core prints that hold a core, mm."""
     #: casting orientation: which end of the body is up (the pour and vent enter at the top)
     up: Literal["base", "tip"] = "base"
+    """Which end of the body is up when cast (the pour and vent enter at the top)."""
 
     @model_validator(mode="after")
     def _keys_fit(self) -> Mould:
@@ -236,15 +283,20 @@ class VolumeMesh(_Section):
     #: sweep: one mesh made in the body's parameter domain, mapped to every q (deterministic, named surfaces);
     #: ftetwild: fTetWild on each q's surface in a child process
     mesher: Literal["sweep", "ftetwild"] = "sweep"
+    """sweep (the body's own parameter-domain mesh, the same at every q) or ftetwild (fTetWild in a child process)."""
     #: the q values to mesh: [0] (the state the actuator is cast in, which a simulator deforms) by default
     q: list[FiniteFloat] = Field([0.0], min_length=1, max_length=MAX_VOLUME_MESHES)
+    """The q values to mesh (default [0], the state the actuator is cast in)."""
     #: target edge length of the tetrahedra (sweep: the largest edge inside the section, and the layers' spacing
     #: along the body, at most 3 skin edges; its skin's nodes are on the export's angles)
     size_mm: FiniteFloat = Field(2.0, ge=MIN_TET_SIZE_MM, le=50.0)
+    """Target edge length of the tetrahedra, mm."""
     #: largest distance of the mesh's boundary from the body's surface
     envelope_mm: FiniteFloat = Field(0.05, ge=0.001, le=1.0)
+    """Largest distance of the mesh's boundary from the body's surface, mm (ftetwild)."""
     #: the mesher is stopped after this long (per q) and the build fails with a clear message
     timeout_s: FiniteFloat = Field(1800.0, gt=0.0, le=MAX_MESHER_SECONDS)
+    """The mesher is stopped after this long per q, s, and the build fails with a clear message."""
 
     @field_validator("q")
     @classmethod
@@ -263,21 +315,32 @@ class Export(_Section):
     """Meshes at the requested q values."""
 
     q: list[FiniteFloat] | None = Field(None, max_length=MAX_EXPORT_Q)
+    """The q values to export, each in [0, 1], at least 0.001 apart (default [0, 0.5, 1])."""
     frames: Integer | None = Field(None, ge=2, le=MAX_EXPORT_Q)
+    """Instead of q: this many q values evenly spaced from 0 to 1."""
     offset_mm: FiniteFloat = 0.0
+    """Move the whole skin outwards (+) or inwards (-) from the fitted wall, mm."""
     wall_mm: FiniteFloat | None = Field(None, gt=0.0)
+    """Make the body hollow: one chamber that follows the skin, with walls and end caps this thick, mm."""
     port_mm: FiniteFloat | None = Field(None, gt=0.0)
+    """The diameter of a port through the base cap into the chamber, mm (needs wall_mm)."""
     # the names come from io.formats' registry (one list); mypy cannot read a Literal built from a tuple at run time
     formats: list[Literal[MESH_FORMATS]] = Field(["stl"], min_length=1)  # type: ignore[valid-type]
+    """Mesh formats: stl ply obj glb vtp (ply and vtp carry each face's region)."""
     spacing_mm: FiniteFloat = Field(0.5, gt=0.0)
+    """Ring spacing of the meshes along l, mm."""
     _offset_bound = field_validator("offset_mm")(size_bound(-MAX_OFFSET_MM, MAX_OFFSET_MM))
     angular_count: Integer = Field(64, ge=MIN_ANGULAR_COUNT, le=MAX_ANGULAR_COUNT)
+    """Vertices around each ring of the meshes."""
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...
     split_regions: bool = False
+    """Also write one STL per face region (wall, caps, chamber, port)."""
     #: a casting mould of the body at q = 0: meshes/mould/{half_a,half_b,core}.stl (the mould stage)
     mould: Mould | None = None
+    """A two-part casting mould of the body at q = 0 (the mould stage)."""
     #: tetrahedral meshes of the body for simulators: meshes/volume/q_0.000.{vtu,msh} (the volume_mesh stage)
     volume_mesh: VolumeMesh | None = None
+    """Volume meshes of the body for simulators, with named surfaces (the volume_mesh stage)."""
 
     @field_validator("q")
     @classmethod
@@ -320,11 +383,16 @@ class Material(_Section):
     """Limits the design is judged against: a preset (``name``) and/or explicit numbers, which win."""
 
     name: PresetName | None = None
+    """A preset (softdesign materials lists them with their sources)."""
     #: a material of the user's own, every figure given (softdesign/config_material.py); not with ``name``
     custom: CustomMaterial | None = None
+    """Your own material: every key required."""
     max_stretch: float | None = Field(None, gt=1.0, le=100.0)
+    """The largest principal stretch allowed (overrides the preset's)."""
     min_stretch: float | None = Field(None, gt=0.0, lt=1.0)
+    """The smallest principal stretch allowed before a thin skin wrinkles (overrides the preset's)."""
     min_wall_mm: float | None = Field(None, gt=0.0, le=100.0)
+    """The thinnest wall allowed, mm (overrides the preset's)."""
 
     @model_validator(mode="after")
     def _one_source(self) -> Material:
@@ -346,22 +414,43 @@ class Case(_Section):
     """A whole case file, every default filled in."""
 
     name: str
+    """The case's name: letters, digits, '-' and '_' (default: the case file's stem); the build folder is build/<name>.
+    """
     units: Literal["mm", "cm", "m"] = "mm"
+    """The unit of the input files and of final.inlet: mm, cm or m; everything is converted to mm at ingest."""
     final: FinalShape
+    """The patient's shape, q = 1: the vessel's centerline and surface as VMTK exports them."""
     initial: InitialShape = InitialShape()
+    """The insertion shape, q = 0, and the body's radius there."""
     intermediate: list[IntermediateShape] = []
+    """Keyframe centerlines reached at given q between 0 and 1 (the morph is piecewise between them)."""
     resample: Resample = Resample()
+    """Arc-length resampling and smoothing of every centerline."""
     frames: Literal["rmf", "frenet"] = "rmf"
+    """The frames along each centerline: rmf (rotation-minimizing, defined on straight runs) or frenet (the seed's;
+    undefined where the curvature vanishes).
+    """
     blend: Literal["auto", "linear", "intrinsic", "pcc"] = "auto"
+    """How c(q, l) morphs from q = 0 to q = 1: auto (linear unless its intermediate shapes fold), linear (the seed's),
+    intrinsic (length-preserving) or pcc (each designed section bends at constant length; needs design:).
+    """
     #: the composed-chain design stage (between ingest and blend); blend: pcc morphs its chain
     design: Design | None = None
+    """Design the actuator as a chain of constant-curvature sections composed from the base (the design stage;
+    softdesign design).
+    """
     links: Links = Links(count=4)
+    """How the body is split into links (sections): exactly one of count, breaks, length_mm."""
     fit: Fit = Fit()
+    """The least-squares spline surface rho(l, angle) fitted to the vessel wall, per link."""
     export: Export = Export()
+    """The meshes written at each q, their format and resolution, and the hollow, mould and volume-mesh options."""
     #: no material: the feasibility figures are reported and judged against nothing
     material: Material | None = None
+    """The material the design is judged against: a preset and/or explicit limits (the verdict of the report)."""
     #: seed 003's three chambers per section with their feed lines, built into the body (issue 31)
     actuation: Actuation | None = None
+    """Seed 003's three chambers per section, with their feed lines, cut into the body."""
 
     _base: Path = PrivateAttr(default_factory=Path.cwd)
 

@@ -36,14 +36,20 @@ MAX_ACTUATION_MM = 50.0
 class Actuation(BaseModel):
     """Three chambers per section (link) at ``distance_mm`` from the backbone, one feed line each."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
 
     chambers_per_section: Literal[3] = 3
+    """Chambers in each section (seed 003's three)."""
     distance_mm: FiniteFloat = Field(2.0, gt=0.0, le=MAX_ACTUATION_MM)
+    """Distance of the chambers' axes from the backbone, mm (absolute: seed 003's d is one number per section)."""
     diameter_mm: FiniteFloat = Field(0.8, gt=0.0, le=MAX_ACTUATION_MM)
+    """Diameter of each chamber, mm."""
     feed_diameter_mm: FiniteFloat = Field(0.4, gt=0.0, le=MAX_ACTUATION_MM)
+    """Diameter of each chamber's feed line, mm."""
     end_wall_mm: FiniteFloat = Field(1.0, gt=0.0, le=MAX_ACTUATION_MM)
+    """Wall at each end of a chamber, mm."""
     first_angle_deg: FiniteFloat = Field(90.0, ge=-360.0, le=360.0)
+    """Angle of the first chamber from the section's base N, degrees (seed 003's first encoder is at 90)."""
 
     @model_validator(mode="after")
     def _chambers_fit_their_ring(self) -> Actuation:

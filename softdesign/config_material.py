@@ -21,12 +21,16 @@ from softdesign.materials import DESIGN_FRACTION, MaterialLimits
 class CustomLaw(BaseModel):
     """A hyperelastic law: Yeoh coefficients in kPa (neo-Hookean: c2 = c3 = 0, mu = 2 c1)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
 
     kind: Literal["neo-hookean", "yeoh"]
+    """neo-hookean or yeoh."""
     c1_kpa: float = Field(gt=0.0, le=1.0e6)
+    """C1 (mu / 2 for neo-Hookean), kPa."""
     c2_kpa: float = Field(ge=-1.0e6, le=1.0e6)
+    """Yeoh's C2, kPa."""
     c3_kpa: float = Field(ge=-1.0e6, le=1.0e6)
+    """Yeoh's C3, kPa."""
 
     @model_validator(mode="after")
     def _neo_hookean_has_one_term(self) -> CustomLaw:
@@ -38,15 +42,21 @@ class CustomLaw(BaseModel):
 class CustomMaterial(BaseModel):
     """A material given in full in the case file, with its source."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
 
     name: str = Field(min_length=1, max_length=80)
+    """Your material's name, as the report names it."""
     shore: str = Field(min_length=1, max_length=20)
+    """Its Shore hardness, as the datasheet gives it (e.g. 00-30, 10A)."""
     tensile_strength_mpa: float = Field(gt=0.0, le=1000.0)
+    """Its tensile strength, MPa."""
     elongation_at_break_pct: float = Field(gt=0.0, le=10000.0)
+    """Its elongation at break, percent."""
     law: CustomLaw
+    """Its hyperelastic law and parameters."""
     #: the document and table the numbers come from (a test report, a datasheet)
     source: str = Field(min_length=3, max_length=500)
+    """Where the numbers come from (document and table)."""
 
     def limits(self) -> MaterialLimits:
         """The presets' rule applied to this material's elongation at break."""
