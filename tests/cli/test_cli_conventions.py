@@ -1,4 +1,4 @@
-"""What a first-time user relies on across commands: -o is the build folder, the README documents it all."""
+"""What a first-time user relies on across commands: -o is the build folder, the reference documents it all."""
 
 from __future__ import annotations
 
@@ -13,7 +13,8 @@ from softdesign.cli import app
 from softdesign.config import Case
 from tests.helpers.paths import REPO
 
-README = (REPO / "README.md").read_text(encoding="utf-8")
+#: The full reference (docs/reference.md); the README is the short introduction (tests/cli/test_readme.py).
+README = (REPO / "docs" / "reference.md").read_text(encoding="utf-8")
 runner = CliRunner()
 
 

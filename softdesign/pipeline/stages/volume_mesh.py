@@ -229,7 +229,8 @@ def describe_volume_mesh(result: VolumeMeshResult) -> list[str]:
             lines.append(f"{name}: closed chamber, {f['faces']} faces, {f['volume_mm3']:.2f} mm3, "
                          f"normals {f['normals']}")
             continue
-        chamber = "" if f["chamber_centroids_inside"] is None else f", {f['chamber_centroids_inside']} in the chamber"
+        inside = f.get("chamber_centroids_inside")  # fTetWild's meshes only
+        chamber = "" if inside is None else f", {inside} in the chamber"
         lines.append(
             f"{name} (and .msh): {f['tets']} tets, volume {f['volume_mm3']:.2f} mm3 "
             f"({100 * f['volume_rel_error']:+.3f}% vs body){chamber}, min dihedral {f['min_dihedral_deg']:.2f} deg, "
