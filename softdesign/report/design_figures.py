@@ -28,10 +28,13 @@ from softdesign.report.plotting import Picture, fixed_figure, link_colours, pict
 from softdesign.report.projection import principal_view
 from softdesign.types import FloatArray
 
-SIZE_IN = (12.0, 4.8)
+SIZE_IN = (12.0, 5.65)
 #: Fixed layout of the two panels, inches: margins (left, right, bottom, top) and the gap between them,
 #: room for tick labels up to 6 characters wide, the axis labels and one line of title.
-MARGINS_IN, GAP_IN = (0.7, 0.2, 0.5, 0.3), 0.85
+MARGINS_IN, GAP_IN = (0.7, 0.2, 1.35, 0.3), 0.85
+#: The legends sit below their axes' place (under the x label), in columns, so they never cover a curve (issue 34:
+#: the legend placed "best" inside covered them): their top this far above the figure's bottom edge, inches.
+LEGEND_TOP_IN, LEGEND_COLUMNS = MARGINS_IN[2] - 0.55, 3
 #: Samples drawn along each arc.
 ARC_SAMPLES = 60
 
@@ -67,6 +70,13 @@ def design_series(chain: LinkChain) -> dict[str, list]:
             "centerline": [curve.points(np.linspace(0.0, 1.0, 400))]}
 
 
+def _legend_below(axes) -> None:
+    """The legend centred under the axes' grid cell (an equal-aspect axes shrinks inside it), above the edge."""
+    cell = axes.get_position(original=True)
+    axes.legend(loc="upper center", bbox_to_anchor=(0.5 * (cell.x0 + cell.x1), LEGEND_TOP_IN / SIZE_IN[1]),
+                bbox_transform=axes.figure.transFigure, ncol=LEGEND_COLUMNS, fontsize=7, frameon=False)
+
+
 def design_picture(chain: LinkChain) -> Picture:
     """The panel's figure: arcs over the centerline, and the distance along it against the tolerance."""
     series = design_series(chain)
@@ -84,13 +94,13 @@ def design_picture(chain: LinkChain) -> Picture:
         chained = view.project(series["chained"][0])
         left.plot(chained[:, 0], chained[:, 1], color="k", lw=1.0, ls=":", label="arcs chained by D-H")
         left.set(aspect="equal", xlabel=view.labels[0], ylabel=view.labels[1], title="one arc per link")
-        left.legend(loc="best", fontsize=7)
+        _legend_below(left)
         for j, (s, d) in enumerate(zip(series["along"], series["distance"], strict=True)):
             right.plot(s, d, color=colours[j], lw=1.4, label=f"link {j}: max {d.max():.3g} mm")
         right.axhline(ARC_TOLERANCE_MM, color="k", lw=0.8, ls="--", label=f"tolerance {ARC_TOLERANCE_MM:g} mm")
         right.set(xlabel="arc length at q = 1 (mm)", ylabel="distance to the link's arc (mm)",
                   title="per-link error", ylim=(0.0, None))
-        right.legend(loc="best", fontsize=7)
+        _legend_below(right)
     caption = (
         "Each link's best constant-curvature arc (seed 003's section) at q = 1, started on the link's start frame "
         "(least squares, as softdesign design fits it), over the centerline; the dotted line chains those arcs from "
@@ -137,7 +147,7 @@ def chain_picture(document: dict[str, Any], profile: dict[str, np.ndarray]) -> P
         base = view.project(np.array(document["base_frame"])[None, :3, 3])
         left.plot(base[:, 0], base[:, 1], "ko", ms=4, label="base frame")
         left.set(aspect="equal", xlabel=view.labels[0], ylabel=view.labels[1], title="chain composed from the base")
-        left.legend(loc="best", fontsize=7)
+        _legend_below(left)
         right.plot(profile["l"] * length, profile["deviation_mm"], color="k", lw=1.2, label="centerline to chain")
         for j, link in enumerate(document["links"]):
             right.axvspan(link["l_start"] * length, link["l_end"] * length, color=colours[j], alpha=0.12, lw=0)
@@ -146,7 +156,7 @@ def chain_picture(document: dict[str, Any], profile: dict[str, np.ndarray]) -> P
         right.set(xlabel="arc length of the centerline (mm)", ylabel="distance to the composed chain (mm)",
                   title=f"tip off by {document['tip_error_mm']:.3g} mm, {document['tip_error_deg']:.3g} deg",
                   ylim=(0.0, None))
-        right.legend(loc="best", fontsize=7)
+        _legend_below(right)
     verdict = "within" if document["meets_tolerance"] else "NOT within"
     caption = (
         f"{len(document['links'])} constant-curvature sections (seed 003), section 1 on the centerline's base frame "

@@ -69,3 +69,27 @@ def test_with_a_design_the_panel_draws_the_composed_chain_and_its_figures(tmp_pa
         assert image.size == EXPECTED_SIZES["design.png"]
     # the profile drawn is each target sample's distance to the chain, at most the chain's two-way deviation
     assert 0.0 < design.profile["deviation_mm"].max() <= document["chain_max_deviation_mm"]
+
+
+def test_the_legends_sit_below_their_axes_and_inside_the_figure(tmp_path, monkeypatch):
+    # issue 34: design.png's legend covered the curves; each legend is now below its axes, whole, in the picture
+    from softdesign.report import design_figures
+
+    outcome = build_through(REPO / "configs" / "demo.yaml", tmp_path / "build", target="kinematics")
+    drawn = []
+    real = design_figures.picture
+
+    def keep(name, figure, size_in, title, caption):
+        drawn.append(figure)
+        return real(name, figure, size_in, title, caption)
+
+    monkeypatch.setattr(design_figures, "picture", keep)
+    design_figures.design_picture(outcome.results["kinematics"].chain)
+    figure = drawn[0]
+    renderer = figure.canvas.get_renderer()
+    whole = figure.bbox
+    for axes in figure.axes:
+        legend = axes.get_legend().get_window_extent(renderer)
+        assert not legend.overlaps(axes.get_window_extent(renderer))
+        assert not legend.overlaps(axes.xaxis.get_tightbbox(renderer))  # the tick labels and the x label
+        assert whole.x0 <= legend.x0 and legend.x1 <= whole.x1 and whole.y0 <= legend.y0 and legend.y1 <= whole.y1
