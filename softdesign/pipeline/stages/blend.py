@@ -18,7 +18,6 @@ import numpy as np
 from softdesign.errors import ConfigError
 from softdesign.geometry.blend import BlendedShape, BlendMode, Shortening, blend_shapes, sampled_shape
 from softdesign.geometry.curves import (
-    TORSION_KAPPA_FLOOR,
     SmoothCurve,
     smooth_curve_from_polyline,
     smooth_curve_from_samples,
@@ -41,7 +40,8 @@ if TYPE_CHECKING:  # only annotations: the report loads stage results without th
 #: 3: the morph's reach r * kappa over q (``morph``), ``blend: auto`` and the blend it chose.
 #: 4: ``blend: pcc`` (the designed chain, each section's curvature q * kappa at constant length).
 #: 5: sharp joints at explicit link breaks (``joints`` in blend/curves.npz when there are any).
-VERSION = 5
+#: 6: the torsion reported where the curvature is at least a fifth of its largest (TORSION_REL_FLOOR), not noise.
+VERSION = 6
 
 
 @dataclass(frozen=True)
@@ -132,7 +132,7 @@ def _summary(case: Case, shape: BlendedShape) -> dict[str, Any]:
             "max_abs_torsion_per_mm": final.max_abs_torsion_per_mm,
             "max_abs_torsion_l": final.max_abs_torsion_l,
             "torsion_defined_fraction": final.torsion_defined_fraction,
-            "torsion_kappa_floor_per_mm": TORSION_KAPPA_FLOOR,
+            "torsion_kappa_floor_per_mm": final.torsion_floor_per_mm,
         },
         "initial_length_mm": shape.keys[0].length,
         "shortening": {
