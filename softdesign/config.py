@@ -335,6 +335,9 @@ class Export(_Section):
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...
     split_regions: bool = False
     """Also write one STL per face region (wall, caps, chamber, port)."""
+    frame: Literal["patient", "base"] = "patient"
+    """The output meshes' coordinates: patient (the input files', over the vessel) or base (the q = 0 body's base
+    at the origin, z along its axis, for printing and CAD); the manifest records the move."""
     #: a casting mould of the body at q = 0: meshes/mould/{half_a,half_b,core}.stl (the mould stage)
     mould: Mould | None = None
     """A two-part casting mould of the body at q = 0 (the mould stage)."""

@@ -40,6 +40,7 @@ from softdesign.meshing.volume import BodySpec, integrate_body
 from softdesign.pipeline import layout
 from softdesign.pipeline.bounds import export_workers
 from softdesign.pipeline.item_progress import item_counter
+from softdesign.pipeline.output_frame import base_pose, frame_record, moved_points, moved_vectors, output_pose
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.actuation import actuation_layout
@@ -50,7 +51,7 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 3  # 2: .glb in metres (glTF's unit), metrics.export.units; 3: .pvd time series, morph.glb
+VERSION = 4  # 2: .glb in metres (glTF's unit), metrics.export.units; 3: .pvd time series, morph.glb; 4: frame
 
 
 @dataclass(frozen=True)
@@ -167,11 +168,14 @@ def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Expo
     counted = item_counter("export", q_values, _mesh_label)  # the command line's per-mesh bar, when it listens
     meshes = tuple(map_items(lambda q: _solid_naming_blend(kinematics, fit, q, case), q_values,
                              most=export_workers(case, longest), on_result=counted))
+    pose = output_pose(case.export.frame, base_pose(kinematics.chain.shape))  # checked first, then moved rigidly
+    meshes = tuple(_moved(m, pose) for m in meshes)
     morph = None
     if "glb" in case.export.formats and len(meshes) >= 2:
         e = case.export
         morph = morph_surfaces(kinematics.chain.shape, fit.field, np.array([m.q for m in meshes]), body_spec(case, fit),
                                e.spacing_mm, e.angular_count)
+        morph = replace(morph, vertices=moved_points(morph.vertices, pose))
     summary = {
         "formats": list(case.export.formats),
         "units": {fmt: FILE_UNITS[fmt] for fmt in case.export.formats},
@@ -186,12 +190,24 @@ def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Expo
                                   "area_mm2": p.area()}
             for m in meshes for p in m.pieces
         }
+    summary["frame"] = frame_record(case.export.frame, pose)
     summary["time_series"] = [layout.CENTERLINES_PVD] + ([layout.MESHES_PVD] if "vtp" in case.export.formats else [])
     if morph is not None:
         summary["morph"] = {"path": layout.MORPH_GLB, "targets": len(morph.q), "vertices": morph.vertices.shape[1],
                             "faces": len(morph.faces), "rings": len(morph.l), "unit": "m",
                             "surface": "outer skin (offset_mm), end caps; no chamber or port"}
     return ExportResult(meshes, summary, morph)
+
+
+def _moved(mesh: ExportedMesh, pose: np.ndarray | None) -> ExportedMesh:
+    """The mesh, its region pieces and its centerline (points and frames) in the output frame."""
+    if pose is None:
+        return mesh
+    centerline = {k: moved_points(v, pose) if k == "points" else moved_vectors(v, pose) if k in ("N", "B", "T") else v
+                  for k, v in mesh.centerline.items()}
+    pieces = tuple(replace(p, vertices=moved_points(p.vertices, pose)) for p in mesh.pieces)
+    return replace(mesh, solid=replace(mesh.solid, vertices=moved_points(mesh.solid.vertices, pose)),
+                   centerline=centerline, pieces=pieces)
 
 
 def write_export(result: ExportResult, staging: Staging) -> None:
@@ -251,7 +267,7 @@ STAGE = Stage(
     version=VERSION,
     # every export key but mould, which only the mould stage reads
     reads=("export.q", "export.frames", "export.offset_mm", "export.wall_mm", "export.port_mm", "export.formats",
-           "export.spacing_mm", "export.angular_count", "export.split_regions", "actuation"),
+           "export.spacing_mm", "export.angular_count", "export.split_regions", "export.frame", "actuation"),
     upstream=("kinematics", "fit"),
     compute=lambda case, results: run_export(case, results["kinematics"], results["fit"]),
     write=write_export,

@@ -13,7 +13,7 @@ manifest lists each part with sha256, volume and the checks.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -25,6 +25,7 @@ from softdesign.meshing.mould import MouldSpec
 from softdesign.meshing.mould_cores import make_actuated_mould
 from softdesign.meshing.mould_make import MouldMesh, make_mould
 from softdesign.pipeline import layout
+from softdesign.pipeline.output_frame import base_pose, moved_points, output_pose
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.actuation import actuation_layout
 from softdesign.pipeline.stages.export import body_spec
@@ -32,7 +33,7 @@ from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 
-VERSION = 1
+VERSION = 2  # 2: export.frame (the parts in the patient's or the base frame)
 
 
 @dataclass(frozen=True)
@@ -78,9 +79,11 @@ def run_mould(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Mould
                 "part": part.name, "vertices": report.vertices, "faces": report.faces, "volume_mm3": report.volume,
                 "area_mm2": report.area, "watertight": report.watertight, "bodies": report.bodies,
                 "euler": report.euler}
+    pose = output_pose(case.export.frame, base_pose(kinematics.chain.shape))  # checked first, then moved rigidly
+    parts = tuple(replace(p, vertices=moved_points(p.vertices, pose)) for p in mould.parts)
     summary = {"requested": True, "spec": case.export.mould.model_dump(mode="json") if case.export.mould else None,
-               "files": files, **mould.figures}
-    return MouldResult(mould.parts, summary)
+               "files": files, **mould.figures, "frame": case.export.frame}
+    return MouldResult(parts, summary)
 
 
 def write_mould(result: MouldResult, staging: Staging) -> None:
@@ -138,7 +141,7 @@ STAGE = Stage(
     name="mould",
     version=VERSION,
     reads=("export.mould", "export.offset_mm", "export.wall_mm", "export.port_mm", "export.spacing_mm",
-           "export.angular_count", "export.formats", "actuation"),
+           "export.angular_count", "export.formats", "export.frame", "actuation"),
     upstream=("kinematics", "fit"),
     compute=lambda case, results: run_mould(case, results["kinematics"], results["fit"]),
     write=write_mould,

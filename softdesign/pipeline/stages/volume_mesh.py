@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import json
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from importlib import metadata
 from pathlib import Path
 from typing import Any
@@ -52,6 +52,7 @@ from softdesign.meshing.tetmesh import TetSettings, tetrahedralize
 from softdesign.meshing.topology import mesh_topology
 from softdesign.pipeline import layout
 from softdesign.pipeline.child import run_in_child
+from softdesign.pipeline.output_frame import base_pose, moved_points, output_pose
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.export import body_spec, solid_at
 from softdesign.pipeline.stages.fit import FitResult
@@ -59,7 +60,7 @@ from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 from softdesign.types import FloatArray, IntArray
 
-VERSION = 2
+VERSION = 3  # 3: export.frame (the meshes in the patient's or the base frame)
 #: The function the child process runs: (vertices, faces, TetSettings) -> (points, tets).  A module attribute,
 #: so that a test can put a crashing or hanging stand-in in its place.
 MESHER = tetrahedralize
@@ -136,8 +137,11 @@ def run_volume_mesh(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
     vm = case.export.volume_mesh
     if vm is None:
         return VolumeMeshResult((), {"requested": False})
+    pose = output_pose(case.export.frame, base_pose(kinematics.chain.shape))  # checked first, then moved rigidly
     if vm.mesher == "sweep":
-        return _run_sweep(case, kinematics, fit)
+        swept = _run_sweep(case, kinematics, fit)
+        return VolumeMeshResult(tuple(_moved(m, pose) for m in swept.meshes), {**swept.summary,
+                                                                               "frame": case.export.frame})
     meshes, files, per_q = [], {}, []
     for q in vm.q:
         mesh, figures = mesh_body(case, kinematics, fit, q)
@@ -150,8 +154,8 @@ def run_volume_mesh(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
     mesher = {"name": "fTetWild through pytetwild, one thread", "pytetwild": metadata.version("pytetwild"),
               "meshio": metadata.version("meshio")}
     summary = {"requested": True, "spec": vm.model_dump(mode="json"), "mesher": mesher,
-               "deterministic": False, "per_q": per_q, "files": files}
-    return VolumeMeshResult(tuple(meshes), summary)
+               "deterministic": False, "per_q": per_q, "files": files, "frame": case.export.frame}
+    return VolumeMeshResult(tuple(_moved(m, pose) for m in meshes), summary)
 
 
 def _run_sweep(case: Case, kinematics: KinematicsResult, fit: FitResult) -> VolumeMeshResult:
@@ -184,6 +188,16 @@ def _run_sweep(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Volu
                             "law": None if material.law is None else material.law.kind},
                "feasible": (not run.reasons) if judged else None, "reasons": run.reasons, "files": files}
     return VolumeMeshResult(tuple(meshes), summary)
+
+
+def _moved(mesh: TetBody, pose: np.ndarray | None) -> TetBody:
+    """The mesh, its chamber and its cavities in the output frame (``export.frame``; None: as it is)."""
+    if pose is None:
+        return mesh
+    chamber = None if mesh.chamber is None else (moved_points(mesh.chamber[0], pose), mesh.chamber[1])
+    cavities = None if mesh.cavities is None else {
+        name: (moved_points(points, pose), faces) for name, (points, faces) in mesh.cavities.items()}
+    return replace(mesh, points=moved_points(mesh.points, pose), chamber=chamber, cavities=cavities)
 
 
 def write_volume_mesh(result: VolumeMeshResult, staging: Staging) -> None:
@@ -241,8 +255,9 @@ def describe_volume_mesh(result: VolumeMeshResult) -> list[str]:
 STAGE = Stage(
     name="volume_mesh",
     version=VERSION,
+    # actuation: the solid it meshes has the chambers
     reads=("export.volume_mesh", "export.offset_mm", "export.wall_mm", "export.port_mm", "export.spacing_mm",
-           "export.angular_count", "actuation", "material"),  # actuation: the solid it meshes has the chambers
+           "export.angular_count", "export.frame", "actuation", "material"),
     upstream=("kinematics", "fit"),
     compute=lambda case, results: run_volume_mesh(case, results["kinematics"], results["fit"]),
     write=write_volume_mesh,
