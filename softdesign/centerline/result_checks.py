@@ -39,8 +39,13 @@ CHECKED_POINTS = 200
 def check_centerlines(
     paths: tuple[npt.NDArray[np.float64], ...], radii: tuple[npt.NDArray[np.float64], ...],
     vertices: npt.NDArray[np.float64], faces: npt.NDArray[np.int64], where: str,
+    continued_mm: tuple[tuple[float, float], ...] = (),
 ) -> None:
-    """InputDataError naming the first path that cannot be a vessel's axis, and why (mm in, mm in messages)."""
+    """InputDataError naming the first path that cannot be a vessel's axis, and why (mm in, mm in messages).
+
+    ``continued_mm``: per path, how far each end was continued straight to its opening's centre (its radius held
+    there, :mod:`.ends`); those runs reach the opening's plane by design and are not held to the wall's distance.
+    """
     fix = ("expected a vessel surface open at its inlet and outlets, or capped (vmtksurfacecapper), in the units "
            "given by --units, finely enough meshed for its radius (vmtksurfaceremeshing)")
     extent = float(np.ptp(vertices, axis=0).max()) if len(vertices) else 0.0
@@ -54,7 +59,8 @@ def check_centerlines(
     for k, (points, radius) in enumerate(zip(paths, radii, strict=True)):
         length = float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum()) if len(points) > 1 else 0.0
         widest = float(np.max(radius)) if len(radius) else 0.0
-        _check_inside_wall(k, points, radius, vertices, faces, where, fix)
+        ends = continued_mm[k] if k < len(continued_mm) else (0.0, 0.0)
+        _check_inside_wall(k, points, radius, _inner(points, ends), vertices, faces, where, fix)
         if length <= widest:
             raise InputDataError(f"{where}: path {k} is {length:.4g} mm long but {widest:.4g} mm wide in radius: "
                                  f"no opening to run between (a closed surface, or a stub); {fix}")
@@ -65,13 +71,21 @@ def check_centerlines(
                 f"{fix}")
 
 
+def _inner(points: npt.NDArray[np.float64], ends: tuple[float, float]) -> npt.NDArray[np.bool_]:
+    """The points of a path outside its straight end continuations (``ends``: mm at the inlet and the outlet)."""
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    return (s >= ends[0]) & (s <= s[-1] - ends[1])
+
+
 def _check_inside_wall(k: int, points: npt.NDArray[np.float64], radius: npt.NDArray[np.float64],
-                       vertices: npt.NDArray[np.float64], faces: npt.NDArray[np.int64], where: str, fix: str) -> None:
+                       inner: npt.NDArray[np.bool_], vertices: npt.NDArray[np.float64], faces: npt.NDArray[np.int64],
+                       where: str, fix: str) -> None:
     from vtkmodules.vtkFiltersCore import vtkImplicitPolyDataDistance
 
     from softdesign.io.vtk_polydata import polydata_from_triangles
 
-    pick = np.unique(np.linspace(0, len(points) - 1, min(CHECKED_POINTS, len(points))).astype(int))
+    candidates = np.flatnonzero(inner) if inner.any() else np.arange(len(points))
+    pick = candidates[np.unique(np.linspace(0, len(candidates) - 1, min(CHECKED_POINTS, len(candidates))).astype(int))]
     wall: Any = vtkImplicitPolyDataDistance()  # vtk's stubs type EvaluateFunction's answer as None
     wall.SetInput(polydata_from_triangles(vertices, faces))
     distance = np.abs(np.array([float(wall.EvaluateFunction(*map(float, p))) for p in points[pick]]))

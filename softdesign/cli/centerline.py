@@ -67,7 +67,8 @@ def centerline(
         start = time.perf_counter()
         vertices, faces = read_surface(surface, scale)
         result = extract_centerlines(vertices, faces, options, str(surface))
-        check_centerlines(result.paths, result.radii, vertices, faces, str(surface))  # nothing written if meaningless
+        check_centerlines(result.paths, result.radii, vertices, faces, str(surface),
+                          result.continued_mm)  # nothing written if meaningless
         try:
             write_centerlines_vtp(output, result, 1.0 / scale)
         except OSError as err:

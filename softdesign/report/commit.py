@@ -45,7 +45,10 @@ def commit_folder(target: Path, files: dict[str, bytes]) -> None:
     temp = parent / f"{TEMP_PREFIX}{os.getpid()}-{uuid.uuid4().hex[:12]}"
     temp.mkdir()  # unlike mkdtemp, honours the umask: the report is as readable as the rest of the build
     old = temp.with_name(temp.name + "-old")
-    marker = {"softdesign": "report", "files": {name: sha256_bytes(data) for name, data in sorted(files.items())}}
+    # a log (report.log: the folder's path and the times) is listed without its hash, so the marker is the same
+    # bytes for the same build wherever and whenever it is drawn, as the page is
+    marker = {"softdesign": "report", "files": {name: None if name.endswith(".log") else sha256_bytes(data)
+                                                for name, data in sorted(files.items())}}
     try:
         (temp / REPORT_MARKER).write_text(canonical_json(marker), encoding="utf-8")
         for name, data in sorted(files.items()):

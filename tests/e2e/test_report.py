@@ -367,7 +367,7 @@ def test_a_build_without_fit_gets_a_report_with_the_centerline_only(tmp_path):
     build_dir = tmp_path / "build"
     build_through(DEMO_CASE, build_dir, target="kinematics")
     result = write_report(build_dir, ReportOptions(gif_frames=4))
-    assert set(result.files) == {PAGE, "morph.png", "kinematics.png", "design.png", "morph.gif", JS_NAME}
+    assert set(result.files) == {PAGE, "morph.png", "kinematics.png", "design.png", "morph.gif", JS_NAME, LOG}
     text = (build_dir / REPORT_DIR / PAGE).read_text(encoding="utf-8")
     assert "no fit in this build folder" in text and "no export in this build folder" in text
     with Image.open(build_dir / REPORT_DIR / "morph.gif") as gif:
