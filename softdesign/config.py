@@ -15,6 +15,7 @@ import math
 import os
 import re
 from collections.abc import Mapping
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, Literal
 
@@ -30,6 +31,7 @@ from pydantic import (
     model_validator,
 )
 
+from softdesign.config_material import CustomMaterial
 from softdesign.config_types import FiniteFloat, Integer
 from softdesign.errors import ConfigError
 from softdesign.io.case_yaml import parse_case_yaml, read_case_text
@@ -206,11 +208,15 @@ class Mould(_Section):
 
 
 class VolumeMesh(_Section):
-    """Tetrahedral meshes of the body for simulators (fTetWild in a child process): sizes in mm."""
+    """Tetrahedral meshes of the body for simulators: sizes in mm."""
 
+    #: sweep: one mesh made in the body's parameter domain, mapped to every q (deterministic, named surfaces);
+    #: ftetwild: fTetWild on each q's surface in a child process
+    mesher: Literal["sweep", "ftetwild"] = "sweep"
     #: the q values to mesh: [0] (the state the actuator is cast in, which a simulator deforms) by default
     q: list[FiniteFloat] = Field([0.0], min_length=1, max_length=MAX_VOLUME_MESHES)
-    #: target edge length of the tetrahedra
+    #: target edge length of the tetrahedra (sweep: the largest edge inside the section; along the body the
+    #: layers are export.spacing_mm apart, the export's rings)
     size_mm: FiniteFloat = Field(2.0, ge=MIN_TET_SIZE_MM, le=50.0)
     #: largest distance of the mesh's boundary from the body's surface
     envelope_mm: FiniteFloat = Field(0.05, ge=0.001, le=1.0)
@@ -290,13 +296,26 @@ class Material(_Section):
     """Limits the design is judged against: a preset (``name``) and/or explicit numbers, which win."""
 
     name: PresetName | None = None
+    #: a material of the user's own, every figure given (softdesign/config_material.py); not with ``name``
+    custom: CustomMaterial | None = None
     max_stretch: float | None = Field(None, gt=1.0, le=100.0)
     min_stretch: float | None = Field(None, gt=0.0, lt=1.0)
     min_wall_mm: float | None = Field(None, gt=0.0, le=100.0)
 
+    @model_validator(mode="after")
+    def _one_source(self) -> Material:
+        if self.name is not None and self.custom is not None:
+            raise ValueError("give name (a preset) or custom (your own material), not both")
+        return self
+
     def limits(self) -> MaterialLimits:
-        """The preset's numbers with the explicit ones put over them."""
-        return resolve_material(self.name, self.max_stretch, self.min_stretch, self.min_wall_mm)
+        """The preset's (or the custom material's) numbers with the explicit ones put over them."""
+        explicit = (self.max_stretch, self.min_stretch, self.min_wall_mm)
+        if self.custom is None:
+            return resolve_material(self.name, *explicit)
+        base = self.custom.limits()
+        return replace(base, max_stretch=self.max_stretch or base.max_stretch, min_stretch=self.min_stretch,
+                       min_wall_mm=self.min_wall_mm)
 
 
 class Case(_Section):

@@ -1,15 +1,15 @@
 """Material limits a design is judged against: presets for the elastomers soft actuators are made of.
 
-A preset's ``max_stretch`` is ``1 + DESIGN_FRACTION * elongation at break``
-(the manufacturer's datasheet figure, as a fraction: 900 % -> 9.0).  The
-design fraction is a rule of thumb, not a sourced number: a skin cycled many
-times should stay well short of the strain at which a tensile bar breaks
-once, and half of it is the margin used here.  The TPU preset uses the
-datasheet's elongation at *yield* instead, at full value: beyond yield a TPU
-part sets permanently, so break is the wrong reference.  No datasheet gives a
-compressive limit for a skin: ``min_stretch`` (where a thin skin in axial
-compression wrinkles or buckles) is a rule of thumb, as is ``min_wall_mm``
-(what a cast or printed wall of that material reliably fills without holes).
+The presets are data, ``softdesign/data/materials.yaml`` (read by
+:mod:`softdesign.material_data`): each datasheet value with its document and
+table, a hyperelastic law with its source, and the rules stated there: a
+silicone's ``max_stretch`` is ``1 + design_fraction x elongation at break``
+(half: the datasheet's elongation is one pull of a dumbbell to failure, an
+actuator's skin is cycled and carries casting flaws); the TPU preset uses
+the elongation at *yield* at full value (beyond yield a printed part sets).
+No datasheet gives a compressive limit for a skin: ``min_stretch`` (where a
+thin skin in axial compression wrinkles) is a rule of thumb, as is
+``min_wall_mm`` (what a cast or printed wall fills without holes).
 
 Explicit numbers in the case file override a preset's (see
 :func:`resolve_material`); these figures describe stock material at room
@@ -21,12 +21,15 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 from typing import Any, Literal, get_args
 
+from softdesign.material_data import MaterialPreset, material_presets
+
 #: The preset names the case file accepts (``material.name``); :data:`PRESETS` has one entry for each.
 PresetName = Literal[
-    "ecoflex-00-30", "ecoflex-00-50", "dragon-skin-10", "dragon-skin-30", "smooth-sil-950", "sylgard-184", "tpu-85a"
+    "ecoflex-00-10", "ecoflex-00-20", "ecoflex-00-30", "ecoflex-00-50", "dragon-skin-10", "dragon-skin-20",
+    "dragon-skin-30", "elastosil-m4601", "smooth-sil-950", "sylgard-184", "tpu-85a",
 ]
 
-#: Fraction of the datasheet's elongation at break a cyclically stretched skin may use (rule of thumb).
+#: Fraction of the datasheet's elongation at break a cyclically stretched skin may use (materials.yaml's rule).
 DESIGN_FRACTION = 0.5
 #: Smallest stretch (axial compression) before a thin elastomer skin wrinkles (rule of thumb, no source).
 DEFAULT_MIN_STRETCH = 0.7
@@ -56,29 +59,14 @@ class MaterialLimits:
         return asdict(self)
 
 
-def _silicone(name: str, elongation_pct: float, datasheet: str, min_wall_mm: float) -> MaterialLimits:
-    source = (f"{datasheet}: elongation at break {elongation_pct:g} %; max_stretch = 1 + {DESIGN_FRACTION:g} x "
-              f"{elongation_pct / 100:g} (design fraction, rule of thumb); min_stretch {DEFAULT_MIN_STRETCH:g} and "
-              f"min_wall_mm {min_wall_mm:g} are rules of thumb")
-    return MaterialLimits(name, 1.0 + DESIGN_FRACTION * elongation_pct / 100.0, DEFAULT_MIN_STRETCH, min_wall_mm,
-                          source)
+def _limits(preset: MaterialPreset) -> MaterialLimits:
+    source = (f"{preset.source}: elongation at break {preset.elongation_at_break_pct:g} %; {preset.rule}; "
+              f"min_stretch {preset.min_stretch:g} and min_wall_mm {preset.min_wall_mm:g} are rules of thumb")
+    return MaterialLimits(preset.name, preset.max_stretch, preset.min_stretch, preset.min_wall_mm, source)
 
 
-#: The presets, by the name the case file uses.
-PRESETS: dict[str, MaterialLimits] = {
-    "ecoflex-00-30": _silicone("ecoflex-00-30", 900, "Smooth-On Ecoflex Series technical bulletin (00-30)", 1.0),
-    "ecoflex-00-50": _silicone("ecoflex-00-50", 980, "Smooth-On Ecoflex Series technical bulletin (00-50)", 1.0),
-    "dragon-skin-10": _silicone("dragon-skin-10", 1000, "Smooth-On Dragon Skin Series technical bulletin (10)", 0.8),
-    "dragon-skin-30": _silicone("dragon-skin-30", 364, "Smooth-On Dragon Skin Series technical bulletin (30)", 0.8),
-    "smooth-sil-950": _silicone("smooth-sil-950", 250, "Smooth-On Smooth-Sil 950 technical bulletin", 0.8),
-    "sylgard-184": _silicone("sylgard-184", 140, "Dow SYLGARD 184 Silicone Elastomer technical data sheet", 0.5),
-    "tpu-85a": MaterialLimits(
-        "tpu-85a", 1.65, DEFAULT_MIN_STRETCH, 0.8,
-        "NinjaTek NinjaFlex (TPU, Shore 85A) technical data sheet: elongation at yield 65 %, at break 660 %; "
-        "max_stretch = 1 + 0.65 (yield, not break: beyond it the print sets); min_stretch "
-        f"{DEFAULT_MIN_STRETCH:g} and min_wall_mm 0.8 (two 0.4 mm perimeters) are rules of thumb",
-    ),
-}
+#: The presets' limits, by the name the case file uses (the data file's every entry).
+PRESETS: dict[str, MaterialLimits] = {name: _limits(p) for name, p in material_presets().items()}
 
 
 def resolve_material(name: str | None, max_stretch: float | None, min_stretch: float | None,
@@ -102,4 +90,6 @@ def resolve_material(name: str | None, max_stretch: float | None, min_stretch: f
 
 
 if set(PRESETS) != set(get_args(PresetName)):  # one list of names, checked at import
-    raise RuntimeError("softdesign.materials: PresetName and PRESETS name different materials")
+    raise RuntimeError("softdesign.materials: PresetName and softdesign/data/materials.yaml name different materials")
+if DESIGN_FRACTION != 0.5 or any(p.min_stretch != DEFAULT_MIN_STRETCH for p in material_presets().values()):
+    raise RuntimeError("softdesign.materials: DESIGN_FRACTION or DEFAULT_MIN_STRETCH differ from materials.yaml")

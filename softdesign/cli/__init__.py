@@ -22,6 +22,7 @@ from softdesign.cli.centerline import centerline
 from softdesign.cli.check import check
 from softdesign.cli.common import list_whole_first_paragraphs
 from softdesign.cli.design import design
+from softdesign.cli.materials import materials
 from softdesign.cli.pcc import PCC_SHORT_HELP, pcc_app
 from softdesign.cli.pose import pose
 from softdesign.cli.report import report
@@ -40,7 +41,7 @@ app = typer.Typer(
 app.add_typer(pcc_app, name="pcc", short_help=PCC_SHORT_HELP)
 for command in (
     validate, build, ingest, blend, links, kinematics, fit, export, mould, pose, check, report, sample, centerline,
-    design,
+    design, materials,
 ):
     app.command()(command)
 for group in (app, pcc_app):
@@ -66,5 +67,5 @@ def main() -> None:
 
 __all__ = [
     "app", "main", "validate", "build", "ingest", "blend", "links", "kinematics", "fit", "export", "mould",
-    "pose", "check", "report", "sample", "centerline", "design",
+    "pose", "check", "report", "sample", "centerline", "design", "materials",
 ]

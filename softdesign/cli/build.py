@@ -108,8 +108,9 @@ def build(
         _print_runs(outcome.build_dir, outcome.runs)
         if with_report:
             report_after_build(outcome.build_dir, jobs=jobs)
-        feasibility = outcome.results.get("feasibility")
-        return feasibility is not None and feasibility.summary.get("feasible") is False
+        verdicts = [outcome.results[k].summary.get("feasible") for k in ("feasibility", "volume_mesh")
+                    if k in outcome.results]  # the skin's stretch (feasibility) and the 3D figures (swept mesh)
+        return False in verdicts
 
     infeasible = run_guarded(action)
     if strict and infeasible:

@@ -24,15 +24,25 @@ def volume_mesh_table(summary: dict[str, Any] | None) -> Table | None:
     if not rows:
         return None
     header = ("q", "tets", "volume vs body", "in chamber", "min dihedral", "max dihedral", "max radius-edge",
-              "size / mean edge", "mesher")
+              "size / mean edge", "3D stretch max", "3D stress max", "mesher")
     body = [(
         f"{f['q']:.3f}", str(f["tets"]), f"{100 * f['volume_rel_error']:+.3f} %",
-        "-" if f["chamber_centroids_inside"] is None else str(f["chamber_centroids_inside"]),
+        "-" if f.get("chamber_centroids_inside") is None else str(f["chamber_centroids_inside"]),
         f"{f['min_dihedral_deg']:.2f} deg", f"{f['max_dihedral_deg']:.2f} deg", f"{f['max_radius_edge']:.2f}",
-        f"{f['size_mm']:g} / {f['mean_edge_mm']:.2f} mm", f"{f['mesher_s']:.1f} s",
+        f"{f['size_mm']:g} / " + ("-" if f.get("mean_edge_mm") is None else f"{f['mean_edge_mm']:.2f} mm"),
+        *_strain_cells(f.get("strain")), f"{f['mesher_s']:.1f} s",
     ) for f in rows]
-    return plain_table("Volume meshes (fTetWild): meshes/volume/q_*.vtu and .msh", header, body,
-                       ("num",) * len(header))
+    swept = bool((summary or {}).get("deterministic"))
+    return plain_table(f"Volume meshes ({'swept' if swept else 'fTetWild'}): meshes/volume/q_*.vtu and .msh", header,
+                       body, ("num",) * len(header))
+
+
+def _strain_cells(strain: dict[str, Any] | None) -> tuple[str, str]:
+    """The swept mesh's largest 3D stretch and principal stress at this q (fTetWild's meshes have none)."""
+    if strain is None:
+        return "-", "-"
+    stress = strain["stress_max_kpa"]
+    return f"{strain['stretch_max']['value']:.4f}", "-" if stress is None else f"{stress['value']:.1f} kPa"
 
 
 def volume_mesh_checks(summary: dict[str, Any] | None) -> list[Check]:

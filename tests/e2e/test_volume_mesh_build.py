@@ -48,7 +48,8 @@ def failing_mesher(vertices, faces, settings):  # noqa: ARG001
 
 
 def tube_case(folder: Path, port_mm: float | None = 1.2, **volume) -> Path:
-    """A straight hollow tube, radius 2.5 mm, 14 mm long, wall 0.8 mm, port 1.2 mm (None: sealed), meshed at 2 mm."""
+    """A straight hollow tube, radius 2.5 mm, 14 mm long, wall 0.8 mm, port 1.2 mm (None: sealed), meshed at 2 mm
+    by fTetWild (the swept mesher's build is tests/e2e/test_swept_volume_mesh_build.py)."""
     vertices, faces = straight_tube(radius=2.5, length=14.0, edge=0.5)
     from softdesign.io.formats import write_mesh
 
@@ -60,7 +61,8 @@ def tube_case(folder: Path, port_mm: float | None = 1.2, **volume) -> Path:
         folder, "tube", final={"centerline": "centerline.vtp", "surface": "surface.stl"}, links={"count": 2},
         fit={"knot_spacing_mm": 2.0, "angular_intervals": 12},
         export={"q": [0, 1], "wall_mm": 0.8, "spacing_mm": 1.0, "angular_count": 40,
-                "volume_mesh": {"size_mm": 2.0, **volume}, **({} if port_mm is None else {"port_mm": port_mm})},
+                "volume_mesh": {"mesher": "ftetwild", "size_mm": 2.0, **volume},
+                **({} if port_mm is None else {"port_mm": port_mm})},
     )
 
 

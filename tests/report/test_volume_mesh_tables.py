@@ -31,3 +31,13 @@ def test_failed_figures_fail_their_checks_and_a_solid_has_no_chamber_check():
     checks = volume_mesh_checks({"requested": True, "per_q": [
         row(volume_rel_error=0.02, chamber_centroids_inside=None, min_tet_volume_mm3=-1.0)]})
     assert [c.passed for c in checks] == [False, False]
+
+
+def test_a_swept_mesh_shows_its_3d_stretch_and_stress():
+    strain = {"stretch_max": {"value": 1.3461}, "stress_max_kpa": {"value": 32.7}}
+    summary = {"requested": True, "deterministic": True,
+               "per_q": [row(chamber_centroids_inside=None, mean_edge_mm=None, strain=strain)]}
+    table = volume_mesh_table(summary)
+    assert table is not None and "swept" in table.caption
+    cells = [c.text for c in table.rows[0]]
+    assert cells[3] == "-" and cells[7] == "2 / -" and cells[8:10] == ["1.3461", "32.7 kPa"]

@@ -1,7 +1,13 @@
-"""Stage, volume_mesh: tetrahedral meshes of the body for simulators (SOFA, FEBio, Abaqus), issue 16.
+"""Stage, volume_mesh: tetrahedral meshes of the body for simulators (SOFA, FEBio, Abaqus), issues 16 and 32.
 
 Runs only when the case has ``export.volume_mesh``; otherwise it writes
-nothing.  At each of its q values (by default q = 0 alone, the state the
+nothing.  ``mesher: sweep`` (the default, issue 32) is
+:mod:`softdesign.pipeline.stages.volume_sweep`: one mesh of the body's
+parameter domain placed at every q (the same connectivity, deterministic
+bytes), its surfaces named in the files (skin, base, tip, the chamber's
+wall and caps, the port's wall; the base's nodes), the 3D strain and stress
+per element in the figures.  ``mesher: ftetwild`` is issue 16's, below.
+At each of its q values (by default q = 0 alone, the state the
 actuator is cast in and that a simulator deforms) the body is the export's
 own checked solid (same grid, offset, wall and port), and fTetWild fills it
 with tetrahedra of the target size (:mod:`softdesign.meshing.tetmesh`) in a
@@ -37,7 +43,7 @@ from softdesign.config import Case
 from softdesign.config import VolumeMesh as VolumeMeshSpec
 from softdesign.errors import ConfigError
 from softdesign.io.formats import mesh_bytes
-from softdesign.io.volume_formats import VOLUME_FORMATS, volume_mesh_bytes
+from softdesign.io.volume_formats import VOLUME_FORMATS, NamedSets, volume_mesh_bytes
 from softdesign.limits_volume import MAX_VOLUME_TETS, MESHER_MEMORY_BYTES
 from softdesign.meshing.body import body_sections
 from softdesign.meshing.chamber import chamber_surface
@@ -53,7 +59,7 @@ from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 from softdesign.types import FloatArray, IntArray
 
-VERSION = 1
+VERSION = 2
 #: The function the child process runs: (vertices, faces, TetSettings) -> (points, tets).  A module attribute,
 #: so that a test can put a crashing or hanging stand-in in its place.
 MESHER = tetrahedralize
@@ -61,12 +67,13 @@ MESHER = tetrahedralize
 
 @dataclass(frozen=True)
 class TetBody:
-    """The tetrahedra of the body at one q, and its closed chamber (hollow bodies)."""
+    """The tetrahedra of the body at one q, and its closed chamber (hollow bodies), and named sets (sweep)."""
 
     q: float
     points: FloatArray
     tets: IntArray
     chamber: tuple[FloatArray, IntArray] | None
+    sets: NamedSets | None = None
 
 
 @dataclass(frozen=True)
@@ -127,6 +134,8 @@ def run_volume_mesh(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
     vm = case.export.volume_mesh
     if vm is None:
         return VolumeMeshResult((), {"requested": False})
+    if vm.mesher == "sweep":
+        return _run_sweep(case, kinematics, fit)
     meshes, files, per_q = [], {}, []
     for q in vm.q:
         mesh, figures = mesh_body(case, kinematics, fit, q)
@@ -143,13 +152,46 @@ def run_volume_mesh(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
     return VolumeMeshResult(tuple(meshes), summary)
 
 
+def _run_sweep(case: Case, kinematics: KinematicsResult, fit: FitResult) -> VolumeMeshResult:
+    """The swept mesher's meshes, files and figures (:mod:`softdesign.pipeline.stages.volume_sweep`)."""
+    from softdesign.pipeline.stages.volume_sweep import material_of, run_sweep
+
+    vm = case.export.volume_mesh or VolumeMeshSpec()
+    run = run_sweep(case, kinematics, fit)
+    meshes, files = [], {}
+    for body, figures in zip(run.bodies, run.per_q, strict=True):
+        mesh = body.mesh
+        surfaces = {name: mesh.group_faces(name) for name in mesh.groups} | dict(mesh.lids)
+        sets = NamedSets(surfaces, {"base_nodes": mesh.base_nodes()}, body.tet_data)
+        chamber = (body.points, mesh.cavity_surface("chamber")) if any(h.name == "chamber" for h in mesh.holes) \
+            else None
+        meshes.append(TetBody(body.q, body.points, mesh.tets, chamber, sets))
+        for suffix in VOLUME_FORMATS:
+            files[layout.volume_mesh_path(body.q, suffix)] = figures
+        if chamber is not None:
+            files[layout.chamber_surface_path(body.q)] = _chamber_figures(body.q, chamber)
+    material = material_of(case)
+    judged = material.max_stretch is not None or material.tensile_strength_kpa is not None
+    first = run.bodies[0].mesh
+    summary = {"requested": True, "spec": vm.model_dump(mode="json"),
+               "mesher": {"name": "sweep: softdesign.meshing.sweep_mesh, one mesh of the parameter domain",
+                          "meshio": metadata.version("meshio")},
+               "deterministic": True, "surfaces": list(first.groups) + list(first.lids),
+               "node_sets": ["base_nodes"], "per_q": run.per_q, "morph": run.morph, "parts": run.parts,
+               "material": {"name": material.name, "max_stretch": material.max_stretch,
+                            "tensile_strength_kpa": material.tensile_strength_kpa,
+                            "law": None if material.law is None else material.law.kind},
+               "feasible": (not run.reasons) if judged else None, "reasons": run.reasons, "files": files}
+    return VolumeMeshResult(tuple(meshes), summary)
+
+
 def write_volume_mesh(result: VolumeMeshResult, staging: Staging) -> None:
     """Stage every mesh in .vtu and .msh, every chamber as STL, and the figures."""
     if not result.summary["requested"]:
         return
     for mesh in result.meshes:
         for suffix in VOLUME_FORMATS:
-            data = volume_mesh_bytes(mesh.points, mesh.tets, suffix)
+            data = volume_mesh_bytes(mesh.points, mesh.tets, suffix, mesh.sets)
             staging.write_bytes(layout.volume_mesh_path(mesh.q, suffix), data)
         if mesh.chamber is not None:
             staging.write_bytes(layout.chamber_surface_path(mesh.q), mesh_bytes(*mesh.chamber, "stl"))
@@ -169,6 +211,10 @@ def describe_volume_mesh(result: VolumeMeshResult) -> list[str]:
     s = result.summary
     if not s["requested"]:
         return ["no export.volume_mesh in the case file: no volume mesh"]
+    if s.get("deterministic"):
+        from softdesign.pipeline.stages.volume_sweep import describe_sweep
+
+        return describe_sweep(s)
     lines = []
     for name, f in s["files"].items():
         if name.endswith(".msh"):
@@ -189,7 +235,7 @@ STAGE = Stage(
     name="volume_mesh",
     version=VERSION,
     reads=("export.volume_mesh", "export.offset_mm", "export.wall_mm", "export.port_mm", "export.spacing_mm",
-           "export.angular_count"),
+           "export.angular_count", "material"),
     upstream=("kinematics", "fit"),
     compute=lambda case, results: run_volume_mesh(case, results["kinematics"], results["fit"]),
     write=write_volume_mesh,

@@ -1,0 +1,56 @@
+"""A user's own material in the case file (``material.custom``): every figure the presets carry, all required.
+
+A preset's numbers come from softdesign/data/materials.yaml with their
+sources; a custom material must give the same figures and say where they
+come from, or the case file is refused (pydantic names each missing key):
+``material: {custom: {name, shore, tensile_strength_mpa,
+elongation_at_break_pct, law: {kind, c1_kpa, c2_kpa, c3_kpa}, source}}``.
+Its ``max_stretch`` follows the presets' rule (1 + design fraction x
+elongation at break) unless ``material.max_stretch`` says otherwise.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from softdesign.materials import DESIGN_FRACTION, MaterialLimits
+
+
+class CustomLaw(BaseModel):
+    """A hyperelastic law: Yeoh coefficients in kPa (neo-Hookean: c2 = c3 = 0, mu = 2 c1)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    kind: Literal["neo-hookean", "yeoh"]
+    c1_kpa: float = Field(gt=0.0, le=1.0e6)
+    c2_kpa: float = Field(ge=-1.0e6, le=1.0e6)
+    c3_kpa: float = Field(ge=-1.0e6, le=1.0e6)
+
+    @model_validator(mode="after")
+    def _neo_hookean_has_one_term(self) -> CustomLaw:
+        if self.kind == "neo-hookean" and (self.c2_kpa != 0 or self.c3_kpa != 0):
+            raise ValueError("a neo-hookean law has c2_kpa = c3_kpa = 0 (use kind: yeoh for more terms)")
+        return self
+
+
+class CustomMaterial(BaseModel):
+    """A material given in full in the case file, with its source."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    name: str = Field(min_length=1, max_length=80)
+    shore: str = Field(min_length=1, max_length=20)
+    tensile_strength_mpa: float = Field(gt=0.0, le=1000.0)
+    elongation_at_break_pct: float = Field(gt=0.0, le=10000.0)
+    law: CustomLaw
+    #: the document and table the numbers come from (a test report, a datasheet)
+    source: str = Field(min_length=3, max_length=500)
+
+    def limits(self) -> MaterialLimits:
+        """The presets' rule applied to this material's elongation at break."""
+        rule = (f"{self.source}: elongation at break {self.elongation_at_break_pct:g} %; max_stretch = 1 + "
+                f"{DESIGN_FRACTION:g} x elongation at break (the presets' rule)")
+        return MaterialLimits(self.name, 1.0 + DESIGN_FRACTION * self.elongation_at_break_pct / 100.0, None, None,
+                              rule)

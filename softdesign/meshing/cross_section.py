@@ -1,0 +1,212 @@
+"""The body's cross-section in its parameter domain: the unit disk, triangulated to conform to circular holes.
+
+Reference plane
+    Coordinates (x, y) along the section's (N, B), in fractions of the section's
+    radius: the outer boundary is the unit circle, sampled at the export's
+    angles ``a_k = 2 pi k / na`` (so the swept mesh's skin has the surface
+    mesh's vertices).  A hole is a circle (centre, radius in the same units)
+    that the triangulation conforms to: its circle is a chain of edges, every
+    triangle lies wholly inside or outside it.  The hole's inside is meshed
+    too: a chamber exists only over part of the length, and where it does not
+    the section is solid (:mod:`softdesign.meshing.sweep_mesh` drops the
+    hole's triangles layer by layer).
+Points
+    Each circle (the outer one and every hole's) is a front: its own nodes,
+    then rings of points stepping away from it (inwards and, for a hole,
+    outwards) by ``sqrt(3)/2`` of the local size, each ring turned half a
+    step from the last (near-equilateral triangles), the size growing by
+    ``GROWTH`` per ring up to ``size``.  Candidates are kept in order of
+    their ring's distance from a circle; one closer than ``KEEP_FRACTION`` of
+    the smaller local size to a kept point is dropped.
+Triangulation
+    Delaunay (qhull through scipy: deterministic for the same points).  The
+    rings either side of a circle make its edges Delaunay; every circle edge
+    is checked present and a missing one is a MeshError (a bug to report),
+    never a silent non-conforming mesh.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from softdesign.errors import MeshError
+from softdesign.types import FloatArray, IntArray
+
+#: Local size grows by this factor per ring away from a circle.
+GROWTH = 1.25
+#: A candidate closer than this fraction of the smaller local size to a kept point is dropped.
+KEEP_FRACTION = 0.7
+#: Fewest nodes on a hole's circle.
+MIN_HOLE_NODES = 12
+#: Ring points stay this many of a circle's edge lengths off it: outside every edge's diametral disk
+#: (half an edge plus the sagitta), so each circle edge is a Gabriel, hence Delaunay, edge.
+CIRCLE_CLEARANCE = 0.6
+
+
+@dataclass(frozen=True)
+class Circle:
+    """A hole of the cross-section: ``center`` (x, y) and ``radius`` in fractions of the section's radius."""
+
+    center: tuple[float, float]
+    radius: float
+    #: nodes on the circle; 0: from the local size (at least MIN_HOLE_NODES)
+    nodes: int = 0
+
+
+@dataclass(frozen=True)
+class CrossSection:
+    """The triangulated unit disk.
+
+    Attributes
+    ----------
+    points : (P, 2) float, reference (x, y); points[:na] are the outer circle at angles 2 pi k / na
+    triangles : (T, 3) int64, counter-clockwise
+    inside : (T, H) bool, triangle t lies inside hole h
+    circle_nodes : tuple of H (m_h,) int64, each hole's circle nodes in counter-clockwise order
+    outer_count : int, na
+    """
+
+    points: FloatArray
+    triangles: IntArray
+    inside: np.ndarray
+    circle_nodes: tuple[IntArray, ...]
+    outer_count: int
+
+    def triangle_areas(self) -> FloatArray:
+        """Signed area of each triangle, (T,) in squared section radii (> 0: counter-clockwise)."""
+        p = self.points[self.triangles]
+        u, v = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+        return 0.5 * (u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0])
+
+    def min_angle_deg(self) -> float:
+        """Smallest interior angle of any triangle, degrees (a quality figure)."""
+        p = self.points[self.triangles]
+        angles = []
+        for k in range(3):
+            u, v = p[:, (k + 1) % 3] - p[:, k], p[:, (k + 2) % 3] - p[:, k]
+            cos = np.einsum("ij,ij->i", u, v) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
+            angles.append(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
+        return float(np.min(angles))
+
+
+def _ring(center: FloatArray, radius: float, count: int, phase: float) -> FloatArray:
+    angles = phase + 2.0 * np.pi * np.arange(count) / count
+    return center + radius * np.column_stack([np.cos(angles), np.sin(angles)])
+
+
+def _front(center: FloatArray, radius: float, h0: float, size: float, outward: bool,
+           reach: float) -> list[tuple[int, FloatArray, float]]:
+    """Rings stepping away from a circle: (ring index from 1, points, local size)."""
+    rings, r, h, phase = [], radius, h0, 0.0
+    for index in range(1, 10_000):
+        step = h * math.sqrt(3.0) / 2.0
+        r = r + step if outward else r - step
+        phase += 0.5 * h / max(r, 1e-12)
+        h = min(h * GROWTH, size)
+        if (not outward and r < 0.5 * h) or (outward and r - radius > reach):
+            if not outward:
+                rings.append((index, center[None, :].copy(), h))
+            break
+        count = max(3, round(2.0 * np.pi * r / h))
+        rings.append((index, _ring(center, r, count, phase), h))
+    return rings
+
+
+def _check_holes(circles: Sequence[Circle]) -> None:
+    for k, c in enumerate(circles):
+        reach = math.hypot(*c.center) + c.radius
+        if not (c.radius > 0 and reach < 1.0):
+            raise MeshError(f"cross-section hole {k}: centre {c.center} radius {c.radius:g} (section radii) must lie "
+                            "inside the unit disk; this is a bug in the chamber layout, please report it")
+
+
+def _candidates(outer_count: int, circles: Sequence[Circle], size: float):
+    """Fixed circle nodes, and candidate rings ordered by ring index then front."""
+    h_outer = 2.0 * np.sin(np.pi / outer_count)
+    fixed = [_ring(np.zeros(2), 1.0, outer_count, 0.0)]
+    sizes = [np.full(outer_count, h_outer)]
+    fronts = [_front(np.zeros(2), 1.0, h_outer, max(size, h_outer), False, 2.0)]
+    for c in circles:
+        centre = np.asarray(c.center, float)
+        count = c.nodes or max(MIN_HOLE_NODES, round(2.0 * np.pi * c.radius / max(size, h_outer)))
+        fixed.append(_ring(centre, c.radius, count, 0.0))
+        sizes.append(np.full(count, 2.0 * c.radius * np.sin(np.pi / count)))
+        fronts.append(_front(centre, c.radius, sizes[-1][0], max(size, h_outer), False, 2.0))
+        fronts.append(_front(centre, c.radius, sizes[-1][0], max(size, h_outer), True, 2.0))
+    rings = sorted(((index, f, pts, h) for f, front in enumerate(fronts) for index, pts, h in front),
+                   key=lambda item: (item[0], item[1]))
+    return fixed, sizes, rings
+
+
+def _keep(fixed: list[FloatArray], sizes: list[FloatArray], rings,
+          circles: Sequence[Circle]) -> tuple[FloatArray, FloatArray]:
+    from scipy.spatial import cKDTree
+
+    points, local = np.concatenate(fixed), np.concatenate(sizes)
+    bounds = [(np.zeros(2), 1.0, sizes[0][0])] + [(np.asarray(c.center, float), c.radius, e[0])
+                                                    for c, e in zip(circles, sizes[1:], strict=True)]
+    for _, _, pts, h in rings:
+        r_ok = np.linalg.norm(pts, axis=1) <= 1.0
+        for centre, radius, edge in bounds:  # off every circle's diametral disks: its edges stay Delaunay
+            r_ok &= np.abs(np.linalg.norm(pts - centre, axis=1) - radius) >= CIRCLE_CLEARANCE * edge
+        pts = pts[r_ok]
+        if not len(pts):
+            continue
+        distance, nearest = cKDTree(points).query(pts)
+        ok = distance >= KEEP_FRACTION * np.minimum(h, local[nearest])
+        pts = pts[ok]
+        # within one ring the points are h apart; keep them all, they are spaced by construction
+        points = np.concatenate([points, pts])
+        local = np.concatenate([local, np.full(len(pts), h)])
+    return points, local
+
+
+def cross_section(outer_count: int, circles: Sequence[Circle], size: float) -> CrossSection:
+    """The unit disk triangulated with ``outer_count`` nodes on its circle and conforming to ``circles``.
+
+    Parameters
+    ----------
+    outer_count : int, nodes on the unit circle at angles 2 pi k / outer_count (the export's angular count)
+    circles : the holes, in fractions of the section's radius (nested holes allowed: a port in a chamber)
+    size : float, largest edge length inside, in fractions of the section's radius
+
+    Raises
+    ------
+    MeshError
+        A hole outside the disk, or a circle whose edges the triangulation does not keep (a bug).
+    """
+    from scipy.spatial import Delaunay
+
+    if outer_count < 3 or not size > 0:
+        raise ValueError(f"cross_section: outer_count >= 3 and size > 0, got {outer_count}, {size}")
+    _check_holes(circles)
+    fixed, sizes, rings = _candidates(outer_count, circles, size)
+    points, _ = _keep(fixed, sizes, rings, circles)
+    triangles = np.asarray(Delaunay(points).simplices, np.int64)
+    u, v = (points[triangles[:, k]] - points[triangles[:, 0]] for k in (1, 2))
+    area2 = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+    triangles = np.where((area2 < 0)[:, None], triangles[:, [0, 2, 1]], triangles)
+    triangles = triangles[np.abs(area2) > 1e-14]
+    starts = np.cumsum([0] + [len(f) for f in fixed])
+    circle_nodes = tuple(np.arange(starts[k], starts[k + 1], dtype=np.int64) for k in range(1, len(fixed)))
+    _check_edges(triangles, [np.arange(outer_count)] + list(circle_nodes))
+    centroids = points[triangles].mean(axis=1)
+    inside = np.stack([np.linalg.norm(centroids - np.asarray(c.center), axis=1) < c.radius for c in circles],
+                      axis=1) if circles else np.zeros((len(triangles), 0), bool)
+    return CrossSection(points, triangles, inside, circle_nodes, outer_count)
+
+
+def _check_edges(triangles: IntArray, chains: list[np.ndarray]) -> None:
+    edges = np.sort(np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]]), axis=1)
+    have = set(map(tuple, edges.tolist()))
+    for k, chain in enumerate(chains):
+        wanted = np.sort(np.column_stack([chain, np.roll(chain, -1)]), axis=1)
+        missing = [e for e in map(tuple, wanted.tolist()) if e not in have]
+        if missing:
+            what = "the outer circle" if k == 0 else f"hole {k - 1}'s circle"
+            raise MeshError(f"cross-section: {len(missing)} edges of {what} are not in the triangulation (first "
+                            f"{missing[0]}); the section would not conform; this is a bug, please report the case")

@@ -1,0 +1,280 @@
+"""The swept mesh of :mod:`softdesign.meshing.sweep_mesh` placed in space: the body at q, node by node.
+
+Map
+    Layer j at q is the export's section at ``l_j(q)``: centre c, frame (N, B),
+    outer section curve ``O(a)`` (the body offset by ``offset_mm``) and, for a
+    hollow body, the chamber's curve ``I(a)`` (offset by ``offset_mm -
+    wall_mm``), both on the export's angle grid, from
+    :func:`~softdesign.meshing.tessellate.sweep_from_sections` (so folds and
+    walls too thick fail here as in the export).  A reference point at polar
+    (t, a) of the unit disk goes to ``c + x N + y B`` with (x, y):
+
+    - solid: ``t O(a)``;
+    - hollow, chamber radius ``r_c`` in the reference: ``(t / r_c) I(a)`` for
+      t <= r_c, ``I + (t - r_c) / (1 - r_c) (O - I)`` beyond (depth through the wall);
+    - chambered (issue 31's layout, :func:`holes_from_layout`): a rigid core
+      ``R0 (x, y)`` for t <= t_c, holding every chamber and feed as the exact
+      circle in mm the layout gives, then ``C + (t - t_c) / (1 - t_c) (O - C)``
+      out to the skin, C the core's circle ``t_c R0 u(a)``;
+
+    ``O(a)``, ``I(a)`` linear between the grid's angles, so the outer circle's
+    nodes (at the grid angles) are the surface mesh's vertices and the mesh's
+    skin is the export's polygon surface.
+Material points
+    A node is one material point at every q (its l and reference (x, y) do
+    not depend on q), so the change between two q is the material's strain.
+    The chamber's ends are its layers at arc lengths ``wall_mm`` and ``L -
+    wall_mm`` at q = 0 (the cast part); at another q the sealed caps are what
+    that material becomes, where the export makes caps ``wall_mm`` thick at
+    every q (on the demo the two volumes differ by 1e-4 of the body's).
+End cuts
+    The export's cut (:mod:`softdesign.meshing.end_cut`): every generator (a
+    reference point's nodes through the layers) slides so the end layer lies
+    in the cut plane; for a hollow body the chamber's end layer then slides
+    into the plane moved ``wall_mm`` inward, and the layers of the sealed cap
+    between are spaced evenly along the straight line joining the two.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from softdesign.errors import MeshError
+from softdesign.fitting.radius_field import RadiusField
+from softdesign.geometry.frames import FramedSpline
+from softdesign.meshing.body import sections_on_grid
+from softdesign.meshing.chamber_layout import ChamberLayout
+from softdesign.meshing.end_cut import CutPlane, _cut_last_end, cut_planes
+from softdesign.meshing.sweep_mesh import Hole, SweptMesh
+from softdesign.meshing.tessellate import Sweep, sweep_from_sections
+from softdesign.meshing.volume import BodySpec, angle_grid
+from softdesign.types import FloatArray
+
+
+@dataclass(frozen=True)
+class SweepReference:
+    """What ties a swept mesh to the body: the reference chamber and where the chamber's end layers are.
+
+    Attributes
+    ----------
+    chamber_radius : float, r_c, the chamber's circle in section radii (0: a solid body)
+    chamber_layers : (j0, j1), the layers of the chamber's ends (hollow), else (0, 0)
+    core : float, t_c, the rigid core's radius in reference units (0: none; chambered bodies)
+    scale_mm : float, R0, mm per reference unit inside the core
+    """
+
+    chamber_radius: float = 0.0
+    chamber_layers: tuple[int, int] = (0, 0)
+    core: float = 0.0
+    scale_mm: float = 0.0
+
+
+def l_at_arclength(curve: FramedSpline, s: FloatArray) -> FloatArray:
+    """Normalized l where the arc length along ``curve`` reaches ``s`` (mm), by the curve's dense table."""
+    l_dense = curve.curve.dense_l()
+    return np.interp(np.asarray(s, float), curve.curve.arc_length(l_dense), l_dense)
+
+
+def section_sweeps(mesh: SweptMesh, ref: SweepReference, curve: FramedSpline, field: RadiusField, q: float,
+                   spec: BodySpec, angular_count: int) -> tuple[Sweep, Sweep | None]:
+    """The outer sweep (and the chamber's, hollow) at the layers of this q."""
+    l = mesh.l
+    a = angle_grid(angular_count)
+    sections = sections_on_grid(curve, q, l, field.evaluate_grid(q, l, a), field.evaluate_grid(q, l, a, dl=1))
+    outer = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
+    if ref.chamber_radius == 0.0:
+        return outer, None
+    return outer, sweep_from_sections(sections, spec.offset_mm - spec.wall_mm, spec.min_radius_mm, field="wall_mm")
+
+
+def _on_curve(xy: FloatArray, angles: FloatArray) -> FloatArray:
+    """Section curves (n, na, 2) at ``angles`` (P,), linear between the grid's angles: (n, P, 2)."""
+    na = xy.shape[1]
+    where = np.mod(angles, 2.0 * np.pi) * na / (2.0 * np.pi)
+    k = np.minimum(np.floor(where).astype(np.int64), na - 1)
+    f = (where - k)[None, :, None]
+    return (1.0 - f) * xy[:, k] + f * xy[:, (k + 1) % na]
+
+
+def section_xy(points: FloatArray, outer: Sweep, inner: Sweep | None, ref: SweepReference) -> FloatArray:
+    """The reference section ``points`` (P, 2) in every layer's (N, B) plane, (n, P, 2) mm."""
+    t = np.linalg.norm(points, axis=1)
+    angles = np.arctan2(points[:, 1], points[:, 0])
+    o = _on_curve(outer.xy, angles)
+    if ref.core > 0.0:
+        tc, r0 = ref.core, ref.scale_mm
+        reach = np.einsum("npk,pk->np", o, np.column_stack([np.cos(angles), np.sin(angles)]))
+        skin = reach[:, t >= 1.0 - 1e-9]
+        if np.any(skin <= tc * r0):
+            row = int(np.argmin(np.min(skin, axis=1)))
+            raise MeshError(f"volume mesh at q={outer.q:.3f}, l={outer.l[row]:.4f}: the skin comes within "
+                            f"{tc * r0:.3f} mm of the centerline, inside the chambers' ring; the layout does not "
+                            "fit this section: use smaller actuation.distance_mm or diameter_mm")
+        core = r0 * points[None, :, :]
+        rim = (tc * r0) * np.column_stack([np.cos(angles), np.sin(angles)])[None]
+        out = rim + np.clip((t - tc) / (1.0 - tc), 0.0, None)[None, :, None] * (o - rim)
+        return np.where((t <= tc)[None, :, None], core, out)
+    if inner is None:
+        return t[None, :, None] * o
+    i = _on_curve(inner.xy, angles)
+    rc = ref.chamber_radius
+    depth = np.clip((t - rc) / (1.0 - rc), 0.0, None)[None, :, None]
+    return np.where((t <= rc)[None, :, None], (t / rc)[None, :, None] * i, i + depth * (o - i))
+
+
+def _grid_points(sweep: Sweep, xy: FloatArray) -> FloatArray:
+    return (sweep.centers[:, None, :] + xy[..., :1] * sweep.frames[:, None, :, 0]
+            + xy[..., 1:] * sweep.frames[:, None, :, 1])
+
+
+def _cut(points: FloatArray, sweep: Sweep, end: int, plane: CutPlane, label: str) -> FloatArray:
+    """``points`` (n, P, 3) with the generators slid so the base (end 0) or tip (1) layer lies in ``plane``."""
+    k = 0 if end == 0 else -1
+    outward = sweep.frames[k][:, 2] * (-1.0 if end == 0 else 1.0)
+    order = slice(None, None, -1) if end == 0 else slice(None)
+    s = sweep.s[-1] - sweep.s[::-1] if end == 0 else sweep.s - sweep.s[0]
+    moved, _ = _cut_last_end(points[order], s, sweep.centers[k], outward, plane, label)
+    out = points.copy()
+    out[order] = moved
+    return out
+
+
+def _cap_between(points: FloatArray, s: FloatArray, first: int, last: int) -> FloatArray:
+    """Layers strictly between ``first`` and ``last`` spaced by ``s`` on the straight line joining them."""
+    w = ((s[first:last + 1] - s[first]) / (s[last] - s[first]))[:, None, None]
+    out = points.copy()
+    out[first:last + 1] = (1.0 - w) * points[first][None] + w * points[last][None]
+    return out
+
+
+def cut_grid(points: FloatArray, outer: Sweep, ref: SweepReference, spec: BodySpec, label: str) -> FloatArray:
+    """The layer grid (n, P, 3) cut at the body's end planes (and the chamber's, moved ``wall_mm`` in)."""
+    planes = cut_planes(outer, spec.end_cuts)
+    for end, plane in enumerate(planes):
+        if plane is not None:
+            points = _cut(points, outer, end, plane, f"{label}: the {('base', 'tip')[end]} end's cut plane")
+    if ref.chamber_radius == 0.0:
+        return points
+    j0, j1 = ref.chamber_layers
+    inset = cut_planes(outer, spec.end_cuts, spec.wall_mm)
+    if inset[0] is not None:
+        part = _sub_sweep(outer, j0, None)
+        points[j0:] = _cut(points[j0:], part, 0, inset[0], f"{label}: the chamber's base cut plane")
+        points = _cap_between(points, outer.s, 0, j0)
+    if inset[1] is not None:
+        part = _sub_sweep(outer, None, j1 + 1)
+        points[:j1 + 1] = _cut(points[:j1 + 1], part, 1, inset[1], f"{label}: the chamber's tip cut plane")
+        points = _cap_between(points, outer.s, j1, len(outer.s) - 1)
+    return points
+
+
+def _sub_sweep(sweep: Sweep, start: int | None, stop: int | None) -> Sweep:
+    part = slice(start, stop)
+    return Sweep(sweep.q, sweep.l[part], sweep.s[part], sweep.centers[part], sweep.frames[part], sweep.xy[part],
+                 sweep.max_rho_kappa)
+
+
+def place_mesh(mesh: SweptMesh, ref: SweepReference, curve: FramedSpline, field: RadiusField, q: float,
+               spec: BodySpec, angular_count: int) -> FloatArray:
+    """The mesh's nodes at q, (V, 3) mm.
+
+    Raises
+    ------
+    MeshError
+        As the export would: a fold, a wall or offset the local radius cannot take, an end plane too far.
+    """
+    outer, inner = section_sweeps(mesh, ref, curve, field, q, spec, angular_count)
+    grid = _grid_points(outer, section_xy(mesh.section.points, outer, inner, ref))
+    grid = cut_grid(grid, outer, ref, spec, f"volume mesh at q={q:.3f}")
+    return grid[mesh.node_layer, mesh.node_point]
+
+
+def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec: BodySpec, angular_count: int,
+              size_mm: float, layout: ChamberLayout | None = None) -> tuple[SweptMesh, SweepReference]:
+    """The swept mesh of the body and its reference, laid out on the body at q = 0 (the cast state).
+
+    Parameters
+    ----------
+    curve0 : the centerline at q = 0
+    field : the radius field
+    layers : (n,) float, l of the layers from 0 to 1 (the chamber's ends are put in)
+    spec : offset, wall (a concentric chamber ``wall_mm`` short of each end), port (a concentric feed
+        through the base cap)
+    angular_count : nodes on the outer circle and on the chamber's and port's circles (the export's angles)
+    size_mm : the largest edge inside the section, mm
+    layout : issue 31's chambers and feeds (a solid body's), or None
+
+    The chamber's reference radius is the median ratio of the chamber's to the outer section's radius
+    at q = 0 (so the depth coordinate is about uniform); the port's is its radius over the chamber's
+    base section's mean radius, in the chamber's units.
+    """
+    from softdesign.meshing.cross_section import Circle
+    from softdesign.meshing.sweep_mesh import Hole, swept_disk
+
+    a = angle_grid(angular_count)
+    rho = field.evaluate_grid(0.0, layers, a)
+    size = size_mm / float(np.median(rho))
+    if layout is not None:
+        if spec.wall_mm > 0:
+            raise MeshError("volume mesh: actuation chambers and export.wall_mm's single chamber together; give one")
+        holes, ref = holes_from_layout(layout, float(np.median(rho)), float(np.min(rho)), angular_count)
+        return swept_disk(angular_count, holes, size, layers), ref
+    if spec.wall_mm == 0:
+        return swept_disk(angular_count, [], size, layers), SweepReference()
+    ends = l_at_arclength(curve0, np.array([spec.wall_mm, curve0.length - spec.wall_mm]))
+    sections = sections_on_grid(curve0, 0.0, layers, rho, field.evaluate_grid(0.0, layers, a, dl=1))
+    outer = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
+    inner = sweep_from_sections(sections, spec.offset_mm - spec.wall_mm, spec.min_radius_mm, field="wall_mm")
+    within = (layers >= ends[0]) & (layers <= ends[1])
+    ratio = np.linalg.norm(inner.xy[within], axis=-1) / np.linalg.norm(outer.xy[within], axis=-1)
+    rc = float(np.median(ratio)) if ratio.size else 0.5
+    holes = [Hole("chamber", Circle((0.0, 0.0), rc, angular_count), (float(ends[0]), float(ends[1])))]
+    if spec.port_mm > 0:
+        base = int(np.argmin(np.abs(layers - ends[0])))
+        rp = rc * 0.5 * spec.port_mm / float(np.mean(np.linalg.norm(inner.xy[base], axis=-1)))
+        holes.append(Hole("port", Circle((0.0, 0.0), rp, angular_count), (0.0, float(ends[0])), cavity="chamber"))
+    mesh = swept_disk(angular_count, holes, size, layers)
+    j = [int(np.argmin(np.abs(mesh.l - e))) for e in ends]
+    return mesh, SweepReference(rc, (j[0], j[1]))
+
+
+#: The rigid core reaches this fraction of the way from the chambers' outer edge to the thinnest skin.
+CORE_GAP_FRACTION = 0.5
+#: Fewest nodes on a chamber's or feed's circle: its polygon holds 1 - sin(h)/h = 0.64 % less than the circle.
+MIN_CHAMBER_NODES = 32
+
+
+def holes_from_layout(layout: ChamberLayout, scale_mm: float, rho_min_mm: float,
+                      angular_count: int) -> tuple[list[Hole], SweepReference]:
+    """Issue 31's chambers and feeds as holes of the reference section, and the rigid core holding them.
+
+    Chamber (section i, chamber j) is ``s{i}_c{j}`` (surfaces ``s{i}_c{j}_wall``, ``_cap``); its feed
+    ``s{i}_c{j}_feed`` belongs to the same cavity and opens at the base (``s{i}_c{j}_feed_inlet``).
+    ``scale_mm`` (R0) is mm per reference unit, ``rho_min_mm`` the thinnest section's radius at q = 0.
+    """
+    from softdesign.meshing.cross_section import Circle
+
+    reach = max([c.distance_mm + 0.5 * c.diameter_mm for c in layout.chambers]
+                + [f.ring_mm + 0.5 * f.diameter_mm for f in layout.feeds])
+    core_mm = reach + CORE_GAP_FRACTION * (rho_min_mm - reach)
+    if not reach < core_mm < rho_min_mm:
+        raise MeshError(f"volume mesh: the chambers reach {reach:.3f} mm from the centerline, the thinnest section "
+                        f"is {rho_min_mm:.3f} mm: no wall; use smaller actuation.distance_mm or diameter_mm")
+    h_outer = 2.0 * np.pi / angular_count
+
+    def circle(distance: float, angle: float, diameter: float) -> Circle:
+        radius = 0.5 * diameter / scale_mm
+        nodes = max(MIN_CHAMBER_NODES, int(np.ceil(2.0 * np.pi * radius / h_outer)))
+        return Circle((distance * np.cos(angle) / scale_mm, distance * np.sin(angle) / scale_mm), radius, nodes)
+
+    holes = []
+    for c in layout.chambers:
+        holes.append(Hole(f"s{c.section}_c{c.index}", circle(c.distance_mm, c.angle, c.diameter_mm),
+                          (c.l_start, c.l_end)))
+    for f in layout.feeds:
+        name = f"s{f.section}_c{f.chamber}"
+        holes.append(Hole(f"{name}_feed", circle(f.ring_mm, f.angle, f.diameter_mm), (f.l_start, f.l_end),
+                          cavity=name))
+    return holes, SweepReference(core=core_mm / scale_mm, scale_mm=scale_mm)

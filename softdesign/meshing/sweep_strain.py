@@ -1,0 +1,101 @@
+"""The 3D strain and stress of the swept mesh between q = 0 and q, with where the extremes sit.
+
+Every node of :mod:`softdesign.meshing.sweep_body` is one material point at
+every q, so :mod:`softdesign.mechanics.kinematic_stress` gives each
+tetrahedron's strain from its nodes at q = 0 and at q.  The traction-free
+direction of the stress is the normal of the surfaces of constant depth
+(``t = sqrt(x^2 + y^2)`` of the reference disk: the skin, and the chamber's
+wall, are such surfaces): ``G^-T grad t`` with G the map from the parameter
+domain to the body at q = 0.
+
+Where
+    section (the link, 0-based), l, angle (rad, of the reference point about
+    the centerline from N) and depth: 0 at the skin, 1 at the axis of a solid
+    body or at the chamber's wall of a hollow one, of the tetrahedron's centroid.
+Skin
+    Each skin triangle's in-plane principal stretches from its edges at q = 0
+    and at q (:func:`softdesign.fitting.strain.principal_stretches` on the
+    triangles' metrics): what the feasibility stage measures from the
+    surface's derivatives, on the mesh.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from softdesign.fitting.strain import principal_stretches
+from softdesign.mechanics.kinematic_stress import ElementStrain, element_strain
+from softdesign.mechanics.laws import HyperelasticLaw
+from softdesign.meshing.sweep_body import SweepReference
+from softdesign.meshing.sweep_mesh import SweptMesh
+from softdesign.types import FloatArray, IntArray
+
+
+@dataclass(frozen=True)
+class Extreme:
+    """A largest value and where: ``value`` at section, l, angle (rad), depth (0 skin .. 1 axis or chamber)."""
+
+    value: float
+    section: int
+    l: float
+    angle: float
+    depth: float
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready, rounded to what the figures can tell."""
+        return {"value": round(self.value, 6), "section": self.section, "l": round(self.l, 5),
+                "angle_rad": round(self.angle, 5), "depth": round(self.depth, 4)}
+
+
+def free_directions(mesh: SweptMesh, rest: FloatArray) -> FloatArray:
+    """(T, 3) unit normals at q = 0 of the surfaces of constant depth through each tetrahedron (module notes)."""
+    param = mesh.reference_points()
+    t = mesh.tets
+    dp = (param[t[:, 1:]] - param[t[:, :1]]).transpose(0, 2, 1)
+    dx = (rest[t[:, 1:]] - rest[t[:, :1]]).transpose(0, 2, 1)
+    centroid = param[t].mean(axis=1)
+    radial = np.column_stack([centroid[:, 0], centroid[:, 1], np.zeros(len(t))])
+    norm = np.linalg.norm(radial, axis=1, keepdims=True)
+    radial = np.where(norm > 1e-9, radial / np.maximum(norm, 1e-300), np.array([1.0, 0.0, 0.0]))
+    # grad_x t = G^-T grad_p t with G = dx dp^-1, so G^-T = dx^-T dp^T
+    normal = np.einsum("nji,nj->ni", np.linalg.inv(dx), np.einsum("nji,nj->ni", dp, radial))
+    return np.asarray(normal / np.linalg.norm(normal, axis=1, keepdims=True), np.float64)
+
+
+def tet_places(mesh: SweptMesh, ref: SweepReference, link_of) -> tuple[IntArray, FloatArray, FloatArray, FloatArray]:
+    """Section (link), l, angle and depth of every tetrahedron's centroid in the parameter domain."""
+    centroid = mesh.reference_points()[mesh.tets].mean(axis=1)
+    t = np.linalg.norm(centroid[:, :2], axis=1)
+    inner = ref.chamber_radius
+    depth = np.clip((1.0 - t) / (1.0 - inner), 0.0, 1.0)
+    angle = np.mod(np.arctan2(centroid[:, 1], centroid[:, 0]), 2.0 * np.pi)
+    return np.asarray(link_of(centroid[:, 2]), np.int64), centroid[:, 2], angle, depth
+
+
+def extreme_of(values: FloatArray, places: tuple[IntArray, FloatArray, FloatArray, FloatArray]) -> Extreme:
+    """The largest of ``values`` (T,) and its place (first of equals: deterministic)."""
+    i = int(np.argmax(values))
+    section, l, angle, depth = places
+    return Extreme(float(values[i]), int(section[i]), float(l[i]), float(angle[i]), float(depth[i]))
+
+
+def strain_at(mesh: SweptMesh, rest: FloatArray, moved: FloatArray, law: HyperelasticLaw | None,
+              free: FloatArray, inverses: FloatArray | None = None) -> ElementStrain:
+    """Every tetrahedron's strain (and stress, with a law) between ``rest`` (q = 0) and ``moved``;
+    ``inverses`` (:func:`~softdesign.mechanics.kinematic_stress.rest_inverses`) computed once for every q."""
+    return element_strain(rest, moved, mesh.tets, law, free, inverses)
+
+
+def skin_stretches(mesh: SweptMesh, rest: FloatArray, moved: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """In-plane principal stretches (lambda1, lambda2) of every skin triangle, each (S,)."""
+    faces = mesh.group_faces("skin")
+
+    def metric(x: FloatArray) -> FloatArray:
+        e1, e2 = x[faces[:, 1]] - x[faces[:, 0]], x[faces[:, 2]] - x[faces[:, 0]]
+        return np.column_stack([np.einsum("ij,ij->i", e1, e1), np.einsum("ij,ij->i", e1, e2),
+                                np.einsum("ij,ij->i", e2, e2)])
+
+    return principal_stretches(metric(rest), metric(moved))

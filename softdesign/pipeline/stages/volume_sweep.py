@@ -1,0 +1,345 @@
+"""The volume_mesh stage's swept mesher: one mesh in the body's parameter domain, placed at every q, with figures.
+
+``export.volume_mesh.mesher: sweep`` (the default).  The mesh
+(:mod:`softdesign.meshing.sweep_mesh`) is laid out once on the body at q = 0,
+layers on the export's rings (``export.spacing_mm``, the finest grid of the
+q values meshed), the section's nodes on the export's angles, its inside at
+``size_mm``; :mod:`softdesign.meshing.sweep_body` places it at each q.
+Checks at each q: every tetrahedron positive (else MeshError naming the
+worst one's section, l, angle and depth), the volume within
+``VOLUME_RTOL`` of the export's surface mesh at that q, the boundary
+watertight.  Figures: round 2's quality figures with the worst element
+named, and the 3D strain and stress (:mod:`softdesign.meshing.sweep_strain`)
+at each q and over the morph's q samples
+(:func:`softdesign.meshing.skin_stretch.morph_samples`), judged against the
+material (stretch vs max_stretch, stress vs tensile strength).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from softdesign.config import Case
+from softdesign.config import VolumeMesh as VolumeMeshSpec
+from softdesign.errors import ConfigError, MeshError
+from softdesign.limits_volume import MAX_VOLUME_TETS
+from softdesign.mechanics.kinematic_stress import rest_inverses
+from softdesign.mechanics.laws import HyperelasticLaw
+from softdesign.meshing.body import export_l_grid
+from softdesign.meshing.skin_stretch import morph_samples
+from softdesign.meshing.sweep_body import SweepReference, place_mesh, plan_mesh
+from softdesign.meshing.sweep_mesh import SweptMesh
+from softdesign.meshing.sweep_strain import extreme_of, free_directions, skin_stretches, strain_at, tet_places
+from softdesign.meshing.tet_quality import dihedral_angles, radius_edge_ratios, tet_volumes
+from softdesign.meshing.topology import mesh_topology
+from softdesign.meshing.volume_tolerance import VOLUME_RTOL
+from softdesign.pipeline.item_progress import item_counter
+from softdesign.pipeline.stages.export import body_spec, solid_at
+from softdesign.pipeline.stages.fit import FitResult
+from softdesign.pipeline.stages.kinematics import KinematicsResult
+from softdesign.types import FloatArray
+
+#: Triangles of a section per node about (Euler: 2 per inside node), for the count bound before meshing.
+TRIANGLES_PER_NODE = 2.0
+
+
+@dataclass(frozen=True)
+class SweptBody:
+    """The mesh at one q: its nodes, the mesh, and per-tetrahedron figures for the file."""
+
+    q: float
+    points: FloatArray
+    mesh: SweptMesh
+    tet_data: dict[str, FloatArray]
+
+
+@dataclass(frozen=True)
+class Material:
+    """What the strain is judged against: the law (or None) and limits (None: not judged)."""
+
+    law: HyperelasticLaw | None
+    max_stretch: float | None
+    tensile_strength_kpa: float | None
+    name: str
+
+
+def _layers(case: Case, kinematics: KinematicsResult, fit: FitResult, vm: VolumeMeshSpec) -> FloatArray:
+    shape = kinematics.chain.shape
+    grids = [export_l_grid(shape.curve_at(q), fit.field, case.export.spacing_mm) for q in sorted({0.0, *vm.q})]
+    return max(grids, key=len)
+
+
+def _check_count(layers: FloatArray, case: Case, fit: FitResult, size_mm: float) -> None:
+    na = case.export.angular_count
+    rho = float(np.median(fit.field.evaluate_grid(0.0, layers[:: max(1, len(layers) // 16)], [0.0])))
+    inside = np.pi * rho**2 / (0.5 * np.sqrt(3.0) * min(size_mm, 2 * np.pi * rho / na) ** 2)
+    count = 3.0 * (len(layers) - 1) * TRIANGLES_PER_NODE * (na + inside)
+    if count > MAX_VOLUME_TETS:
+        raise ConfigError(
+            f"export.volume_mesh: the swept mesh would hold about {count:.3g} tetrahedra ({len(layers)} layers of "
+            f"{na} angles at export.spacing_mm {case.export.spacing_mm:g}, size_mm {size_mm:g}), more than the "
+            f"limit of {MAX_VOLUME_TETS} (softdesign/limits_volume.py); raise size_mm or export.spacing_mm")
+
+
+Places = tuple[Any, FloatArray, FloatArray, FloatArray]
+
+
+def _where(places: Places, index: int) -> dict[str, Any]:
+    section, l, angle, depth = (p[index] for p in places)
+    return {"tet": index, "section": int(section), "l": round(float(l), 5), "angle_rad": round(float(angle), 5),
+            "depth": round(float(depth), 4)}
+
+
+def _quality(points: FloatArray, mesh: SweptMesh, places: Places) -> dict[str, Any]:
+    volumes = tet_volumes(points, mesh.tets)
+    angles = np.degrees(dihedral_angles(points, mesh.tets))
+    ratio = radius_edge_ratios(points, mesh.tets)
+    worst = {"min_volume": int(np.argmin(volumes)), "min_dihedral": int(np.argmin(angles.min(axis=1))),
+             "max_radius_edge": int(np.argmax(ratio))}
+    return {"tets": len(mesh.tets), "points": len(points), "volume_mm3": float(volumes.sum()),
+            "min_tet_volume_mm3": float(volumes.min()), "min_dihedral_deg": float(angles.min()),
+            "max_dihedral_deg": float(angles.max()), "max_radius_edge": float(ratio.max()),
+            "worst": {k: _where(places, i) for k, i in worst.items()}}
+
+
+def _check(figures: dict[str, Any], surface_mm3: float, q: float) -> None:
+    figures["body_volume_mm3"] = surface_mm3
+    figures["volume_rel_error"] = figures["volume_mm3"] / surface_mm3 - 1.0
+    figures["volume_rtol"] = VOLUME_RTOL
+    problems = []
+    if figures["min_tet_volume_mm3"] <= 0:
+        w = figures["worst"]["min_volume"]
+        problems.append(f"tetrahedron {w['tet']} has volume {figures['min_tet_volume_mm3']:.3g} mm3 (inverted) at "
+                        f"section {w['section']}, l={w['l']:.4f}, angle {np.degrees(w['angle_rad']):.0f} deg, "
+                        f"depth {w['depth']:.2f}")
+    if abs(figures["volume_rel_error"]) > VOLUME_RTOL:
+        rel = 100 * figures["volume_rel_error"]
+        problems.append(f"the tetrahedra hold {figures['volume_mm3']:.2f} mm3, {rel:+.3f} % of the surface mesh's "
+                        f"{surface_mm3:.2f} mm3 (expected within {100 * VOLUME_RTOL:g} %)")
+    if problems:
+        raise MeshError(f"volume mesh at q={q:.3f}: " + "; ".join(problems) + "; this is a bug in the swept mesher, "
+                        "please report it with the case file (or use export.volume_mesh.mesher: ftetwild)")
+
+
+def _strain_figures(placed: _Placed, moved: FloatArray) -> tuple[dict[str, Any], dict[str, FloatArray]]:
+    mesh, rest, material, places = placed.mesh, placed.rest, placed.material, placed.places
+    strain = strain_at(mesh, rest, moved, material.law, placed.free, placed.inverses)
+    lam1, lam2 = skin_stretches(mesh, rest, moved)
+    out: dict[str, Any] = {
+        "stretch_max": extreme_of(strain.stretches[:, 0], places).as_dict(),
+        "stretch_min": extreme_of(-strain.stretches[:, 2], places).as_dict(),
+        "green_strain_max": extreme_of(strain.green_max, places).as_dict(),
+        "skin_stretch_max": float(lam1.max()), "skin_stretch_min": float(lam2.min()),
+        "stress_max_kpa": None if strain.stress_max is None else extreme_of(strain.stress_max, places).as_dict(),
+    }
+    out["stretch_min"]["value"] = -out["stretch_min"]["value"]
+    data = {"stretch_max": strain.stretches[:, 0]}  # two arrays only: each adds seconds to an ASCII .vtu
+    if strain.stress_max is not None:
+        data["stress_max_kpa"] = strain.stress_max
+    return out, data
+
+
+def material_of(case: Case) -> Material:
+    """The case's law and limits for the 3D figures (no material: figures only, not judged)."""
+    from softdesign.material_data import law_from, material_presets
+
+    m = case.material
+    if m is None:
+        return Material(None, None, None, "none")
+    limits = m.limits()
+    if m.custom is not None:
+        c = m.custom
+        law = law_from(c.law.kind, c.law.c1_kpa, c.law.c2_kpa, c.law.c3_kpa, c.source)
+        return Material(law, limits.max_stretch, 1000.0 * c.tensile_strength_mpa, limits.name)
+    if m.name is None:
+        return Material(None, limits.max_stretch, None, limits.name)
+    preset = material_presets()[m.name]
+    return Material(preset.law(), limits.max_stretch, preset.tensile_strength_kpa, limits.name)
+
+
+def judge(figures: dict[str, Any], material: Material, where: str) -> list[str]:
+    """One reason per limit the figures pass (stretch over max_stretch, stress over the tensile strength)."""
+    reasons = []
+
+    def place(e: dict[str, Any]) -> str:
+        return (f"section {e['section']}, l={e['l']:.4f}, angle {np.degrees(e['angle_rad']):.0f} deg, "
+                f"depth {e['depth']:.2f}")
+
+    stretch = figures["stretch_max"]
+    if material.max_stretch is not None and stretch["value"] > material.max_stretch:
+        reasons.append(f"{where}: 3D stretch {stretch['value']:.4f} > max_stretch {material.max_stretch:g} "
+                       f"({material.name}) at {place(stretch)}")
+    stress = figures["stress_max_kpa"]
+    if stress is not None and material.tensile_strength_kpa is not None and \
+            stress["value"] > material.tensile_strength_kpa:
+        reasons.append(f"{where}: 3D stress {stress['value']:.1f} kPa > tensile strength "
+                       f"{material.tensile_strength_kpa:.1f} kPa ({material.name}) at {place(stress)}")
+    return reasons
+
+
+@dataclass(frozen=True)
+class SweepRun:
+    """The meshes at the requested q, the figures per q, over the morph, and the verdict's reasons."""
+
+    bodies: tuple[SweptBody, ...]
+    per_q: list[dict[str, Any]]
+    morph: dict[str, Any]
+    reasons: list[str]
+    parts: list[dict[str, Any]]
+
+
+@dataclass(frozen=True)
+class _Placed:
+    """What placing the mesh at a q and measuring it needs."""
+
+    mesh: SweptMesh
+    ref: SweepReference
+    fit: FitResult
+    shape: Any  # BlendedShape
+    spec: Any  # BodySpec
+    angular_count: int
+    rest: FloatArray
+    free: FloatArray
+    material: Material
+    inverses: FloatArray
+    places: Places
+
+    def at(self, q: float) -> FloatArray:
+        if q == 0.0:
+            return self.rest
+        return place_mesh(self.mesh, self.ref, self.shape.curve_at(q), self.fit.field, q, self.spec,
+                          self.angular_count)
+
+    def strain(self, points: FloatArray) -> tuple[dict[str, Any], dict[str, FloatArray]]:
+        return _strain_figures(self, points)
+
+
+def actuation_layout_of(case: Case, kinematics: KinematicsResult) -> Any:
+    """Issue 31's chambers and feeds when the case has ``actuation:`` (its stage's own layout), else None.
+
+    Written against issue 31's ``softdesign.pipeline.stages.actuation.actuation_layout``; on a tree without
+    it (no actuation key in the case file) there is nothing to conform to.
+    """
+    if getattr(case, "actuation", None) is None:
+        return None
+    import importlib
+
+    return importlib.import_module("softdesign.pipeline.stages.actuation").actuation_layout(case, kinematics)
+
+
+def _plan(case: Case, kinematics: KinematicsResult, fit: FitResult, vm: VolumeMeshSpec) -> _Placed:
+    e, spec, shape = case.export, body_spec(case, fit), kinematics.chain.shape
+    layers = _layers(case, kinematics, fit, vm)
+    _check_count(layers, case, fit, vm.size_mm)
+    layout = actuation_layout_of(case, kinematics)
+    mesh, ref = plan_mesh(shape.curve_at(0.0), fit.field, layers, spec, e.angular_count, vm.size_mm, layout)
+    rest = place_mesh(mesh, ref, shape.curve_at(0.0), fit.field, 0.0, spec, e.angular_count)
+    return _Placed(mesh, ref, fit, shape, spec, e.angular_count, rest, free_directions(mesh, rest), material_of(case),
+                   rest_inverses(rest, mesh.tets), tet_places(mesh, ref, fit.field.link_of))
+
+
+def run_sweep(case: Case, kinematics: KinematicsResult, fit: FitResult) -> SweepRun:
+    """Plan the mesh at q = 0, place and check it at every q, and measure its strain (module notes)."""
+    vm = case.export.volume_mesh or VolumeMeshSpec()
+    samples = [q for q in morph_samples() if q not in vm.q]
+    tick = item_counter("volume_mesh", ["plan", *vm.q, *samples], _part_label)
+    log: list[dict[str, Any]] = []
+    start = time.perf_counter()
+    placed = _plan(case, kinematics, fit, vm)
+    _tell(tick, "plan", start, log)
+    bodies, per_q, reasons = [], [], []
+    for q in vm.q:
+        start = time.perf_counter()
+        points = placed.at(q)
+        figures = _quality(points, placed.mesh, placed.places)
+        _check(figures, float(solid_at(kinematics, fit, q, case).figures["volume_mm3"]), q)
+        strain, data = placed.strain(points)
+        figures.update({"q": q, "size_mm": vm.size_mm, "layers": len(placed.mesh.l),
+                        "body_kind": _kind(placed.spec, placed.mesh), "strain": strain,
+                        "boundary_watertight": bool(mesh_topology(points, placed.mesh.faces).watertight)})
+        reasons += judge(strain, placed.material, f"q={q:.3f}")
+        figures["mesher_s"] = round(time.perf_counter() - start, 3)
+        bodies.append(SweptBody(q, points, placed.mesh, data))
+        per_q.append(figures)
+        _tell(tick, q, start, log)
+    morph = _morph(placed, per_q, samples, lambda q, t: _tell(tick, q, t, log))
+    if morph["stretch_max"] is not None:
+        reasons += judge(morph, placed.material, f"over the morph, at q={morph['stretch_max']['q']:.3f}")
+    return SweepRun(tuple(bodies), per_q, morph, reasons, log)
+
+
+def _kind(spec: Any, mesh: SweptMesh) -> str:
+    if spec.wall_mm == 0:
+        return "chambered" if mesh.holes else "solid"
+    return "ported" if spec.port_mm > 0 else "hollow"
+
+
+def _part_label(item: Any) -> str:
+    part, seconds = item
+    return f"{'mesh plan' if part == 'plan' else f'q={part:.3f}'} ({seconds:.2f} s)"
+
+
+def _tell(tick: Any, part: Any, start: float, log: list[dict[str, Any]]) -> None:
+    """Tell the bar (on a terminal) and keep the part's time for the log (the stage's description)."""
+    seconds = time.perf_counter() - start
+    log.append({"part": part, "seconds": round(seconds, 3)})
+    if tick is not None:
+        tick((part, seconds), None)
+
+
+def _morph(placed: _Placed, per_q: list[dict[str, Any]], samples: list[float], tell: Any) -> dict[str, Any]:
+    """The largest stretch and stress over the exported q and the morph's q samples, with their q."""
+    rows = [(row["q"], row["strain"]) for row in per_q]
+    for q in samples:
+        start = time.perf_counter()
+        rows.append((q, placed.strain(placed.at(q))[0]))
+        tell(q, start)
+    out: dict[str, Any] = {"q_samples": sorted(q for q, _ in rows)}
+    for key in ("stretch_max", "green_strain_max", "stress_max_kpa"):
+        found = [(q, s[key]) for q, s in rows if s[key] is not None]
+        if found:
+            q, best = max(found, key=lambda item: item[1]["value"])
+            out[key] = {**best, "q": q}
+        else:
+            out[key] = None
+    return out
+
+
+def _place_text(e: dict[str, Any]) -> str:
+    return f"section {e['section']}, l={e['l']:.4f}, angle {np.degrees(e['angle_rad']):.0f} deg, depth {e['depth']:.2f}"
+
+
+def describe_sweep(summary: dict[str, Any]) -> list[str]:
+    """A line per part with its time, per mesh with its figures and strain, the morph's extremes, the verdict."""
+    lines = [f"{'mesh plan' if p['part'] == 'plan' else 'q=' + format(p['part'], '.3f')}: {p['seconds']:.2f} s"
+             for p in summary["parts"]]
+    for f in summary["per_q"]:
+        w = f["worst"]["min_dihedral"]
+        lines.append(f"q={f['q']:.3f} (.vtu, .msh): {f['tets']} tets, {f['volume_mm3']:.2f} mm3 "
+                     f"({100 * f['volume_rel_error']:+.4f} % vs the surface mesh), min volume "
+                     f"{f['min_tet_volume_mm3']:.3g} mm3, min dihedral {f['min_dihedral_deg']:.2f} deg "
+                     f"(tet {w['tet']}, {_place_text(w)}), max radius-edge {f['max_radius_edge']:.2f}")
+        st = f["strain"]
+        stress = "" if st["stress_max_kpa"] is None else (f", stress max {st['stress_max_kpa']['value']:.1f} kPa at "
+                                                           f"{_place_text(st['stress_max_kpa'])}")
+        lines.append(f"  3D stretch max {st['stretch_max']['value']:.4f} at {_place_text(st['stretch_max'])}, min "
+                     f"{st['stretch_min']['value']:.4f}{stress}")
+    m = summary["morph"]
+    if m["stretch_max"] is not None:
+        stress = "" if m["stress_max_kpa"] is None else (f", stress max {m['stress_max_kpa']['value']:.1f} kPa at "
+                                                         f"q={m['stress_max_kpa']['q']:.3f}")
+        lines.append(f"over {len(m['q_samples'])} q: 3D stretch max {m['stretch_max']['value']:.4f} at "
+                     f"q={m['stretch_max']['q']:.3f}{stress}")
+    material = summary["material"]
+    if summary["feasible"] is None:
+        lines.append("material: none judged (add material: to the case file)")
+    else:
+        verdict = "feasible" if summary["feasible"] else "NOT feasible"
+        lines.append(f"material {material['name']} (max_stretch {material['max_stretch']}, tensile strength "
+                     f"{material['tensile_strength_kpa']} kPa): {verdict} in 3D")
+        lines += [f"WARN {r}" for r in summary["reasons"]]
+    return lines
