@@ -31,6 +31,7 @@ from pydantic import (
     model_validator,
 )
 
+from softdesign.config_actuation import Actuation
 from softdesign.config_material import CustomMaterial
 from softdesign.config_types import FiniteFloat, Integer
 from softdesign.errors import ConfigError
@@ -334,6 +335,8 @@ class Case(_Section):
     export: Export = Export()
     #: no material: the feasibility figures are reported and judged against nothing
     material: Material | None = None
+    #: seed 003's three chambers per section with their feed lines, built into the body (issue 31)
+    actuation: Actuation | None = None
 
     _base: Path = PrivateAttr(default_factory=Path.cwd)
 
@@ -391,6 +394,15 @@ class Case(_Section):
                 "or drop export.mould"
             )
         return export
+
+    @field_validator("actuation")
+    @classmethod
+    def _one_kind_of_cavity(cls, actuation: Actuation | None, info: ValidationInfo) -> Actuation | None:
+        export = info.data.get("export")
+        if actuation is not None and isinstance(export, Export) and export.wall_mm is not None:
+            raise ValueError("actuation's chambers and export.wall_mm's single hollow chamber are two designs of "
+                             "the cavity; drop export.wall_mm (and port_mm) or drop actuation")
+        return actuation
 
     @field_validator("name")
     @classmethod

@@ -108,9 +108,9 @@ def build(
         _print_runs(outcome.build_dir, outcome.runs)
         if with_report:
             report_after_build(outcome.build_dir, jobs=jobs)
-        verdicts = [outcome.results[k].summary.get("feasible") for k in ("feasibility", "volume_mesh")
-                    if k in outcome.results]  # the skin's stretch (feasibility) and the 3D figures (swept mesh)
-        return False in verdicts
+        # the skin's stretch (feasibility), the 3D figures (swept mesh), actuation's walls and extension
+        judged = [outcome.results.get(name) for name in ("feasibility", "volume_mesh", "actuation")]
+        return any(r is not None and r.summary.get("feasible") is False for r in judged)
 
     infeasible = run_guarded(action)
     if strict and infeasible:

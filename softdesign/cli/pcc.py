@@ -232,11 +232,11 @@ def _csv_text(header: list[str], rows: Sequence[Sequence[Any]]) -> str:
     return buffer.getvalue()
 
 
-def _tips_csv(readings: Readings, arcs, tip2base: np.ndarray) -> str:
+def _tips_csv(readings: Readings, arcs, tip2base: np.ndarray, first: str = "time") -> str:
     import numpy as np
 
     sections = readings.lengths.shape[1]
-    header = ["time", "tip_x", "tip_y", "tip_z"] + [f"r{i}{j}" for i in range(1, 4) for j in range(1, 4)]
+    header = [first, "tip_x", "tip_y", "tip_z"] + [f"r{i}{j}" for i in range(1, 4) for j in range(1, 4)]
     header += [f"{name}_{s}" for s in range(1, sections + 1) for name in ("kappa", "phi", "length", "theta")]
     per_section = np.stack([arcs.kappa, arcs.phi, arcs.length, arcs.theta], axis=-1).reshape(
         len(readings.times), 4 * sections
@@ -266,10 +266,34 @@ def _write_backbones(path: Path, readings: Readings, arcs, points_per_section: i
     return write_polylines_vtp(path, list(poses[:, :, :3, 3]), point_arrays, cell_arrays)
 
 
+def _readings_and_arcs(path: Path, d: str | None, max_rate: float | None) -> tuple[Readings, Any, str]:
+    """The readings of an encoder CSV (``--d`` required) or of an actuation table, their arcs, the first column."""
+    import numpy as np
+
+    from softdesign.io.actuation_table import first_row, is_actuation_header, read_actuation_table
+    from softdesign.kinematics import pcc
+    from softdesign.kinematics.chamber_lengths import arcs_from_chamber_lengths
+
+    if is_actuation_header(first_row(path)):
+        table = read_actuation_table(path)
+        if d is not None:
+            given = spacing_from_text(d, table.lengths.shape[1], where=str(path))
+            if not np.allclose(given, table.distance_mm, rtol=0.0, atol=1e-9):
+                raise ConfigError(f"--d {d} differs from {path}'s distance_mm {table.distance_mm.tolist()}; omit --d "
+                                  "(the table carries each section's distance)")
+        count = len(table.q)
+        readings = Readings(table.q, table.lengths, np.arange(2, count + 2), [])
+        return readings, arcs_from_chamber_lengths(table.lengths, table.distance_mm, table.first_angle), "q"
+    if d is None:
+        raise ConfigError(f"{path}: an encoder-readings CSV needs --d (the cables' distance from the backbone, mm)")
+    readings = read_readings(path, max_rate)
+    spacing = spacing_from_text(d, readings.lengths.shape[1], where=str(path))
+    return readings, pcc.arcs_from_lengths(readings.lengths, spacing), "time"
+
+
 @pcc_app.command()
 def reconstruct(
     readings_csv: Annotated[Path, typer.Argument(help="Encoder readings over time (CSV).", show_default=False)],
-    d: DOpt,
     out_dir: Annotated[
         Path,
         typer.Option("--shapes-dir", help="Folder for the reconstructed shapes (created if missing).",
@@ -281,8 +305,14 @@ def reconstruct(
     points_per_section: Annotated[
         int, typer.Option("--points-per-section", min=2, help="Backbone samples per arc.")
     ] = 21,
+    d: Annotated[
+        str | None,
+        typer.Option("--d", help='Distance of the cables from the backbone, mm: one value ("15") or one per section '
+                     '("15,14,13"); required for readings, taken from the table for a build\'s actuation.csv.',
+                     show_default=False),
+    ] = None,
 ) -> None:
-    """Backbone and tip pose for every row of an encoder-readings CSV.
+    """Backbone and tip pose for every row of an encoder-readings CSV, or every q of a build's actuation.csv.
 
     READINGS.csv has a header row, then per row a time (first column, s) and
     three lengths (mm) per section, sections in order.  Writes, in SHAPES_DIR:
@@ -294,6 +324,10 @@ def reconstruct(
     reported on stderr, when a length is not a number or not > 0, its time is
     not after the previous accepted row, or (with --max-rate) a cable changed
     faster than MAX_RATE mm/s since the previous accepted row.
+
+    A build's actuation.csv (columns q, section, chamber, angle_deg, distance_mm,
+    length_mm, ...) is read as it is: one reading per q (tips.csv's first column
+    is then q), each section's chambers at their own angles and distance.
     """
 
     def action() -> None:
@@ -303,15 +337,13 @@ def reconstruct(
             raise ConfigError(
                 f"--max-rate must be a finite number > 0 mm/s, got {max_rate:g}; omit it to skip the check"
             )
-        readings = read_readings(readings_csv, max_rate)
-        spacing = spacing_from_text(d, readings.lengths.shape[1], where=str(readings_csv))
+        readings, arcs, first = _readings_and_arcs(readings_csv, d, max_rate)
         for line, time, reason in readings.rejected:
             note(f"{readings_csv} line {line} (time {time}): rejected: {reason}")
         out_dir.mkdir(parents=True, exist_ok=True)
-        arcs = pcc.arcs_from_lengths(readings.lengths, spacing)
         tip2base = pcc.chain_transforms(pcc.transform_from_arc(arcs.kappa, arcs.phi, arcs.length))[:, -1]
         written = [
-            _write_text_atomically(out_dir / "tips.csv", _tips_csv(readings, arcs, tip2base)),
+            _write_text_atomically(out_dir / "tips.csv", _tips_csv(readings, arcs, tip2base, first)),
             _write_backbones(out_dir / "backbones.vtp", readings, arcs, points_per_section),
             _write_text_atomically(out_dir / "rejected.csv", _csv_text(["line", "time", "reason"], readings.rejected)),
         ]

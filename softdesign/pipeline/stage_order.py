@@ -12,6 +12,7 @@ from softdesign.config import Case
 from softdesign.pipeline import inputs
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages import (
+    actuation,
     blend,
     export,
     feasibility,
@@ -25,7 +26,8 @@ from softdesign.pipeline.stages import (
 
 #: Every stage, in build order.
 STAGES: list[Stage] = [
-    ingest.STAGE, blend.STAGE, links.STAGE, kinematics.STAGE, fit.STAGE, export.STAGE, mould.STAGE, volume_mesh.STAGE,
+    ingest.STAGE, blend.STAGE, links.STAGE, kinematics.STAGE, fit.STAGE, actuation.STAGE, export.STAGE, mould.STAGE,
+    volume_mesh.STAGE,
     feasibility.STAGE,
 ]
 

@@ -36,6 +36,7 @@ from softdesign.pipeline import layout
 from softdesign.report.build_folder import BuildData
 from softdesign.report.display_mesh import decimated_surface, max_distance_to_mesh
 from softdesign.report.mould_figures import COLOURS as MOULD_COLOURS
+from softdesign.report.mould_figures import part_colour
 from softdesign.types import FloatArray
 
 #: At most this many triangles of each mould part are shown (more only to meet the display tolerance).
@@ -65,11 +66,12 @@ def mould_traces(data: BuildData, tolerance_mm: float) -> tuple[list[dict[str, A
         return [], []
     traces: list[dict[str, Any]] = []
     notes: list[str] = []
-    for part in sorted(block["parts"], key=list(MOULD_COLOURS).index):
+    order = list(MOULD_COLOURS)  # halves, core, core plate; an actuated body's pins after them by name
+    for part in sorted(block["parts"], key=lambda p: (order.index(p) if p in order else len(order), p)):
         vertices, faces = read_mesh(data.build_dir / layout.mould_path(part, "stl"))
         v, f, error = decimated_surface(vertices, faces, MOULD_FACES, tolerance_mm)
         v = v.astype(np.float32)
-        traces.append({"color": MOULD_COLOURS[part], "flatshading": True, "hoverinfo": "name", "i": f[:, 0],
+        traces.append({"color": part_colour(part), "flatshading": True, "hoverinfo": "name", "i": f[:, 0],
                        "j": f[:, 1], "k": f[:, 2], "name": MOULD_PREFIX + part, "opacity": MOULD_OPACITY,
                        "showlegend": True, "visible": "legendonly", "x": v[:, 0], "y": v[:, 1], "z": v[:, 2],
                        "type": "mesh3d"})

@@ -34,7 +34,7 @@ EXPLODE = 0.6
 #: Viewing direction (from the eye into the scene) and light, in the mould frame (x along the body, z the pull).
 VIEW = np.array([0.45, 1.0, -0.55])
 LIGHT = np.array([-0.3, -0.5, 0.8])
-COLOURS = {"half_a": "#8fb3d9", "half_b": "#d9b38f", "core": "#9acd8f"}
+COLOURS = {"half_a": "#8fb3d9", "half_b": "#d9b38f", "core": "#9acd8f", "core_plate": "#b0a0c8"}
 
 
 def _shaded(vertices: FloatArray, faces: np.ndarray, colour: str) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -58,6 +58,11 @@ def _shaded(vertices: FloatArray, faces: np.ndarray, colour: str) -> tuple[Float
     return screen, tri.mean(axis=1) @ view, rgba
 
 
+def part_colour(part: str) -> str:
+    """A part's colour: the halves', a core's (a single core, each pin of an actuated body), the core plate's."""
+    return COLOURS.get(part, COLOURS["core_plate"] if part == "core_plate" else COLOURS["core"])
+
+
 def mould_figure_png(build_dir: str | Path) -> bytes | None:
     """The exploded view of ``build_dir``'s mould as PNG bytes; None when the build has no mould."""
     build_dir = Path(build_dir)
@@ -79,10 +84,10 @@ def _exploded_png(build_dir: Path, block: dict[str, Any] | None) -> bytes | None
     parts = {p: read_mesh(build_dir / layout.mould_path(p, "stl")) for p in block["parts"]}
     local = {p: ((np.asarray(v, float) - origin) @ axes.T, np.asarray(f)) for p, (v, f) in parts.items()}
     height = max(float(np.ptp(v[:, 2])) for v, _ in local.values())
-    shift = {"half_a": EXPLODE * height, "half_b": -EXPLODE * height, "core": 0.0}
+    shift = {"half_a": EXPLODE * height, "half_b": -EXPLODE * height}  # a core, the core plate and pins: 0
     screens, depths, colours = [], [], []
     for name, (v, f) in local.items():
-        s, d, c = _shaded(v + [0.0, 0.0, shift[name]], f, COLOURS[name])
+        s, d, c = _shaded(v + [0.0, 0.0, shift.get(name, 0.0)], f, part_colour(name))
         screens.append(s)
         depths.append(d)
         colours.append(c)
@@ -100,7 +105,8 @@ def _exploded_png(build_dir: Path, block: dict[str, Any] | None) -> bytes | None
     title = "Casting mould, exploded: half A (pulled up), half B (down)"
     title += f", core ({core['process']})" if core else ""
     figure.suptitle(title, fontsize=9.5)
-    ax.legend(handles=[Patch(color=COLOURS[p], label=p) for p in local], loc="lower right", fontsize=7.5)
+    labels = dict.fromkeys("cores" if p.startswith("core_") and p != "core_plate" else p for p in local)
+    ax.legend(handles=[Patch(color=part_colour(p), label=p) for p in labels], loc="lower right", fontsize=7.5)
     out = io.BytesIO()
     figure.savefig(out, format="png", dpi=DPI, metadata={"Software": None})
     return out.getvalue()

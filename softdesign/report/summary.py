@@ -62,6 +62,7 @@ def summary_facts(data: BuildData) -> list[Fact]:
             facts.append(Fact(f"volume of {entry['path']}", _num(entry["volume_mm3"]), "mm^3",
                               f"/outputs/{i}/volume_mm3"))
     facts += _feasibility_facts(m)
+    facts += _actuation_facts(m)
     rho_kappa = resolve_or(m, "/metrics/fit/max_rho_kappa", None)
     if rho_kappa is not None:
         facts.append(Fact("largest rho * kappa at q = 1 (folds at 1)", _num(rho_kappa), "",
@@ -96,6 +97,26 @@ def _feasibility_facts(m: dict[str, Any]) -> list[Fact]:
     return facts
 
 
+def _actuation_facts(m: dict[str, Any]) -> list[Fact]:
+    """The thinnest wall of each kind and the chambers' extension range, with where (actuated builds only)."""
+    block = resolve_or(m, "/metrics/actuation", None)
+    if not isinstance(block, dict) or "thinnest" not in block:
+        return []
+    facts = [Fact(f"actuation: thinnest {kind} wall (section {w['section']}"
+                  + (f", chamber {w['chamber']}" if w["chamber"] else "")
+                  + (f", q = {format_value(w['q'])}" if w["q"] is not None else "") + ")",
+                  _num(w["thickness_mm"]), "mm", f"/metrics/actuation/thinnest/{kind}/thickness_mm")
+             for kind, w in block["thinnest"].items()]
+    ext = block["extensions"]
+    low, high = min(ext, key=lambda e: e["min"]), max(ext, key=lambda e: e["max"])
+    facts.append(Fact("actuation: chamber extension (length at q over q = 0)",
+                      f"{format_value(low['min'])} to {format_value(high['max'])}", ""))
+    verdict = block.get("feasible")
+    facts.append(Fact("actuation feasible for its material", "not judged (no material)" if verdict is None
+                      else format_value(verdict), "", "/metrics/actuation/feasible" if verdict is not None else ""))
+    return facts
+
+
 def summary_warnings(data: BuildData, checks: list[Check]) -> list[str]:
     """Every warning of the build, most serious first: stale, failed checks, infeasible, fold, arc misfit."""
     m = data.manifest
@@ -109,6 +130,9 @@ def summary_warnings(data: BuildData, checks: list[Check]) -> list[str]:
     if isinstance(block, dict) and block.get("feasible") is False:
         warnings += [f"infeasible{' (thin wall)' if 'wall' in reason else ''}: {reason}"
                      for reason in block.get("reasons", [])]
+    actuation = resolve_or(m, "/metrics/actuation", None)
+    if isinstance(actuation, dict) and actuation.get("feasible") is False:
+        warnings += [f"infeasible actuation: {reason}" for reason in actuation.get("reasons", [])[:10]]
     rho_kappa = resolve_or(m, "/metrics/fit/max_rho_kappa", None)
     if rho_kappa is not None and rho_kappa >= FOLD_LIMIT:
         warnings.append(f"the surface folds through itself at q = 1: largest rho * kappa {rho_kappa:.3g} >= 1")

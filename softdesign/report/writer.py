@@ -27,6 +27,7 @@ from softdesign.pipeline.out_folder import folder_errors
 from softdesign.pipeline.parallel import jobs_for_build, map_items
 from softdesign.pipeline.store import process_alive
 from softdesign.report import (
+    actuation_figures,
     animation,
     design_figures,
     fit_figures,
@@ -87,6 +88,7 @@ EXPECTED_SIZES = {
     stretch_figures.NAME: pixel_size(stretch_figures.SIZE_IN),
     mould_figures.NAME: mould_figures.PIXEL_SIZE,
     profile_figures.NAME: pixel_size(profile_figures.SIZE_IN),
+    actuation_figures.NAME: pixel_size(actuation_figures.SIZE_IN),
 }
 
 
@@ -281,6 +283,9 @@ def report_sections(
     stretch = run(stretch_figures.NAME, lambda: stretch_figures.stretch_picture(data))
     if stretch is not None:
         sections.insert(4, Section("feasibility", "Skin stretch and wall", pictures=[stretch]))
+    actuation = run(actuation_figures.NAME, lambda: actuation_figures.actuation_picture(data))
+    if actuation is not None:
+        sections.insert(5, Section("actuation", "Actuation: chambers, feeds, lengths", pictures=[actuation]))
     fabrication = _fabrication_section(data, run)
     if fabrication is not None:
         sections.insert(-2, fabrication)

@@ -30,6 +30,7 @@ from softdesign.io.gltf_morph import morph_glb_bytes
 from softdesign.io.polylines_vtp import write_polylines_vtp
 from softdesign.io.pvd import pvd_bytes
 from softdesign.meshing.body import body_breaks, body_sections, body_stations
+from softdesign.meshing.chambers import build_actuated
 from softdesign.meshing.checks import check_solid
 from softdesign.meshing.end_cut import end_cuts_from_record
 from softdesign.meshing.morph_body import MorphSurfaces, morph_surfaces
@@ -41,6 +42,7 @@ from softdesign.pipeline.bounds import export_workers
 from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.actuation import actuation_layout
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
@@ -99,7 +101,9 @@ def solid_at(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case)
     curve = kinematics.chain.shape.curve_at(q)
     e = case.export
     spec = body_spec(case, fit)
-    solid = build_solid(body_sections(curve, fit.field, q, e.spacing_mm, e.angular_count), spec)
+    sections = body_sections(curve, fit.field, q, e.spacing_mm, e.angular_count)
+    layout = actuation_layout(case, kinematics)
+    solid = build_solid(sections, spec) if layout is None else build_actuated(sections, spec, curve, layout)
     integral = integrate_body(body_stations(curve, fit.field, q, e.angular_count), body_breaks(fit.field), spec)
     report = check_solid(solid.vertices, solid.faces, solid.expectation(integral.volume), label=f"q={q:.3f}")
     figures = {
@@ -247,7 +251,7 @@ STAGE = Stage(
     version=VERSION,
     # every export key but mould, which only the mould stage reads
     reads=("export.q", "export.frames", "export.offset_mm", "export.wall_mm", "export.port_mm", "export.formats",
-           "export.spacing_mm", "export.angular_count", "export.split_regions"),
+           "export.spacing_mm", "export.angular_count", "export.split_regions", "actuation"),
     upstream=("kinematics", "fit"),
     compute=lambda case, results: run_export(case, results["kinematics"], results["fit"]),
     write=write_export,

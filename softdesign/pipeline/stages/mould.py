@@ -22,9 +22,11 @@ from softdesign.io.formats import mesh_bytes
 from softdesign.meshing.body import body_sections
 from softdesign.meshing.checks import Expectation, check_solid
 from softdesign.meshing.mould import MouldSpec
+from softdesign.meshing.mould_cores import make_actuated_mould
 from softdesign.meshing.mould_make import MouldMesh, make_mould
 from softdesign.pipeline import layout
 from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.actuation import actuation_layout
 from softdesign.pipeline.stages.export import body_spec
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
@@ -61,10 +63,16 @@ def run_mould(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Mould
         return MouldResult((), {"requested": False})
     e = case.export
     sections = body_sections(kinematics.chain.shape.curve_at(0.0), fit.field, 0.0, e.spacing_mm, e.angular_count)
-    mould = make_mould(sections, body_spec(case, fit), spec, fit.field.link_of)
+    actuated = actuation_layout(case, kinematics)
+    if actuated is None:
+        mould = make_mould(sections, body_spec(case, fit), spec, fit.field.link_of)
+    else:
+        mould = make_actuated_mould(sections, body_spec(case, fit), spec, kinematics.chain.shape.curve_at(0.0),
+                                    actuated, fit.field.link_of)
     files: dict[str, Any] = {}
     for part in mould.parts:
-        report = check_solid(part.vertices, part.faces, Expectation(euler=2, bodies=1), label=f"mould {part.name}")
+        euler = 2 - 2 * mould.figures["parts"][part.name]["genus"]  # the core plate has a hole per core print
+        report = check_solid(part.vertices, part.faces, Expectation(euler=euler, bodies=1), label=f"mould {part.name}")
         for fmt in _formats(case):
             files[layout.mould_path(part.name, fmt)] = {
                 "part": part.name, "vertices": report.vertices, "faces": report.faces, "volume_mm3": report.volume,
@@ -130,7 +138,7 @@ STAGE = Stage(
     name="mould",
     version=VERSION,
     reads=("export.mould", "export.offset_mm", "export.wall_mm", "export.port_mm", "export.spacing_mm",
-           "export.angular_count", "export.formats"),
+           "export.angular_count", "export.formats", "actuation"),
     upstream=("kinematics", "fit"),
     compute=lambda case, results: run_mould(case, results["kinematics"], results["fit"]),
     write=write_mould,

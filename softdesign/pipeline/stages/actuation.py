@@ -1,0 +1,350 @@
+"""Stage: actuation -- the chambers' layout (refused when it cannot fit), lengths per q, walls and extensions.
+
+With ``actuation:`` in the case, every link is a seed 003 section with three
+chambers and their feeds (:mod:`softdesign.meshing.chamber_layout`).  This
+stage, before export:
+
+1. lays them out and refuses (exit 2) a layout whose walls cannot fit the
+   body's thinnest section (radius over q = 0 and 1, every angle), naming the
+   section, the walls and the largest chamber diameter, feed diameter and
+   section count that fit;
+2. at every export q and on a dense grid (``DENSE_Q`` values, q = 0 ... 1),
+   fits each section's best arc at that q (:func:`~softdesign.kinematics.pcc_fit.fit_links`,
+   started on the section's base frame; exact for a body whose sections are
+   arcs, and its misfit stated otherwise) and writes seed 003's chamber
+   lengths on it: ``actuation.csv`` and the same rows in the manifest;
+3. measures the thinnest walls (chamber-skin, feed-skin at every q;
+   chamber-chamber, chamber-feed, feed-feed once: they do not change with q)
+   and each chamber's extension (its axis length at q over q = 0, on the body
+   itself), and judges them against ``material:`` (``--strict`` exits 1).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from softdesign.errors import ConfigError
+from softdesign.kinematics.chamber_lengths import chamber_lengths_from_arc
+from softdesign.kinematics.pcc_fit import fit_links
+from softdesign.meshing.body import body_sections
+from softdesign.meshing.chamber_layout import ChamberLayout, analytic_walls, chamber_angles, plan_layout
+from softdesign.meshing.chamber_walls import Wall, chamber_lengths_mm, ring_walls, skin_walls
+from softdesign.meshing.chambers import measured_skin_walls
+from softdesign.pipeline.bounds import export_workers
+from softdesign.pipeline.layout import q_label
+from softdesign.pipeline.parallel import map_items
+from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.fit import FitResult
+from softdesign.pipeline.stages.kinematics import KinematicsResult
+from softdesign.pipeline.store import Staging
+
+if TYPE_CHECKING:
+    from softdesign.config import Case
+
+VERSION = 1
+SUMMARY = "actuation/summary.json"
+TABLE = "actuation.csv"
+#: The dense q grid's size (q = 0, 0.05, ..., 1).
+DENSE_Q = 21
+#: Backbone samples per section for its best arc.
+ARC_SAMPLES = 201
+#: The thinnest wall a layout may have anywhere, mm: below it the booleans and a cast leave no material to speak
+#: of (rule of thumb); ``material.min_wall_mm`` then judges the design as feasible or not.
+MIN_LAYOUT_WALL_MM = 0.2
+#: Columns of actuation.csv.
+COLUMNS = ("q", "export", "section", "chamber", "angle_deg", "distance_mm", "length_mm", "extension", "arc_kappa",
+           "arc_phi", "arc_length_mm", "arc_misfit_mm")
+
+
+@dataclass(frozen=True)
+class ActuationResult:
+    """The figures (JSON-ready, rows included) and the CSV text."""
+
+    summary: dict[str, Any]
+    table: str
+
+
+def actuation_layout(case: Case, kinematics: KinematicsResult) -> ChamberLayout | None:
+    """The case's chambers and feeds on its links (None without ``actuation:``); end walls on the q = 0 body."""
+    if case.actuation is None:
+        return None
+    curve0 = kinematics.chain.shape.curve_at(0.0)
+    l = curve0.curve.dense_l()
+    try:
+        return plan_layout(case.actuation.spec(), kinematics.chain.breaks, l, curve0.curve.arc_length(l))
+    except ValueError as err:
+        raise ConfigError(f"actuation.end_wall_mm: {err}; use a thinner end wall or fewer links") from err
+
+
+def q_grid(case: Case) -> list[tuple[float, bool]]:
+    """(q, is an export q) for the dense grid and the export q values, sorted, once per file label."""
+    export = case.export.q_values()
+    chosen = {q_label(q): (q, True) for q in export}
+    for q in np.linspace(0.0, 1.0, DENSE_Q):
+        chosen.setdefault(q_label(float(q)), (float(q), False))
+    return sorted(chosen.values())
+
+
+def section_radii(fit: FitResult, layout: ChamberLayout) -> list[float]:
+    """The smallest body radius of each section at q = 0 and 1 (every angle), mm."""
+    a = np.linspace(0.0, 2.0 * np.pi, 360, endpoint=False)
+    radii = []
+    for i in range(layout.sections):
+        l = np.linspace(layout.breaks[i], layout.breaks[i + 1], 101)
+        radii.append(float(min(fit.field.evaluate_grid(q, l, a).min() for q in (0.0, 1.0))))
+    return radii
+
+
+def _largest(spec, sections: int, radius: float, wall: float) -> str:
+    """The largest chamber diameter, feed diameter and section count that fit a section of ``radius``."""
+    d, big, small = spec.distance_mm, spec.diameter_mm, spec.feed_diameter_mm
+    chord = 2.0 * d * np.sin(np.pi / (3.0 * sections)) if sections > 1 else np.inf
+    most_big = min(2.0 * (radius - d - wall), 2.0 * d * np.sin(np.pi / 3.0) - wall, 2.0 * (chord - wall) - small)
+    most_small = min(2.0 * (radius - d - wall), 2.0 * (chord - wall) - big, chord - wall, big)
+    count = 1
+    for n in range(2, 101):
+        gap = 2.0 * d * np.sin(np.pi / (3.0 * n))
+        if gap - 0.5 * (big + small) < wall or gap - small < wall:
+            break
+        count = n
+    fits = [f"diameter_mm <= {most_big:.3f}" if most_big > 0 else "no chamber diameter (move distance_mm)",
+            f"feed_diameter_mm <= {most_small:.3f}" if most_small > 0 else "no feed diameter",
+            f"at most {count} sections (links) at these diameters"]
+    return "; ".join(fits)
+
+
+def check_layout(layout: ChamberLayout, radii: list[float]) -> list[dict[str, Any]]:
+    """Each section's analytic walls; ConfigError (exit 2) naming the section and walls when one is too thin."""
+    rows, problems = [], []
+    for i, radius in enumerate(radii):
+        walls = analytic_walls(layout.spec, layout.sections, i, radius)
+        row = {"section": i + 1, "radius_min_mm": radius, "chamber_skin_mm": walls.chamber_skin,
+               "chamber_chamber_mm": walls.chamber_chamber, "chamber_feed_mm": _finite(walls.chamber_feed),
+               "feed_feed_mm": _finite(walls.feed_feed), "feed_skin_mm": _finite(walls.feed_skin),
+               "feeds_through": len(layout.feeds_through(i))}
+        rows.append(row)
+        thin = {k: v for k, v in row.items() if k.endswith("_mm") and k != "radius_min_mm" and v is not None
+                and v < MIN_LAYOUT_WALL_MM}
+        if thin:
+            named = ", ".join(f"{k.removesuffix('_mm').replace('_', '-')} {v:.3f} mm" for k, v in thin.items())
+            problems.append(f"section {i + 1} (radius {radius:.3f} mm, {row['feeds_through']} feeds through it): "
+                            f"{named}; largest that fit: "
+                            f"{_largest(layout.spec, layout.sections, radius, MIN_LAYOUT_WALL_MM)}")
+    if problems:
+        s = layout.spec
+        raise ConfigError(
+            f"actuation: the layout (distance_mm {s.distance_mm:g}, diameter_mm {s.diameter_mm:g}, feed_diameter_mm "
+            f"{s.feed_diameter_mm:g}, {layout.sections} sections) leaves walls under {MIN_LAYOUT_WALL_MM:g} mm: "
+            + " | ".join(problems) + "; change the actuation block (or links.count)"
+        )
+    return rows
+
+
+def _finite(value: float) -> float | None:
+    return float(value) if np.isfinite(value) else None
+
+
+def _rows_at(kinematics: KinematicsResult, layout: ChamberLayout, q: float, export: bool,
+             reference: np.ndarray | None) -> tuple[list[dict[str, Any]], np.ndarray]:
+    """The table's rows at one q (seed 003's lengths on each section's best arc) and the (n, 3) lengths."""
+    fits = fit_links(kinematics.chain, q, ARC_SAMPLES)
+    first = chamber_angles(layout.spec, layout.sections)
+    d = layout.spec.distance_mm
+    lengths = np.array([chamber_lengths_from_arc(f.kappa, f.phi, f.length, d, first[i, 0])
+                        for i, f in enumerate(fits)])
+    base = lengths if reference is None else reference
+    rows = [{"q": q, "export": int(export), "section": i + 1, "chamber": j + 1,
+             "angle_deg": float(np.rad2deg(first[i, j])), "distance_mm": d, "length_mm": float(lengths[i, j]),
+             "extension": float(lengths[i, j] / base[i, j]), "arc_kappa": f.kappa, "arc_phi": f.phi,
+             "arc_length_mm": f.length, "arc_misfit_mm": f.backbone_max_mm}
+            for i, f in enumerate(fits) for j in range(layout.spec.chambers_per_section)]
+    return rows, lengths
+
+
+def table_text(rows: list[dict[str, Any]]) -> str:
+    """actuation.csv: a header, then one row per (q, section, chamber); floats as repr (exact round trip)."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(COLUMNS)
+    writer.writerows([[repr(float(r[k])) if isinstance(r[k], float) else r[k] for k in COLUMNS] for r in rows])
+    return buffer.getvalue()
+
+
+def _extensions(kinematics: KinematicsResult, layout: ChamberLayout, grid: list[float]) -> list[dict[str, Any]]:
+    """Each chamber's axis length over the grid (on the body itself): its largest and smallest extension."""
+    shape = kinematics.chain.shape
+    lengths = np.array([chamber_lengths_mm(shape.curve_at(q), layout) for q in grid])
+    ratio = lengths / lengths[grid.index(0.0)]
+    out = []
+    for c in layout.chambers:
+        series = ratio[:, c.section, c.index]
+        hi, lo = int(np.argmax(series)), int(np.argmin(series))
+        out.append({"section": c.section + 1, "chamber": c.index + 1, "length_q0_mm": float(lengths[0, c.section,
+                    c.index]), "max": float(series[hi]), "q_max": grid[hi], "min": float(series[lo]),
+                    "q_min": grid[lo]})
+    return out
+
+
+def _skin(kinematics: KinematicsResult, fit: FitResult, layout: ChamberLayout, grid: list[float],
+          offset_mm: float) -> list[Wall]:
+    """The thinnest chamber-skin and feed-skin wall at every q of the grid."""
+    out: list[Wall] = []
+    for q in grid:
+        walls = skin_walls(kinematics.chain.shape.curve_at(q), fit.field, q, layout, offset_mm)
+        for kind in ("chamber-skin", "feed-skin"):
+            of_kind = [w for w in walls if w.kind == kind]
+            if of_kind:
+                out.append(min(of_kind, key=lambda w: w.thickness_mm))
+    return out
+
+
+def _meshed(case: Case, kinematics: KinematicsResult, fit: FitResult, layout: ChamberLayout) -> list[Wall]:
+    """At every export q (on the build's worker processes), the thinnest skin over chambers and feeds measured
+    on the meshes the export makes."""
+    from softdesign.pipeline.stages.export import body_spec  # export imports this stage's layout
+
+    e, spec = case.export, body_spec(case, fit)
+
+    def at(q: float) -> list[Wall]:
+        curve = kinematics.chain.shape.curve_at(q)
+        sections = body_sections(curve, fit.field, q, e.spacing_mm, e.angular_count)
+        walls = [Wall(kind, value, section + 1, chamber + 1, q, l, None)
+                 for kind, value, section, chamber, l in measured_skin_walls(sections, spec, curve, layout)]
+        return [min((w for w in walls if w.kind == kind), key=lambda w: w.thickness_mm)
+                for kind in dict.fromkeys(w.kind for w in walls)]
+
+    longest = max(key.length for key in kinematics.chain.shape.keys)
+    return [w for walls in map_items(at, e.q_values(), most=export_workers(case, longest)) for w in walls]
+
+
+def judge(walls: list[Wall], extensions: list[dict[str, Any]], limits: dict[str, Any] | None) -> list[str]:
+    """One reason per wall or extension beyond the material's limits (empty when none, or no material)."""
+    if limits is None:
+        return []
+    reasons, name = [], limits["name"]
+    if limits["min_wall_mm"] is not None:
+        reasons += [f"{w.kind} wall {w.thickness_mm:.3f} mm < min_wall_mm {limits['min_wall_mm']:g} ({name}) at "
+                    f"{w.place()}" for w in walls if w.thickness_mm < limits["min_wall_mm"]]
+    for e in extensions:
+        where = f"section {e['section']} chamber {e['chamber']}"
+        if limits["max_stretch"] is not None and e["max"] > limits["max_stretch"]:
+            reasons.append(f"{where}: extension {e['max']:.4f} at q={e['q_max']:.3f} > max_stretch "
+                           f"{limits['max_stretch']:g} ({name})")
+        if limits["min_stretch"] is not None and e["min"] < limits["min_stretch"]:
+            reasons.append(f"{where}: extension {e['min']:.4f} at q={e['q_min']:.3f} < min_stretch "
+                           f"{limits['min_stretch']:g} ({name})")
+    return reasons
+
+
+def layout_document(layout: ChamberLayout) -> dict[str, Any]:
+    """The layout as JSON: the spec, every chamber and feed (angles in degrees)."""
+    return {
+        "rule": "section i chamber j at first_angle + 120 j + i 120/n deg in the body's RMF (0 along N); feeds on "
+                "the chambers' ring at their chamber's angle, from the base face into the chamber",
+        "chambers": [{"section": c.section + 1, "chamber": c.index + 1, "angle_deg": float(np.rad2deg(c.angle)),
+                      "distance_mm": c.distance_mm, "diameter_mm": c.diameter_mm, "l_start": c.l_start,
+                      "l_end": c.l_end} for c in layout.chambers],
+        "feeds": [{"section": f.section + 1, "chamber": f.chamber + 1, "angle_deg": float(np.rad2deg(f.angle)),
+                   "ring_mm": f.ring_mm, "diameter_mm": f.diameter_mm, "l_start": f.l_start, "l_end": f.l_end}
+                  for f in layout.feeds],
+    }
+
+
+def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult) -> ActuationResult | None:
+    """Layout (or refusal), the lengths table, the walls and extensions and their verdict; None without actuation."""
+    layout = actuation_layout(case, kinematics)
+    if layout is None:
+        return None
+    sections = check_layout(layout, section_radii(fit, layout))
+    grid = q_grid(case)
+    rows, reference = _rows_at(kinematics, layout, 0.0, 0.0 in case.export.q_values(), None)
+    for q, export in grid:
+        if q != 0.0:
+            rows += _rows_at(kinematics, layout, q, export, reference)[0]
+    qs = [q for q, _ in grid]
+    walls = ring_walls(layout) + _skin(kinematics, fit, layout, qs, case.export.offset_mm)
+    walls += _meshed(case, kinematics, fit, layout)
+    extensions = _extensions(kinematics, layout, qs)
+    limits = case.material.limits().as_dict() if case.material is not None else None
+    reasons = judge(walls, extensions, limits)
+    thinnest = {kind: min((w for w in walls if w.kind == kind), key=lambda w: w.thickness_mm).as_dict()
+                for kind in dict.fromkeys(w.kind for w in walls)}
+    summary = {
+        "spec": case.actuation.model_dump() if case.actuation is not None else None,
+        "layout": layout_document(layout),
+        "sections": sections,
+        "thinnest": thinnest,
+        "walls": [w.as_dict() for w in walls],
+        "extensions": extensions,
+        "arc_misfit_max_mm": [max(r["arc_misfit_mm"] for r in rows if r["section"] == i + 1)
+                              for i in range(layout.sections)],
+        "rows": rows,
+        "table": TABLE,
+        "material": limits,
+        "feasible": None if limits is None else not reasons,
+        "reasons": reasons if limits is not None else ["no material: in the case file: figures only, not judged"],
+        "method": "lengths: seed 003 on each section's best arc at q (backbone started on the section's base "
+                  "frame); extension: the chamber's axis on the body at q over q = 0; walls in the sections' "
+                  "normal planes (chamber-skin, feed-skin at every q; between tubes constant over q), and at every "
+                  "export q the skin over each tube measured on the mesh (end caps included)",
+    }
+    return ActuationResult(summary, table_text(rows))
+
+
+def write_actuation(result: ActuationResult | None, staging: Staging) -> None:
+    """``actuation.csv`` and ``actuation/summary.json`` (nothing without actuation)."""
+    if result is None:
+        return
+    staging.write_bytes(TABLE, result.table.encode("utf-8"))
+    staging.write_json(SUMMARY, result.summary)
+
+
+def load_actuation(build_dir: Path) -> ActuationResult | None:
+    """The kept figures and table, or None when the build has no actuation."""
+    summary_path = Path(build_dir) / SUMMARY
+    if not summary_path.is_file():
+        return None
+    table = (Path(build_dir) / TABLE).read_text(encoding="utf-8")
+    return ActuationResult(json.loads(summary_path.read_text(encoding="utf-8")), table)
+
+
+def describe_actuation(result: ActuationResult | None) -> list[str]:
+    """The thinnest walls, the extension range and the verdict."""
+    if result is None:
+        return []
+    s = result.summary
+    lines = [f"{TABLE}: {len(s['rows'])} rows ({len({r['q'] for r in s['rows']})} q values), arc misfit max "
+             + ", ".join(f"{m:.3f}" for m in s["arc_misfit_max_mm"]) + " mm per section"]
+    lines += [f"thinnest {kind}: {w['thickness_mm']:.3f} mm at {Wall(**w).place()}"
+              for kind, w in s["thinnest"].items()]
+    ext = s["extensions"]
+    hi, lo = max(ext, key=lambda e: e["max"]), min(ext, key=lambda e: e["min"])
+    lines.append(f"chamber extension {lo['min']:.4f} (section {lo['section']} chamber {lo['chamber']}, "
+                 f"q={lo['q_min']:.3f}) to {hi['max']:.4f} (section {hi['section']} chamber {hi['chamber']}, "
+                 f"q={hi['q_max']:.3f})")
+    if s["material"] is not None:
+        lines.append(f"actuation for {s['material']['name']}: {'feasible' if s['feasible'] else 'NOT feasible'}")
+        lines += [f"WARN {reason}" for reason in s["reasons"]]
+    return lines
+
+
+STAGE = Stage(
+    name="actuation",
+    version=VERSION,
+    reads=("actuation", "export.q", "export.frames", "export.offset_mm", "export.spacing_mm", "export.angular_count",
+           "material"),
+    upstream=("kinematics", "fit"),
+    compute=lambda case, results: run_actuation(case, results["kinematics"], results["fit"]),
+    write=write_actuation,
+    load=lambda build_dir, results: load_actuation(build_dir),
+    describe=describe_actuation,
+    metrics=lambda result: {} if result is None else result.summary,
+    figures=lambda result: {} if result is None else {TABLE: {"rows": len(result.summary["rows"])}},
+)

@@ -1,0 +1,48 @@
+"""The case file's actuation block: defaults, bounds and cross-checks refused by `softdesign validate` (exit 2)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from softdesign.cli import app
+from softdesign.config import load_case
+from tests.cli.test_cli_validate import demo_case
+
+runner = CliRunner()
+
+
+def test_defaults_are_documented_values(tmp_path: Path) -> None:
+    case = load_case(demo_case(tmp_path, actuation={}))
+    a = case.actuation
+    assert a is not None
+    assert (a.chambers_per_section, a.distance_mm, a.diameter_mm, a.feed_diameter_mm, a.end_wall_mm,
+            a.first_angle_deg) == (3, 2.0, 0.8, 0.4, 1.0, 90.0)
+    assert load_case(demo_case(tmp_path, name="plain")).actuation is None
+
+
+@pytest.mark.parametrize(("actuation", "message"), [
+    ({"distance_mm": 0}, "distance_mm"),
+    ({"diameter_mm": -1}, "diameter_mm"),
+    ({"end_wall_mm": 51}, "end_wall_mm"),
+    ({"first_angle_deg": 400}, "first_angle_deg"),
+    ({"chambers_per_section": 4}, "chambers_per_section"),
+    ({"distance_mm": ".nan"}, "distance_mm"),
+    ({"chamber_count": 3}, "chamber_count"),
+    ({"feed_diameter_mm": 1.0}, "use feed_diameter_mm <= 0.8"),
+    ({"distance_mm": 0.5, "diameter_mm": 0.9, "feed_diameter_mm": 0.3}, "overlap (centres 0.866 mm apart"),
+    ({"distance_mm": 0.3, "diameter_mm": 0.7, "feed_diameter_mm": 0.3}, "reaches across the backbone"),
+])
+def test_bad_actuation_is_refused_naming_the_key(tmp_path: Path, actuation: dict, message: str) -> None:
+    result = runner.invoke(app, ["validate", str(demo_case(tmp_path, actuation=actuation))])
+    assert result.exit_code == 2, result.output
+    assert "actuation" in result.stderr and message in result.stderr
+    assert "Traceback" not in result.output
+
+
+def test_actuation_and_a_hollow_wall_are_refused_together(tmp_path: Path) -> None:
+    case = demo_case(tmp_path, actuation={}, export={"wall_mm": 0.5})
+    result = runner.invoke(app, ["validate", str(case)])
+    assert result.exit_code == 2 and "drop export.wall_mm" in result.stderr
