@@ -27,6 +27,7 @@ from softdesign.cli.pcc import PCC_SHORT_HELP, pcc_app
 from softdesign.cli.pose import pose
 from softdesign.cli.report import report
 from softdesign.cli.sample import sample
+from softdesign.cli.simulate import simulate
 from softdesign.pipeline.parallel import one_blas_thread
 
 #: Help is click's plain text, not typer's rich panels: rich markup ate every ``[default: ...]`` in the option
@@ -41,7 +42,7 @@ app = typer.Typer(
 app.add_typer(pcc_app, name="pcc", short_help=PCC_SHORT_HELP)
 for command in (
     validate, build, ingest, blend, links, kinematics, fit, export, mould, pose, check, report, sample, centerline,
-    design, materials,
+    design, materials, simulate,
 ):
     app.command()(command)
 for group in (app, pcc_app):
@@ -67,5 +68,5 @@ def main() -> None:
 
 __all__ = [
     "app", "main", "validate", "build", "ingest", "blend", "links", "kinematics", "fit", "export", "mould",
-    "pose", "check", "report", "sample", "centerline", "design", "materials",
+    "pose", "check", "report", "sample", "centerline", "design", "materials", "simulate",
 ]
