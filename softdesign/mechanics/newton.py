@@ -123,6 +123,22 @@ def factor_tangent(tangent: Tangent, free: np.ndarray) -> Callable[[FloatArray],
     return solve
 
 
+#: Halvings of a Newton update that turns an element inside out before the update is taken as it is.
+UPDATE_HALVINGS = 4
+
+
+def _admissible(problem: PressureProblem, u: FloatArray, du: FloatArray) -> FloatArray:
+    """``u + s du`` with the largest ``s`` of 1, 1/2, ... 1/16 that inverts no element (else the full update)."""
+    for k in range(UPDATE_HALVINGS + 1):
+        trial = u + du / 2**k
+        try:
+            volumetric_state(problem.mesh, problem.law, trial)
+        except InvertedElementError:
+            continue
+        return trial
+    return u + du
+
+
 def _newton_step(problem: PressureProblem, u: FloatArray, face_pressure: FloatArray,
                  settings: NewtonSettings) -> tuple[FloatArray, list[float]] | tuple[None, list[float]]:
     """Equilibrium at ``face_pressure`` from ``u``: the new displacement and residual history, or None if it failed."""
@@ -143,8 +159,21 @@ def _newton_step(problem: PressureProblem, u: FloatArray, face_pressure: FloatAr
         du = factor_tangent(K, free)(-R)
         if not np.all(np.isfinite(du)):
             return None, history
-        u = u + du.reshape(-1, 3)
+        u = _admissible(problem, u, du.reshape(-1, 3))
     return None, history
+
+
+def _predicted(problem: PressureProblem, u: FloatArray, t: float, target: float,
+               previous: tuple[float, FloatArray] | None) -> FloatArray:
+    """The start of a load step: the last two equilibria extrapolated to ``target`` (secant), if no element inverts."""
+    if previous is None or t <= previous[0]:
+        return u
+    guess = u + (target - t) / (t - previous[0]) * (u - previous[1])
+    try:
+        volumetric_state(problem.mesh, problem.law, guess)
+    except InvertedElementError:
+        return u
+    return guess
 
 
 def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: NewtonSettings,
@@ -163,10 +192,11 @@ def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: N
     u, p0 = (np.zeros_like(problem.mesh.points), np.zeros_like(pressures)) if start is None else start
     record = SolveRecord()
     t, dt, step = 0.0, 1.0 / settings.load_steps, 0
+    previous: tuple[float, FloatArray] | None = None
     while t < 1.0 - 1e-12:
         target = min(1.0, t + dt)
         face_pressure = ((1.0 - target) * p0 + target * pressures)[problem.face_cavity]
-        new_u, history = _newton_step(problem, u, face_pressure, settings)
+        new_u, history = _newton_step(problem, _predicted(problem, u, t, target, previous), face_pressure, settings)
         if new_u is None:
             if record.cutbacks >= settings.max_cutbacks:
                 last = f"{history[-1]:.3g} mN" if history else "none (an element turned inside out)"
@@ -177,6 +207,7 @@ def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: N
             record.cutbacks += 1
             dt /= 2.0
             continue
+        previous = (t, u)
         u, t, step = new_u, target, step + 1
         record.load_factors.append(t)
         record.iterations.append(len(history))
