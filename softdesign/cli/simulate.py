@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Annotated, Any
 
 import typer
@@ -18,6 +19,8 @@ TargetOpt = Annotated[float | None, typer.Option(
 SizeOpt = Annotated[float, typer.Option("--size-mm", help="Element size in the cross-section, mm.")]
 LayerOpt = Annotated[float, typer.Option("--layer-mm", help="Layer spacing along the section, mm.")]
 TimeoutOpt = Annotated[float, typer.Option("--timeout", help="Longest time the solve may take, s.")]
+FigureOpt = Annotated[Path | None, typer.Option(
+    "--figure", help="Also draw the deformed centerline, its arcs and the convergence to this .png file.")]
 MaxPressureOpt = Annotated[float, typer.Option("--max-pressure", help="Upper bound of the inverse search, kPa.")]
 
 PRESSURES_FIX = "give three numbers in kPa separated by commas, e.g. --pressures 40,0,0"
@@ -29,6 +32,16 @@ def pressures_from_text(text: str) -> tuple[float, ...]:
     if len(parts) != 3:
         raise ConfigError(f"--pressures: got {len(parts)} values in {text!r}, expected 3; {PRESSURES_FIX}")
     return tuple(finite_number(p, f"--pressures value {k + 1}", PRESSURES_FIX) for k, p in enumerate(parts))
+
+
+def _check_figure_path(figure: Path | None) -> None:
+    """Refuse a ``--figure`` that is not a .png in an existing folder, before any work."""
+    if figure is None:
+        return
+    if figure.suffix.lower() != ".png":
+        raise ConfigError(f"--figure {figure}: expected a .png file, got the suffix {figure.suffix!r}")
+    if not figure.parent.resolve().is_dir():
+        raise ConfigError(f"--figure {figure}: the folder {figure.parent} does not exist; create it first")
 
 
 def _print(payload: dict[str, Any]) -> None:
@@ -63,6 +76,7 @@ def simulate(
     layer_mm: LayerOpt = 4.0,
     max_pressure: MaxPressureOpt = 300.0,
     timeout: TimeoutOpt = 600.0,
+    figure: FigureOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Solve one section under chamber pressures (hyperelastic finite elements), or find the pressures for a q.
@@ -75,10 +89,16 @@ def simulate(
     def action() -> None:
         from softdesign.pipeline.simulate_run import SimulateOptions, run_simulate
 
+        _check_figure_path(figure)
         values = None if pressures is None else pressures_from_text(pressures)
         options = SimulateOptions(section, values, target, size_mm, layer_mm, max_pressure_kpa=max_pressure,
                                   timeout_s=timeout)
         result = run_simulate(case_file, out, options, note)
+        if figure is not None:
+            from softdesign.io.atomic import write_bytes_atomically
+            from softdesign.report.simulate_figures import simulate_figure_png
+
+            write_bytes_atomically(figure, simulate_figure_png(result))
         emit_json(result) if as_json else _print(result)
 
     run_guarded(action)
