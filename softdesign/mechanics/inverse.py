@@ -17,7 +17,9 @@ Method
     step size ``max_step_kpa``.  Each evaluation solves the section, continuing
     from the last equilibrium; its Jacobian ``de/dp`` is the equilibrium's exact
     sensitivity ``du/dp`` (:func:`~softdesign.mechanics.newton.pressure_sensitivity`)
-    carried through the arc fit by central differences along it.  At most
+    carried through the arc fit by central differences along it.  A trial whose
+    solve does not converge (beyond what the chambers hold) counts as a very
+    large error, so the trust region shrinks back (the start's must converge).  At most
     ``max_iterations`` evaluations; the result keeps the remaining error, says
     whether it is below ``tolerance_mm``, and gives the Jacobian's singular
     values: an unreinforced chamber balloons rather than lengthens, so the
@@ -30,11 +32,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from softdesign.errors import SolveError
 from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.newton import NewtonSettings, pressure_sensitivity, solve_pressures
 from softdesign.mechanics.section import SectionMesh, SectionResult, arc_of, measure_section, prepare_section
 from softdesign.types import FloatArray
 
+#: The error (mm, each component) given to the search for a trial whose solve did not converge.
+FAILED_TRIAL_MM = 1e6
 #: Central-difference step of the arc fit along the sensitivity, as a share of the section's length, 1.
 ARC_STEP_SHARE = 1e-4
 
@@ -100,6 +105,7 @@ class _Evaluations:
         self.states: dict[bytes, tuple[FloatArray, SectionResult]] = {}
         self.last: tuple[FloatArray, FloatArray] | None = None
         self.solves = 0
+        self.failed: list[str] = []
 
     def state(self, p: FloatArray) -> tuple[FloatArray, SectionResult]:
         key = np.asarray(p, float).tobytes()
@@ -115,7 +121,14 @@ class _Evaluations:
         return weighted_error(arc_vector(result.kappa, result.phi, result.length), self.target)
 
     def error_or_stop(self, p: FloatArray) -> FloatArray:
-        error = self.error(p)
+        try:
+            error = self.error(p)
+        except SolveError as err:
+            if self.last is None:
+                raise
+            # a trial beyond what the solve reaches: a large error makes the trust region shrink
+            self.failed.append(str(err))
+            return np.full(len(self.target), FAILED_TRIAL_MM)
         if np.linalg.norm(error) <= self.tolerance_mm:
             raise _Reached(np.array(p, float))
         return error
@@ -154,6 +167,7 @@ def find_pressures(section: SectionMesh, law: HyperelasticLaw, target: tuple[flo
     error = runs.error(p)
     converged = bool(np.linalg.norm(error) <= settings.tolerance_mm)
     conditioning = np.linalg.svd(runs.jacobian(p), compute_uv=False)
-    why = (f"{message} ({runs.solves} forward solves; the weighted Jacobian's singular values "
+    failed = f"; {len(runs.failed)} trial solves did not converge (a step back each)" if runs.failed else ""
+    why = (f"{message} ({runs.solves} forward solves{failed}; the weighted Jacobian's singular values "
            f"{', '.join(f'{v:.3g}' for v in conditioning)} mm/kPa)")
     return InverseResult(p, result, error, runs.solves, converged, why)

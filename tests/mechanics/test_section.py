@@ -87,3 +87,16 @@ def test_a_section_without_a_chamber_wall_is_refused() -> None:
                       section.chamber_angles)
     with pytest.raises(MeshError, match="chambers without any: \\[2\\]"):
         check_section(bad)
+
+
+def test_an_unreachable_arc_is_reported_not_converged() -> None:
+    # a 1 rad bend: far beyond what these unreinforced chambers give before they balloon (at 30 kPa, 0.046 rad);
+    # the trials the solve cannot reach count as huge errors and the search steps back from them
+    settings = InverseSettings(max_pressure_kpa=400.0, start_kpa=10.0, max_step_kpa=100.0, tolerance_mm=1e-3,
+                               max_iterations=8)
+    found = find_pressures(_section(), LAW, (0.05, -np.pi / 2, 20.0), settings,
+                           NewtonSettings(load_steps=1, max_iterations=8, max_cutbacks=1))
+    assert not found.converged
+    assert np.linalg.norm(found.error_mm) > 1.0
+    assert "did not converge" in found.stopped_because
+    assert found.section.record.load_factors[-1] == 1.0  # the pressures returned are a converged equilibrium
