@@ -203,7 +203,8 @@ def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: N
                 raise SolveError(
                     f"the solve did not converge at load step {step + 1} (load factor {target:.4g} towards the "
                     f"pressures {', '.join(f'{p:g}' for p in pressures)} kPa) after {record.cutbacks} step halvings; "
-                    f"last residual {last}; lower the pressures or raise simulate.load_steps")
+                    f"last residual {last}; lower the pressures (a chamber that balloons past its largest "
+                    "pressure has no equilibrium beyond it) or take more load steps")
             record.cutbacks += 1
             dt /= 2.0
             continue
