@@ -30,6 +30,7 @@ from softdesign.cli.pose import pose
 from softdesign.cli.report import report
 from softdesign.cli.sample import sample
 from softdesign.cli.schema import schema
+from softdesign.cli.simulate import simulate
 from softdesign.pipeline.parallel import one_blas_thread
 
 #: Help is click's plain text, not typer's rich panels: rich markup ate every ``[default: ...]`` in the option
@@ -64,7 +65,7 @@ def _options(
 app.add_typer(pcc_app, name="pcc", short_help=PCC_SHORT_HELP)
 for command in (
     validate, build, ingest, blend, links, kinematics, fit, export, mould, pose, check, report, sample, centerline,
-    design, init, schema, materials,
+    design, init, schema, materials, simulate,
 ):
     app.command()(command)
 for group in (app, pcc_app):
@@ -90,5 +91,5 @@ def main() -> None:
 
 __all__ = [
     "app", "main", "validate", "build", "ingest", "blend", "links", "kinematics", "fit", "export", "mould",
-    "pose", "check", "report", "sample", "centerline", "design", "init", "schema", "materials",
+    "pose", "check", "report", "sample", "centerline", "design", "init", "schema", "materials", "simulate",
 ]

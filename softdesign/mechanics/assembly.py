@@ -125,8 +125,33 @@ def element_stiffness(mesh: TetMesh, law: HyperelasticLaw, state: VolumetricStat
     return (iso_f + vol_f).reshape(E, 12), (K_iso + K_geo).reshape(E, 12, 12)
 
 
-def force_and_tangent(mesh: TetMesh, law: HyperelasticLaw, state: VolumetricState) -> tuple[FloatArray, sp.csr_matrix]:
-    """Internal forces (3V,) mN and the tangent (3V, 3V) mN/mm of a state (the exact Hessian of Psi)."""
+@dataclass(frozen=True)
+class Tangent:
+    """The Newton matrix of the internal forces, kept in two parts so it stays as sparse as one element's patch.
+
+    The exact tangent is ``K + G^T diag(U''(J_a) / V_a) G``; its last term couples
+    each node with its neighbours' neighbours and makes a sparse LU fill in five
+    times more.  :func:`softdesign.mechanics.newton` solves instead the
+    equivalent augmented system with one volume unknown per node (see there).
+
+    Attributes
+    ----------
+    K : (3V, 3V) the isochoric and geometric part, mN/mm
+    G : (V, 3V) the gradient of the nodal deformed volumes, mm^2
+    compliance : (V,) ``V_a / U''(J_a)``, mm^3/kPa
+    """
+
+    K: sp.csr_matrix
+    G: sp.csr_matrix
+    compliance: FloatArray
+
+    def condensed(self) -> sp.csr_matrix:
+        """The exact tangent ``K + G^T diag(1 / compliance) G`` (3V, 3V)."""
+        return (self.K + self.G.T @ sp.diags(1.0 / self.compliance) @ self.G).tocsr()
+
+
+def force_and_tangent(mesh: TetMesh, law: HyperelasticLaw, state: VolumetricState) -> tuple[FloatArray, Tangent]:
+    """Internal forces (3V,) mN and the tangent (the exact Hessian of Psi, in two parts) of a state."""
     forces, blocks = element_stiffness(mesh, law, state)
     dofs = element_dofs(mesh.tets)
     n = mesh.dof_count
@@ -134,6 +159,4 @@ def force_and_tangent(mesh: TetMesh, law: HyperelasticLaw, state: VolumetricStat
     rows = np.broadcast_to(dofs[:, :, None], blocks.shape).ravel()
     cols = np.broadcast_to(dofs[:, None, :], blocks.shape).ravel()
     K = sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(n, n))
-    G = volume_gradient(mesh, state)
-    K_vol = G.T @ sp.diags(law.bulk_kpa / mesh.node_volumes) @ G
-    return f, (K + K_vol).tocsr()
+    return f, Tangent(K, volume_gradient(mesh, state), mesh.node_volumes / law.bulk_kpa)

@@ -3,7 +3,17 @@
 At a load factor ``t`` the residual is ``R(u) = f_int(u) - t f_p(u)`` with the
 follower pressure forces ``f_p`` of :mod:`softdesign.mechanics.pressure`, and
 the Newton matrix is its consistent derivative ``K(u) - t dF_p/dx`` restricted
-to the free unknowns (a sparse LU, SuperLU).  A step converges when the free
+to the free unknowns.  The volumetric part of that matrix couples each node
+with its neighbours' neighbours; the step is solved instead from the
+equivalent augmented system with one volume unknown ``q`` per node
+(:class:`~softdesign.mechanics.assembly.Tangent`)::
+
+    [K - t dF_p/dx   G^T        ] [du]   [-R]
+    [G              -diag(c)    ] [dq] = [ 0],   c_a = V_a / U''(J_a),
+
+whose elimination of ``dq = diag(1/c) G du`` gives back the exact tangent,
+and whose sparse LU (SuperLU, COLAMD order) fills in about half as much: on
+7k unknowns 8 M entries and 2.5 s against 17 M and 20 s.  A step converges when the free
 residual is below ``rtol`` times the free pressure load of that step (plus
 ``atol``).  A step that does not converge in ``max_iterations``, or whose trial
 turns an element inside out, is halved, at most ``max_cutbacks`` times over the
@@ -13,6 +23,7 @@ naming the step, the load factor and the residual: never a silent answer.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -22,6 +33,7 @@ import scipy.sparse.linalg as spla
 from softdesign.errors import SolveError
 from softdesign.mechanics.assembly import (
     InvertedElementError,
+    Tangent,
     force_and_tangent,
     internal_force,
     volumetric_state,
@@ -83,15 +95,48 @@ class SolveRecord:
 
 
 def _residual(problem: PressureProblem, u: FloatArray, face_pressure: FloatArray, tangent: bool
-              ) -> tuple[FloatArray, FloatArray, sp.csr_matrix | None]:
+              ) -> tuple[FloatArray, FloatArray, Tangent | None]:
     """Residual (3V,), the pressure load (3V,) and, if asked, the Newton matrix at displacement ``u`` (V, 3)."""
     state = volumetric_state(problem.mesh, problem.law, u)
     positions = problem.mesh.points + u
     f_p, dfp = pressure_load(positions, problem.faces, face_pressure, tangent)
-    if not tangent:
+    if not tangent or dfp is None:
         return internal_force(problem.mesh, problem.law, state) - f_p, f_p, None
     f_int, K = force_and_tangent(problem.mesh, problem.law, state)
-    return f_int - f_p, f_p, (K - dfp).tocsc() if dfp is not None else None
+    return f_int - f_p, f_p, Tangent(K.K - dfp, K.G, K.compliance)
+
+
+def factor_tangent(tangent: Tangent, free: np.ndarray) -> Callable[[FloatArray], FloatArray]:
+    """The solver ``r (3V,) -> du (3V,)`` of the Newton matrix on the free unknowns (fixed ones get 0)."""
+    G = sp.csr_matrix(tangent.G[:, free])
+    volume_block = sp.csr_matrix(sp.diags(-tangent.compliance))
+    blocks = [[sp.csr_matrix(tangent.K[free][:, free]), sp.csr_matrix(G.T)], [G, volume_block]]
+    augmented = sp.csc_matrix(sp.bmat(blocks))
+    lu = spla.splu(augmented, permc_spec="COLAMD", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+    n_free = int(free.sum())
+
+    def solve(r: FloatArray) -> FloatArray:
+        du = np.zeros(len(free))
+        du[free] = lu.solve(np.concatenate([r[free], np.zeros(len(tangent.compliance))]))[:n_free]
+        return du
+
+    return solve
+
+
+#: Halvings of a Newton update that turns an element inside out before the update is taken as it is.
+UPDATE_HALVINGS = 4
+
+
+def _admissible(problem: PressureProblem, u: FloatArray, du: FloatArray) -> FloatArray:
+    """``u + s du`` with the largest ``s`` of 1, 1/2, ... 1/16 that inverts no element (else the full update)."""
+    for k in range(UPDATE_HALVINGS + 1):
+        trial = u + du / 2**k
+        try:
+            volumetric_state(problem.mesh, problem.law, trial)
+        except InvertedElementError:
+            continue
+        return trial
+    return u + du
 
 
 def _newton_step(problem: PressureProblem, u: FloatArray, face_pressure: FloatArray,
@@ -111,42 +156,80 @@ def _newton_step(problem: PressureProblem, u: FloatArray, face_pressure: FloatAr
             return u, history
         if K is None:
             return None, history
-        du = np.zeros(problem.mesh.dof_count)
-        du[free] = spla.splu(K[free][:, free].tocsc()).solve(-R[free])
+        du = factor_tangent(K, free)(-R)
         if not np.all(np.isfinite(du)):
             return None, history
-        u = u + du.reshape(-1, 3)
+        u = _admissible(problem, u, du.reshape(-1, 3))
     return None, history
 
 
-def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: NewtonSettings
-                    ) -> tuple[FloatArray, SolveRecord]:
-    """Displacement (V, 3) mm at cavity ``pressures`` (k,) kPa, reached in load steps from 0, and the record.
+def _predicted(problem: PressureProblem, u: FloatArray, t: float, target: float,
+               previous: tuple[float, FloatArray] | None) -> FloatArray:
+    """The start of a load step: the last two equilibria extrapolated to ``target`` (secant), if no element inverts."""
+    if previous is None or t <= previous[0]:
+        return u
+    guess = u + (target - t) / (t - previous[0]) * (u - previous[1])
+    try:
+        volumetric_state(problem.mesh, problem.law, guess)
+    except InvertedElementError:
+        return u
+    return guess
+
+
+def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: NewtonSettings,
+                    start: tuple[FloatArray, FloatArray] | None = None) -> tuple[FloatArray, SolveRecord]:
+    """Displacement (V, 3) mm at cavity ``pressures`` (k,) kPa, reached in load steps, and the record.
+
+    The load path runs from zero, or from ``start`` = (displacement (V, 3) mm, pressures (k,) kPa), an
+    equilibrium converged before (a hyperelastic solid's equilibrium does not depend on the path to it).
 
     Raises
     ------
     SolveError
         A step did not converge after every allowed halving (its index, load factor and last residual).
     """
-    face_pressure = np.asarray(pressures, float)[problem.face_cavity]
-    u = np.zeros_like(problem.mesh.points)
+    pressures = np.asarray(pressures, float)
+    u, p0 = (np.zeros_like(problem.mesh.points), np.zeros_like(pressures)) if start is None else start
     record = SolveRecord()
     t, dt, step = 0.0, 1.0 / settings.load_steps, 0
+    previous: tuple[float, FloatArray] | None = None
     while t < 1.0 - 1e-12:
         target = min(1.0, t + dt)
-        new_u, history = _newton_step(problem, u, target * face_pressure, settings)
+        face_pressure = ((1.0 - target) * p0 + target * pressures)[problem.face_cavity]
+        new_u, history = _newton_step(problem, _predicted(problem, u, t, target, previous), face_pressure, settings)
         if new_u is None:
             if record.cutbacks >= settings.max_cutbacks:
                 last = f"{history[-1]:.3g} mN" if history else "none (an element turned inside out)"
                 raise SolveError(
-                    f"the solve did not converge at load step {step + 1} (load factor {target:.4g} of the pressures "
-                    f"{', '.join(f'{p:g}' for p in pressures)} kPa) after {record.cutbacks} step halvings; last "
-                    f"residual {last}; lower the pressures or raise simulate.load_steps")
+                    f"the solve did not converge at load step {step + 1} (load factor {target:.4g} towards the "
+                    f"pressures {', '.join(f'{p:g}' for p in pressures)} kPa) after {record.cutbacks} step halvings; "
+                    f"last residual {last}; lower the pressures (a chamber that balloons past its largest "
+                    "pressure has no equilibrium beyond it) or take more load steps")
             record.cutbacks += 1
             dt /= 2.0
             continue
+        previous = (t, u)
         u, t, step = new_u, target, step + 1
         record.load_factors.append(t)
         record.iterations.append(len(history))
         record.residuals.append(history)
     return u, record
+
+
+def pressure_sensitivity(problem: PressureProblem, u: FloatArray, pressures: FloatArray) -> FloatArray:
+    """``du/dp_c`` (k, V, 3) mm/kPa at the equilibrium ``u`` (V, 3) of ``pressures`` (k,) kPa.
+
+    Differentiating ``f_int(u) = f_p(u, p)`` gives ``(K - dF_p/dx) du/dp_c = f_c``, the
+    forces of a unit pressure in cavity c alone on the deformed walls: one more factorization.
+    """
+    pressures = np.asarray(pressures, float)
+    _, _, tangent = _residual(problem, u, pressures[problem.face_cavity], tangent=True)
+    if tangent is None:
+        raise SolveError("no tangent at the equilibrium for the pressure sensitivity")
+    solve = factor_tangent(tangent, ~problem.fixed)
+    positions = problem.mesh.points + u
+    out = []
+    for c in range(len(pressures)):
+        unit, _ = pressure_load(positions, problem.faces, (problem.face_cavity == c).astype(float), False)
+        out.append(solve(unit).reshape(-1, 3))
+    return np.stack(out)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from softdesign.errors import SolveError
 from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.newton import NewtonSettings, PressureProblem, solve_pressures
 from softdesign.mechanics.tets import boundary_faces, make_tet_mesh
@@ -21,8 +22,7 @@ DEFAULT_COUNTS = (8, 16, 1)
 INFLATION_RTOL = 0.02
 
 
-def _inflate(counts: tuple[int, int, int], pressure: float) -> float:
-    """The mean deformed inner radius, mm, of the quarter tube at ``pressure`` kPa."""
+def _problem(counts: tuple[int, int, int]) -> tuple[np.ndarray, PressureProblem]:
     points, tets = quarter_tube(INNER, OUTER, HEIGHT, counts)
     mesh = make_tet_mesh(points, tets)
     faces = boundary_faces(mesh.tets)
@@ -32,7 +32,12 @@ def _inflate(counts: tuple[int, int, int], pressure: float) -> float:
     fixed[:, 2] = True  # plane strain
     fixed[np.isclose(points[:, 0], 0.0), 0] = True  # symmetry planes
     fixed[np.isclose(points[:, 1], 0.0), 1] = True
-    problem = PressureProblem(mesh, LAW, fixed.ravel(), wall, np.zeros(len(wall), np.int64))
+    return points, PressureProblem(mesh, LAW, fixed.ravel(), wall, np.zeros(len(wall), np.int64))
+
+
+def _inflate(counts: tuple[int, int, int], pressure: float) -> float:
+    """The mean deformed inner radius, mm, of the quarter tube at ``pressure`` kPa."""
+    points, problem = _problem(counts)
     u, record = solve_pressures(problem, np.array([pressure]), NewtonSettings(load_steps=4))
     assert all(h[-1] < 1e-6 for h in record.residuals)
     nodes = np.isclose(np.hypot(points[:, 0], points[:, 1]), INNER)
@@ -59,3 +64,9 @@ def test_tube_small_pressure_is_lame() -> None:
     expected = lame_displacement(MU, LAW.bulk_kpa, INNER, OUTER, pressure, INNER)
     # the mesh's error at this size is ~1 % (the polygonal inner wall); the analytic and linear answers agree to 1e-3
     assert abs((a - INNER) / expected - 1) < INFLATION_RTOL
+
+
+def test_a_solve_that_does_not_converge_says_where() -> None:
+    _, problem = _problem((2, 4, 1))
+    with pytest.raises(SolveError, match=r"load step 1 \(load factor 1 .* after 0 step halvings; last residual \d"):
+        solve_pressures(problem, np.array([20.0]), NewtonSettings(load_steps=1, max_iterations=2, max_cutbacks=0))

@@ -1,0 +1,104 @@
+"""`softdesign simulate`: what pressures do to one section (finite elements), or which pressures reach a q."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from softdesign.cli.common import CaseArg, JsonOpt, OutOpt, emit_json, finite_number, note, run_guarded
+from softdesign.errors import ConfigError
+
+SectionOpt = Annotated[int, typer.Option("--section", help="The section (link) to solve, 0 at the base.")]
+PressuresOpt = Annotated[str | None, typer.Option(
+    "--pressures", help="Chamber pressures P1,P2,P3 in kPa (chambers 0, 1, 2 of the section).")]
+TargetOpt = Annotated[float | None, typer.Option(
+    "--target", help="Find the pressures whose section best matches the designed arc at this q.")]
+SizeOpt = Annotated[float, typer.Option("--size-mm", help="Element size in the cross-section, mm.")]
+LayerOpt = Annotated[float, typer.Option("--layer-mm", help="Layer spacing along the section, mm.")]
+TimeoutOpt = Annotated[float, typer.Option("--timeout", help="Longest time the solve may take, s.")]
+FigureOpt = Annotated[Path | None, typer.Option(
+    "--figure", help="Also draw the deformed centerline, its arcs and the convergence to this .png file.")]
+MaxPressureOpt = Annotated[float, typer.Option("--max-pressure", help="Upper bound of the inverse search, kPa.")]
+
+PRESSURES_FIX = "give three numbers in kPa separated by commas, e.g. --pressures 40,0,0"
+
+
+def pressures_from_text(text: str) -> tuple[float, ...]:
+    """``--pressures`` as three finite numbers (ConfigError naming the bad one)."""
+    parts = text.split(",")
+    if len(parts) != 3:
+        raise ConfigError(f"--pressures: got {len(parts)} values in {text!r}, expected 3; {PRESSURES_FIX}")
+    return tuple(finite_number(p, f"--pressures value {k + 1}", PRESSURES_FIX) for k, p in enumerate(parts))
+
+
+def _check_figure_path(figure: Path | None) -> None:
+    """Refuse a ``--figure`` that is not a .png in an existing folder, before any work."""
+    if figure is None:
+        return
+    if figure.suffix.lower() != ".png":
+        raise ConfigError(f"--figure {figure}: expected a .png file, got the suffix {figure.suffix!r}")
+    if not figure.parent.resolve().is_dir():
+        raise ConfigError(f"--figure {figure}: the folder {figure.parent} does not exist; create it first")
+
+
+def _print(payload: dict[str, Any]) -> None:
+    arc = payload["arc"]
+    typer.echo(f"section {payload['section']}: {payload['mesh']['nodes']} nodes, {payload['mesh']['tets']} tets, "
+               f"{payload['material']['name']} ({payload['material']['law']}), {payload['seconds']:.1f} s")
+    typer.echo("pressures kPa: " + ", ".join(f"{p:.3f}" for p in payload["pressures_kpa"]))
+    typer.echo(f"best arc: kappa {arc['kappa_per_mm']:.6g} 1/mm, phi {math.degrees(arc['phi_rad']):.2f} deg, "
+               f"L {arc['length_mm']:.4f} mm (misfit max {arc['misfit_max_mm']:.4f} mm)")
+    typer.echo("chamber lengths mm: " + ", ".join(f"{v:.4f}" for v in payload["chamber_lengths_mm"]))
+    strength = payload["tensile_strength_kpa"]
+    versus = f" (tensile strength {strength:.0f} kPa)" if strength else ""
+    typer.echo(f"largest stretch {payload['max_stretch']:.4f}, largest principal stress "
+               f"{payload['max_stress_kpa']:.2f} kPa{versus}")
+    for k, step in enumerate(payload["convergence"], start=1):
+        typer.echo(f"  step {k}: load {step['load_factor']:.3f}, {step['iterations']} iterations, residual "
+                   f"{step['residuals_mN'][-1]:.2e} mN")
+    if "target" in payload:
+        t = payload["target"]
+        typer.echo(f"target q={t['q']:g}: error mm {', '.join(f'{e:.4f}' for e in t['error_mm'])} "
+                   f"({'converged' if t['converged'] else 'NOT converged'}: {t['how']})")
+    typer.echo("leaves out: " + "; ".join(payload["leaves_out"]))
+
+
+def simulate(
+    case_file: CaseArg,
+    section: SectionOpt = 0,
+    pressures: PressuresOpt = None,
+    target: TargetOpt = None,
+    out: OutOpt = None,
+    size_mm: SizeOpt = 1.5,
+    layer_mm: LayerOpt = 4.0,
+    max_pressure: MaxPressureOpt = 300.0,
+    timeout: TimeoutOpt = 600.0,
+    figure: FigureOpt = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """Solve one section under chamber pressures (hyperelastic finite elements), or find the pressures for a q.
+
+    The section's base is clamped and each chamber's wall carries its pressure on the deformed surface. It
+    reports the best arc through the deformed centerline, each chamber's length, the largest stretch and stress
+    and the convergence; with --target, the pressures whose arc best matches the design at q.
+    """
+
+    def action() -> None:
+        from softdesign.pipeline.simulate_run import SimulateOptions, run_simulate
+
+        _check_figure_path(figure)
+        values = None if pressures is None else pressures_from_text(pressures)
+        options = SimulateOptions(section, values, target, size_mm, layer_mm, max_pressure_kpa=max_pressure,
+                                  timeout_s=timeout)
+        result = run_simulate(case_file, out, options, note)
+        if figure is not None:
+            from softdesign.io.atomic import write_bytes_atomically
+            from softdesign.report.simulate_figures import simulate_figure_png
+
+            write_bytes_atomically(figure, simulate_figure_png(result))
+        emit_json(result) if as_json else _print(result)
+
+    run_guarded(action)

@@ -1,0 +1,29 @@
+"""The bounds of ``softdesign simulate``: pressures, load steps, iterations, mesh size, time and memory of a solve.
+
+A section's solve factors a sparse matrix (SuperLU) once per Newton
+iteration; its fill, and so its time and memory, grows faster than the node
+count (3D).  Measured on the loaded 2-core machine: 800 nodes 0.55 s per
+factorization, 2,350 nodes about 3 s, 5,500 nodes about 9 s, each with a few
+hundred MB.  MAX_SECTION_NODES keeps one solve within SIMULATE_MEMORY_BYTES
+(the child's address space) and minutes, and is checked on the mesh before
+the solve starts.
+"""
+
+from __future__ import annotations
+
+#: Largest chamber pressure, kPa (10 bar: far beyond what a silicone chamber holds).
+MAX_PRESSURE_KPA = 1000.0
+#: Load steps of a solve (each one a Newton solve), and Newton iterations per step.
+MAX_LOAD_STEPS = 64
+MAX_NEWTON_ITERATIONS = 50
+#: Forward solves of one inverse search.
+MAX_INVERSE_SOLVES = 40
+#: Nodes of one section's mesh.
+MAX_SECTION_NODES = 12_000
+#: The smallest element and layer size, mm.
+MIN_SIZE_MM = 0.2
+#: Nodes on the outer circle of a section.
+MIN_ANGULAR_COUNT, MAX_ANGULAR_COUNT = 8, 256
+#: The child's address space, bytes (2 GiB), and the longest time a solve may take, s.
+SIMULATE_MEMORY_BYTES = 2**31
+MAX_SIMULATE_SECONDS = 3600.0

@@ -1,0 +1,111 @@
+"""One section of a chambered body as a finite-element mesh: issue 32's swept mesh over the section alone.
+
+The section i of a body with issue 31's chambers is meshed on its own with
+the parametric mesher (:func:`softdesign.meshing.sweep_mesh.swept_disk`): the
+unit disk with the section's three chamber circles, swept through layers
+from the section's start ``l0`` to its end ``l1``, and placed on the body at
+q = 0 (the cast, unloaded state) the way the volume mesh is
+(:mod:`softdesign.meshing.sweep_body`: a rigid core keeps the chambers
+round and at their distance, the annulus outside it is stretched to the
+skin).  It differs from the body's own volume mesh in what a solve of one
+section needs and can afford:
+
+- only this section's chambers are holes; the feed lines of more distal
+  chambers that run through it are left out (solid), as is the short feed
+  from the section's base into its own chamber (the chamber is closed);
+- the layers are ``size_mm`` apart and the outer circle has ``angular_count``
+  nodes (not the export's), so that a solve fits in its time;
+- the section's ends are planes normal to the centerline (the body's slanted
+  end cuts, at the base of section 0 and the tip of the last, are not applied).
+
+The result is expressed in the section's base frame at q = 0: origin the
+centerline's point at ``l0``, axes (N, B, T) of the body's frame there, so a
+chamber's angle is its layout angle.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from softdesign.geometry.frames import FramedSpline
+from softdesign.mechanics.section import SectionMesh
+from softdesign.meshing.chamber_layout import ChamberLayout
+from softdesign.meshing.cross_section import Circle
+from softdesign.meshing.sweep_body import SweepReference, section_sweeps, section_xy
+from softdesign.meshing.sweep_mesh import Hole, swept_disk
+from softdesign.meshing.volume import BodySpec, angle_grid
+from softdesign.types import FloatArray
+
+#: The rigid core reaches this fraction of the way from the chambers' outer edge to the thinnest skin (as issue 32).
+CORE_GAP_FRACTION = 0.5
+#: Fewest nodes on a chamber's circle.
+MIN_CHAMBER_NODES = 12
+
+
+def section_layers(curve0: FramedSpline, l0: float, l1: float, size_mm: float) -> FloatArray:
+    """Layers (n,) in [l0, l1], about ``size_mm`` apart along the q = 0 centerline."""
+    s = curve0.curve.arc_length(np.array([l0, l1]))
+    count = max(2, int(np.ceil((s[1] - s[0]) / size_mm)))
+    return np.linspace(l0, l1, count + 1)
+
+
+def _holes(layout: ChamberLayout, section: int, scale_mm: float, size_mm: float) -> list[Hole]:
+    """The section's chambers as holes, their l-ranges in the section's own l (0 at its start, 1 at its end)."""
+    l0, l1 = layout.breaks[section], layout.breaks[section + 1]
+    holes = []
+    for c in layout.section_chambers(section):
+        radius = 0.5 * c.diameter_mm / scale_mm
+        nodes = max(MIN_CHAMBER_NODES, int(np.ceil(np.pi * c.diameter_mm / size_mm)))
+        centre = (c.distance_mm * np.cos(c.angle) / scale_mm, c.distance_mm * np.sin(c.angle) / scale_mm)
+        own = ((c.l_start - l0) / (l1 - l0), (c.l_end - l0) / (l1 - l0))
+        holes.append(Hole(f"s{section}_c{c.index}", Circle(centre, radius, nodes), own))
+    return holes
+
+
+def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, layout: ChamberLayout, section: int,
+                        size_mm: float, angular_count: int, layer_mm: float) -> SectionMesh:
+    """Section ``section``'s mesh at q = 0 in its base frame, with its base fixed and chamber walls named.
+
+    Parameters
+    ----------
+    curve0 : the centerline at q = 0
+    field : the fit's radius field (``evaluate_grid(q, l, angles)``)
+    spec : the body's offset (its wall must be 0: chambers and a single hollow chamber exclude each other)
+    layout : the chambers
+    section : index, 0 at the base
+    size_mm : edge length inside the cross-section, mm
+    angular_count : nodes on the outer circle
+    layer_mm : spacing of the layers along the centerline, mm
+
+    Raises
+    ------
+    MeshError
+        As the swept mesher: a chamber that does not fit, a fold.
+    """
+    l0, l1 = layout.breaks[section], layout.breaks[section + 1]
+    layers = section_layers(curve0, l0, l1, layer_mm)
+    rho = field.evaluate_grid(0.0, layers, angle_grid(angular_count))  # type: ignore[attr-defined]
+    scale = float(np.median(rho))
+    chambers = layout.section_chambers(section)
+    reach = max(c.distance_mm + 0.5 * c.diameter_mm for c in chambers)
+    core_mm = reach + CORE_GAP_FRACTION * (float(np.min(rho)) - reach)
+    holes = _holes(layout, section, scale, size_mm)
+    # the mesher sweeps l from 0 to 1: the section's own l, put back on the body's before placing
+    own = swept_disk(angular_count, holes, size_mm / scale, (layers - l0) / (l1 - l0))
+    mesh = replace(own, l=l0 + own.l * (l1 - l0))
+    ref = SweepReference(core=core_mm / scale, scale_mm=scale)
+    outer, inner = section_sweeps(mesh, ref, curve0, field, 0.0, spec, angular_count)  # type: ignore[arg-type]
+    xy = section_xy(mesh.section.points, outer, inner, ref)
+    frames = outer.frames[:, None, :, :]
+    grid = outer.centers[:, None, :] + xy[..., :1] * frames[..., 0] + xy[..., 1:] * frames[..., 1]
+    world = grid[mesh.node_layer, mesh.node_point]
+    origin, frame = curve0.points([l0])[0], curve0.frames([l0])[0]
+    local = (world - origin) @ frame
+    walls = [mesh.cavity_surface(h.name) for h in holes]
+    centerline = (curve0.points(mesh.l) - origin) @ frame
+    s = curve0.curve.arc_length(mesh.l)
+    return SectionMesh(local, mesh.tets, mesh.node_layer == 0, np.concatenate(walls),
+                       np.concatenate([np.full(len(w), k, np.int64) for k, w in enumerate(walls)]),
+                       centerline, (s - s[0])[mesh.node_layer], np.array([c.angle for c in chambers]))

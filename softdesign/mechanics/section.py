@@ -1,0 +1,219 @@
+"""One section of the actuator under chamber pressures: its deformed centerline, best arc, chamber lengths, stress.
+
+A section's mesh (:class:`SectionMesh`) is the unloaded body as cast, with its
+base face's nodes fixed and each chamber's wall triangles named.  The solve
+(:func:`simulate_section`) gives the displacement; from it:
+
+- the deformed centerline: the reference centerline's points carried by the
+  displacement interpolated in the element that holds each one;
+- the best arc through it (:func:`softdesign.kinematics.pcc_fit.fit_arc`, in the
+  section's base frame: z along the centerline's tangent, x along N, y along
+  B) and how far it misses (max and RMS over the centerline's points, mm);
+- each chamber's length: the polyline through the centroids of its wall nodes,
+  level by level along the reference centerline's arc length;
+- the largest principal stretch and the largest principal Cauchy stress of any
+  element, and where.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from softdesign.errors import MeshError
+from softdesign.kinematics.pcc_fit import arc_points, fit_arc, trapezoid_weights
+from softdesign.mechanics.assembly import volumetric_state
+from softdesign.mechanics.laws import HyperelasticLaw, cauchy_stress
+from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord, solve_pressures
+from softdesign.mechanics.tets import TetMesh, make_tet_mesh
+from softdesign.types import FloatArray, IntArray
+
+#: A centerline point counts as inside an element when its barycentric coordinates are all above this.
+INSIDE_TOL = -1e-9
+#: Node levels along the centerline are the same when their arc lengths differ by less than this, mm.
+LEVEL_TOL_MM = 1e-6
+
+
+@dataclass(frozen=True)
+class SectionMesh:
+    """A section's reference mesh and named sets, in the section's base frame (mm).
+
+    Attributes
+    ----------
+    points : (V, 3) float, mm, in the base frame (base centre at the origin, centerline tangent +z)
+    tets : (E, 4) int, positively oriented
+    base : (V,) bool, nodes of the base face (fixed)
+    wall_faces : (F, 3) int, chamber walls, normals out of the chamber into the material
+    face_chamber : (F,) int, the chamber (0 .. k-1) of each wall face
+    centerline : (n, 3) float, mm, the reference centerline from base to tip, inside the material
+    node_l : (V,) float, mm, each node's arc length along the centerline (its level)
+    chamber_angles : (k,) float, rad, each chamber's angle from x towards y
+    """
+
+    points: FloatArray
+    tets: IntArray
+    base: np.ndarray
+    wall_faces: IntArray
+    face_chamber: IntArray
+    centerline: FloatArray
+    node_l: FloatArray
+    chamber_angles: FloatArray
+
+    @property
+    def chamber_count(self) -> int:
+        """How many chambers (pressures) the section takes."""
+        return len(self.chamber_angles)
+
+
+@dataclass(frozen=True)
+class SectionResult:
+    """What one forward solve gives (mm, rad, kPa)."""
+
+    pressures_kpa: FloatArray  #: (k,) the chamber pressures
+    centerline: FloatArray  #: (n, 3) the deformed centerline, base frame
+    kappa: float  #: best arc's curvature, 1/mm
+    phi: float  #: best arc's bending-plane angle, rad (towards the centre of curvature)
+    length: float  #: best arc's length, mm
+    arc_max_mm: float  #: largest distance between the centerline and its arc
+    arc_rms_mm: float  #: arc-length RMS of that distance
+    chamber_lengths: FloatArray  #: (k,) deformed chamber lengths, mm
+    rest_chamber_lengths: FloatArray  #: (k,) the same unloaded, mm
+    max_stretch: float  #: largest principal stretch of any element
+    max_stress_kpa: float  #: largest principal Cauchy stress of any element, kPa
+    max_stress_at: FloatArray  #: (3,) reference centroid of that element, mm
+    record: SolveRecord  #: load steps, iterations and residuals
+
+
+def check_section(section: SectionMesh) -> TetMesh:
+    """The reference mesh of a section, its named sets checked (MeshError naming what is wrong)."""
+    mesh = make_tet_mesh(section.points, section.tets)
+    V = len(mesh.points)
+    if section.base.shape != (V,) or not section.base.any():
+        raise MeshError(f"section mesh: the base node set must be (V,) = ({V},) and not empty")
+    faces, chambers = np.asarray(section.wall_faces), np.asarray(section.face_chamber)
+    if faces.ndim != 2 or faces.shape[1] != 3 or chambers.shape != (len(faces),):
+        raise MeshError(f"section mesh: wall faces (F, 3) with one chamber each; got {faces.shape}, {chambers.shape}")
+    missing = sorted(set(range(section.chamber_count)) - set(chambers.tolist()))
+    if missing or (len(chambers) and chambers.max() >= section.chamber_count):
+        raise MeshError(f"section mesh: every chamber needs wall faces; chambers without any: {missing}")
+    if section.node_l.shape != (V,) or section.centerline.ndim != 2 or len(section.centerline) < 3:
+        raise MeshError("section mesh: node_l must be (V,) and the centerline (n >= 3, 3)")
+    return mesh
+
+
+def section_problem(section: SectionMesh, law: HyperelasticLaw) -> PressureProblem:
+    """The pressure problem of a section: base nodes fixed in every direction, walls loaded per chamber."""
+    mesh = check_section(section)
+    fixed = np.repeat(section.base, 3)
+    return PressureProblem(mesh, law, fixed, np.asarray(section.wall_faces, np.int64),
+                           np.asarray(section.face_chamber, np.int64))
+
+
+def locate(mesh: TetMesh, query: FloatArray) -> tuple[IntArray, FloatArray]:
+    """The element (n,) holding each reference point of ``query`` (n, 3) and its barycentric weights (n, 4).
+
+    Raises
+    ------
+    MeshError
+        A point lies in no element (outside the material).
+    """
+    corners = mesh.points[mesh.tets]
+    inverse = np.linalg.inv((corners[:, 1:] - corners[:, :1]).transpose(0, 2, 1))  # (E, 3, 3)
+    local = np.einsum("eij,nej->nei", inverse, query[:, None, :] - corners[None, :, 0, :])  # (n, E, 3)
+    bary = np.concatenate([1.0 - local.sum(axis=2, keepdims=True), local], axis=2)
+    worst = bary.min(axis=2)  # (n, E)
+    element = np.argmax(worst, axis=1)
+    if np.any(worst[np.arange(len(query)), element] < INSIDE_TOL):
+        bad = int(np.argmin(worst.max(axis=1)))
+        raise MeshError(f"section mesh: centerline point {bad} at {np.round(query[bad], 3).tolist()} mm is in no "
+                        "element; the centerline must run through the material")
+    return element, bary[np.arange(len(query)), element]
+
+
+def chamber_lengths(section: SectionMesh, positions: FloatArray) -> FloatArray:
+    """Each chamber's length (k,), mm: the polyline through its wall nodes' centroids, level by level."""
+    lengths = np.zeros(section.chamber_count)
+    for c in range(section.chamber_count):
+        nodes = np.unique(section.wall_faces[section.face_chamber == c])
+        levels = np.round(section.node_l[nodes] / LEVEL_TOL_MM).astype(np.int64)
+        _, which = np.unique(levels, return_inverse=True)
+        counts = np.bincount(which)
+        centroids = np.stack([np.bincount(which, positions[nodes, k]) / counts for k in range(3)], axis=1)
+        lengths[c] = np.linalg.norm(np.diff(centroids, axis=0), axis=1).sum()
+    return lengths
+
+
+def arc_of(centerline: FloatArray, fractions: FloatArray) -> tuple[float, float, float, float, float]:
+    """Best arc (kappa 1/mm, phi rad, L mm) through ``centerline`` (n, 3) mm and its misfit (max, RMS) mm."""
+    length = float(np.linalg.norm(np.diff(centerline, axis=0), axis=1).sum())
+    arc = fit_arc(centerline - centerline[0], fractions, length)
+    miss = np.linalg.norm(arc_points(arc.kappa, arc.phi, arc.length, fractions) - (centerline - centerline[0]), axis=1)
+    rms = float(np.sqrt(trapezoid_weights(fractions) @ miss**2))
+    return arc.kappa, arc.phi, arc.length, float(miss.max()), rms
+
+
+def _stress_figures(problem: PressureProblem, u: FloatArray) -> tuple[float, float, FloatArray]:
+    state = volumetric_state(problem.mesh, problem.law, u)
+    stretch = np.sqrt(np.linalg.eigvalsh(np.einsum("eki,ekj->eij", state.F, state.F))[:, -1])
+    sigma = cauchy_stress(problem.law, state.F, state.element_pressure)
+    principal = np.linalg.eigvalsh(sigma)[:, -1]
+    worst = int(np.argmax(principal))
+    at = problem.mesh.points[problem.mesh.tets[worst]].mean(axis=0)
+    return float(stretch.max()), float(principal[worst]), at
+
+
+@dataclass(frozen=True)
+class PreparedSection:
+    """A section ready to solve: its problem, where its centerline's points lie, their arc-length fractions."""
+
+    section: SectionMesh
+    problem: PressureProblem
+    elements: IntArray  #: (n,) the element holding each centerline point
+    weights: FloatArray  #: (n, 4) their barycentric weights
+    fractions: FloatArray  #: (n,) arc-length fraction of each centerline point, 0 to 1
+
+    def carried_centerline(self, u: FloatArray) -> FloatArray:
+        """The centerline (n, 3) mm carried by the displacement ``u`` (V, 3) mm."""
+        corners = u[self.problem.mesh.tets[self.elements]]
+        return self.section.centerline + np.einsum("na,nai->ni", self.weights, corners)
+
+
+def prepare_section(section: SectionMesh, law: HyperelasticLaw) -> PreparedSection:
+    """Check a section and locate its centerline (MeshError when either is wrong)."""
+    problem = section_problem(section, law)
+    elements, weights = locate(problem.mesh, section.centerline)
+    steps = np.linalg.norm(np.diff(section.centerline, axis=0), axis=1)
+    fractions = np.concatenate([[0.0], np.cumsum(steps)]) / steps.sum()
+    return PreparedSection(section, problem, elements, weights, fractions)
+
+
+def measure_section(prepared: PreparedSection, u: FloatArray, pressures: FloatArray,
+                    record: SolveRecord) -> SectionResult:
+    """The figures of an equilibrium ``u`` (V, 3) mm at ``pressures`` (k,) kPa."""
+    centerline = prepared.carried_centerline(u)
+    kappa, phi, length, arc_max, arc_rms = arc_of(centerline, prepared.fractions)
+    stretch, stress, at = _stress_figures(prepared.problem, u)
+    section = prepared.section
+    return SectionResult(np.asarray(pressures, float), centerline, kappa, phi, length, arc_max, arc_rms,
+                         chamber_lengths(section, section.points + u), chamber_lengths(section, section.points),
+                         stretch, stress, at, record)
+
+
+def simulate_section(section: SectionMesh, law: HyperelasticLaw, pressures: FloatArray,
+                     settings: NewtonSettings) -> SectionResult:
+    """Solve the section at chamber ``pressures`` (k,) kPa and measure it (see the module's docstring).
+
+    Raises
+    ------
+    MeshError
+        Bad named sets, or a centerline outside the material.
+    SolveError
+        The solve did not converge.
+    """
+    pressures = np.asarray(pressures, float)
+    if pressures.shape != (section.chamber_count,):
+        raise ValueError(f"expected {section.chamber_count} pressures, got shape {pressures.shape}")
+    prepared = prepare_section(section, law)
+    u, record = solve_pressures(prepared.problem, pressures, settings)
+    return measure_section(prepared, u, pressures, record)

@@ -1,0 +1,183 @@
+"""``softdesign simulate``: one section of a chambered body solved under chamber pressures, or for a designed arc.
+
+The build runs (cached) through the actuation stage; the section's mesh is
+made (:mod:`softdesign.mechanics.layout_section`) and checked against the
+bounds of :mod:`softdesign.limits_simulate` before any solve; the solve runs
+in a child process with a time and memory limit
+(:func:`~softdesign.pipeline.child.run_in_child`), so a runaway factorization
+fails cleanly.  Nothing is written: the command prints the figures.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from softdesign.errors import ConfigError, MeshError, SolveError
+from softdesign.limits_simulate import (
+    MAX_ANGULAR_COUNT,
+    MAX_INVERSE_SOLVES,
+    MAX_LOAD_STEPS,
+    MAX_NEWTON_ITERATIONS,
+    MAX_PRESSURE_KPA,
+    MAX_SECTION_NODES,
+    MAX_SIMULATE_SECONDS,
+    MIN_ANGULAR_COUNT,
+    MIN_SIZE_MM,
+    SIMULATE_MEMORY_BYTES,
+)
+
+#: What the model leaves out, stated with every answer.
+LEAVES_OUT = (
+    "fibre reinforcement (an unreinforced chamber balloons rather than lengthens)",
+    "contact with the vessel wall",
+    "viscoelasticity (the answer is the static, long-time equilibrium)",
+    "the Mullins effect (softening after the first loading)",
+    "the feed lines through the section (meshed solid) and the body's slanted end cuts",
+    "the neighbouring sections (the section's base is clamped, its tip free)",
+)
+#: Samples of the designed link's backbone for its best arc.
+ARC_SAMPLES = 65
+
+
+@dataclass(frozen=True)
+class SimulateOptions:
+    """The command's choices (kPa, mm, s), each checked by :func:`check_options` before work."""
+
+    section: int
+    pressures_kpa: tuple[float, ...] | None
+    target_q: float | None
+    size_mm: float = 1.5
+    layer_mm: float = 4.0
+    angular_count: int = 24
+    load_steps: int = 2
+    max_iterations: int = 12
+    max_pressure_kpa: float = 300.0
+    max_solves: int = 16
+    timeout_s: float = 600.0
+
+
+def check_options(o: SimulateOptions) -> None:
+    """Refuse options outside the bounds (ConfigError: the option, the value, the bound, the fix)."""
+    def bound(name: str, value: float, low: float, high: float) -> None:
+        if not (math.isfinite(value) and low <= value <= high):
+            raise ConfigError(f"simulate {name}: got {value:g}, expected a number in [{low:g}, {high:g}] "
+                              "(softdesign/limits_simulate.py)")
+    if (o.pressures_kpa is None) == (o.target_q is None):
+        raise ConfigError("simulate: give either --pressures P1,P2,P3 (kPa) or --target q, not both or neither")
+    for k, p in enumerate(o.pressures_kpa or ()):
+        bound(f"--pressures value {k + 1}", p, 0.0, MAX_PRESSURE_KPA)
+    if o.target_q is not None:
+        bound("--target", o.target_q, 0.0, 1.0)
+    bound("--size-mm", o.size_mm, MIN_SIZE_MM, 100.0)
+    bound("--layer-mm", o.layer_mm, MIN_SIZE_MM, 100.0)
+    bound("--angular-count", o.angular_count, MIN_ANGULAR_COUNT, MAX_ANGULAR_COUNT)
+    bound("--load-steps", o.load_steps, 1, MAX_LOAD_STEPS)
+    bound("--max-iterations", o.max_iterations, 1, MAX_NEWTON_ITERATIONS)
+    bound("--max-pressure", o.max_pressure_kpa, 1.0, MAX_PRESSURE_KPA)
+    bound("--max-solves", o.max_solves, 1, MAX_INVERSE_SOLVES)
+    bound("--timeout", o.timeout_s, 1.0, MAX_SIMULATE_SECONDS)
+
+
+def solve_in_child(section: Any, law: Any, o: SimulateOptions, target: tuple[float, float, float] | None
+                   ) -> dict[str, Any]:
+    """The worker (module-level: pickled by name): the forward solve, or the inverse for ``target``."""
+    from softdesign.mechanics.inverse import InverseSettings, find_pressures
+    from softdesign.mechanics.newton import NewtonSettings
+    from softdesign.mechanics.section import simulate_section
+
+    newton = NewtonSettings(load_steps=o.load_steps, max_iterations=o.max_iterations)
+    if target is None:
+        result = simulate_section(section, law, np.array(o.pressures_kpa, float), newton)
+        return {"result": result, "inverse": None}
+    settings = InverseSettings(o.max_pressure_kpa, 0.1 * o.max_pressure_kpa, 0.25 * o.max_pressure_kpa,
+                               tolerance_mm=1e-3, max_iterations=o.max_solves)
+    found = find_pressures(section, law, target, settings, newton)
+    return {"result": found.section, "inverse": found}
+
+
+def _section_mesh(outcome: Any, o: SimulateOptions) -> Any:
+    from softdesign.mechanics.layout_section import layout_section_mesh
+    from softdesign.pipeline.stages.actuation import actuation_layout
+    from softdesign.pipeline.stages.export import body_spec
+
+    kinematics, fit = outcome.results["kinematics"], outcome.results["fit"]
+    layout = actuation_layout(outcome.case, kinematics)
+    if layout is None:
+        raise ConfigError("simulate: the case has no actuation chambers; add an `actuation:` block")
+    if not 0 <= o.section < layout.sections:
+        raise ConfigError(f"simulate --section: got {o.section}, the body has sections 0 to {layout.sections - 1}")
+    curve0 = kinematics.chain.shape.curve_at(0.0)
+    return layout_section_mesh(curve0, fit.field, body_spec(outcome.case), layout, o.section, o.size_mm,
+                               o.angular_count, o.layer_mm)
+
+
+def run_simulate(case_file: Path, out: Path | None, o: SimulateOptions, progress: Any) -> dict[str, Any]:
+    """Build through actuation, mesh the section, solve it in a child process; the figures as a dict."""
+    from softdesign.kinematics.pcc_fit import fit_links
+    from softdesign.pipeline.api import build_through
+    from softdesign.pipeline.child import run_in_child
+    from softdesign.pipeline.stages.volume_sweep import material_of
+
+    check_options(o)
+    start = time.perf_counter()
+    outcome = build_through(case_file, out, "actuation", progress=progress)
+    material = material_of(outcome.case)
+    if material.law is None:
+        raise ConfigError(f"{case_file}: simulate needs material.name (a preset with a law) or material.custom")
+    section = _section_mesh(outcome, o)
+    if len(section.points) > MAX_SECTION_NODES:
+        raise ConfigError(f"simulate: section {o.section}'s mesh has {len(section.points)} nodes, more than "
+                          f"{MAX_SECTION_NODES} (softdesign/limits_simulate.py); raise --size-mm or --layer-mm")
+    target = None
+    if o.target_q is not None:
+        arc = fit_links(outcome.results["kinematics"].chain, o.target_q, ARC_SAMPLES)[o.section]
+        target = (arc.kappa, arc.phi, arc.length)
+    what = f"the finite-element solve of section {o.section} ({len(section.points)} nodes)"
+    fix = "raise --size-mm or --layer-mm, lower the pressures, or raise --timeout"
+    try:
+        answer = run_in_child(solve_in_child, (section, material.law, o, target), o.timeout_s, what, fix,
+                              SIMULATE_MEMORY_BYTES)
+    except MeshError as err:  # the child's failures, a non-converging solve among them
+        raise SolveError(str(err)) from err
+    return payload(o, section, material, answer, target, time.perf_counter() - start)
+
+
+def payload(o: SimulateOptions, section: Any, material: Any, answer: dict[str, Any],
+            target: tuple[float, float, float] | None, seconds: float) -> dict[str, Any]:
+    """The JSON-ready figures of a solve."""
+    r, inverse = answer["result"], answer["inverse"]
+    out: dict[str, Any] = {
+        "section": o.section,
+        "material": {"name": material.name, "law": material.law.kind, "c1_kpa": material.law.c1,
+                     "c2_kpa": material.law.c2, "c3_kpa": material.law.c3, "bulk_kpa": material.law.bulk_kpa,
+                     "source": material.law.source},
+        "formulation": "linear tetrahedra, average nodal pressure (near-incompressible), follower pressure",
+        "mesh": {"nodes": len(section.points), "tets": len(section.tets), "size_mm": o.size_mm,
+                 "layer_mm": o.layer_mm, "angular_count": o.angular_count},
+        "pressures_kpa": [round(float(p), 6) for p in r.pressures_kpa],
+        "arc": {"kappa_per_mm": r.kappa, "phi_rad": r.phi, "length_mm": r.length,
+                "misfit_max_mm": r.arc_max_mm, "misfit_rms_mm": r.arc_rms_mm},
+        "chamber_lengths_mm": [float(v) for v in r.chamber_lengths],
+        "rest_chamber_lengths_mm": [float(v) for v in r.rest_chamber_lengths],
+        "max_stretch": r.max_stretch,
+        "max_stress_kpa": r.max_stress_kpa,
+        "tensile_strength_kpa": material.tensile_strength_kpa,
+        "convergence": [{"load_factor": t, "iterations": n, "residuals_mN": h}
+                        for t, n, h in zip(r.record.load_factors, r.record.iterations, r.record.residuals,
+                                           strict=True)],
+        "deformed_centerline_mm": np.round(r.centerline, 6).tolist(),
+        "leaves_out": list(LEAVES_OUT),
+        "seconds": round(seconds, 2),
+    }
+    if target is not None and inverse is not None:
+        out["target"] = {"q": o.target_q, "kappa_per_mm": target[0], "phi_rad": target[1], "length_mm": target[2],
+                         "weighting": "error mm = [L/2 dtheta_x, L/2 dtheta_y, dL] (tip displacement, first order)",
+                         "error_mm": [float(v) for v in inverse.error_mm], "converged": inverse.converged,
+                         "how": inverse.stopped_because, "forward_solves": inverse.iterations}
+    return out

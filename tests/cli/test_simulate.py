@@ -1,0 +1,52 @@
+"""`softdesign simulate`: help, and bad options refused with exit 2 and the option named before any work."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from softdesign.cli import app
+from tests.helpers.paths import DEMO
+
+runner = CliRunner()
+
+
+def test_help_names_the_options() -> None:
+    result = runner.invoke(app, ["simulate", "--help"])
+    assert result.exit_code == 0
+    for option in ("--section", "--pressures", "--target", "--json", "--timeout"):
+        assert option in result.output
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--pressures", "10,20"], "expected 3"),
+    (["--pressures", "10,x,0"], "is not a number"),
+    (["--pressures", "10,2000,0"], "expected a number in [0, 1000]"),
+    (["--pressures", "-1,0,0"], "expected a number in [0, 1000]"),
+    (["--pressures", "10,0,0", "--target", "1"], "not both or neither"),
+    ([], "not both or neither"),
+    (["--target", "1.5"], "--target: got 1.5"),
+    (["--pressures", "10,0,0", "--size-mm", "0"], "--size-mm: got 0"),
+    (["--pressures", "10,0,0", "--timeout", "1e9"], "--timeout"),
+    (["--pressures", "10,0,0", "--figure", "out.svg"], "expected a .png file"),
+    (["--pressures", "10,0,0", "--figure", "no/such/folder/out.png"], "does not exist"),
+])
+def test_bad_options_exit_2_before_any_work(args: list[str], message: str, tmp_path) -> None:
+    result = runner.invoke(app, ["simulate", str(DEMO), "--out", str(tmp_path / "build"), *args])
+    assert result.exit_code == 2, result.output
+    assert message in result.output
+    assert not (tmp_path / "build").exists()  # refused before the build started
+
+
+def test_the_figure_draws_a_payload(tmp_path) -> None:
+    from softdesign.report.simulate_figures import simulate_figure_png
+
+    z = np.linspace(0.0, 20.0, 11)
+    payload = {"section": 0, "pressures_kpa": [10.0, 0.0, 0.0],
+               "arc": {"kappa_per_mm": 0.01, "phi_rad": -1.5, "length_mm": 20.0},
+               "deformed_centerline_mm": np.column_stack([0 * z, -0.005 * z**2, z]).tolist(),
+               "convergence": [{"load_factor": 1.0, "residuals_mN": [1.0, 1e-3, 1e-9]}],
+               "target": {"q": 1.0, "kappa_per_mm": 0.02, "phi_rad": -1.5, "length_mm": 20.0}}
+    png = simulate_figure_png(payload)
+    assert png.startswith(b"\x89PNG") and png == simulate_figure_png(payload)  # same figures, same bytes

@@ -1,0 +1,57 @@
+"""A section of a straight chambered body meshed alone (issue 32's swept mesher): its volume, frame and sets."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from softdesign.geometry.blend import blend_shapes
+from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
+from softdesign.geometry.initial import straight_initial_shape
+from softdesign.mechanics.layout_section import layout_section_mesh
+from softdesign.mechanics.section import check_section
+from softdesign.meshing.chamber_layout import ActuationSpec, plan_layout
+from softdesign.meshing.volume import BodySpec
+from tests.fitting.test_fit_strain import _constant_field
+
+RADIUS_MM, LENGTH_MM = 5.0, 40.0
+SPEC = ActuationSpec(distance_mm=2.5, diameter_mm=2.0, feed_diameter_mm=0.5, end_wall_mm=1.5, first_angle_deg=90.0)
+#: the chamber circles have 12 nodes: an inscribed polygon holds 1 - sin(h)/h = 4.5 % less than the circle,
+#: the outer one (24 nodes) 1.1 % less; the volume is compared with the polygons' to the swept mesher's accuracy
+VOLUME_RTOL = 1e-3
+
+
+def _section(index: int):
+    s = np.linspace(0.0, LENGTH_MM, 801)
+    line = np.column_stack([np.zeros_like(s), np.zeros_like(s), s])
+    final = smooth_curve_from_polyline(line, CurveOptions(spacing_mm=0.25, smoothing_mm=0.0))
+    shape = blend_shapes(straight_initial_shape(final), final, mode="intrinsic")
+    curve0 = shape.curve_at(0.0)
+    l = curve0.curve.dense_l()
+    layout = plan_layout(SPEC, (0.0, 0.5, 1.0), l, curve0.curve.arc_length(l))
+    section = layout_section_mesh(curve0, _constant_field(RADIUS_MM, RADIUS_MM), BodySpec(), layout, index,
+                                  size_mm=1.5, angular_count=24, layer_mm=4.0)
+    return section, layout
+
+
+def _polygon_area(radius: float, nodes: int) -> float:
+    return 0.5 * nodes * radius**2 * np.sin(2 * np.pi / nodes)
+
+
+def test_section_volume_frame_and_chambers() -> None:
+    section, layout = _section(1)
+    mesh = check_section(section)
+    chambers = layout.section_chambers(1)
+    half = LENGTH_MM / 2
+    chamber_length = (chambers[0].l_end - chambers[0].l_start) * LENGTH_MM
+    expected = _polygon_area(RADIUS_MM, 24) * half - 3 * _polygon_area(1.0, 12) * chamber_length
+    np.testing.assert_allclose(mesh.volumes.sum(), expected, rtol=VOLUME_RTOL)
+    # in the section's base frame: the base at z = 0, the centerline along +z, the tip at the section's length
+    np.testing.assert_allclose(section.points[section.base, 2], 0.0, atol=1e-9)
+    np.testing.assert_allclose(section.centerline[:, :2], 0.0, atol=1e-9)
+    np.testing.assert_allclose(section.centerline[-1, 2], half, rtol=1e-6)
+    # each chamber's wall lies around its layout angle at its distance
+    for k, chamber in enumerate(chambers):
+        wall = section.points[np.unique(section.wall_faces[section.face_chamber == k])]
+        centre = wall[:, :2].mean(axis=0)
+        expected_centre = chamber.distance_mm * np.array([np.cos(chamber.angle), np.sin(chamber.angle)])
+        np.testing.assert_allclose(centre, expected_centre, atol=0.05)
