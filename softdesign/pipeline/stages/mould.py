@@ -17,6 +17,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from softdesign.config import Case
 from softdesign.io.formats import mesh_bytes
 from softdesign.meshing.body import body_sections
@@ -25,7 +27,7 @@ from softdesign.meshing.mould import MouldSpec
 from softdesign.meshing.mould_cores import make_actuated_mould
 from softdesign.meshing.mould_make import MouldMesh, make_mould
 from softdesign.pipeline import layout
-from softdesign.pipeline.output_frame import base_pose, moved_points, output_pose
+from softdesign.pipeline.output_frame import base_pose, moved_points, moved_vectors, output_pose
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.actuation import actuation_layout
 from softdesign.pipeline.stages.export import body_spec
@@ -81,8 +83,14 @@ def run_mould(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Mould
                 "euler": report.euler}
     pose = output_pose(case.export.frame, base_pose(kinematics.chain.shape))  # checked first, then moved rigidly
     parts = tuple(replace(p, vertices=moved_points(p.vertices, pose)) for p in mould.parts)
+    figures = dict(mould.figures)
+    if pose is not None and "frame" in figures:  # the parting frame (origin, axes as rows) moves with the parts
+        parting = dict(figures["frame"])
+        parting["origin"] = moved_points(np.asarray(parting["origin"], float), pose).tolist()
+        parting["axes"] = moved_vectors(np.asarray(parting["axes"], float), pose).tolist()
+        figures["frame"] = parting
     summary = {"requested": True, "spec": case.export.mould.model_dump(mode="json") if case.export.mould else None,
-               "files": files, **mould.figures, "frame": case.export.frame}
+               "files": files, **figures, "output_frame": case.export.frame}
     return MouldResult(parts, summary)
 
 

@@ -141,7 +141,7 @@ def run_volume_mesh(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
     if vm.mesher == "sweep":
         swept = _run_sweep(case, kinematics, fit)
         return VolumeMeshResult(tuple(_moved(m, pose) for m in swept.meshes), {**swept.summary,
-                                                                               "frame": case.export.frame})
+                                                                               "output_frame": case.export.frame})
     meshes, files, per_q = [], {}, []
     for q in vm.q:
         mesh, figures = mesh_body(case, kinematics, fit, q)
@@ -154,7 +154,7 @@ def run_volume_mesh(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
     mesher = {"name": "fTetWild through pytetwild, one thread", "pytetwild": metadata.version("pytetwild"),
               "meshio": metadata.version("meshio")}
     summary = {"requested": True, "spec": vm.model_dump(mode="json"), "mesher": mesher,
-               "deterministic": False, "per_q": per_q, "files": files, "frame": case.export.frame}
+               "deterministic": False, "per_q": per_q, "files": files, "output_frame": case.export.frame}
     return VolumeMeshResult(tuple(_moved(m, pose) for m in meshes), summary)
 
 
