@@ -257,3 +257,33 @@ def test_mould_and_chamber_traces_exist_only_when_built_and_start_hidden(session
     assert after[CHAMBER_NAME] is True  # shown by its legend entry; the rest unchanged
     assert {k: v for k, v in after.items() if k != CHAMBER_NAME} == {k: v for k, v in before.items()
                                                                      if k != CHAMBER_NAME}
+
+
+def test_the_aortas_page_opens_on_its_verdict_not_on_its_check_tally(tmp_path, aorta_dir):
+    """Issue 34: the aorta's page opened on "Checks: 93 of 93 passed" above a design that is not feasible."""
+    sync_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed (make install)")
+    executable = chromium()
+    from tests.helpers.cases import write_case
+
+    case = write_case(tmp_path, "aorta", final={"centerline": str(aorta_dir / "aorta-centerline.vtp"),
+                                                 "surface": str(aorta_dir / "aorta-surface.stl"), "path": 0},
+                      material={"name": "ecoflex-00-30"})
+    build_through(case, tmp_path / "build")
+    write_report(tmp_path / "build", ReportOptions(gif_frames=3))
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    with sync_api.sync_playwright() as playwright:
+        try:
+            browser = playwright.chromium.launch(executable_path=executable, args=CHROMIUM_ARGS)
+        except Exception as err:  # playwright's Error: the browser cannot start here
+            pytest.skip(f"{executable} cannot start headless: {err}")
+        page = browser.new_page(viewport=VIEWPORT)
+        page.goto((tmp_path / "build" / REPORT_DIR / PAGE).resolve().as_uri())
+        page.screenshot(path=str(ARTIFACTS / "aorta_first_screen.png"))
+        verdict = page.evaluate("(() => { const v = document.getElementById('verdict'); "
+                                "return [v.getBoundingClientRect().top, v.dataset.status, v.innerText]; })()")
+        tally = page.evaluate("document.querySelector('.tally').getBoundingClientRect().top")
+        browser.close()
+    top, status, text = verdict
+    assert 0 <= top < tally < VIEWPORT["height"]  # the verdict first, the tally after it, both on the first screen
+    assert status == "infeasible" and text.startswith("NOT feasible: skin stretch")
+    assert "mm from the base" in text
