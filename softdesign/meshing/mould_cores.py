@@ -51,7 +51,7 @@ from softdesign.meshing.mould_checks import (
     shared_volume,
 )
 from softdesign.meshing.mould_frame import PartingFrame, parting_frame
-from softdesign.meshing.mould_make import Mould, MouldMesh
+from softdesign.meshing.mould_make import Mould, MouldMesh, checks_passed
 from softdesign.meshing.solids import checked, cut_body, manifold_from_mesh
 from softdesign.meshing.tessellate import Region, Sweep, TubeMesh, TubeSections, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec
@@ -195,15 +195,7 @@ def _check(parts: MouldParts, half_a: m3.Manifold, half_b: m3.Manifold, plate: m
     # inside the cast part a pin passes its narrower feed by stretching it (figures["core"]); the plate slides off
     # the halves, and the pins are prisms along the pull
     figures["pull"] = _pulls(parts, half_a, half_b, plate, pins, frame, outward, facet_tol)
-    bad = [k for k, v in figures["parts"].items() if not v["ok"]]
-    bad += [k for k in ("disjoint", "cavity") if not figures[k]["ok"]]
-    if bad:
-        from softdesign.errors import MeshError
-
-        raise MeshError(f"mould: checks failed for {', '.join(bad)}: {figures}; this is a bug, please report it "
-                        "with the case file")
-    figures["frame"] = {"origin": frame.origin.tolist(), "axes": frame.axes.tolist(), "straight": frame.straight,
-                        "out_of_plane_mm": frame.out_of_plane_mm}
+    checks_passed(figures, frame)
     return figures
 
 

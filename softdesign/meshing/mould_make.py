@@ -153,6 +153,17 @@ def make_mould(sections: TubeSections, body_spec: BodySpec, spec: MouldSpec,
     return Mould(tuple(meshes), figures)
 
 
+def checks_passed(figures: dict[str, Any], frame: PartingFrame) -> None:
+    """Refuse (MeshError, a bug) a mould whose parts, disjointness or cavity check failed; then add the frame."""
+    bad = [k for k, v in figures["parts"].items() if not v["ok"]]
+    bad += [k for k in ("disjoint", "cavity") if not figures[k]["ok"]]
+    if bad:
+        raise MeshError(f"mould: checks failed for {', '.join(bad)}: {figures}; this is a bug, please report it "
+                        "with the case file")
+    figures["frame"] = {"origin": frame.origin.tolist(), "axes": frame.axes.tolist(), "straight": frame.straight,
+                        "out_of_plane_mm": frame.out_of_plane_mm}
+
+
 def _check(parts: MouldParts, frame: PartingFrame, name: Callable[[int, int], str], facet_tol: float) -> dict:
     """Every check of :mod:`~softdesign.meshing.mould_checks`; refuse an undercut, MeshError on anything else."""
     solids = {"half_a": parts.half_a, "half_b": parts.half_b}
@@ -176,13 +187,7 @@ def _check(parts: MouldParts, frame: PartingFrame, name: Callable[[int, int], st
             _refuse_undercut(half, pull, frame, failures, len(failures))
         pulls[f"half_{half.lower()}"] = {**result, "pull": (frame.axes.T @ pull).tolist()}
     figures["pull"] = pulls
-    bad = [k for k, v in figures["parts"].items() if not v["ok"]]
-    bad += [k for k in ("disjoint", "cavity") if not figures[k]["ok"]]
-    if bad:
-        raise MeshError(f"mould: checks failed for {', '.join(bad)}: {figures}; this is a bug, please report it "
-                        "with the case file")
-    figures["frame"] = {"origin": frame.origin.tolist(), "axes": frame.axes.tolist(), "straight": frame.straight,
-                        "out_of_plane_mm": frame.out_of_plane_mm}
+    checks_passed(figures, frame)
     figures["casting"] = {"up": (frame.axes.T @ parts.up).tolist(), "pour_at": (frame.axes.T @ parts.pour_at
                           + frame.origin).tolist(), "vent_at": (frame.axes.T @ parts.vent_at + frame.origin).tolist()}
     return figures
