@@ -22,7 +22,8 @@ def trans_z(distance: float) -> np.ndarray:
 
 
 def seed_chain(kappa: float, phi: float, length: float) -> np.ndarray:
-    """Seed section 3.2's five steps Rz(phi) Ry(theta/2) Tz(chord) Ry(theta/2) Rz(-phi), chord from eq. 7."""
+    """Seed section 3.2's five steps Rz(phi) Ry(theta/2) Tz(chord) Ry(theta/2) Rz(-phi), chord from eq. 7
+    (a straight section, kappa = 0: the chord is its length)."""
     theta = kappa * length
-    chord = 2.0 / kappa * np.sin(theta / 2)
+    chord = length if kappa == 0.0 else 2.0 / kappa * np.sin(theta / 2)
     return rot_z(phi) @ rot_y(theta / 2) @ trans_z(chord) @ rot_y(theta / 2) @ rot_z(-phi)

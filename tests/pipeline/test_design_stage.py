@@ -20,6 +20,7 @@ from softdesign.pipeline.api import build_through
 from softdesign.pipeline.stages.blend import load_blend
 from softdesign.pipeline.stages.design import load_design
 from tests.helpers.paths import DEMO
+from tests.helpers.seed_transforms import seed_chain
 
 runner = CliRunner()
 #: Issue 30's done-when figures at T = 1 mm.
@@ -38,37 +39,14 @@ BETWEEN_SAMPLES_TOL_MM = 2e-3
 Q_VALUES = np.linspace(0.0, 1.0, 21)
 
 
-def rz(angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
-
-
-def ry(angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, 0, s, 0], [0, 1, 0, 0], [-s, 0, c, 0], [0, 0, 0, 1.0]])
-
-
-def tz(d: float) -> np.ndarray:
-    out = np.eye(4)
-    out[2, 3] = d
-    return out
-
-
-def seed_section(kappa: float, phi: float, s: float) -> np.ndarray:
-    """Seed 003, section 3.2: Rz(phi) Ry(theta/2) Tz(|O1 O2|) Ry(theta/2) Rz(-phi), |O1 O2| = 2 sin(theta/2) / kappa."""
-    theta = kappa * s
-    chord = s if kappa == 0.0 else 2.0 * np.sin(theta / 2.0) / kappa
-    return rz(phi) @ ry(theta / 2.0) @ tz(chord) @ ry(theta / 2.0) @ rz(-phi)
-
-
-def seed_chain(document: dict, step_mm: float = 0.01) -> tuple[list[np.ndarray], np.ndarray]:
+def composed_chain(document: dict, step_mm: float = 0.01) -> tuple[list[np.ndarray], np.ndarray]:
     """Each section's tip frame and points every ``step_mm`` along the chain, composed from base_frame."""
     pose = np.array(document["base_frame"])
     tips, points = [], []
     for link in document["links"]:
         s = np.linspace(0.0, link["length"], int(np.ceil(link["length"] / step_mm)) + 1)
-        points += [(pose @ seed_section(link["kappa"], link["phi"], v))[:3, 3] for v in s]
-        pose = pose @ seed_section(link["kappa"], link["phi"], link["length"])
+        points += [(pose @ seed_chain(link["kappa"], link["phi"], v))[:3, 3] for v in s]
+        pose = pose @ seed_chain(link["kappa"], link["phi"], link["length"])
         tips.append(pose)
     return tips, np.array(points)
 
@@ -95,7 +73,7 @@ def test_demo_design_meets_the_issue_bounds_and_its_json_composes_again(demo_pcc
     document = json.loads((demo_pcc / "design" / "summary.json").read_text())
     assert document["meets_tolerance"] and len(document["links"]) <= DEMO_MOST_LINKS
     assert document["chain_max_deviation_mm"] <= T_MM and document["tip_error_mm"] <= T_MM
-    tips, points = seed_chain(document)
+    tips, points = composed_chain(document)
     for link, tip in zip(document["links"], tips, strict=True):
         np.testing.assert_allclose(link["tip_frame"], tip, rtol=0, atol=COMPOSE_TOL)
         assert link["theta"] == pytest.approx(link["kappa"] * link["length"], abs=COMPOSE_TOL)
@@ -123,13 +101,13 @@ def test_pcc_blend_sections_are_arcs_of_their_length_and_q_times_kappa(demo_pcc)
         samples = curve.points(l)
         for link, a, b in zip(design.document["links"], breaks[:-1], breaks[1:], strict=True):
             inside = (l >= a - 1e-12) & (l <= b + 1e-12)
-            expected = [(pose @ seed_section(q * link["kappa"], link["phi"], v * total - a * total))[:3, 3]
+            expected = [(pose @ seed_chain(q * link["kappa"], link["phi"], v * total - a * total))[:3, 3]
                         for v in l[inside]]
             np.testing.assert_allclose(samples[inside], expected, rtol=0, atol=SAMPLE_TOL_MM)
-            pose = pose @ seed_section(q * link["kappa"], link["phi"], link["length"])
+            pose = pose @ seed_chain(q * link["kappa"], link["phi"], link["length"])
         if q == 1.0:
             dense = curve.dense_l()
-            _, chain = seed_chain(design.document, 0.001)
+            _, chain = composed_chain(design.document, 0.001)
             between, _ = cKDTree(chain).query(curve.points(dense))
             assert between.max() <= BETWEEN_SAMPLES_TOL_MM
     straight = shape.smooth_curve_at(0.0)

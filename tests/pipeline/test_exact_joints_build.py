@@ -21,7 +21,7 @@ from softdesign.io.centerline_vtp import write_centerlines_vtp
 from softdesign.pipeline.api import build_through
 from softdesign.pipeline.layout import KINEMATICS
 from softdesign.pipeline.stages.blend import describe_blend
-from tests.helpers.seed_transforms import seed_chain, trans_z
+from tests.helpers.seed_transforms import seed_chain
 
 #: (kappa 1/mm, phi rad, L mm); joints at 20, 32.5 and 47.5 mm of 70: samples of a 0.5 mm grid.
 ARCS = ((0.05, 0.4, 20.0), (0.0, 0.0, 12.5), (0.07, 2.0, 15.0), (0.03, -1.5, 22.5))
@@ -31,7 +31,7 @@ MM_TOL = 1e-4
 
 
 def section(kappa: float, phi: float, length: float) -> np.ndarray:
-    return seed_chain(kappa, phi, length) if kappa > 0.0 else trans_z(length)
+    return seed_chain(kappa, phi, length)
 
 
 @pytest.mark.slow
