@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from softdesign.fitting.strain import principal_stretches
-from softdesign.mechanics.kinematic_stress import ElementStrain, element_strain
+from softdesign.mechanics.kinematic_stress import ElementStrain, element_strain, rest_inverses
 from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.meshing.sweep_body import SweepReference
 from softdesign.meshing.sweep_mesh import SweptMesh
@@ -50,18 +50,19 @@ class Extreme:
                 "angle_rad": round(self.angle, 5), "depth": round(self.depth, 4)}
 
 
-def free_directions(mesh: SweptMesh, rest: FloatArray) -> FloatArray:
-    """(T, 3) unit normals at q = 0 of the surfaces of constant depth through each tetrahedron (module notes)."""
+def free_directions(mesh: SweptMesh, rest: FloatArray, inverses: FloatArray | None = None) -> FloatArray:
+    """(T, 3) unit normals at q = 0 of the surfaces of constant depth through each tetrahedron (module notes);
+    ``inverses``: :func:`~softdesign.mechanics.kinematic_stress.rest_inverses` of ``rest``, when at hand."""
     param = mesh.reference_points()
     t = mesh.tets
     dp = (param[t[:, 1:]] - param[t[:, :1]]).transpose(0, 2, 1)
-    dx = (rest[t[:, 1:]] - rest[t[:, :1]]).transpose(0, 2, 1)
+    dx_inverse = rest_inverses(rest, t) if inverses is None else inverses
     centroid = param[t].mean(axis=1)
     radial = np.column_stack([centroid[:, 0], centroid[:, 1], np.zeros(len(t))])
     norm = np.linalg.norm(radial, axis=1, keepdims=True)
     radial = np.where(norm > 1e-9, radial / np.maximum(norm, 1e-300), np.array([1.0, 0.0, 0.0]))
     # grad_x t = G^-T grad_p t with G = dx dp^-1, so G^-T = dx^-T dp^T
-    normal = np.einsum("nji,nj->ni", np.linalg.inv(dx), np.einsum("nji,nj->ni", dp, radial))
+    normal = np.einsum("nji,nj->ni", dx_inverse, np.einsum("nji,nj->ni", dp, radial))
     return np.asarray(normal / np.linalg.norm(normal, axis=1, keepdims=True), np.float64)
 
 
