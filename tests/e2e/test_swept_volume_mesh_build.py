@@ -5,6 +5,7 @@ same bytes on a second build."""
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import meshio
@@ -39,7 +40,11 @@ def test_swept_mesh_of_a_hollow_tube(tmp_path):
     out = tmp_path / "build"
     result = runner.invoke(app, ["build", str(case), "--out", str(out)])
     assert result.exit_code == 0, result.output
+    # a line per part with its time in the build's log (its printed lines), none in the summary (issue 35)
+    assert re.search(r"^  mesh plan: \d+\.\d\d s$", result.output, re.M), result.output
+    assert re.search(r"^  q=0\.050\.\.0\.950 \(19 q\): \d+\.\d\d s$", result.output, re.M), result.output
     summary = json.loads((out / "volume_mesh" / "summary.json").read_text())
+    assert "mesher_s" not in json.dumps(summary) and "seconds" not in json.dumps(summary)
     assert summary["deterministic"] and summary["surfaces"] == [
         "skin", "base", "tip", "chamber_wall", "chamber_cap", "port_wall", "port_inlet"]
     for row in summary["per_q"]:
@@ -72,6 +77,7 @@ def test_swept_mesh_of_a_hollow_tube(tmp_path):
     assert runner.invoke(app, ["build", str(case), "--out", str(again)]).exit_code == 0
     for name in ("q_0.000.vtu", "q_0.000.msh", "q_1.000.vtu", "chamber_q_1.000.stl"):
         assert (volume / name).read_bytes() == (again / "meshes" / "volume" / name).read_bytes(), name
+    assert (out / "volume_mesh" / "summary.json").read_bytes() == (again / "volume_mesh" / "summary.json").read_bytes()
 
 
 def test_strict_fails_on_the_3d_stress_alone(tmp_path):

@@ -206,7 +206,8 @@ def judge(figures: dict[str, Any], material: Material, where: str) -> list[str]:
 
 @dataclass(frozen=True)
 class SweepRun:
-    """The meshes at the requested q, the figures per q, over the morph, and the verdict's reasons."""
+    """The meshes at the requested q, the figures per q, over the morph, the verdict's reasons, and each part's
+    time (``parts``: for the log, never in the summary: a build's outputs are a function of its inputs)."""
 
     bodies: tuple[SweptBody, ...]
     per_q: list[dict[str, Any]]
@@ -300,7 +301,6 @@ def run_sweep(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Sweep
                         "body_kind": _kind(placed.spec, placed.mesh), "strain": strain,
                         "boundary_watertight": bool(mesh_topology(points, placed.mesh.faces).watertight)})
         reasons += judge(strain, placed.material, f"q={q:.3f}")
-        figures["mesher_s"] = round(time.perf_counter() - start, 3)
         bodies.append(SweptBody(q, points, placed.mesh, data))
         per_q.append(figures)
         _tell(tick, q, time.perf_counter() - start, log)
@@ -331,7 +331,7 @@ def _part_label(item: Any) -> str:
 
 
 def _tell(tick: Any, part: Any, seconds: float, log: list[dict[str, Any]]) -> None:
-    """Tell the bar (on a terminal) and keep the part's time for the log (the stage's description)."""
+    """Tell the bar (on a terminal) and keep the part's time for the log (the build's printed lines)."""
     log.append({"part": part, "seconds": round(seconds, 3)})
     if tick is not None:
         tick((part, seconds), None)
@@ -368,9 +368,14 @@ def _place_text(e: dict[str, Any]) -> str:
     return f"section {e['section']}, l={e['l']:.4f}, angle {np.degrees(e['angle_rad']):.0f} deg, depth {e['depth']:.2f}"
 
 
+def part_lines(parts: list[dict[str, Any]]) -> list[str]:
+    """A line per part of the stage with its time (the mesh plan, each q, each batch of the morph's samples)."""
+    return [f"{_part_name(p['part'])}: {p['seconds']:.2f} s" for p in parts]
+
+
 def describe_sweep(summary: dict[str, Any]) -> list[str]:
-    """A line per part with its time, per mesh with its figures and strain, the morph's extremes, the verdict."""
-    lines = [f"{_part_name(p['part'])}: {p['seconds']:.2f} s" for p in summary["parts"]]
+    """A line per mesh with its figures and strain, the morph's extremes, the verdict."""
+    lines: list[str] = []
     for f in summary["per_q"]:
         w = f["worst"]["min_dihedral"]
         lines.append(f"q={f['q']:.3f} (.vtu, .msh): {f['tets']} tets, {f['volume_mm3']:.2f} mm3 "
