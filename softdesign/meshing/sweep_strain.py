@@ -13,10 +13,11 @@ Where
     the centerline from N) and depth: 0 at the skin, 1 at the axis of a solid
     body or at the chamber's wall of a hollow one, of the tetrahedron's centroid.
 Skin
-    Each skin triangle's in-plane principal stretches from its edges at q = 0
-    and at q (:func:`softdesign.fitting.strain.principal_stretches` on the
-    triangles' metrics): what the feasibility stage measures from the
-    surface's derivatives, on the mesh.
+    The in-plane principal stretches at the centre of each skin quad (two
+    layers by two angles) from the central differences of its corners at
+    q = 0 and at q (:func:`softdesign.fitting.strain.principal_stretches` on
+    the metrics): what the feasibility stage measures from the surface's
+    derivatives, on the mesh's nodes, to second order in their spacing.
 """
 
 from __future__ import annotations
@@ -90,13 +91,40 @@ def strain_at(mesh: SweptMesh, rest: FloatArray, moved: FloatArray, law: Hyperel
     return element_strain(rest, moved, mesh.tets, law, free, inverses)
 
 
+def skin_grid(mesh: SweptMesh) -> IntArray:
+    """The skin's nodes (n, na): node of layer j at angle ``2 pi k / na`` (the cross-section's outer circle)."""
+    na = mesh.section.outer_count
+    grid = np.full((len(mesh.l), na), -1, np.int64)
+    skin = mesh.node_point < na
+    grid[mesh.node_layer[skin], mesh.node_point[skin]] = np.flatnonzero(skin)
+    if np.any(grid < 0):
+        raise ValueError("skin_grid: a layer lacks a node of the outer circle (a bug in the swept mesh)")
+    return grid
+
+
+def skin_places(mesh: SweptMesh) -> tuple[FloatArray, FloatArray]:
+    """l (n - 1,) and angle (na,) rad of the centres of the skin's quads (between layers and angles)."""
+    na = mesh.section.outer_count
+    return 0.5 * (mesh.l[1:] + mesh.l[:-1]), 2.0 * np.pi * (np.arange(na) + 0.5) / na
+
+
 def skin_stretches(mesh: SweptMesh, rest: FloatArray, moved: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """In-plane principal stretches (lambda1, lambda2) of every skin triangle, each (S,)."""
-    faces = mesh.group_faces("skin")
+    """In-plane principal stretches (lambda1, lambda2) at the centre of every skin quad, each (n - 1, na).
+
+    A quad's two tangents at its centre are the central differences of its corners (the mean of its two
+    edges along l, and of its two along the angle), exact to second order in the quad's size, where one
+    triangle's constant gradient is exact to first order only: on the demo at q = 1 they agree with the
+    feasibility stage's metric at the quads' centres within 0.16 % away from the end cuts, the triangles
+    within 3 %.  Places: :func:`skin_places`.
+    """
+    grid = skin_grid(mesh)
 
     def metric(x: FloatArray) -> FloatArray:
-        e1, e2 = x[faces[:, 1]] - x[faces[:, 0]], x[faces[:, 2]] - x[faces[:, 0]]
-        return np.column_stack([np.einsum("ij,ij->i", e1, e1), np.einsum("ij,ij->i", e1, e2),
-                                np.einsum("ij,ij->i", e2, e2)])
+        corner = x[grid]
+        turned = np.roll(corner, -1, axis=1)
+        along = 0.5 * (corner[1:] + turned[1:] - corner[:-1] - turned[:-1])
+        around = 0.5 * (turned[:-1] + turned[1:] - corner[:-1] - corner[1:])
+        return np.stack([np.einsum("...k,...k->...", along, along), np.einsum("...k,...k->...", along, around),
+                         np.einsum("...k,...k->...", around, around)], axis=-1)
 
     return principal_stretches(metric(rest), metric(moved))

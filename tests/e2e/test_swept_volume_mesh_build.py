@@ -103,3 +103,53 @@ def test_strict_fails_on_the_3d_stress_alone(tmp_path):
     assert summary["feasible"] is False and "3D stress" in summary["reasons"][0]
     manifest = json.loads((out / "manifest.json").read_text())
     assert "volume_mesh" in json.dumps(manifest) and "stress_max_kpa" in json.dumps(manifest)
+
+
+#: Issue 32: the swept mesh's skin stretches agree with the feasibility stage's within 1 %.
+SKIN_RTOL = 0.01
+
+
+def test_the_demos_skin_stretches_agree_with_the_feasibility_stages(tmp_path):
+    """configs/demo.yaml as it is, with a volume mesh at q = 0.5 and 1: the skin quads' largest and least
+    stretch against the feasibility stage's (its grid converged to 1e-4), within 1 %.
+
+    One pair cannot agree, and the test says why instead of loosening the bound: at q = 0.5 the feasibility's
+    least stretch sits on the tip's end ring (l = 1), where the mesh has no quad centre (the last row's is
+    half a layer inside, in the zone the tip's cut moves); the surface's own least stretch at the mesh's quad
+    centres agrees with the mesh's within 1 %.
+    """
+    import yaml
+
+    from softdesign.config import load_case
+    from softdesign.fitting.strain import principal_stretches, skin_metric
+    from softdesign.meshing.sweep_strain import skin_places
+    from softdesign.pipeline.api import build_through
+    from softdesign.pipeline.stages.volume_sweep import _plan
+    from tests.helpers.paths import REPO
+
+    data = yaml.safe_load((REPO / "configs" / "demo.yaml").read_text())
+    for key in ("centerline", "surface"):
+        data["final"][key] = str((REPO / "configs" / data["final"][key]).resolve())
+    data["export"]["volume_mesh"] = {"q": [0.5, 1.0]}
+    case_file = tmp_path / "demo.yaml"
+    case_file.write_text(yaml.safe_dump(data, sort_keys=False))
+    outcome = build_through(case_file, tmp_path / "build")
+    volume = outcome.results["volume_mesh"].summary["per_q"]
+    feasibility = {row["q"]: row for row in outcome.results["feasibility"].summary["per_q"]}
+    for row in volume:
+        skin, surface = row["strain"], feasibility[row["q"]]
+        np.testing.assert_allclose(skin["skin_stretch_max"], surface["stretch_max"], rtol=SKIN_RTOL)
+        if row["q"] == 1.0:
+            np.testing.assert_allclose(skin["skin_stretch_min"], surface["stretch_min"], rtol=SKIN_RTOL)
+    half = feasibility[0.5]
+    assert half["where"]["stretch_min"]["l"] == 1.0  # the end ring: why q = 0.5's least stretch is not compared
+    case = load_case(case_file)
+    results = outcome.results
+    placed = _plan(case, results["kinematics"], results["fit"], case.export.volume_mesh)
+    l, a = skin_places(placed.mesh)
+    shape, field = results["kinematics"].chain.shape, results["fit"].field
+    _, least = principal_stretches(skin_metric(shape.curve_at(0.0), field, 0.0, l, a, case.frames),
+                                   skin_metric(shape.curve_at(0.5), field, 0.5, l, a, case.frames))
+    np.testing.assert_allclose(volume[0]["strain"]["skin_stretch_min"], least.min(), rtol=SKIN_RTOL)
+
+
