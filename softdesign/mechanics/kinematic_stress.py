@@ -170,14 +170,34 @@ def rest_state(rest: npt.ArrayLike, tets: npt.ArrayLike, free: npt.ArrayLike | N
     return RestState(tets, inverse, directions)
 
 
+#: Tetrahedra measured at once by :func:`strains`: its few dozen temporaries of this many float64 stay in the
+#: processor's cache (the chambered demo's 543k tetrahedra: 0.14 s a q in chunks of 8192, 0.21 s whole).
+STRAIN_CHUNK = 8192
+
+
 def strains(state: RestState, moved: npt.ArrayLike, law: HyperelasticLaw | None) -> ElementStrain:
     """:func:`element_strain` of every tetrahedron at one or several moved states at once.
 
     ``moved`` is (V, 3) mm, or (Q, V, 3) for Q states: the arrays returned then have a leading (Q,) axis.
-    Component by component on whole arrays (F, C = F^T F, its closed-form eigenvalues, det F): no batched
-    3 x 3 products, which numpy does an element at a time.
+    Component by component on arrays of STRAIN_CHUNK values (tetrahedra times states: F, C = F^T F, its
+    closed-form eigenvalues, det F): no batched 3 x 3 products, which numpy does an element at a time.  Each
+    tetrahedron's figures are computed alone, so the chunks change no bit.
     """
     moved = np.asarray(moved, float)
+    count, size = len(state.tets), max(1, STRAIN_CHUNK // int(np.prod(moved.shape[:-2], dtype=np.int64)))
+    if count <= size:
+        return _strains(state, moved, law)
+    parts = [_strains(RestState(state.tets[k:k + size], state.inverse[:, :, k:k + size],
+                                None if state.free is None else state.free[:, k:k + size]), moved, law)
+             for k in range(0, count, size)]
+    stress = None if law is None else np.concatenate([p.stress_max for p in parts if p.stress_max is not None],
+                                                     axis=-1)
+    return ElementStrain(np.concatenate([p.stretches for p in parts], axis=-2),
+                         np.concatenate([p.green_max for p in parts], axis=-1), stress)
+
+
+def _strains(state: RestState, moved: FloatArray, law: HyperelasticLaw | None) -> ElementStrain:
+    """:func:`strains` on one chunk."""
     t = state.tets
     # edges[k][i]: component i of edge k (node k + 1 less node 0), each (..., T)
     coords = [moved[..., c][..., t] for c in range(3)]  # (..., T, 4) per coordinate
