@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import json
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import meshio
@@ -153,3 +155,24 @@ def test_the_demos_skin_stretches_agree_with_the_feasibility_stages(tmp_path):
     np.testing.assert_allclose(volume[0]["strain"]["skin_stretch_min"], least.min(), rtol=SKIN_RTOL)
 
 
+
+
+def test_meshing_and_its_metrics_show_a_bar_on_a_terminal_and_a_line_per_part_with_its_time(tmp_path):
+    """Issue 32 item 5: on a terminal the volume_mesh stage's bar counts its parts (the mesh plan, each q, each
+    batch of the morph's samples, each with its time); the build's printed log has a line per part with its
+    time; a pipe gets no bar."""
+    from tests.e2e.test_export_progress import CODE, _on_a_terminal
+    from tests.helpers.paths import REPO
+
+    case = _swept(tmp_path)
+    code, stdout, screen = _on_a_terminal("build", str(case), "--out", str(tmp_path / "tty"), "--jobs", "1")
+    assert code == 0, screen
+    parts = ["mesh plan", "q=0.000", "q=1.000", r"q=0\.050\.\.0\.950 \(19 q\)"]
+    for done, part in enumerate(parts, start=1):
+        assert re.search(rf"volume_mesh: {part} \(\d+\.\d\d s\) done .*{done}/{len(parts)}", screen), screen
+        assert re.search(rf"^  {part}: \d+\.\d\d s$", stdout, re.M), stdout
+    piped = subprocess.run([sys.executable, "-c", CODE, "build", str(case), "--out", str(tmp_path / "pipe")],
+                           capture_output=True, text=True, cwd=REPO, timeout=600, stdin=subprocess.DEVNULL)
+    assert piped.returncode == 0, piped.stderr
+    assert "\x1b" not in piped.stderr and "mesh plan (" not in piped.stderr
+    assert re.search(r"^  mesh plan: \d+\.\d\d s$", piped.stdout, re.M), piped.stdout
