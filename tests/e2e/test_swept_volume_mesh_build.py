@@ -47,6 +47,9 @@ def test_swept_mesh_of_a_hollow_tube(tmp_path):
     assert re.search(r"^  q=0\.050\.\.0\.950 \(19 q\): \d+\.\d\d s$", result.output, re.M), result.output
     summary = json.loads((out / "volume_mesh" / "summary.json").read_text())
     assert "mesher_s" not in json.dumps(summary) and "seconds" not in json.dumps(summary)
+    run = {row["name"]: row for row in json.loads((out / "run.log.json").read_text())["stages"]}
+    assert re.fullmatch(r"mesh plan: \d+\.\d\d s", run["volume_mesh"]["log"][0]), run["volume_mesh"]
+    assert len(run["volume_mesh"]["log"]) == 4  # the plan, q = 0 and 1, one batch of the morph's samples
     assert summary["deterministic"] and summary["surfaces"] == [
         "skin", "base", "tip", "chamber_wall", "chamber_cap", "port_wall", "port_inlet"]
     for row in summary["per_q"]:

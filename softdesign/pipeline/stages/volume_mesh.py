@@ -86,8 +86,8 @@ class VolumeMeshResult:
 
     meshes: tuple[TetBody, ...]
     summary: dict[str, Any]
-    #: a line per part with its time, printed with the stage's description (the build's log), never written
-    #: into the build folder, whose files depend on the inputs alone (issue 35)
+    #: a line per part with its time: printed with the stage's description and kept in the build folder's run log
+    #: (run.log.json), never in an output, which depends on the inputs alone (issue 35)
     log: tuple[str, ...] = ()
 
 
@@ -272,4 +272,5 @@ STAGE = Stage(
     describe=describe_volume_mesh,
     metrics=lambda result: {k: v for k, v in result.summary.items() if k != "files"},
     figures=lambda result: result.summary["files"] if result.summary["requested"] else {},
+    log=lambda result: list(result.log),
 )
