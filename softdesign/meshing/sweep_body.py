@@ -41,7 +41,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from softdesign.errors import MeshError
+from softdesign.errors import ConfigError, MeshError
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.geometry.frames import FramedSpline
 from softdesign.meshing.body import sections_on_grid
@@ -337,4 +337,34 @@ def holes_from_layout(layout: ChamberLayout, scale_mm: float, rho_min_mm: float,
         name = f"s{f.section}_c{f.chamber}"
         holes.append(Hole(f"{name}_feed", circle(f.ring_mm, f.angle, f.diameter_mm, MIN_FEED_NODES),
                           (f.l_start, f.l_end), cavity=name))
+    check_resolvable(layout, holes, scale_mm)
     return holes, SweepReference(core=core_mm / scale_mm, scale_mm=scale_mm)
+
+
+def check_resolvable(layout: ChamberLayout, holes: list[Hole], scale_mm: float) -> None:
+    """Refuse (ConfigError, exit 2) a layout whose chambers and feeds the one cross-section cannot resolve.
+
+    The section holds every section's chambers and feeds at once
+    (:mod:`softdesign.meshing.section_gaps`): neighbouring sections' chambers are ``2 d sin(60 deg / n) - D``
+    apart there, less than the layout's own walls.  Checked before any meshing.
+    """
+    from softdesign.meshing.section_gaps import MAX_CIRCLE_NODES, smallest_gap, unresolved
+
+    bad = unresolved([h.circle for h in holes])
+    if bad is None:
+        return
+    first, second = holes[bad.first], holes[bad.second]
+    spec, n = layout.spec, layout.sections
+    floor = smallest_gap(0.5 * spec.diameter_mm / scale_mm, MIN_CHAMBER_NODES) * scale_mm
+    chord = 2.0 * spec.distance_mm * np.sin(np.pi / (3.0 * n))
+    most = max((k for k in range(1, n + 1) if 2.0 * spec.distance_mm * np.sin(np.pi / (3.0 * k))
+                - spec.diameter_mm >= floor), default=1)
+    what = (f"{'touch' if bad.gap == 0 else 'cross'}" if bad.gap <= 0 else
+            f"are {bad.gap * scale_mm:.4f} mm apart, which needs {bad.nodes} nodes on a circle (at most "
+            f"{MAX_CIRCLE_NODES})")
+    raise ConfigError(
+        f"export.volume_mesh (mesher sweep): {first.name} and {second.name} {what} in the swept mesher's cross-"
+        f"section, which holds every section's chambers and feeds at once (neighbouring sections' chambers "
+        f"2 d sin(60 deg / {n}) - D = {chord - spec.diameter_mm:.4f} mm apart; it resolves {floor:.4f} mm); "
+        f"use actuation.diameter_mm <= {chord - floor:.3f}, or links.count <= {most}, or "
+        "export.volume_mesh.mesher: ftetwild")
