@@ -76,15 +76,16 @@ class Unresolved:
     nodes: int
 
 
-def unresolved(circles: Sequence[Circle]) -> Unresolved | None:
-    """The narrowest pair that touches, crosses, or needs more than ``MAX_CIRCLE_NODES`` on a circle, or None."""
+def unresolved(circles: Sequence[Circle], resolved: Sequence[Circle] | None = None) -> Unresolved | None:
+    """The narrowest pair that touches, crosses, or needs more than ``MAX_CIRCLE_NODES`` on a circle, or None
+    (``resolved``: :func:`resolve_circles` of ``circles`` if already made)."""
     if len(circles) < 2:
         return None
     gaps = pair_gaps(circles)
     i, j = np.unravel_index(int(np.argmin(gaps)), gaps.shape)
     if gaps[i, j] <= 0:
         return Unresolved(int(min(i, j)), int(max(i, j)), float(gaps[i, j]), 0)
-    counts = [len(c.angles) or c.nodes for c in resolve_circles(circles)]
+    counts = [len(c.angles) or c.nodes for c in (resolved or resolve_circles(circles))]
     over = [k for k, m in enumerate(counts) if m > MAX_CIRCLE_NODES]
     if not over:
         return None
@@ -119,15 +120,22 @@ def clearance(circle: Circle, others: Sequence[Circle], angles: FloatArray) -> F
     return np.min(np.abs(dist - _radii(others)[None]), axis=1)
 
 
+def _graded(edge: FloatArray, x: FloatArray, period: float) -> FloatArray:
+    """min over j of edge[j] + EDGE_SLOPE |x - x_j| on a periodic line (x increasing within one period)."""
+    xs = np.concatenate([x - period, x, x + period])
+    es = np.tile(edge, 3)
+    forward = np.minimum.accumulate(es - EDGE_SLOPE * xs) + EDGE_SLOPE * xs
+    backward = (np.minimum.accumulate((es + EDGE_SLOPE * xs)[::-1]) - EDGE_SLOPE * xs[::-1])[::-1]
+    return np.minimum(forward, backward)[x.size:2 * x.size]
+
+
 def graded_angles(circle: Circle, gap_edge: FloatArray, angles: FloatArray) -> tuple[float, ...]:
     """Node angles whose edges follow ``gap_edge`` (K,) (the longest edge each sample allows), no edge longer
     than the circle's own, the step graded by ``EDGE_SLOPE``; () when the equal steps already do."""
     radius, base = circle.radius, 2.0 * np.pi / circle.nodes
     if np.all(gap_edge >= radius * base):
         return ()
-    arc = np.abs(np.mod(angles[:, None] - angles[None] + np.pi, 2.0 * np.pi) - np.pi) * radius
-    edge = np.min(gap_edge[None, :] + EDGE_SLOPE * arc, axis=1)  # graded: Lipschitz from every sample
-    edge = np.minimum(edge, radius * base)
+    edge = np.minimum(_graded(gap_edge, radius * angles, 2.0 * np.pi * radius), radius * base)
     if np.all(edge >= radius * base * (1.0 - 1e-12)):
         return ()
     step = angles[1] - angles[0]
@@ -148,7 +156,7 @@ def resolve_circles(circles: Sequence[Circle]) -> list[Circle]:
     angles = 2.0 * np.pi * np.arange(CLEARANCE_SAMPLES) / CLEARANCE_SAMPLES
     out = []
     for k, c in enumerate(circles):
-        if c.nodes:
+        if c.nodes and not c.angles:
             others = [o for i, o in enumerate(circles) if i != k]
             # the reach R (1 - cos(h/2) + sin(h/2)) <= GAP_REACH x clearance, with h/2 at most the equal step's
             allowed = 2.0 * GAP_REACH * clearance(c, others, angles) / (1.0 + np.pi / (2.0 * c.nodes))

@@ -337,22 +337,26 @@ def holes_from_layout(layout: ChamberLayout, scale_mm: float, rho_min_mm: float,
         name = f"s{f.section}_c{f.chamber}"
         holes.append(Hole(f"{name}_feed", circle(f.ring_mm, f.angle, f.diameter_mm, MIN_FEED_NODES),
                           (f.l_start, f.l_end), cavity=name))
-    check_resolvable(layout, holes, scale_mm)
-    return holes, SweepReference(core=core_mm / scale_mm, scale_mm=scale_mm)
+    return check_resolvable(layout, holes, scale_mm), SweepReference(core=core_mm / scale_mm, scale_mm=scale_mm)
 
 
-def check_resolvable(layout: ChamberLayout, holes: list[Hole], scale_mm: float) -> None:
-    """Refuse (ConfigError, exit 2) a layout whose chambers and feeds the one cross-section cannot resolve.
+def check_resolvable(layout: ChamberLayout, holes: list[Hole], scale_mm: float) -> list[Hole]:
+    """``holes`` with their circles graded at narrow gaps (:func:`~softdesign.meshing.section_gaps.
+    resolve_circles`); ConfigError (exit 2) for a layout whose chambers and feeds the one cross-section
+    cannot resolve.
 
     The section holds every section's chambers and feeds at once
     (:mod:`softdesign.meshing.section_gaps`): neighbouring sections' chambers are ``2 d sin(60 deg / n) - D``
     apart there, less than the layout's own walls.  Checked before any meshing.
     """
-    from softdesign.meshing.section_gaps import MAX_CIRCLE_NODES, smallest_gap, unresolved
+    from softdesign.meshing.section_gaps import MAX_CIRCLE_NODES, resolve_circles, smallest_gap, unresolved
 
-    bad = unresolved([h.circle for h in holes])
+    circles = [h.circle for h in holes]
+    crossing = unresolved(circles, circles)  # touching or crossing only: no grading yet
+    resolved = resolve_circles(circles) if crossing is None else circles
+    bad = crossing or unresolved(circles, resolved)
     if bad is None:
-        return
+        return [replace(h, circle=c) for h, c in zip(holes, resolved, strict=True)]
     first, second = holes[bad.first], holes[bad.second]
     spec, n = layout.spec, layout.sections
     floor = smallest_gap(0.5 * spec.diameter_mm / scale_mm, MIN_CHAMBER_NODES) * scale_mm
