@@ -41,12 +41,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from softdesign.errors import ConfigError, MeshError
+from softdesign.errors import MeshError
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.geometry.frames import FramedSpline
 from softdesign.meshing.body import sections_on_grid
 from softdesign.meshing.chamber_layout import ChamberLayout
 from softdesign.meshing.end_cut import CutPlane, along_generators, cut_planes, cut_targets
+from softdesign.meshing.sweep_layout import MIN_FEED_NODES, check_resolvable, layout_holes
 from softdesign.meshing.sweep_mesh import Hole, SweptMesh
 from softdesign.meshing.tessellate import Sweep, sweep_from_sections
 from softdesign.meshing.volume import BodySpec, angle_grid
@@ -300,9 +301,6 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
 CORE_Q_SAMPLES = tuple(np.linspace(0.0, 1.0, 11))
 #: The rigid core reaches this fraction of the way from the chambers' outer edge to the thinnest skin.
 CORE_GAP_FRACTION = 0.5
-#: Nodes on a chamber's and a feed's circle (at least): their polygons have the circle's area
-#: (Circle.equal_area), so the cavity's volume is the layout's; more nodes where the skin's are closer.
-MIN_CHAMBER_NODES, MIN_FEED_NODES = 16, 12
 
 
 def holes_from_layout(layout: ChamberLayout, scale_mm: float, rho_min_mm: float,
@@ -313,62 +311,11 @@ def holes_from_layout(layout: ChamberLayout, scale_mm: float, rho_min_mm: float,
     ``s{i}_c{j}_feed`` belongs to the same cavity and opens at the base (``s{i}_c{j}_feed_inlet``).
     ``scale_mm`` (R0) is mm per reference unit, ``rho_min_mm`` the thinnest section's radius over the morph.
     """
-    from softdesign.meshing.cross_section import Circle
-
     reach = max([c.distance_mm + 0.5 * c.diameter_mm for c in layout.chambers]
                 + [f.ring_mm + 0.5 * f.diameter_mm for f in layout.feeds])
     core_mm = reach + CORE_GAP_FRACTION * (rho_min_mm - reach)
     if not reach < core_mm < rho_min_mm:
         raise MeshError(f"volume mesh: the chambers reach {reach:.3f} mm from the centerline, the thinnest section "
                         f"is {rho_min_mm:.3f} mm: no wall; use smaller actuation.distance_mm or diameter_mm")
-    h_outer = 2.0 * np.pi / angular_count
-
-    def circle(distance: float, angle: float, diameter: float, least: int) -> Circle:
-        radius = 0.5 * diameter / scale_mm
-        nodes = max(least, int(np.ceil(2.0 * np.pi * radius / h_outer)))
-        return Circle((distance * np.cos(angle) / scale_mm, distance * np.sin(angle) / scale_mm), radius, nodes,
-                      equal_area=True)
-
-    holes = []
-    for c in layout.chambers:
-        holes.append(Hole(f"s{c.section}_c{c.index}", circle(c.distance_mm, c.angle, c.diameter_mm,
-                                                             MIN_CHAMBER_NODES), (c.l_start, c.l_end)))
-    for f in layout.feeds:
-        name = f"s{f.section}_c{f.chamber}"
-        holes.append(Hole(f"{name}_feed", circle(f.ring_mm, f.angle, f.diameter_mm, MIN_FEED_NODES),
-                          (f.l_start, f.l_end), cavity=name))
-    return check_resolvable(layout, holes, scale_mm), SweepReference(core=core_mm / scale_mm, scale_mm=scale_mm)
-
-
-def check_resolvable(layout: ChamberLayout, holes: list[Hole], scale_mm: float) -> list[Hole]:
-    """``holes`` with their circles graded at narrow gaps (:func:`~softdesign.meshing.section_gaps.
-    resolve_circles`); ConfigError (exit 2) for a layout whose chambers and feeds the one cross-section
-    cannot resolve.
-
-    The section holds every section's chambers and feeds at once
-    (:mod:`softdesign.meshing.section_gaps`): neighbouring sections' chambers are ``2 d sin(60 deg / n) - D``
-    apart there, less than the layout's own walls.  Checked before any meshing.
-    """
-    from softdesign.meshing.section_gaps import MAX_CIRCLE_NODES, resolve_circles, smallest_gap, unresolved
-
-    circles = [h.circle for h in holes]
-    crossing = unresolved(circles, circles)  # touching or crossing only: no grading yet
-    resolved = resolve_circles(circles) if crossing is None else circles
-    bad = crossing or unresolved(circles, resolved)
-    if bad is None:
-        return [replace(h, circle=c) for h, c in zip(holes, resolved, strict=True)]
-    first, second = holes[bad.first], holes[bad.second]
-    spec, n = layout.spec, layout.sections
-    floor = smallest_gap(0.5 * spec.diameter_mm / scale_mm, MIN_CHAMBER_NODES) * scale_mm
-    chord = 2.0 * spec.distance_mm * np.sin(np.pi / (3.0 * n))
-    most = max((k for k in range(1, n + 1) if 2.0 * spec.distance_mm * np.sin(np.pi / (3.0 * k))
-                - spec.diameter_mm >= floor), default=1)
-    what = (f"{'touch' if bad.gap == 0 else 'cross'}" if bad.gap <= 0 else
-            f"are {bad.gap * scale_mm:.4f} mm apart, which needs {bad.nodes} nodes on a circle (at most "
-            f"{MAX_CIRCLE_NODES})")
-    raise ConfigError(
-        f"export.volume_mesh (mesher sweep): {first.name} and {second.name} {what} in the swept mesher's cross-"
-        f"section, which holds every section's chambers and feeds at once (neighbouring sections' chambers "
-        f"2 d sin(60 deg / {n}) - D = {chord - spec.diameter_mm:.4f} mm apart; it resolves {floor:.4f} mm); "
-        f"use actuation.diameter_mm <= {chord - floor:.3f}, or links.count <= {most}, or "
-        "export.volume_mesh.mesher: ftetwild")
+    holes = check_resolvable(layout, layout_holes(layout, scale_mm, angular_count), scale_mm)
+    return holes, SweepReference(core=core_mm / scale_mm, scale_mm=scale_mm)
