@@ -7,6 +7,8 @@ Paths are POSIX, relative to the build folder.
 
 from __future__ import annotations
 
+from softdesign.io.format_names import q_label
+
 MANIFEST = "manifest.json"
 KINEMATICS = "kinematics.json"
 REPORT_DIR = "report"
@@ -83,11 +85,6 @@ def stage_record(stage: str) -> str:
 def ingest_keyframe(index: int | str) -> str:
     """``ingest/keyframe_<index>.npz``: the intermediate keyframe centerline ``index``."""
     return f"ingest/keyframe_{index}.npz"
-
-
-def q_label(q: float) -> str:
-    """``q_0.500``: three decimals, as DESIGN.md names the meshes."""
-    return f"q_{q:.3f}"
 
 
 def mesh_path(q: float, fmt: str) -> str:

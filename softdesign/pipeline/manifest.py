@@ -16,7 +16,7 @@ from softdesign.config import Case
 from softdesign.pipeline import layout
 from softdesign.pipeline.stage import Results, Stage, StageRun, Status
 from softdesign.pipeline.store import read_record, sha256_file
-from softdesign.versions import software_versions
+from softdesign.pipeline.versions import software_versions
 
 
 def build_manifest(

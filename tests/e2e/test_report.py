@@ -25,6 +25,7 @@ from typer.testing import CliRunner
 
 from softdesign.pipeline.api import build_through
 from softdesign.pipeline.owned import REPORT_MARKER
+from softdesign.pipeline.versions import software_versions
 from softdesign.report.interactive import DISPLAY_TOLERANCE_MM, DIV_ID, JS_NAME
 from softdesign.report.writer import (
     EXPECTED_SIZES,
@@ -35,7 +36,6 @@ from softdesign.report.writer import (
     commit_folder,
     write_report,
 )
-from softdesign.versions import software_versions
 from tests.helpers.cases import write_case
 from tests.helpers.paths import REPO
 

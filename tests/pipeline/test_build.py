@@ -16,7 +16,7 @@ import yaml
 from typer.testing import CliRunner
 
 from softdesign.cli import app
-from softdesign.versions import software_versions
+from softdesign.pipeline.versions import software_versions
 from tests.helpers.paths import REPO
 
 runner = CliRunner()
@@ -250,7 +250,7 @@ def killing(*args, **kwargs):
     return original(*args, **kwargs)
 export_stage.mesh_bytes = killing
 from softdesign.cli import app
-from softdesign.versions import software_versions
+from softdesign.pipeline.versions import software_versions
 sys.argv = ["softdesign"] + sys.argv[1:]
 app()
 """

@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from softdesign.errors import ConfigError
+from softdesign.io.format_names import q_label
 from softdesign.kinematics.chamber_lengths import chamber_lengths_from_arc
 from softdesign.kinematics.pcc_fit import fit_links
 from softdesign.meshing.body import body_sections
@@ -38,8 +39,8 @@ from softdesign.meshing.chamber_layout import ChamberLayout, analytic_walls, cha
 from softdesign.meshing.chamber_walls import Wall, chamber_lengths_mm, ring_walls, skin_walls
 from softdesign.meshing.chambers import measured_skin_walls
 from softdesign.meshing.sweep_layout import check_resolvable, layout_holes
+from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import export_workers
-from softdesign.pipeline.layout import q_label
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.fit import FitResult
@@ -209,8 +210,6 @@ def _skin(kinematics: KinematicsResult, fit: FitResult, layout: ChamberLayout, g
 def _meshed(case: Case, kinematics: KinematicsResult, fit: FitResult, layout: ChamberLayout) -> list[Wall]:
     """At every export q (on the build's worker processes), the thinnest skin over chambers and feeds measured
     on the meshes the export makes."""
-    from softdesign.pipeline.stages.export import body_spec  # export imports this stage's layout
-
     e, spec = case.export, body_spec(case, fit)
 
     def at(q: float) -> list[Wall]:
