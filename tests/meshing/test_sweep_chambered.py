@@ -129,3 +129,21 @@ def test_crossing_chambers_refused_before_meshing():
     text = str(err.value)
     assert "cross" in text and "actuation.diameter_mm <=" in text and "links.count <=" in text
     assert "mesher: ftetwild" in text
+
+
+def test_graded_mesh_same_bytes_twice():
+    """Five sections at the defaults (graded circles): the same section, tetrahedra and names on a second run."""
+    from softdesign.meshing.sweep_layout import check_resolvable, layout_holes
+    from softdesign.meshing.sweep_mesh import swept_disk
+
+    shape, _, _ = _body(5)
+    layout = _layout(shape, 5, 0.8, 0.4)
+    runs = []
+    for _ in range(2):
+        holes = check_resolvable(layout, layout_holes(layout, RADIUS_MM, NA), RADIUS_MM)
+        assert any(h.circle.angles for h in holes)
+        runs.append(swept_disk(NA, holes, 2.0 / RADIUS_MM, np.linspace(0.0, 1.0, 11)))
+    first, second = runs
+    assert first.section.points.tobytes() == second.section.points.tobytes()
+    assert first.tets.tobytes() == second.tets.tobytes() and first.groups == second.groups
+    assert first.faces.tobytes() == second.faces.tobytes()
