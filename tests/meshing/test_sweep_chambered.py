@@ -59,7 +59,7 @@ def test_many_sections_mesh_with_every_cavity_closed(sections, diameter, feed):
     shape, field, length = _body(sections)
     layout = _layout(shape, sections, diameter, feed)
     spec = BodySpec()
-    mesh, ref = plan_mesh(shape.curve_at(0.0), field, np.linspace(0.0, 1.0, int(length / 0.5) + 1), spec, NA,
+    mesh, ref = plan_mesh(shape.curve_at(0.0), field, np.linspace(0.0, 1.0, int(length) + 1), spec, NA,
                           2.0, layout)
     rest = place_mesh(mesh, ref, shape.curve_at(0.0), field, 0.0, spec, NA)
     moved = place_mesh(mesh, ref, shape.curve_at(1.0), field, 1.0, spec, NA)
