@@ -17,7 +17,10 @@ Points
     step from the last (near-equilateral triangles), the size growing by
     ``GROWTH`` per ring up to ``size``.  Candidates are kept in order of
     their ring's distance from a circle; one closer than ``KEEP_FRACTION`` of
-    the smaller local size to a kept point is dropped.
+    the smaller local size to a kept point is dropped.  A circle's nodes are
+    equal steps from angle 0, or graded (``Circle.angles``) where it passes a
+    narrow gap (:mod:`softdesign.meshing.section_gaps`); a graded circle's
+    fronts start at its largest edge and keep off it by that edge.
 Triangulation
     Delaunay (qhull through scipy: deterministic for the same points).  The
     rings either side of a circle make its edges Delaunay; every circle edge
