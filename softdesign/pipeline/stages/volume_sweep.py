@@ -18,6 +18,7 @@ material (stretch vs max_stretch, stress vs tensile strength).
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -26,12 +27,14 @@ import numpy as np
 from softdesign.config import Case
 from softdesign.config import VolumeMesh as VolumeMeshSpec
 from softdesign.errors import ConfigError, MeshError
+from softdesign.fitting.strain import principal_stretches, skin_metric
 from softdesign.limits.volume import MAX_VOLUME_TETS
 from softdesign.mechanics.kinematic_stress import ElementStrain, RestState, rest_inverses, rest_state, strains
 from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.meshing.body import export_l_grid
 from softdesign.meshing.skin_stretch import morph_samples
 from softdesign.meshing.sweep_body import SweepReference, place_mesh, plan_mesh
+from softdesign.meshing.sweep_grading import Grading, graded_layers
 from softdesign.meshing.sweep_mesh import SweptMesh
 from softdesign.meshing.sweep_strain import extreme_of, free_directions, skin_stretches, tet_places
 from softdesign.meshing.tet_quality import dihedral_angles, radius_edge_ratios, tet_volumes
@@ -56,6 +59,12 @@ MORPH_BATCH_VALUES = 2_000_000
 MORPH_WORKERS_VALUES = 4_000_000
 #: Tetrahedra measured at once by the quality figures (:func:`_measures`).
 QUALITY_CHUNK = 16_384
+#: The largest relative change of a skin stretch between neighbouring layers (:mod:`softdesign.meshing.
+#: sweep_grading`): a skin quad's centre then comes within about half of it of the stretch anywhere in its
+#: interval, inside issue 32's 1 % between the mesh's skin and the feasibility stage's.
+STRETCH_STEP = 0.01
+#: The shortest layer interval, in skin edges around the section (the grading's floor).
+MIN_LAYER_EDGES = 0.125
 #: Triangles of a section per node about (Euler: 2 per inside node), for the count bound before meshing.
 TRIANGLES_PER_NODE = 2.0
 
@@ -88,20 +97,60 @@ def layer_spacing_mm(case: Case, fit: FitResult, size_mm: float) -> float:
 
 
 def _layers(case: Case, kinematics: KinematicsResult, fit: FitResult, vm: VolumeMeshSpec) -> FloatArray:
+    """The even layers (:func:`layer_spacing_mm`, the finest grid of the q meshed), graded by the skin's stretch
+    at every q meshed and sampled by the morph (:mod:`softdesign.meshing.sweep_grading`), the count checked."""
     shape, spacing = kinematics.chain.shape, layer_spacing_mm(case, fit, vm.size_mm)
     grids = [export_l_grid(shape.curve_at(q), fit.field, spacing) for q in sorted({0.0, *vm.q})]
-    return max(grids, key=len)
+    even = max(grids, key=len)
+    _check_count(even, case, fit, vm.size_mm)
+    per_layer = _tets_per_layer(even, case, fit, vm.size_mm)
+    curve0 = shape.curve_at(0.0)
+    grading = Grading(STRETCH_STEP, MIN_LAYER_EDGES * _skin_edge_mm(case, fit),
+                      max(len(even), int(MAX_VOLUME_TETS // per_layer) + 1))
+    layers = graded_layers(even, curve0.curve.arc_length, _skin_stretches(case, kinematics, fit, vm), grading)
+    _check_count(layers, case, fit, vm.size_mm)
+    return layers
 
 
-def _check_count(layers: FloatArray, case: Case, fit: FitResult, size_mm: float) -> None:
+def _skin_edge_mm(case: Case, fit: FitResult) -> float:
+    """The skin's edge around the section, 2 pi rho / angular_count at the median radius at q = 0."""
+    rho = float(np.median(fit.field.evaluate_grid(0.0, np.linspace(0.0, 1.0, 33), [0.0, 0.5 * np.pi, np.pi])))
+    return 2.0 * np.pi * rho / case.export.angular_count
+
+
+def _skin_stretches(case: Case, kinematics: KinematicsResult, fit: FitResult,
+                    vm: VolumeMeshSpec) -> Callable[[FloatArray], FloatArray]:
+    """l (m,) -> the skin's principal stretches (m, 2 Q, na), lambda1 and lambda2 at each q the stage exports
+    (but 0), at the skin quads' angles: the feasibility stage's metric (:func:`softdesign.fitting.strain.
+    skin_metric`), the skin figures the mesh reports and issue 32 compares."""
+    shape, field, frames = kinematics.chain.shape, fit.field, case.frames
+    na = case.export.angular_count
+    angles = 2.0 * np.pi * (np.arange(na) + 0.5) / na
+    qs = sorted(set(vm.q) - {0.0})
+
+    def at(l: FloatArray) -> FloatArray:
+        rest = skin_metric(shape.curve_at(0.0), field, 0.0, l, angles, frames)
+        groups = [g for q in qs for g in principal_stretches(rest, skin_metric(shape.curve_at(q), field, q, l,
+                                                                                angles, frames))]
+        return np.stack(groups, axis=1) if groups else np.ones((len(l), 2, na))
+
+    return at
+
+
+def _tets_per_layer(layers: FloatArray, case: Case, fit: FitResult, size_mm: float) -> float:
+    """About how many tetrahedra one layer holds (3 per prism, Euler's 2 triangles per section node)."""
     na = case.export.angular_count
     rho = float(np.median(fit.field.evaluate_grid(0.0, layers[:: max(1, len(layers) // 16)], [0.0])))
     inside = np.pi * rho**2 / (0.5 * np.sqrt(3.0) * min(size_mm, 2 * np.pi * rho / na) ** 2)
-    count = 3.0 * (len(layers) - 1) * TRIANGLES_PER_NODE * (na + inside)
+    return 3.0 * TRIANGLES_PER_NODE * (na + inside)
+
+
+def _check_count(layers: FloatArray, case: Case, fit: FitResult, size_mm: float) -> None:
+    count = (len(layers) - 1) * _tets_per_layer(layers, case, fit, size_mm)
     if count > MAX_VOLUME_TETS:
         raise ConfigError(
             f"export.volume_mesh: the swept mesh would hold about {count:.3g} tetrahedra ({len(layers)} layers of "
-            f"{na} angles at size_mm {size_mm:g}), more than the limit of {MAX_VOLUME_TETS} "
+            f"{case.export.angular_count} angles at size_mm {size_mm:g}), more than the limit of {MAX_VOLUME_TETS} "
             "(softdesign/limits/volume.py); raise size_mm or lower export.angular_count")
 
 
@@ -277,7 +326,6 @@ def actuation_layout_of(case: Case, kinematics: KinematicsResult) -> Any:
 def _plan(case: Case, kinematics: KinematicsResult, fit: FitResult, vm: VolumeMeshSpec) -> _Placed:
     e, spec, shape = case.export, body_spec(case, fit), kinematics.chain.shape
     layers = _layers(case, kinematics, fit, vm)
-    _check_count(layers, case, fit, vm.size_mm)
     layout = actuation_layout_of(case, kinematics)
     mesh, ref = plan_mesh(shape.curve_at(0.0), fit.field, layers, spec, e.angular_count, vm.size_mm, layout)
     rest = place_mesh(mesh, ref, shape.curve_at(0.0), fit.field, 0.0, spec, e.angular_count)
