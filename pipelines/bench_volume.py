@@ -14,7 +14,7 @@ machine's other load does not count: the target is judged on them) and as
 wall seconds.  ``--jobs`` as ``softdesign build`` (default 1: CPU time does
 not depend on it).
 
-Usage: ``python pipelines/bench_volume.py [--jobs N] [--only solid,hollow,chambered,aorta,aorta-hollow,aorta-chambered]``;
+Usage: ``python pipelines/bench_volume.py [--jobs N] [--only CASE,...]`` (CASES below);
 ``make bench`` runs it after the build benchmark (pipelines/bench.py).
 """
 
