@@ -10,6 +10,9 @@ from __future__ import annotations
 from softdesign.io.format_names import q_label
 
 MANIFEST = "manifest.json"
+#: How the last run went (each stage's status: ran, skipped, kept or stale, and its seconds): a log, outside the
+#: manifest, so that the manifest and every output are the same bytes for the same inputs however they were reached.
+RUN_LOG = "run.log.json"
 KINEMATICS = "kinematics.json"
 REPORT_DIR = "report"
 MESHES_DIR = "meshes"

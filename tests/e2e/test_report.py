@@ -341,7 +341,7 @@ def test_a_stale_stage_is_noted_on_the_page(demo, tmp_path):
     manifest = json.loads(manifest_file.read_text())
     for stage in manifest["stages"]:
         if stage["name"] == "export":
-            stage["status"] = "stale"
+            stage["stale"] = True
     manifest_file.write_text(json.dumps(manifest))
     write_report(copy, ReportOptions(gif_frames=3))
     text = (copy / REPORT_DIR / PAGE).read_text(encoding="utf-8")

@@ -38,6 +38,7 @@ from softdesign.meshing.body import body_sections
 from softdesign.meshing.chamber_layout import ChamberLayout, analytic_walls, chamber_angles, plan_layout
 from softdesign.meshing.chamber_walls import Wall, chamber_lengths_mm, ring_walls, skin_walls
 from softdesign.meshing.chambers import measured_skin_walls
+from softdesign.meshing.sweep_layout import check_resolvable, layout_holes
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import export_workers
 from softdesign.pipeline.parallel import map_items
@@ -269,12 +270,24 @@ def layout_document(layout: ChamberLayout) -> dict[str, Any]:
     }
 
 
+def _check_sweep(case: Case, fit: FitResult, layout: ChamberLayout) -> None:
+    """The swept volume mesher's check of the layout (:func:`~softdesign.meshing.sweep_layout.check_resolvable`),
+    made here too so that a layout it cannot mesh is refused before the export, mould and volume stages run."""
+    volume = case.export.volume_mesh
+    if volume is None or volume.mesher != "sweep":
+        return
+    a = np.linspace(0.0, 2.0 * np.pi, case.export.angular_count, endpoint=False)
+    scale = float(np.median(fit.field.evaluate_grid(0.0, np.linspace(0.0, 1.0, 65), a)))
+    check_resolvable(layout, layout_holes(layout, scale, case.export.angular_count), scale)
+
+
 def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult) -> ActuationResult | None:
     """Layout (or refusal), the lengths table, the walls and extensions and their verdict; None without actuation."""
     layout = actuation_layout(case, kinematics)
     if layout is None:
         return None
     sections = check_layout(layout, section_radii(fit, layout))
+    _check_sweep(case, fit, layout)
     grid = q_grid(case)
     rows, reference = _rows_at(kinematics, layout, 0.0, 0.0 in case.export.q_values(), None)
     for q, export in grid:
