@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -101,20 +101,33 @@ def solve_in_child(section: Any, law: Any, o: SimulateOptions, target: tuple[flo
     return {"result": found.section, "inverse": found}
 
 
-def _section_mesh(outcome: Any, o: SimulateOptions) -> Any:
+def inverses_in_child(section: Any, law: Any, o: SimulateOptions,
+                      targets: list[tuple[float, tuple[float, float, float]]]) -> list[dict[str, Any]]:
+    """The worker of the build's simulate stage: :func:`solve_in_child`'s inverse for each (q, target arc)."""
+    return [solve_in_child(section, law, replace(o, target_q=q), target) for q, target in targets]
+
+
+def section_mesh_of(case: Any, kinematics: Any, fit: Any, section: int, size_mm: float, angular_count: int,
+                    layer_mm: float) -> Any:
+    """Section ``section``'s (0 at the base) mesh at q = 0 (ConfigError without chambers or for a bad index)."""
     from softdesign.mechanics.layout_section import layout_section_mesh
     from softdesign.pipeline.stages.actuation import actuation_layout
     from softdesign.pipeline.stages.export import body_spec
 
-    kinematics, fit = outcome.results["kinematics"], outcome.results["fit"]
-    layout = actuation_layout(outcome.case, kinematics)
+    layout = actuation_layout(case, kinematics)
     if layout is None:
         raise ConfigError("simulate: the case has no actuation chambers; add an `actuation:` block")
-    if not 0 <= o.section < layout.sections:
-        raise ConfigError(f"simulate --section: got {o.section}, the body has sections 0 to {layout.sections - 1}")
+    if not 0 <= section < layout.sections:
+        raise ConfigError(f"simulate --section: got {section}, the body has sections 0 to {layout.sections - 1}")
     curve0 = kinematics.chain.shape.curve_at(0.0)
-    return layout_section_mesh(curve0, fit.field, body_spec(outcome.case), layout, o.section, o.size_mm,
-                               o.angular_count, o.layer_mm)
+    return layout_section_mesh(curve0, fit.field, body_spec(case), layout, section, size_mm, angular_count, layer_mm)
+
+
+def check_node_count(section: Any, index: int, fix: str) -> None:
+    """Refuse (ConfigError) a section mesh beyond MAX_SECTION_NODES, before its solve."""
+    if len(section.points) > MAX_SECTION_NODES:
+        raise ConfigError(f"simulate: section {index}'s mesh has {len(section.points)} nodes, more than "
+                          f"{MAX_SECTION_NODES} (softdesign/limits_simulate.py); {fix}")
 
 
 def run_simulate(case_file: Path, out: Path | None, o: SimulateOptions, progress: Any) -> dict[str, Any]:
@@ -130,10 +143,9 @@ def run_simulate(case_file: Path, out: Path | None, o: SimulateOptions, progress
     material = material_of(outcome.case)
     if material.law is None:
         raise ConfigError(f"{case_file}: simulate needs material.name (a preset with a law) or material.custom")
-    section = _section_mesh(outcome, o)
-    if len(section.points) > MAX_SECTION_NODES:
-        raise ConfigError(f"simulate: section {o.section}'s mesh has {len(section.points)} nodes, more than "
-                          f"{MAX_SECTION_NODES} (softdesign/limits_simulate.py); raise --size-mm or --layer-mm")
+    section = section_mesh_of(outcome.case, outcome.results["kinematics"], outcome.results["fit"], o.section,
+                              o.size_mm, o.angular_count, o.layer_mm)
+    check_node_count(section, o.section, "raise --size-mm or --layer-mm")
     target = None
     if o.target_q is not None:
         arc = fit_links(outcome.results["kinematics"].chain, o.target_q, ARC_SAMPLES)[o.section]
@@ -181,3 +193,34 @@ def payload(o: SimulateOptions, section: Any, material: Any, answer: dict[str, A
                          "error_mm": [float(v) for v in inverse.error_mm], "converged": inverse.converged,
                          "how": inverse.stopped_because, "forward_solves": inverse.iterations}
     return out
+
+
+def write_to_table(case_file: Path, out: Path | None, o: SimulateOptions, progress: Any) -> dict[str, Any]:
+    """``--target q --write``: build through actuation with ``simulate`` enabled for this section and q.
+
+    The case file's ``simulate:`` block (or the defaults) with ``enabled: true``, ``q: [q]``, ``sections:
+    [section + 1]`` and the command's mesh, bound and time: the simulate stage solves it and the actuation stage
+    writes the pressures into the build folder's actuation.csv, the build's manifest recording that case.  The
+    figures are the stage's for that section (as :func:`payload`, section numbered from 0 as --section).
+    """
+    from softdesign.config import load_case
+    from softdesign.config_simulate import Simulate
+    from softdesign.pipeline.api import build_through
+
+    check_options(o)
+    if o.target_q is None:
+        raise ConfigError("simulate --write: writes the pressures found for --target q; give --target, not --pressures")
+    case = load_case(case_file)
+    if case.actuation is None:
+        raise ConfigError("simulate: the case has no actuation chambers; add an `actuation:` block")
+    settings = (case.simulate or Simulate()).model_dump()
+    settings.update(enabled=True, q=[o.target_q], sections=[o.section + 1], size_mm=o.size_mm, layer_mm=o.layer_mm,
+                    angular_count=o.angular_count, max_pressure_kpa=o.max_pressure_kpa, max_solves=o.max_solves,
+                    timeout_s=o.timeout_s)
+    start = time.perf_counter()
+    outcome = build_through(case_file, out, "actuation", progress=progress,
+                            case=case.model_copy(update={"simulate": Simulate.model_validate(settings)}))
+    solve = dict(outcome.results["simulate"].summary["solves"][0])
+    solve.update(section=o.section, seconds=round(time.perf_counter() - start, 2),
+                 written=str(outcome.build_dir / "actuation.csv"))
+    return solve

@@ -20,8 +20,8 @@ from softdesign.versions import software_versions
 from tests.helpers.paths import REPO
 
 runner = CliRunner()
-STAGES = ["ingest", "design", "blend", "links", "kinematics", "fit", "actuation", "export", "mould", "volume_mesh",
-          "feasibility"]
+STAGES = ["ingest", "design", "blend", "links", "kinematics", "fit", "simulate", "actuation", "export", "mould",
+          "volume_mesh", "feasibility"]
 
 
 def snapshot(folder: Path) -> dict[str, str]:
