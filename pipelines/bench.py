@@ -36,6 +36,10 @@ Start-up
     console script beside this Python), wall time from start to exit, and
     the median CPU time (user + system) of the same runs.
 
+Simulate
+    ``softdesign simulate`` on section 0 of the sample case with chambers and of the aorta, forward and inverse,
+    against issue 33's 60 s each (pipelines/bench_simulate.py).
+
 Report
     ``softdesign report`` against a forced ``softdesign build`` of the same
     case, fresh processes with the cores available (issue 17: the report no
@@ -688,6 +692,7 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
     emit(stage_table(measure(volume, scratch, jobs=args.jobs)) + [""])
     emit(centerline_lines() + [""])
     emit(design_lines() + [""])
+    emit(simulate_lines() + [""])
     plan = synthetic_plan(scratch, args.triangles, args.frames)
     results = run_synthetic(plan, scratch, args.jobs)
     largest = next(c for c in plan if (c.triangles, c.frames) == (max(args.triangles), min(args.frames)))
@@ -737,6 +742,15 @@ def design_lines() -> list[str]:
     if done.returncode not in (0, 1):  # 1: a target missed, which its lines say
         raise RuntimeError(f"bench_design.py failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
     return ["design stage (issue 30), CPU s of the core per case and tolerance:"] + done.stdout.splitlines()
+
+
+def simulate_lines() -> list[str]:
+    """`softdesign simulate` on a demo section and an aorta section against 60 s (pipelines/bench_simulate.py)."""
+    done = subprocess.run([sys.executable, str(REPO / "pipelines" / "bench_simulate.py")],
+                          capture_output=True, text=True, cwd=REPO)
+    if done.returncode not in (0, 1):  # 1: a target missed, which its lines say
+        raise RuntimeError(f"bench_simulate.py failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
+    return ["simulate (issue 33):"] + done.stdout.splitlines()
 
 
 def parse_counts(text: str) -> list[int]:
