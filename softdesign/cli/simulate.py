@@ -94,7 +94,8 @@ def simulate(
     """
 
     def action() -> None:
-        from softdesign.pipeline.simulate_run import SimulateOptions, run_simulate, write_to_table
+        from softdesign.pipeline.simulate_command import run_simulate, write_to_table
+        from softdesign.pipeline.simulate_run import SimulateOptions
 
         _check_figure_path(figure)
         values = None if pressures is None else pressures_from_text(pressures)

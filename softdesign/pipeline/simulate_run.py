@@ -1,25 +1,23 @@
-"""``softdesign simulate``: one section of a chambered body solved under chamber pressures, or for a designed arc.
+"""One section of a chambered body solved under chamber pressures, or for a designed arc: the pieces that
+``softdesign simulate`` (:mod:`softdesign.pipeline.simulate_command`) and the build's simulate stage share.
 
-The build runs (cached) through the actuation stage; the section's mesh is
-made (:mod:`softdesign.mechanics.layout_section`) and checked against the
-bounds of :mod:`softdesign.limits_simulate` before any solve; the solve runs
-in a child process with a time and memory limit
+The section's mesh is made (:mod:`softdesign.mechanics.layout_section`) and
+checked against the bounds of :mod:`softdesign.limits.simulate` before any
+solve; the solve runs in a child process with a time and memory limit
 (:func:`~softdesign.pipeline.child.run_in_child`), so a runaway factorization
-fails cleanly.  Nothing is written: the command prints the figures.
+fails cleanly; :func:`payload` gives its figures as JSON.
 """
 
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass, replace
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from softdesign.errors import ConfigError, MeshError, SolveError
-from softdesign.limits_simulate import (
+from softdesign.errors import ConfigError
+from softdesign.limits.simulate import (
     MAX_ANGULAR_COUNT,
     MAX_INVERSE_SOLVES,
     MAX_LOAD_STEPS,
@@ -29,7 +27,6 @@ from softdesign.limits_simulate import (
     MAX_SIMULATE_SECONDS,
     MIN_ANGULAR_COUNT,
     MIN_SIZE_MM,
-    SIMULATE_MEMORY_BYTES,
 )
 
 #: What the model leaves out, stated with every answer.
@@ -67,7 +64,7 @@ def check_options(o: SimulateOptions) -> None:
     def bound(name: str, value: float, low: float, high: float) -> None:
         if not (math.isfinite(value) and low <= value <= high):
             raise ConfigError(f"simulate {name}: got {value:g}, expected a number in [{low:g}, {high:g}] "
-                              "(softdesign/limits_simulate.py)")
+                              "(softdesign/limits/simulate.py)")
     if (o.pressures_kpa is None) == (o.target_q is None):
         raise ConfigError("simulate: give either --pressures P1,P2,P3 (kPa) or --target q, not both or neither")
     for k, p in enumerate(o.pressures_kpa or ()):
@@ -111,8 +108,8 @@ def section_mesh_of(case: Any, kinematics: Any, fit: Any, section: int, size_mm:
                     layer_mm: float) -> Any:
     """Section ``section``'s (0 at the base) mesh at q = 0 (ConfigError without chambers or for a bad index)."""
     from softdesign.mechanics.layout_section import layout_section_mesh
+    from softdesign.pipeline.body_spec import body_spec
     from softdesign.pipeline.stages.actuation import actuation_layout
-    from softdesign.pipeline.stages.export import body_spec
 
     layout = actuation_layout(case, kinematics)
     if layout is None:
@@ -127,37 +124,7 @@ def check_node_count(section: Any, index: int, fix: str) -> None:
     """Refuse (ConfigError) a section mesh beyond MAX_SECTION_NODES, before its solve."""
     if len(section.points) > MAX_SECTION_NODES:
         raise ConfigError(f"simulate: section {index}'s mesh has {len(section.points)} nodes, more than "
-                          f"{MAX_SECTION_NODES} (softdesign/limits_simulate.py); {fix}")
-
-
-def run_simulate(case_file: Path, out: Path | None, o: SimulateOptions, progress: Any) -> dict[str, Any]:
-    """Build through actuation, mesh the section, solve it in a child process; the figures as a dict."""
-    from softdesign.kinematics.pcc_fit import fit_links
-    from softdesign.pipeline.api import build_through
-    from softdesign.pipeline.child import run_in_child
-    from softdesign.pipeline.stages.volume_sweep import material_of
-
-    check_options(o)
-    start = time.perf_counter()
-    outcome = build_through(case_file, out, "actuation", progress=progress)
-    material = material_of(outcome.case)
-    if material.law is None:
-        raise ConfigError(f"{case_file}: simulate needs material.name (a preset with a law) or material.custom")
-    section = section_mesh_of(outcome.case, outcome.results["kinematics"], outcome.results["fit"], o.section,
-                              o.size_mm, o.angular_count, o.layer_mm)
-    check_node_count(section, o.section, "raise --size-mm or --layer-mm")
-    target = None
-    if o.target_q is not None:
-        arc = fit_links(outcome.results["kinematics"].chain, o.target_q, ARC_SAMPLES)[o.section]
-        target = (arc.kappa, arc.phi, arc.length)
-    what = f"the finite-element solve of section {o.section} ({len(section.points)} nodes)"
-    fix = "raise --size-mm or --layer-mm, lower the pressures, or raise --timeout"
-    try:
-        answer = run_in_child(solve_in_child, (section, material.law, o, target), o.timeout_s, what, fix,
-                              SIMULATE_MEMORY_BYTES)
-    except MeshError as err:  # the child's failures, a non-converging solve among them
-        raise SolveError(str(err)) from err
-    return payload(o, section, material, answer, target, time.perf_counter() - start)
+                          f"{MAX_SECTION_NODES} (softdesign/limits/simulate.py); {fix}")
 
 
 def payload(o: SimulateOptions, section: Any, material: Any, answer: dict[str, Any],
@@ -193,34 +160,3 @@ def payload(o: SimulateOptions, section: Any, material: Any, answer: dict[str, A
                          "error_mm": [float(v) for v in inverse.error_mm], "converged": inverse.converged,
                          "how": inverse.stopped_because, "forward_solves": inverse.iterations}
     return out
-
-
-def write_to_table(case_file: Path, out: Path | None, o: SimulateOptions, progress: Any) -> dict[str, Any]:
-    """``--target q --write``: build through actuation with ``simulate`` enabled for this section and q.
-
-    The case file's ``simulate:`` block (or the defaults) with ``enabled: true``, ``q: [q]``, ``sections:
-    [section + 1]`` and the command's mesh, bound and time: the simulate stage solves it and the actuation stage
-    writes the pressures into the build folder's actuation.csv, the build's manifest recording that case.  The
-    figures are the stage's for that section (as :func:`payload`, section numbered from 0 as --section).
-    """
-    from softdesign.config import load_case
-    from softdesign.config_simulate import Simulate
-    from softdesign.pipeline.api import build_through
-
-    check_options(o)
-    if o.target_q is None:
-        raise ConfigError("simulate --write: writes the pressures found for --target q; give --target, not --pressures")
-    case = load_case(case_file)
-    if case.actuation is None:
-        raise ConfigError("simulate: the case has no actuation chambers; add an `actuation:` block")
-    settings = (case.simulate or Simulate()).model_dump()
-    settings.update(enabled=True, q=[o.target_q], sections=[o.section + 1], size_mm=o.size_mm, layer_mm=o.layer_mm,
-                    angular_count=o.angular_count, max_pressure_kpa=o.max_pressure_kpa, max_solves=o.max_solves,
-                    timeout_s=o.timeout_s)
-    start = time.perf_counter()
-    outcome = build_through(case_file, out, "actuation", progress=progress,
-                            case=case.model_copy(update={"simulate": Simulate.model_validate(settings)}))
-    solve = dict(outcome.results["simulate"].summary["solves"][0])
-    solve.update(section=o.section, seconds=round(time.perf_counter() - start, 2),
-                 written=str(outcome.build_dir / "actuation.csv"))
-    return solve

@@ -20,8 +20,8 @@ import yaml
 
 from softdesign.config import load_case
 from softdesign.pipeline.api import build_through
+from softdesign.pipeline.simulate_estimates import ESTIMATE_COLUMNS
 from softdesign.pipeline.stages.actuation import COLUMNS
-from softdesign.pipeline.stages.simulate import ESTIMATE_COLUMNS
 from tests.helpers.paths import REPO
 
 pytestmark = pytest.mark.slow
@@ -119,7 +119,8 @@ def test_without_simulate_the_table_keeps_its_columns_and_rows(built: tuple[Path
 
 
 def test_simulate_write_puts_one_sections_pressures_in_the_table(tmp_path: Path) -> None:
-    from softdesign.pipeline.simulate_run import SimulateOptions, write_to_table
+    from softdesign.pipeline.simulate_command import write_to_table
+    from softdesign.pipeline.simulate_run import SimulateOptions
 
     case = case_file(tmp_path, None)  # no simulate block: --write enables it for this run's section and q
     options = SimulateOptions(1, None, 0.5, size_mm=4.0, layer_mm=10.0, angular_count=8, max_pressure_kpa=50.0,

@@ -6,7 +6,7 @@ With ``simulate: {enabled: true}`` in the case (and ``actuation:``, a
 1. refuses a chamber layout that does not fit (the actuation stage's own check,
    exit 2) and meshes every requested section alone at q = 0
    (:func:`~softdesign.pipeline.simulate_run.section_mesh_of`), each mesh's
-   node count checked against :data:`~softdesign.limits_simulate.MAX_SECTION_NODES`
+   node count checked against :data:`~softdesign.limits.simulate.MAX_SECTION_NODES`
    before any solve;
 2. for each section, in a child process with ``simulate.timeout_s`` and the
    solve's memory limit (:func:`~softdesign.pipeline.child.run_in_child`),
@@ -19,7 +19,7 @@ With ``simulate: {enabled: true}`` in the case (and ``actuation:``, a
    and stress, convergence) in ``simulate/summary.json`` and the manifest.
 
 The actuation stage then adds the pressures to ``actuation.csv`` as model
-estimates (:func:`estimate_cells`).  A solve that fails (a timeout, a Newton
+estimates (:func:`~softdesign.pipeline.simulate_estimates.estimate_cells`).  A solve that fails (a timeout, a Newton
 solve that does not converge at the search's start) fails the build with its
 message (exit 1); an inverse that stops above its tolerance is kept with its
 remaining error and ``converged: false``.
@@ -28,13 +28,11 @@ remaining error and ``converged: false``.
 from __future__ import annotations
 
 import json
-import math
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from softdesign.errors import ConfigError, MeshError, SolveError
-from softdesign.pipeline.layout import q_label
+from softdesign.pipeline.simulate_estimates import SimulateResult, arc_error_mm
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.store import Staging
 
@@ -45,15 +43,6 @@ if TYPE_CHECKING:
 
 VERSION = 1
 SUMMARY = "simulate/summary.json"
-#: actuation.csv's columns for the estimates (only when the build has them).
-ESTIMATE_COLUMNS = ("pressure_kpa", "pressure_arc_error_mm", "pressure_source")
-
-
-@dataclass(frozen=True)
-class SimulateResult:
-    """The figures of every solve (JSON-ready)."""
-
-    summary: dict[str, Any]
 
 
 def _options(case: Case, section: int) -> Any:
@@ -98,7 +87,7 @@ def _solve_section(case: Case, kinematics: KinematicsResult, mesh: Any, index: i
                    ) -> list[tuple[float, tuple[float, float, float], dict[str, Any]]]:
     """(q, target arc, answer) at every requested q of one section, solved in a child process (SolveError)."""
     from softdesign.kinematics.pcc_fit import fit_links
-    from softdesign.limits_simulate import SIMULATE_MEMORY_BYTES
+    from softdesign.limits.simulate import SIMULATE_MEMORY_BYTES
     from softdesign.pipeline.child import run_in_child
     from softdesign.pipeline.simulate_run import inverses_in_child
     from softdesign.pipeline.stages.actuation import ARC_SAMPLES
@@ -148,22 +137,6 @@ def source_label(figures: dict[str, Any]) -> str:
     return (f"model estimate (finite elements, not measured): {m['name']} {m['law']}; section mesh {mesh['nodes']} "
             f"nodes {mesh['tets']} tets, size {mesh['size_mm']:g} mm, layers {mesh['layer_mm']:g} mm, "
             f"{mesh['angular_count']} around; {figures['formulation']}")
-
-
-def arc_error_mm(figures: dict[str, Any]) -> float:
-    """The remaining weighted arc error of a solve (the norm of its error vector), mm."""
-    return math.hypot(*figures["target"]["error_mm"])
-
-
-def estimate_cells(result: SimulateResult | None, q: float, section: int) -> dict[str, Any] | None:
-    """actuation.csv's estimate cells of (q, section from 1) as {column: per-chamber list or value}, or None."""
-    if result is None:
-        return None
-    for solve in result.summary["solves"]:
-        if solve["section"] == section and q_label(solve["q"]) == q_label(q):
-            return {"pressure_kpa": solve["pressures_kpa"], "pressure_arc_error_mm": arc_error_mm(solve),
-                    "pressure_source": solve["source"]}
-    return None
 
 
 def write_simulate(result: SimulateResult | None, staging: Staging) -> None:

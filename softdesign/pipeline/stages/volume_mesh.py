@@ -44,17 +44,18 @@ from softdesign.config import VolumeMesh as VolumeMeshSpec
 from softdesign.errors import ConfigError
 from softdesign.io.formats import mesh_bytes
 from softdesign.io.volume_formats import VOLUME_FORMATS, NamedSets, volume_mesh_bytes
-from softdesign.limits_volume import MAX_VOLUME_TETS, MESHER_MEMORY_BYTES
+from softdesign.limits.volume import MAX_VOLUME_TETS, MESHER_MEMORY_BYTES
 from softdesign.meshing.body import body_sections
 from softdesign.meshing.chamber import chamber_surface
 from softdesign.meshing.tet_checks import REGULAR_TET_FACTOR, check_tet_mesh, expected_tets
 from softdesign.meshing.tetmesh import TetSettings, tetrahedralize
 from softdesign.meshing.topology import mesh_topology
 from softdesign.pipeline import layout
+from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.child import run_in_child
 from softdesign.pipeline.output_frame import base_pose, moved_points, output_pose
 from softdesign.pipeline.stage import Stage
-from softdesign.pipeline.stages.export import body_spec, solid_at
+from softdesign.pipeline.stages.export import solid_at
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
@@ -94,7 +95,7 @@ def _check_count(volume_mm3: float, size_mm: float, q: float) -> None:
         raise ConfigError(
             f"export.volume_mesh.size_mm: {size_mm:g} mm asks for about {count:.3g} tetrahedra in the body's "
             f"{volume_mm3:.1f} mm3 at q={q:.3f}, more than the limit of {MAX_VOLUME_TETS} "
-            f"(softdesign/limits_volume.py); use size_mm >= {np.ceil(least * 1000) / 1000:g} mm"
+            f"(softdesign/limits/volume.py); use size_mm >= {np.ceil(least * 1000) / 1000:g} mm"
         )
 
 

@@ -26,7 +26,7 @@ import numpy as np
 from softdesign.config import Case
 from softdesign.config import VolumeMesh as VolumeMeshSpec
 from softdesign.errors import ConfigError, MeshError
-from softdesign.limits_volume import MAX_VOLUME_TETS
+from softdesign.limits.volume import MAX_VOLUME_TETS
 from softdesign.mechanics.kinematic_stress import rest_inverses
 from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.meshing.body import export_l_grid
@@ -37,8 +37,9 @@ from softdesign.meshing.sweep_strain import extreme_of, free_directions, skin_st
 from softdesign.meshing.tet_quality import dihedral_angles, radius_edge_ratios, tet_volumes
 from softdesign.meshing.topology import mesh_topology
 from softdesign.meshing.volume_tolerance import VOLUME_RTOL
+from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.item_progress import item_counter
-from softdesign.pipeline.stages.export import body_spec, solid_at
+from softdesign.pipeline.stages.export import solid_at
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.types import FloatArray
@@ -95,7 +96,7 @@ def _check_count(layers: FloatArray, case: Case, fit: FitResult, size_mm: float)
         raise ConfigError(
             f"export.volume_mesh: the swept mesh would hold about {count:.3g} tetrahedra ({len(layers)} layers of "
             f"{na} angles at size_mm {size_mm:g}), more than the limit of {MAX_VOLUME_TETS} "
-            "(softdesign/limits_volume.py); raise size_mm or lower export.angular_count")
+            "(softdesign/limits/volume.py); raise size_mm or lower export.angular_count")
 
 
 Places = tuple[Any, FloatArray, FloatArray, FloatArray]
@@ -158,7 +159,7 @@ def _strain_figures(placed: _Placed, moved: FloatArray) -> tuple[dict[str, Any],
 
 def material_of(case: Case) -> Material:
     """The case's law and limits for the 3D figures (no material: figures only, not judged)."""
-    from softdesign.material_data import law_from, material_presets
+    from softdesign.materials.data import law_from, material_presets
 
     m = case.material
     if m is None:

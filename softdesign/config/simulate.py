@@ -8,16 +8,16 @@ them to ``actuation.csv`` as model estimates.  Each inverse takes many forward
 solves (minutes per section on 2 cores), so it never runs unless asked for;
 ``softdesign simulate CASE --target q --write`` does the same for one section
 and one q.  Every size is bounded here, before any work
-(:mod:`softdesign.limits_simulate`).
+(:mod:`softdesign.limits.simulate`).
 """
 
 from __future__ import annotations
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-from softdesign.config_types import FiniteFloat, Integer
+from softdesign.config.types import FiniteFloat, Integer
 from softdesign.limits import MAX_LINKS
-from softdesign.limits_simulate import (
+from softdesign.limits.simulate import (
     MAX_ANGULAR_COUNT,
     MAX_INVERSE_SOLVES,
     MAX_PRESSURE_KPA,
