@@ -126,9 +126,11 @@ def design(
     "tip_tolerance_mm", "tip_tolerance_deg", "min_link_mm", "max_links",
     "meets_tolerance", "chain_max_deviation_mm", "tip_error_mm",
     "tip_error_deg", "base_frame" (4x4), "links": [{"index", "l_start",
-    "l_end", "kappa", "phi", "length", "theta", "tip_frame" (4x4),
+    "l_end", "kappa", "phi", "length", "theta", "dh" (seed 003's five D-H
+    rows {"theta", "d", "a", "alpha"}), "tip_frame" (4x4),
     "max_deviation_mm", "chamber_lengths"}], "breaks", "searched", "method",
-    "convention"}; mm and radians, degrees only in keys ending _deg.
+    "convention", "dh_convention"}; mm and radians, degrees only in keys
+    ending _deg.
     """
 
     def action() -> None:

@@ -79,7 +79,8 @@ def _all_outputs(folder: Path, stages: list[Stage]) -> list[dict[str, Any]]:
 
 def run_log(runs: list[StageRun]) -> dict[str, Any]:
     """:data:`~softdesign.pipeline.layout.RUN_LOG`: each stage's status in this run and its seconds (none for a
-    stage kept or stale from an earlier run)."""
+    stage kept or stale from an earlier run), and the stage's own log lines when it ran (e.g. each part's time)."""
     return {"stages": [{"name": r.name, "status": r.status,
-                        **({} if r.status in (Status.KEPT, Status.STALE) else {"seconds": round(r.seconds, 3)})}
+                        **({} if r.status in (Status.KEPT, Status.STALE) else {"seconds": round(r.seconds, 3)}),
+                        **({"log": r.log} if r.log else {})}
                        for r in runs]}

@@ -172,7 +172,8 @@ def _run_one(
     staging.write_json(layout.stage_record(stage.name), done)
     seconds = time.perf_counter() - start
     options.progress(f"{stage.name}: done in {seconds:.2f} s")
-    return StageRun(stage.name, key, Status.RAN, seconds, stage.describe(results[stage.name]))
+    result = results[stage.name]
+    return StageRun(stage.name, key, Status.RAN, seconds, stage.describe(result), stage.log(result))
 
 
 def _kept_run(stage: Stage, record: dict[str, Any], key: str, results: Results, staging: Staging) -> StageRun:
