@@ -276,7 +276,7 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
             raise MeshError("volume mesh: actuation chambers and export.wall_mm's single chamber together; give one")
         # the core must stay inside the skin at every q: the thinnest radius over the morph, not at q = 0 alone
         thinnest = min(float(np.min(field.evaluate_grid(q, layers, a))) for q in CORE_Q_SAMPLES)
-        holes, ref = holes_from_layout(layout, scale, thinnest, angular_count)
+        holes, ref = holes_from_layout(layout, scale, thinnest, size_mm)
         mesh = swept_disk(angular_count, holes, size, layers)
         return mesh, _with_cuts(mesh, ref, curve0, field, spec, angular_count)
     if spec.wall_mm == 0:
@@ -316,12 +316,13 @@ CORE_GAP_FRACTION = 0.5
 
 
 def holes_from_layout(layout: ChamberLayout, scale_mm: float, rho_min_mm: float,
-                      angular_count: int) -> tuple[list[Hole], SweepReference]:
+                      size_mm: float) -> tuple[list[Hole], SweepReference]:
     """Issue 31's chambers and feeds as holes of the reference section, and the rigid core holding them.
 
     Chamber (section i, chamber j) is ``s{i}_c{j}`` (surfaces ``s{i}_c{j}_wall``, ``_cap``); its feed
     ``s{i}_c{j}_feed`` belongs to the same cavity and opens at the base (``s{i}_c{j}_feed_inlet``).
-    ``scale_mm`` (R0) is mm per reference unit, ``rho_min_mm`` the thinnest section's radius over the morph.
+    ``scale_mm`` (R0) is mm per reference unit, ``rho_min_mm`` the thinnest section's radius over the morph,
+    ``size_mm`` the element size the circles' nodes follow (:func:`~softdesign.meshing.sweep_layout.circle_nodes`).
     """
     reach = max([c.distance_mm + 0.5 * c.diameter_mm for c in layout.chambers]
                 + [f.ring_mm + 0.5 * f.diameter_mm for f in layout.feeds])
@@ -329,5 +330,5 @@ def holes_from_layout(layout: ChamberLayout, scale_mm: float, rho_min_mm: float,
     if not reach < core_mm < rho_min_mm:
         raise MeshError(f"volume mesh: the chambers reach {reach:.3f} mm from the centerline, the thinnest section "
                         f"is {rho_min_mm:.3f} mm: no wall; use smaller actuation.distance_mm or diameter_mm")
-    holes = check_resolvable(layout, layout_holes(layout, scale_mm, angular_count), scale_mm)
+    holes = check_resolvable(layout, layout_holes(layout, scale_mm, size_mm), scale_mm)
     return holes, SweepReference(core=core_mm / scale_mm, scale_mm=scale_mm)

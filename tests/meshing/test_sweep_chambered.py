@@ -140,7 +140,7 @@ def test_graded_mesh_same_bytes_twice():
     layout = _layout(shape, 5, 0.8, 0.4)
     runs = []
     for _ in range(2):
-        holes = check_resolvable(layout, layout_holes(layout, RADIUS_MM, NA), RADIUS_MM)
+        holes = check_resolvable(layout, layout_holes(layout, RADIUS_MM, 2.0), RADIUS_MM)
         assert any(h.circle.angles for h in holes)
         runs.append(swept_disk(NA, holes, 2.0 / RADIUS_MM, np.linspace(0.0, 1.0, 11)))
     first, second = runs

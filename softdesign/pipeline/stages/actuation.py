@@ -303,7 +303,7 @@ def _check_sweep(case: Case, fit: FitResult, layout: ChamberLayout) -> None:
         return
     a = np.linspace(0.0, 2.0 * np.pi, case.export.angular_count, endpoint=False)
     scale = float(np.median(fit.field.evaluate_grid(0.0, np.linspace(0.0, 1.0, 65), a)))
-    check_resolvable(layout, layout_holes(layout, scale, case.export.angular_count), scale)
+    check_resolvable(layout, layout_holes(layout, scale, volume.size_mm), scale)
 
 
 def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult,

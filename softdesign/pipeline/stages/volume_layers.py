@@ -1,8 +1,7 @@
 """The swept mesh's layers (the l stations of :mod:`softdesign.meshing.sweep_mesh`), planned on the body at q = 0.
 
-Layers evenly ``size_mm`` apart in arc length but at most ``LAYER_ASPECT``
-skin edges (the finest grid of the q values meshed, every link joint a
-layer), then graded by the skin's stretch near its extremes at every
+Layers evenly ``size_mm`` apart in arc length (the finest grid of the q
+values meshed, every link joint a layer), then graded by the skin's stretch near its extremes at every
 exported q (:mod:`softdesign.meshing.sweep_grading`), so that the mesh's skin
 figures meet the feasibility stage's within issue 32's 1 %; the tetrahedra
 they make bounded by ``MAX_VOLUME_TETS`` before the grading and after it.
@@ -11,6 +10,7 @@ they make bounded by ``MAX_VOLUME_TETS`` before the grading and after it.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TypeVar
 
 import numpy as np
 
@@ -25,9 +25,15 @@ from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.types import FloatArray
 
-#: Largest layer spacing in skin edges: prisms taller than 3 edges split into needles (the demo hollow at 2 mm
-#: layers over 0.36 mm skin edges: 26 % of tets under 10 degrees of dihedral, 3.4 degrees the least; at 1 mm:
-#: 1.3 %, 6.3 degrees).
+T = TypeVar("T")
+
+#: The layers follow ``size_mm``, not the skin's edge (2 pi rho / angular_count): a cap of 3 skin edges made
+#: the actuator's 101 layers (543,216 tets, 8-9 s CPU) at every size_mm from 2 to 8.  Prisms taller than their
+#: skin edge cost needles at the skin, reported as the mesh's least dihedral angle and its worst element (the
+#: demo hollow: 5.8 degrees the least at 3 skin edges, 3.1 at 2 mm layers): a smaller size_mm buys quality
+#: with elements.  Layers too far apart for a bend can invert a tetrahedron or miss the volume (the aorta
+#: chambered at 4 mm layers: one inverted at q = 1; the demo solid at 4 mm: -0.50 % at q = 1), so the stage
+#: halves the spacing (:func:`sound_layers`) down to ``LAYER_ASPECT`` skin edges, the spacing meshed before.
 LAYER_ASPECT = 3.0
 #: The largest relative change of a skin stretch between neighbouring layers (:mod:`softdesign.meshing.
 #: sweep_grading`): a skin quad's centre then comes within about half of it of the stretch anywhere in its
@@ -39,19 +45,30 @@ MIN_LAYER_EDGES = 0.125
 TRIANGLES_PER_NODE = 2.0
 
 
-def layer_spacing_mm(case: Case, fit: FitResult, size_mm: float) -> float:
-    """The layers' spacing: ``size_mm``, at most ``LAYER_ASPECT`` skin edges (2 pi rho / angular_count at the
-    median radius at q = 0), so that no prism is much taller than its base is wide."""
-    rho = float(np.median(fit.field.evaluate_grid(0.0, np.linspace(0.0, 1.0, 33), [0.0, 0.5 * np.pi, np.pi])))
-    return min(size_mm, LAYER_ASPECT * 2.0 * np.pi * rho / case.export.angular_count)
+def sound_layers(size_mm: float, floor_mm: float, plan: Callable[[float], T],
+                 sound: Callable[[T], bool]) -> T:
+    """``plan(spacing)`` at ``size_mm``, the spacing halved while ``sound`` refuses the plan (an inverted
+    tetrahedron, a volume off at an exported q) and it exceeds ``floor_mm`` (then the floor's plan, checked by
+    the stage as every plan is)."""
+    spacing = float(size_mm)
+    while True:
+        planned = plan(spacing)
+        if spacing <= floor_mm or sound(planned):
+            return planned
+        spacing = max(floor_mm, 0.5 * spacing)
 
 
-def swept_layers(case: Case, kinematics: KinematicsResult, fit: FitResult,
-                 vm: VolumeMeshSpec) -> tuple[FloatArray, FloatArray]:
-    """The layers (n,) l: the even ones (:func:`layer_spacing_mm`, the finest grid of the q meshed), graded by
+def floor_spacing_mm(case: Case, fit: FitResult) -> float:
+    """The finest even spacing :func:`sound_layers` falls back to: ``LAYER_ASPECT`` skin edges."""
+    return LAYER_ASPECT * _skin_edge_mm(case, fit)
+
+
+def swept_layers(case: Case, kinematics: KinematicsResult, fit: FitResult, vm: VolumeMeshSpec,
+                 spacing: float) -> tuple[FloatArray, FloatArray]:
+    """The layers (n,) l: the even ones (``spacing`` mm apart, the finest grid of the q meshed), graded by
     the skin's stretch near its extremes at every q exported (:mod:`softdesign.meshing.sweep_grading`), the
     count checked; and the even ones (m,) l, a subset (where the reference section is measured)."""
-    shape, spacing = kinematics.chain.shape, layer_spacing_mm(case, fit, vm.size_mm)
+    shape = kinematics.chain.shape
     grids = [export_l_grid(shape.curve_at(q), fit.field, spacing) for q in sorted({0.0, *vm.q})]
     even = max(grids, key=len)
     _check_count(even, case, fit, vm.size_mm)

@@ -40,7 +40,7 @@ from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.stages.export import solid_at
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
-from softdesign.pipeline.stages.volume_layers import swept_layers
+from softdesign.pipeline.stages.volume_layers import floor_spacing_mm, sound_layers, swept_layers
 from softdesign.types import FloatArray
 
 #: Tetrahedra times q values of the morph's samples in one batch: one task of a worker and one part of the log
@@ -242,9 +242,31 @@ def actuation_layout_of(case: Case, kinematics: KinematicsResult) -> Any:
     return importlib.import_module("softdesign.pipeline.stages.actuation").actuation_layout(case, kinematics)
 
 
-def _plan(case: Case, kinematics: KinematicsResult, fit: FitResult, vm: VolumeMeshSpec) -> _Placed:
+def _plan(case: Case, kinematics: KinematicsResult, fit: FitResult, vm: VolumeMeshSpec,
+          surface: dict[float, float] | None = None) -> _Placed:
+    """The mesh planned with layers ``size_mm`` apart, closer where that is not sound at an exported q
+    (:func:`~softdesign.pipeline.stages.volume_layers.sound_layers`; ``surface``: q -> the surface mesh's mm3)."""
+    surface = surface or _surface_mm3(case, kinematics, fit, vm)
+
+    def sound(placed: _Placed) -> bool:
+        for q in vm.q:
+            volumes = tet_volumes(placed.at(q), placed.mesh.tets)
+            if volumes.min() <= 0 or abs(volumes.sum() / surface[q] - 1.0) > 0.5 * VOLUME_RTOL:
+                return False
+        return True
+
+    return sound_layers(vm.size_mm, floor_spacing_mm(case, fit),
+                        lambda spacing: _plan_at(case, kinematics, fit, vm, spacing), sound)
+
+
+def _surface_mm3(case: Case, kinematics: KinematicsResult, fit: FitResult, vm: VolumeMeshSpec) -> dict[float, float]:
+    """q -> the export's surface mesh's volume, mm3, at each exported q."""
+    return {q: float(solid_at(kinematics, fit, q, case).figures["volume_mm3"]) for q in vm.q}
+
+
+def _plan_at(case: Case, kinematics: KinematicsResult, fit: FitResult, vm: VolumeMeshSpec, spacing: float) -> _Placed:
     e, spec, shape = case.export, body_spec(case, fit), kinematics.chain.shape
-    layers, even = swept_layers(case, kinematics, fit, vm)
+    layers, even = swept_layers(case, kinematics, fit, vm, spacing)
     layout = actuation_layout_of(case, kinematics)
     mesh, ref = plan_mesh(shape.curve_at(0.0), fit.field, layers, spec, e.angular_count, vm.size_mm, layout,
                           even)
@@ -266,7 +288,8 @@ def run_sweep(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Sweep
     vm = case.export.volume_mesh or VolumeMeshSpec()
     log: list[dict[str, Any]] = []
     start = time.perf_counter()
-    placed = _plan(case, kinematics, fit, vm)
+    surface = _surface_mm3(case, kinematics, fit, vm)
+    placed = _plan(case, kinematics, fit, vm, surface)
     batches = morph_batches([q for q in morph_samples() if q not in vm.q], len(placed.mesh.tets))
     tick = item_counter("volume_mesh", ["plan", *vm.q, *batches], _part_label)
     _tell(tick, "plan", time.perf_counter() - start, log)
@@ -275,7 +298,7 @@ def run_sweep(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Sweep
         start = time.perf_counter()
         points = placed.at(q)
         figures = _quality(points, placed.mesh, placed.places)
-        _check(figures, float(solid_at(kinematics, fit, q, case).figures["volume_mm3"]), q)
+        _check(figures, surface[q], q)
         strain, data = placed.strain(points)
         figures.update({"q": q, "size_mm": vm.size_mm, "layers": len(placed.mesh.l),
                         "body_kind": _kind(placed.spec, placed.mesh), "strain": strain,
