@@ -36,6 +36,9 @@ Start-up
     console script beside this Python), wall time from start to exit, and
     the median CPU time (user + system) of the same runs.
 
+Volume mesh
+    The volume_mesh stage alone (pipelines/bench_volume.py, issue 32): the
+    sample case solid, hollow and chambered and the aorta, CPU s against 10 s.
 Report
     ``softdesign report`` against a forced ``softdesign build`` of the same
     case, fresh processes with the cores available (issue 17: the report no
@@ -315,25 +318,6 @@ def aorta_case(folder: Path) -> BenchCase | None:
         "  path: 0\n"
     )
     return BenchCase("VMTK aorta (path 0, capped surface)", case)
-
-
-def volume_mesh_case(folder: Path, case: Path, label: str, export: str) -> BenchCase:
-    """``case`` with an ``export`` block asking for the swept volume mesh (issue 32): its stage's row times it."""
-    import yaml
-
-    data = yaml.safe_load(case.read_text(encoding="utf-8"))
-    for key in ("centerline", "surface"):  # the copy lives elsewhere: absolute input paths
-        data["final"][key] = str((case.parent / data["final"][key]).resolve())
-    data["export"] = {**data.get("export", {}), **yaml.safe_load(export)}
-    folder.mkdir(parents=True, exist_ok=True)
-    path = folder / f"{case.stem}-volume.yaml"
-    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
-    return BenchCase(label, path)
-
-
-#: The swept volume mesh's benchmark: hollow with a port, q = 0, 0.5, 1 (issue 32's cases; solid is the stage's
-#: cheapest).
-VOLUME_EXPORT = "{wall_mm: 1.0, port_mm: 1.2, volume_mesh: {q: [0, 0.5, 1]}}"
 
 
 def write_synthetic_inputs(folder: Path, triangles: int) -> None:
@@ -684,8 +668,7 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
         emit([f"VMTK aorta: skipped, {AORTA_DIR} not found", ""])
     else:
         emit(stage_table(measure(aorta, scratch, jobs=args.jobs)) + [""])
-    volume = volume_mesh_case(scratch / "volume", DEMO_CASE, "sample case, hollow, swept volume mesh", VOLUME_EXPORT)
-    emit(stage_table(measure(volume, scratch, jobs=args.jobs)) + [""])
+    emit(volume_lines() + [""])
     emit(centerline_lines() + [""])
     emit(design_lines() + [""])
     plan = synthetic_plan(scratch, args.triangles, args.frames)
@@ -727,6 +710,16 @@ def centerline_lines() -> list[str]:
                           capture_output=True, text=True, cwd=REPO)
     if done.returncode != 0:
         raise RuntimeError(f"bench_centerline.py failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
+    return done.stdout.splitlines()
+
+
+def volume_lines() -> list[str]:
+    """The volume_mesh stage alone on the sample case solid, hollow, chambered and the aorta, against issue 32's
+    10 s (pipelines/bench_volume.py)."""
+    done = subprocess.run([sys.executable, str(REPO / "pipelines" / "bench_volume.py")],
+                          capture_output=True, text=True, cwd=REPO)
+    if done.returncode not in (0, 1):  # 1: a target missed, which its lines say
+        raise RuntimeError(f"bench_volume.py failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
     return done.stdout.splitlines()
 
 

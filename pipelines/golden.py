@@ -14,7 +14,7 @@ writes OUT/<case>/ as a reference folder for ``softdesign check``:
   :func:`softdesign.regression.decimation_entry` gives them; ``check`` widens
   that mesh's tolerances by them), the case file's path and sha256, the input
   files' sha256, and the versions of the software that made the build
-  (:func:`softdesign.versions.software_versions`, as the manifest records them).
+  (:func:`softdesign.pipeline.versions.software_versions`, as the manifest records them).
 
 The new references are written beside OUT and swapped in only when every
 case succeeded, so a failed run leaves the old references as they were.
@@ -38,8 +38,8 @@ from softdesign.meshing.compare import MeshDifference, compare_meshes
 from softdesign.meshing.topology import is_winding_consistent
 from softdesign.pipeline.layout import MANIFEST
 from softdesign.pipeline.store import sha256_file
+from softdesign.pipeline.versions import software_versions
 from softdesign.regression import GOLDEN, KINEMATICS, decimation_entry, mesh_names
-from softdesign.versions import software_versions
 
 #: Strongest target reduction tried, and how many bisection steps find the strongest acceptable one.
 MAX_REDUCTION, BISECTIONS = 0.97, 6
@@ -56,7 +56,7 @@ def decimate(vertices: np.ndarray, faces: np.ndarray, reduction: float) -> tuple
     from vtkmodules.util.numpy_support import vtk_to_numpy
     from vtkmodules.vtkFiltersCore import vtkQuadricDecimation
 
-    from softdesign.io.vtk_polydata import polydata_from_triangles
+    from softdesign.meshing.vtk_triangles import polydata_from_triangles
 
     if reduction <= 0.0:
         return vertices, faces

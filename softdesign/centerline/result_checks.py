@@ -82,7 +82,7 @@ def _check_inside_wall(k: int, points: npt.NDArray[np.float64], radius: npt.NDAr
                        where: str, fix: str) -> None:
     from vtkmodules.vtkFiltersCore import vtkImplicitPolyDataDistance
 
-    from softdesign.io.vtk_polydata import polydata_from_triangles
+    from softdesign.meshing.vtk_triangles import polydata_from_triangles
 
     candidates = np.flatnonzero(inner) if inner.any() else np.arange(len(points))
     pick = candidates[np.unique(np.linspace(0, len(candidates) - 1, min(CHECKED_POINTS, len(candidates))).astype(int))]

@@ -29,11 +29,15 @@ def check(
     ],
     tolerance_mm: Annotated[
         float,
-        typer.Option("--tolerance-mm", help="Surface distance, transform translation, lengths and fit metrics, mm."),
+        typer.Option("--tolerance-mm", help="Surface distance, transform translation, lengths, and the most a fit "
+                     "or design residual may move, mm."),
     ] = 0.01,
-    rtol: Annotated[float, typer.Option("--rtol", help="Relative change of mesh volume and area.")] = 1e-3,
+    rtol: Annotated[float, typer.Option(
+        "--rtol", help="Relative change of mesh volume and area and of stage figures; a residual (fit, design) "
+        "within the smaller of this and its absolute tolerance.")] = 1e-3,
     rotation_tol: Annotated[
-        float, typer.Option("--rotation-tol", help="Rotation between link transforms and POE theta2, rad.")
+        float, typer.Option("--rotation-tol", help="Rotation between link transforms and POE theta2, and the "
+                            "most the design's tip angle may move, rad.")
     ] = 1e-4,
     json_out: Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")] = False,
     failures_only: Annotated[
@@ -41,7 +45,7 @@ def check(
         typer.Option("--failures-only", help="List only the figures outside tolerance (the verdict counts all)."),
     ] = False,
 ) -> None:
-    """Compare meshes (by geometry), kinematics and fit metrics with a reference build.
+    """Compare meshes (by geometry), kinematics and every stage's figures with a reference build.
 
     Exit 0 when every figure is within tolerance, 1 when one is not (or a mesh
     is missing on either side), 2 for a missing folder or bad option.  A

@@ -27,7 +27,7 @@ from softdesign.cli.common import (
     refuse_overwriting_inputs,
     run_guarded,
 )
-from softdesign.design_config import MAX_DESIGN_LINKS
+from softdesign.config.design import MAX_DESIGN_LINKS
 from softdesign.errors import ConfigError, SoftdesignError
 
 if TYPE_CHECKING:  # numpy is imported where it is used: `softdesign --help` starts without it
@@ -58,7 +58,7 @@ def _case_with_design(case_file: Path, options: dict[str, Any]) -> Case:
     from pydantic import ValidationError
 
     from softdesign.config import load_case
-    from softdesign.design_config import Design
+    from softdesign.config.design import Design
 
     case = load_case(case_file)
     given = {k: v for k, v in options.items() if v is not None}
@@ -126,9 +126,11 @@ def design(
     "tip_tolerance_mm", "tip_tolerance_deg", "min_link_mm", "max_links",
     "meets_tolerance", "chain_max_deviation_mm", "tip_error_mm",
     "tip_error_deg", "base_frame" (4x4), "links": [{"index", "l_start",
-    "l_end", "kappa", "phi", "length", "theta", "tip_frame" (4x4),
+    "l_end", "kappa", "phi", "length", "theta", "dh" (seed 003's five D-H
+    rows {"theta", "d", "a", "alpha"}), "tip_frame" (4x4),
     "max_deviation_mm", "chamber_lengths"}], "breaks", "searched", "method",
-    "convention"}; mm and radians, degrees only in keys ending _deg.
+    "convention", "dh_convention"}; mm and radians, degrees only in keys
+    ending _deg.
     """
 
     def action() -> None:
@@ -195,7 +197,7 @@ def _write_case(case_file: Path, target: Path, breaks: list[float], case: Case, 
     flow = "{" + ", ".join(f"{k}: {v!r}" for k, v in block.items()) + "}"
     updates: dict[str, tuple[Any, str]] = {"design": (block, flow), "blend": ("pcc", "pcc"),
                                            "links": ({"breaks": rounded_breaks(breaks)}, breaks_text(breaks))}
-    from softdesign.design_config import pcc_blend_problems
+    from softdesign.config.design import pcc_blend_problems
 
     problems = pcc_blend_problems("pcc", case.design, case.initial.kind, len(case.intermediate))
     if problems:  # the case's own q = 0 shape or keyframes: keep its blend, say why

@@ -11,7 +11,7 @@ def materials(as_json: JsonOpt = False) -> None:
     """List the material presets (softdesign/data/materials.yaml): datasheet values, sources, laws and limits."""
 
     def action() -> None:
-        from softdesign.material_data import material_presets
+        from softdesign.materials.data import material_presets
 
         presets = [p.as_dict() for p in material_presets().values()]
         if as_json:

@@ -9,16 +9,32 @@ on the whole grid, since every value is computed point by point.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Sequence
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
 
 from softdesign.fitting import bspline_basis as bb
+from softdesign.fitting.bspline_surface import RadiusSpline
 from softdesign.types import FloatArray, IntArray
 
-if TYPE_CHECKING:  # the field builds its bases; this module only reads them
-    from softdesign.fitting.radius_field import RadiusField
+
+class LinkBases(Protocol):
+    """What :class:`SlopeRows` reads of a radius field: each link's two splines and the bases along l.
+
+    :class:`~softdesign.fitting.radius_field.RadiusField` is one; naming only this keeps the field's
+    module above this one (the field imports the rows, never the other way).
+    """
+
+    @property
+    def final(self) -> Sequence[RadiusSpline]: ...
+
+    @property
+    def initial(self) -> Sequence[RadiusSpline]: ...
+
+    def along_bases(self, l: npt.ArrayLike, slopes: bool = True
+                    ) -> tuple[tuple[int, IntArray, IntArray, FloatArray, FloatArray], ...]: ...
 
 #: Grid points evaluated at a time by the callers of :class:`SlopeRows` (the skin's metric and
 #: stretches, the folding check): a block's dozen temporaries (16384 float64 each, 128 kB) stay in a
@@ -45,7 +61,7 @@ class SlopeRows:
     :mod:`softdesign.meshing.wall`).
     """
 
-    def __init__(self, field: RadiusField, q: float, l: npt.ArrayLike, a: npt.ArrayLike, slopes: bool = True,
+    def __init__(self, field: LinkBases, q: float, l: npt.ArrayLike, a: npt.ArrayLike, slopes: bool = True,
                  angular: bool = True) -> None:
         l = np.asarray(l, float).reshape(-1)
         self.shape = (len(l), int(np.size(a)))

@@ -18,8 +18,9 @@ so blends of shapes are exact on the spline coefficients, and curvature and
 torsion come from analytic derivatives, not finite differences.
 
 Joints: link breaks where the curvature jumps (seed 003's sections meet) are
-kept sharp when asked: each piece between them is smoothed and resampled on
-its own (:mod:`softdesign.geometry.curve_joints` says when a break is one).
+kept sharp when asked, at any smoothing: each piece between them is smoothed
+(pinned at its joints) and resampled on its own, so no smoothing crosses a
+joint (:mod:`softdesign.geometry.curve_joints` says when a break is one).
 """
 
 from __future__ import annotations
@@ -52,6 +53,10 @@ ARC_REL_TOL = 1e-13
 SMOOTHING_SLACK = 1.5
 #: Fewest distinct input points: a cubic (torsion needs a third derivative) needs 4.
 MIN_POLYLINE_POINTS = 4
+#: Weight of a joint's vertex in the smoothing of the pieces it ends: a pin.  The spline may leave a point of
+#: weight w by at most sqrt(s) / w (s the smoothing's sum of squares, n * smoothing_mm**2): 6e-4 mm for 36 points
+#: at 0.1 mm; on seed 003's arcs it leaves it by 1e-9 mm.
+JOINT_WEIGHT = 1e3
 #: Curvature below which torsion is not reported, 1/mm: a bend of radius 1 m or more.  Torsion, the
 #: turning rate of the osculating plane, is (c' x c'') . c''' / |c' x c''|^2: it divides by kappa^2,
 #: so near an inflection it is the noise of c''' magnified.  At the vessel scale such a bend is
@@ -297,35 +302,57 @@ def smooth_curve_from_polyline(
             f"resample.end_straight_mm = {end:g} mm must be less than half the path length "
             f"({total:.4g} mm); lower it"
         )
-    count = options.count if options.count is not None else int(np.ceil(total / options.spacing_mm - 1e-9)) + 1
-    count = max(count, DEGREE + 1)
-    cuts = joint_cuts(table, count, np.asarray(joints, float).ravel())
-    if cuts:
-        pieced = _samples_by_piece(points, options.smoothing_mm, cuts, count, end)
-        if pieced is not None:
-            return smooth_curve_from_samples(pieced, tuple(grid for _, grid in cuts))
+    joints = np.asarray(joints, float).ravel()
+    pieced = _pieced_samples(points, options, joints) if joints.size else None
+    if pieced is not None:
+        return smooth_curve_from_samples(*pieced)
+    count = _sample_count(options, total)
     s_target = np.linspace(0.0, total, count)
     samples = _points_at_arc_length(spline, u, table, s_target, end)
     return smooth_curve_from_samples(samples)
 
 
-def _samples_by_piece(
-    points: Points, smoothing_mm: float, cuts: list[tuple[int, int]], count: int, end_mm: float
-) -> Points | None:
+def _sample_count(options: CurveOptions, total: float) -> int:
+    """Samples of the resampling grid over a path of ``total`` mm (``count``, or spacing at most ``spacing_mm``)."""
+    count = options.count if options.count is not None else int(np.ceil(total / options.spacing_mm - 1e-9)) + 1
+    return max(count, DEGREE + 1)
+
+
+def _pieced_samples(points: Points, options: CurveOptions, joints: FloatArray) -> tuple[Points, tuple[int, ...]] | None:
+    """Samples (count, 3) smoothed piece by piece between the joints, and the joints' samples; None without a joint.
+
+    Whether a break is a joint is read on the spline interpolating every vertex, whatever the smoothing: a
+    smoothing spline through the whole path rounds the corner and moves the vertex's arc length by about the
+    smoothing, far more than :data:`~softdesign.geometry.curve_joints.JOINT_TOL_SPACINGS` allows.  The grid is
+    that spline's length's; each piece then keeps its own length (:func:`_samples_by_piece`).
+    """
+    spline, u = _chord_spline(points, 0.0)
+    table = _arc_length_table(spline, u)
+    count = _sample_count(options, float(table[-1]))
+    cuts = joint_cuts(table, count, joints)
+    samples = _samples_by_piece(points, options, cuts, count) if cuts else None
+    return None if samples is None else (samples, tuple(grid for _, grid in cuts))
+
+
+def _samples_by_piece(points: Points, options: CurveOptions, cuts: list[tuple[int, int]], count: int) -> Points | None:
     """Samples (count, 3) with each piece between joints smoothed and resampled on its own; None if one is too short.
 
     A piece from vertex a to vertex b fills grid samples g_a..g_b at equal arc length of its own spline; the
-    straight ends apply to the first piece's start and the last one's end.  Where two smoothing pieces end a
-    little apart, the joint's sample is their midpoint.
+    straight ends apply to the first piece's start and the last one's end.  A smoothing piece is pinned at its
+    joints (:data:`JOINT_WEIGHT`): both pieces pass through the joint's vertex, and the joint's sample is their
+    midpoint (the same point to ~1e-9 mm).
     """
     vertices = [0, *(v for v, _ in cuts), len(points) - 1]
     grids = [0, *(g for _, g in cuts), count - 1]
+    end_mm = options.end_straight_mm
     pieces = []
     for i in range(len(vertices) - 1):
         va, vb, ga, gb = vertices[i], vertices[i + 1], grids[i], grids[i + 1]
         if vb - va + 1 < MIN_POLYLINE_POINTS or gb - ga < DEGREE:
             return None
-        spline, u = _chord_spline(points[va : vb + 1], smoothing_mm)
+        weights = np.ones(vb - va + 1)
+        weights[[0, -1]] = (JOINT_WEIGHT if i > 0 else 1.0), (JOINT_WEIGHT if i < len(vertices) - 2 else 1.0)
+        spline, u = _chord_spline(points[va : vb + 1], options.smoothing_mm, weights)
         table = _arc_length_table(spline, u)
         start, stop = (end_mm if i == 0 else 0.0), (end_mm if i == len(vertices) - 2 else 0.0)
         if start + stop >= table[-1]:
@@ -388,15 +415,19 @@ def _distinct_points(points: npt.ArrayLike) -> Points:
     return kept
 
 
-def _chord_spline(points: Points, smoothing_mm: float) -> tuple[BSpline, FloatArray]:
-    """Spline on the chord-length parameter u (mm) and the parameters of the input points."""
+def _chord_spline(points: Points, smoothing_mm: float, weights: FloatArray | None = None) -> tuple[BSpline, FloatArray]:
+    """Spline on the chord-length parameter u (mm) and the parameters of the input points.
+
+    ``weights`` (n,) scale the points' residuals in the smoothing's sum of squares (default 1; unused when
+    interpolating): a large weight pins the spline to that point.
+    """
     u = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
     k = DEGREE if len(points) > DEGREE else 3
     if smoothing_mm == 0.0:
         return make_interp_spline(u, points, k=k), u
     s = len(points) * smoothing_mm**2
     # splprep returns [t, c, k] with the k it was given
-    ((t, c, _), _), fp, ier, msg = splprep(points.T, u=u, k=k, s=s, full_output=True, quiet=True)
+    ((t, c, _), _), fp, ier, msg = splprep(points.T, w=weights, u=u, k=k, s=s, full_output=True, quiet=True)
     # FITPACK: ier <= 0 success, 1..3 warnings (then check the residual it reached), >= 10 bad input.
     if ier >= 10 or (ier > 0 and fp > SMOOTHING_SLACK * s):
         raise GeometryError(

@@ -169,8 +169,9 @@ def _vtp_bytes(vertices: np.ndarray, faces: np.ndarray, regions: np.ndarray | No
     from vtkmodules.util.numpy_support import numpy_to_vtk
     from vtkmodules.vtkCommonCore import vtkStringArray
 
-    from softdesign.io.vtk_polydata import polydata_from_triangles, polydata_writer
+    from softdesign.io.vtk_polydata import polydata_writer
     from softdesign.meshing.tessellate import Region
+    from softdesign.meshing.vtk_triangles import polydata_from_triangles
 
     poly = polydata_from_triangles(np.asarray(vertices, float), np.asarray(faces, np.int64))
     if regions is not None:

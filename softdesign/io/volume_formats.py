@@ -1,4 +1,4 @@
-"""Tetrahedral meshes as simulators load them, through meshio: ASCII XML .vtu and Gmsh .msh 2.2.
+"""Tetrahedral meshes as simulators load them: ASCII XML .vtu and Gmsh .msh 2.2, read back through meshio.
 
 SOFA's ``MeshVTKLoader`` reads only inline (ASCII) data of an XML ``.vtu``,
 not the appended or base64 binary blocks most writers make, and SOFA's
@@ -16,28 +16,24 @@ a point array per node set is 1 on its nodes, and
 per-tetrahedron figures are cell arrays (NaN on the triangles); in ``.msh``
 the body is physical group 1 (``body``, dimension 3), each surface a
 physical group of dimension 2 numbered from 2, each node set a group of
-dimension 0 (point elements), all named in ``$PhysicalNames``.  meshio writes only to
-file names, so the bytes are written in a temporary folder and read back;
-neither format holds a timestamp, so the bytes depend only on the arrays.
+dimension 0 (point elements), all named in ``$PhysicalNames``.  The writing is
+:mod:`softdesign.io.volume_text`'s (VTK's writer for ``.vtu``, meshio's
+bytes of ``.msh`` at C speed); neither format holds a timestamp, so the
+bytes depend only on the arrays.
 """
 
 from __future__ import annotations
 
-import contextlib
-import io
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from softdesign.errors import InputDataError
+from softdesign.io.volume_text import msh22_ascii, vtu_ascii
 
-#: suffix -> meshio's name of the format for writing, its reader's module, and the writer's options.
-VOLUME_FORMATS: dict[str, tuple[str, str, dict[str, object]]] = {
-    "vtu": ("vtu", "vtu", {"binary": False}),
-    "msh": ("gmsh22", "gmsh", {"binary": False}),
-}
+#: suffix -> meshio's name of the format and its reader's module (the reading side).
+VOLUME_FORMATS: dict[str, tuple[str, str]] = {"vtu": ("vtu", "vtu"), "msh": ("gmsh22", "gmsh")}
 
 
 @dataclass(frozen=True)
@@ -56,37 +52,6 @@ class NamedSets:
     tet_data: dict[str, np.ndarray] = field(default_factory=dict)
 
 
-def _mesh(points: np.ndarray, tets: np.ndarray, suffix: str, sets: NamedSets):  # -> meshio.Mesh
-    import meshio
-
-    names = list(sets.surfaces)
-    triangles = [np.asarray(sets.surfaces[n], np.int64).reshape(-1, 3) for n in names]
-    if suffix == "msh":
-        cells = [("tetra", tets)] + [("triangle", t) for t in triangles] + [
-            ("vertex", np.asarray(v, np.int64).reshape(-1, 1)) for v in sets.node_sets.values()]
-        tags = [1] + list(range(2, 2 + len(cells) - 1))
-        blocks = [np.full(len(c[1]), tag, np.int64) for c, tag in zip(cells, tags, strict=True)]
-        dims = [3] + [2] * len(triangles) + [0] * len(sets.node_sets)
-        field_data = {name: np.array([tag, dim]) for name, tag, dim in
-                      zip(["body", *names, *sets.node_sets], tags, dims, strict=True)}
-        return meshio.Mesh(points, cells, cell_data={"gmsh:physical": blocks, "gmsh:geometrical": blocks},
-                           field_data=field_data if len(cells) > 1 else {})
-    cells = [("tetra", tets)] + ([("triangle", np.concatenate(triangles))] if triangles else [])
-    cell_data: dict[str, list[np.ndarray]] = {}
-    if triangles:
-        ids = np.concatenate([np.full(len(t), k, np.int64) for k, t in enumerate(triangles)])
-        cell_data["surface"] = [np.full(len(tets), -1, np.int64), ids]
-    for name, values in sets.tet_data.items():
-        cell_data[name] = [np.asarray(values, np.float64)] + ([np.full(len(ids), np.nan)] if triangles else [])
-    point_data = {}
-    for name, nodes in sets.node_sets.items():  # surfaces are named by the cell array (a point array per surface
-        # cost the chambered demo's 39 surfaces 6 million ASCII numbers)
-        flag = np.zeros(len(points), np.uint8)
-        flag[np.asarray(nodes, np.int64).ravel()] = 1
-        point_data[name] = flag
-    return meshio.Mesh(points, cells, cell_data=cell_data, point_data=point_data)
-
-
 def volume_mesh_bytes(points: np.ndarray, tets: np.ndarray, suffix: str, sets: NamedSets | None = None) -> bytes:
     """The file of a tetrahedral mesh, ``suffix`` ``vtu`` or ``msh``, with its named sets (module notes).
 
@@ -96,19 +61,34 @@ def volume_mesh_bytes(points: np.ndarray, tets: np.ndarray, suffix: str, sets: N
     tets : (T, 4) int, VTK order
     sets : named surfaces, node sets and per-tetrahedron figures, or None (the tetrahedra alone)
     """
-    import meshio
-
     if suffix not in VOLUME_FORMATS:
         raise ValueError(f"volume mesh format must be one of {', '.join(VOLUME_FORMATS)}, got {suffix!r}")
-    file_format, _, options = VOLUME_FORMATS[suffix]
-    tets = np.asarray(tets, np.int64)
-    mesh = _mesh(np.asarray(points, np.float64), tets, suffix, sets or NamedSets())
-    with tempfile.TemporaryDirectory(prefix="softdesign-volume-") as folder:
-        path = Path(folder) / f"mesh.{suffix}"
-        # meshio warns on stderr that ASCII .vtu is "only meant for debugging": it is what SOFA reads
-        with contextlib.redirect_stderr(io.StringIO()):
-            meshio.write(path, mesh, file_format=file_format, **options)
-        return path.read_bytes()
+    sets = sets or NamedSets()
+    points, tets = np.asarray(points, np.float64), np.asarray(tets, np.int64)
+    names = list(sets.surfaces)
+    triangles = [np.asarray(sets.surfaces[n], np.int64).reshape(-1, 3) for n in names]
+    if suffix == "msh":
+        blocks = [("tetra", tets, 1)] + [("triangle", t, 2 + k) for k, t in enumerate(triangles)] + [
+            ("vertex", np.asarray(v, np.int64).reshape(-1, 1), 2 + len(names) + k)
+            for k, v in enumerate(sets.node_sets.values())]
+        dims = [3] + [2] * len(triangles) + [0] * len(sets.node_sets)
+        groups = {name: (tag, dim) for name, (_, _, tag), dim in
+                  zip(["body", *names, *sets.node_sets], blocks, dims, strict=True)}
+        return msh22_ascii(points, blocks, groups if len(blocks) > 1 else {})
+    faces = np.concatenate(triangles) if triangles else np.zeros((0, 3), np.int64)
+    cell_data: dict[str, np.ndarray] = {}
+    if triangles:
+        ids = np.concatenate([np.full(len(t), k, np.int64) for k, t in enumerate(triangles)])
+        cell_data["surface"] = np.concatenate([np.full(len(tets), -1, np.int64), ids])
+    for name, values in sets.tet_data.items():
+        cell_data[name] = np.concatenate([np.asarray(values, np.float64), np.full(len(faces), np.nan)])
+    point_data = {}
+    for name, nodes in sets.node_sets.items():  # surfaces are named by the cell array (a point array per surface
+        # cost the chambered demo's 39 surfaces 6 million ASCII numbers)
+        flag = np.zeros(len(points), np.uint8)
+        flag[np.asarray(nodes, np.int64).ravel()] = 1
+        point_data[name] = flag
+    return vtu_ascii(points, tets, faces, cell_data, point_data)
 
 
 def read_volume_mesh(path: str | Path) -> tuple[np.ndarray, np.ndarray]:

@@ -113,24 +113,6 @@ def triangles_from_polydata(poly) -> tuple[np.ndarray, np.ndarray]:
 
 
 
-def polydata_from_triangles(vertices: np.ndarray, faces: np.ndarray):
-    """A ``vtkPolyData`` of a triangle mesh: vertices (V, 3) float, faces (F, 3) int."""
-    from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
-    from vtkmodules.vtkCommonCore import vtkPoints
-    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
-
-    poly = vtkPolyData()
-    points = vtkPoints()
-    points.SetData(numpy_to_vtk(np.ascontiguousarray(vertices, dtype=np.float64), deep=True))
-    poly.SetPoints(points)
-    cells = vtkCellArray()
-    offsets = np.arange(0, 3 * len(faces) + 1, 3, dtype=np.int64)
-    connectivity = np.ascontiguousarray(np.asarray(faces).reshape(-1), dtype=np.int64)
-    cells.SetData(numpy_to_vtkIdTypeArray(offsets, deep=True), numpy_to_vtkIdTypeArray(connectivity, deep=True))
-    poly.SetPolys(cells)
-    return poly
-
-
 def polydata_writer(poly):
     """A ``vtkXMLPolyDataWriter`` of ``poly``: binary, zlib-compressed, as VMTK writes its files."""
     from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter

@@ -179,7 +179,7 @@ def squared_distances(points: FloatArray, vertices: FloatArray, faces: IntArray)
     from vtkmodules.vtkCommonCore import reference
     from vtkmodules.vtkCommonDataModel import vtkStaticCellLocator
 
-    from softdesign.io.vtk_polydata import polydata_from_triangles
+    from softdesign.meshing.vtk_triangles import polydata_from_triangles
 
     poly = polydata_from_triangles(np.asarray(vertices, float), np.asarray(faces, np.int64))
     locator: Any = vtkStaticCellLocator()  # VTK's stubs lack FindClosestPoint's overload with reference arguments

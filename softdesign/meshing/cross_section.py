@@ -17,7 +17,10 @@ Points
     step from the last (near-equilateral triangles), the size growing by
     ``GROWTH`` per ring up to ``size``.  Candidates are kept in order of
     their ring's distance from a circle; one closer than ``KEEP_FRACTION`` of
-    the smaller local size to a kept point is dropped.
+    the smaller local size to a kept point is dropped.  A circle's nodes are
+    equal steps from angle 0, or graded (``Circle.angles``) where it passes a
+    narrow gap (:mod:`softdesign.meshing.section_gaps`); a graded circle's
+    fronts start at its largest edge and keep off it by that edge.
 Triangulation
     Delaunay (qhull through scipy: deterministic for the same points).  The
     rings either side of a circle make its edges Delaunay; every circle edge
@@ -58,11 +61,33 @@ class Circle:
     #: put the nodes on the radius whose polygon has the circle's area (a cavity of the right volume with
     #: few nodes: r sqrt(h / sin h), h = 2 pi / nodes) rather than on the circle itself
     equal_area: bool = False
+    #: the nodes' angles (rad, increasing from 0), graded where the circle passes a narrow gap
+    #: (:func:`softdesign.meshing.section_gaps.resolve_circles`); empty: ``nodes`` equal steps from angle 0
+    angles: tuple[float, ...] = ()
+
+    def node_angles(self, count: int) -> FloatArray:
+        """The nodes' angles: ``angles`` if given, else ``count`` equal steps from 0."""
+        if self.angles:
+            return np.asarray(self.angles, float)
+        return 2.0 * np.pi * np.arange(count) / count
 
     def node_radius(self, count: int) -> float:
-        """The radius the circle's ``count`` nodes lie on."""
-        h = 2.0 * np.pi / count
-        return float(self.radius * np.sqrt(h / np.sin(h))) if self.equal_area else self.radius
+        """The radius the circle's nodes lie on (``count`` of them unless ``angles`` are given): with
+        ``equal_area``, the one whose polygon has the circle's area, r sqrt(2 pi / sum sin(step))."""
+        if not self.equal_area:
+            return self.radius
+        if not self.angles:
+            h = 2.0 * np.pi / count
+            return float(self.radius * np.sqrt(h / np.sin(h)))
+        steps = np.diff(np.append(self.node_angles(count), 2.0 * np.pi + self.node_angles(count)[0]))
+        return float(self.radius * np.sqrt(2.0 * np.pi / np.sum(np.sin(steps))))
+
+    def largest_edge(self, count: int) -> float:
+        """The longest edge of the circle's polygon."""
+        if not self.angles:
+            return float(2.0 * self.node_radius(count) * np.sin(np.pi / count))
+        steps = np.diff(np.append(self.node_angles(count), 2.0 * np.pi + self.node_angles(count)[0]))
+        return float(2.0 * self.node_radius(count) * np.sin(0.5 * np.max(steps)))
 
 
 @dataclass(frozen=True)
@@ -140,12 +165,19 @@ def _candidates(outer_count: int, circles: Sequence[Circle], size: float):
     fronts = [_front(np.zeros(2), 1.0, h_outer, max(size, h_outer), False, 2.0)]
     for c in circles:
         centre = np.asarray(c.center, float)
-        count = c.nodes or max(MIN_HOLE_NODES, round(2.0 * np.pi * c.radius / max(size, h_outer)))
+        count = len(c.angles) or c.nodes or max(MIN_HOLE_NODES, round(2.0 * np.pi * c.radius / max(size, h_outer)))
         radius = c.node_radius(count)
-        fixed.append(_ring(centre, radius, count, 0.0))
-        sizes.append(np.full(count, 2.0 * radius * np.sin(np.pi / count)))
-        fronts.append(_front(centre, radius, sizes[-1][0], max(size, h_outer), False, 2.0))
-        fronts.append(_front(centre, radius, sizes[-1][0], max(size, h_outer), True, 2.0))
+        if c.angles:  # graded: a node's local size is its smaller edge; the fronts start at the largest
+            nodes = centre + radius * np.column_stack([np.cos(c.node_angles(count)), np.sin(c.node_angles(count))])
+            edges = np.linalg.norm(np.roll(nodes, -1, axis=0) - nodes, axis=1)
+            fixed.append(nodes)
+            sizes.append(np.minimum(edges, np.roll(edges, 1)))
+        else:
+            fixed.append(_ring(centre, radius, count, 0.0))
+            sizes.append(np.full(count, 2.0 * radius * np.sin(np.pi / count)))
+        h0 = c.largest_edge(count)
+        fronts.append(_front(centre, radius, h0, max(size, h_outer), False, 2.0))
+        fronts.append(_front(centre, radius, h0, max(size, h_outer), True, 2.0))
     rings = sorted(((index, f, pts, h) for f, front in enumerate(fronts) for index, pts, h in front),
                    key=lambda item: (item[0], item[1]))
     return fixed, sizes, rings
@@ -156,7 +188,8 @@ def _keep(fixed: list[FloatArray], sizes: list[FloatArray], rings,
     from scipy.spatial import cKDTree
 
     points, local = np.concatenate(fixed), np.concatenate(sizes)
-    bounds = [(np.zeros(2), 1.0, sizes[0][0])] + [(np.asarray(c.center, float), c.node_radius(len(e)), e[0])
+    bounds = [(np.zeros(2), 1.0, sizes[0][0])] + [(np.asarray(c.center, float), c.node_radius(len(e)),
+                                                     c.largest_edge(len(e)))
                                                     for c, e in zip(circles, sizes[1:], strict=True)]
     for _, _, pts, h in rings:
         r_ok = np.linalg.norm(pts, axis=1) <= 1.0

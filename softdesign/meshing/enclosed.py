@@ -40,7 +40,7 @@ def points_inside(points: npt.ArrayLike, vertices: npt.ArrayLike, faces: npt.Arr
     from vtkmodules.vtkCommonDataModel import vtkPolyData
     from vtkmodules.vtkFiltersModeling import vtkSelectEnclosedPoints
 
-    from softdesign.io.vtk_polydata import polydata_from_triangles
+    from softdesign.meshing.vtk_triangles import polydata_from_triangles
 
     p: FloatArray = np.ascontiguousarray(points, np.float64).reshape(-1, 3)
     topology = mesh_topology(vertices, faces)

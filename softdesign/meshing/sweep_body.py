@@ -47,6 +47,7 @@ from softdesign.geometry.frames import FramedSpline
 from softdesign.meshing.body import sections_on_grid
 from softdesign.meshing.chamber_layout import ChamberLayout
 from softdesign.meshing.end_cut import CutPlane, along_generators, cut_planes, cut_targets
+from softdesign.meshing.sweep_layout import MIN_FEED_NODES, check_resolvable, layout_holes
 from softdesign.meshing.sweep_mesh import Hole, SweptMesh
 from softdesign.meshing.tessellate import Sweep, sweep_from_sections
 from softdesign.meshing.volume import BodySpec, angle_grid
@@ -300,9 +301,6 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
 CORE_Q_SAMPLES = tuple(np.linspace(0.0, 1.0, 11))
 #: The rigid core reaches this fraction of the way from the chambers' outer edge to the thinnest skin.
 CORE_GAP_FRACTION = 0.5
-#: Nodes on a chamber's and a feed's circle (at least): their polygons have the circle's area
-#: (Circle.equal_area), so the cavity's volume is the layout's; more nodes where the skin's are closer.
-MIN_CHAMBER_NODES, MIN_FEED_NODES = 16, 12
 
 
 def holes_from_layout(layout: ChamberLayout, scale_mm: float, rho_min_mm: float,
@@ -313,28 +311,11 @@ def holes_from_layout(layout: ChamberLayout, scale_mm: float, rho_min_mm: float,
     ``s{i}_c{j}_feed`` belongs to the same cavity and opens at the base (``s{i}_c{j}_feed_inlet``).
     ``scale_mm`` (R0) is mm per reference unit, ``rho_min_mm`` the thinnest section's radius over the morph.
     """
-    from softdesign.meshing.cross_section import Circle
-
     reach = max([c.distance_mm + 0.5 * c.diameter_mm for c in layout.chambers]
                 + [f.ring_mm + 0.5 * f.diameter_mm for f in layout.feeds])
     core_mm = reach + CORE_GAP_FRACTION * (rho_min_mm - reach)
     if not reach < core_mm < rho_min_mm:
         raise MeshError(f"volume mesh: the chambers reach {reach:.3f} mm from the centerline, the thinnest section "
                         f"is {rho_min_mm:.3f} mm: no wall; use smaller actuation.distance_mm or diameter_mm")
-    h_outer = 2.0 * np.pi / angular_count
-
-    def circle(distance: float, angle: float, diameter: float, least: int) -> Circle:
-        radius = 0.5 * diameter / scale_mm
-        nodes = max(least, int(np.ceil(2.0 * np.pi * radius / h_outer)))
-        return Circle((distance * np.cos(angle) / scale_mm, distance * np.sin(angle) / scale_mm), radius, nodes,
-                      equal_area=True)
-
-    holes = []
-    for c in layout.chambers:
-        holes.append(Hole(f"s{c.section}_c{c.index}", circle(c.distance_mm, c.angle, c.diameter_mm,
-                                                             MIN_CHAMBER_NODES), (c.l_start, c.l_end)))
-    for f in layout.feeds:
-        name = f"s{f.section}_c{f.chamber}"
-        holes.append(Hole(f"{name}_feed", circle(f.ring_mm, f.angle, f.diameter_mm, MIN_FEED_NODES),
-                          (f.l_start, f.l_end), cavity=name))
+    holes = check_resolvable(layout, layout_holes(layout, scale_mm, angular_count), scale_mm)
     return holes, SweepReference(core=core_mm / scale_mm, scale_mm=scale_mm)

@@ -30,7 +30,7 @@ Named surfaces
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import numpy.typing as npt
@@ -256,6 +256,11 @@ def _lids(section: CrossSection, holes: Sequence[Hole], l: FloatArray, used: Int
 
 
 def swept_disk(outer_count: int, holes: Sequence[Hole], size: float, l: npt.ArrayLike) -> SweptMesh:
-    """:func:`cross_section` with the holes' circles, swept through :func:`layer_grid` of ``l``."""
-    section = cross_section(outer_count, [h.circle for h in holes], size)
+    """:func:`cross_section` with the holes' circles, swept through :func:`layer_grid` of ``l``; circles next
+    to a narrow gap get more nodes (:func:`~softdesign.meshing.section_gaps.resolve_circles`)."""
+    from softdesign.meshing.section_gaps import resolve_circles
+
+    circles = resolve_circles([h.circle for h in holes])
+    holes = [replace(h, circle=c) for h, c in zip(holes, circles, strict=True)]
+    section = cross_section(outer_count, circles, size)
     return sweep_mesh(section, layer_grid(l, holes), holes)

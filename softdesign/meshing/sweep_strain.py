@@ -13,10 +13,11 @@ Where
     the centerline from N) and depth: 0 at the skin, 1 at the axis of a solid
     body or at the chamber's wall of a hollow one, of the tetrahedron's centroid.
 Skin
-    Each skin triangle's in-plane principal stretches from its edges at q = 0
-    and at q (:func:`softdesign.fitting.strain.principal_stretches` on the
-    triangles' metrics): what the feasibility stage measures from the
-    surface's derivatives, on the mesh.
+    The in-plane principal stretches at the centre of each skin quad (two
+    layers by two angles) from the central differences of its corners at
+    q = 0 and at q (:func:`softdesign.fitting.strain.principal_stretches` on
+    the metrics): what the feasibility stage measures from the surface's
+    derivatives, on the mesh's nodes, to second order in their spacing.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from softdesign.fitting.strain import principal_stretches
-from softdesign.mechanics.kinematic_stress import ElementStrain, element_strain
+from softdesign.mechanics.kinematic_stress import ElementStrain, element_strain, rest_inverses
 from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.meshing.sweep_body import SweepReference
 from softdesign.meshing.sweep_mesh import SweptMesh
@@ -50,18 +51,19 @@ class Extreme:
                 "angle_rad": round(self.angle, 5), "depth": round(self.depth, 4)}
 
 
-def free_directions(mesh: SweptMesh, rest: FloatArray) -> FloatArray:
-    """(T, 3) unit normals at q = 0 of the surfaces of constant depth through each tetrahedron (module notes)."""
+def free_directions(mesh: SweptMesh, rest: FloatArray, inverses: FloatArray | None = None) -> FloatArray:
+    """(T, 3) unit normals at q = 0 of the surfaces of constant depth through each tetrahedron (module notes);
+    ``inverses``: :func:`~softdesign.mechanics.kinematic_stress.rest_inverses` of ``rest``, when at hand."""
     param = mesh.reference_points()
     t = mesh.tets
     dp = (param[t[:, 1:]] - param[t[:, :1]]).transpose(0, 2, 1)
-    dx = (rest[t[:, 1:]] - rest[t[:, :1]]).transpose(0, 2, 1)
+    dx_inverse = rest_inverses(rest, t) if inverses is None else inverses
     centroid = param[t].mean(axis=1)
     radial = np.column_stack([centroid[:, 0], centroid[:, 1], np.zeros(len(t))])
     norm = np.linalg.norm(radial, axis=1, keepdims=True)
     radial = np.where(norm > 1e-9, radial / np.maximum(norm, 1e-300), np.array([1.0, 0.0, 0.0]))
     # grad_x t = G^-T grad_p t with G = dx dp^-1, so G^-T = dx^-T dp^T
-    normal = np.einsum("nji,nj->ni", np.linalg.inv(dx), np.einsum("nji,nj->ni", dp, radial))
+    normal = np.einsum("nji,nj->ni", dx_inverse, np.einsum("nji,nj->ni", dp, radial))
     return np.asarray(normal / np.linalg.norm(normal, axis=1, keepdims=True), np.float64)
 
 
@@ -89,13 +91,40 @@ def strain_at(mesh: SweptMesh, rest: FloatArray, moved: FloatArray, law: Hyperel
     return element_strain(rest, moved, mesh.tets, law, free, inverses)
 
 
+def skin_grid(mesh: SweptMesh) -> IntArray:
+    """The skin's nodes (n, na): node of layer j at angle ``2 pi k / na`` (the cross-section's outer circle)."""
+    na = mesh.section.outer_count
+    grid = np.full((len(mesh.l), na), -1, np.int64)
+    skin = mesh.node_point < na
+    grid[mesh.node_layer[skin], mesh.node_point[skin]] = np.flatnonzero(skin)
+    if np.any(grid < 0):
+        raise ValueError("skin_grid: a layer lacks a node of the outer circle (a bug in the swept mesh)")
+    return grid
+
+
+def skin_places(mesh: SweptMesh) -> tuple[FloatArray, FloatArray]:
+    """l (n - 1,) and angle (na,) rad of the centres of the skin's quads (between layers and angles)."""
+    na = mesh.section.outer_count
+    return 0.5 * (mesh.l[1:] + mesh.l[:-1]), 2.0 * np.pi * (np.arange(na) + 0.5) / na
+
+
 def skin_stretches(mesh: SweptMesh, rest: FloatArray, moved: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """In-plane principal stretches (lambda1, lambda2) of every skin triangle, each (S,)."""
-    faces = mesh.group_faces("skin")
+    """In-plane principal stretches (lambda1, lambda2) at the centre of every skin quad, each (n - 1, na).
+
+    A quad's two tangents at its centre are the central differences of its corners (the mean of its two
+    edges along l, and of its two along the angle), exact to second order in the quad's size, where one
+    triangle's constant gradient is exact to first order only: on the demo at q = 1 they agree with the
+    feasibility stage's metric at the quads' centres within 0.16 % away from the end cuts, the triangles
+    within 3 %.  Places: :func:`skin_places`.
+    """
+    grid = skin_grid(mesh)
 
     def metric(x: FloatArray) -> FloatArray:
-        e1, e2 = x[faces[:, 1]] - x[faces[:, 0]], x[faces[:, 2]] - x[faces[:, 0]]
-        return np.column_stack([np.einsum("ij,ij->i", e1, e1), np.einsum("ij,ij->i", e1, e2),
-                                np.einsum("ij,ij->i", e2, e2)])
+        corner = x[grid]
+        turned = np.roll(corner, -1, axis=1)
+        along = 0.5 * (corner[1:] + turned[1:] - corner[:-1] - turned[:-1])
+        around = 0.5 * (turned[:-1] + turned[1:] - corner[:-1] - corner[1:])
+        return np.stack([np.einsum("...k,...k->...", along, along), np.einsum("...k,...k->...", along, around),
+                         np.einsum("...k,...k->...", around, around)], axis=-1)
 
     return principal_stretches(metric(rest), metric(moved))

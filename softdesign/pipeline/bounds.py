@@ -90,7 +90,7 @@ def check_sizes(case: Case, ingest: IngestResult) -> None:
     check_offset(case, ingest)  # before the fit: an offset the vessel's radius cannot take
 
 
-_BUDGET = f"softdesign/limits.py, which keeps a build within {MEMORY_BUDGET_TEXT} of memory"
+_BUDGET = f"softdesign/limits/__init__.py, which keeps a build within {MEMORY_BUDGET_TEXT} of memory"
 
 
 def _up(value: float) -> str:
@@ -120,7 +120,7 @@ def mesh_vertices(case: Case, longest: float) -> int:
 def meshes_at_once(case: Case, longest: float) -> int:
     """How many export meshes may be built at the same time (by parallel workers) within the memory budget.
 
-    The budget holds one mesh of MAX_MESH_VERTICES while it is built (softdesign/limits.py); as many
+    The budget holds one mesh of MAX_MESH_VERTICES while it is built (softdesign/limits/__init__.py); as many
     meshes as together have that many vertices fit in the same memory, each in its own worker.
     """
     return max(1, MAX_MESH_VERTICES // max(1, mesh_vertices(case, longest)))

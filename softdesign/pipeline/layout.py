@@ -7,7 +7,12 @@ Paths are POSIX, relative to the build folder.
 
 from __future__ import annotations
 
+from softdesign.io.format_names import q_label
+
 MANIFEST = "manifest.json"
+#: How the last run went (each stage's status: ran, skipped, kept or stale, and its seconds): a log, outside the
+#: manifest, so that the manifest and every output are the same bytes for the same inputs however they were reached.
+RUN_LOG = "run.log.json"
 KINEMATICS = "kinematics.json"
 REPORT_DIR = "report"
 MESHES_DIR = "meshes"
@@ -83,11 +88,6 @@ def stage_record(stage: str) -> str:
 def ingest_keyframe(index: int | str) -> str:
     """``ingest/keyframe_<index>.npz``: the intermediate keyframe centerline ``index``."""
     return f"ingest/keyframe_{index}.npz"
-
-
-def q_label(q: float) -> str:
-    """``q_0.500``: three decimals, as DESIGN.md names the meshes."""
-    return f"q_{q:.3f}"
 
 
 def mesh_path(q: float, fmt: str) -> str:

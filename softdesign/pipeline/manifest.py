@@ -1,10 +1,14 @@
-"""The manifest: software versions, inputs with sha256, the resolved case, stages, timing, metrics, outputs.
+"""The manifest: software versions, inputs with sha256, the resolved case, stages, metrics, outputs; and the run log.
 
 Outputs are those recorded by the stages in the new folder (this run's, and
 later stages kept from an earlier run), each with its sha256 and the figures
 its stage gives (volume, area, ...); outputs of a stale stage are flagged
 ``"stale": true``.  With ``records`` (each ``<stage>/stage.json``), the
-manifest lists every file of the folder but itself.
+manifest lists every file of the folder but itself and the run log.
+
+The manifest is a function of the build's inputs: the same bytes after a fresh build and after any sequence
+of incremental ones (issue 35).  How the run went, each stage's status and seconds, goes to
+:data:`~softdesign.pipeline.layout.RUN_LOG` (:func:`run_log`), which no check or report compares.
 """
 
 from __future__ import annotations
@@ -16,7 +20,7 @@ from softdesign.config import Case
 from softdesign.pipeline import layout
 from softdesign.pipeline.stage import Results, Stage, StageRun, Status
 from softdesign.pipeline.store import read_record, sha256_file
-from softdesign.versions import software_versions
+from softdesign.pipeline.versions import software_versions
 
 
 def build_manifest(
@@ -52,8 +56,8 @@ def build_manifest(
             {"path": case.resolved_path(p), "sha256": h, "bytes": p.stat().st_size}
             for p, h in zip(inputs, input_hashes, strict=True)
         ],
-        "stages": [{"name": r.name, "status": r.status, "key": r.key} for r in runs],
-        "timing_s": {r.name: round(r.seconds, 3) for r in runs if r.status not in (Status.KEPT, Status.STALE)},
+        "stages": [{"name": r.name, "key": r.key, **({"stale": True} if r.status == Status.STALE else {})}
+                   for r in runs],
         "metrics": {s.name: s.metrics(results[s.name]) for s in stages if s.name in results},
         "outputs": outputs,
         "records": [
@@ -71,3 +75,12 @@ def _all_outputs(folder: Path, stages: list[Stage]) -> list[dict[str, Any]]:
         record = read_record(folder / layout.stage_record(stage.name)) or {}
         found.update((rel, (stage.name, sha)) for rel, sha in record.get("outputs", {}).items())
     return [{"path": rel, "sha256": sha, "stage": name} for rel, (name, sha) in sorted(found.items())]
+
+
+def run_log(runs: list[StageRun]) -> dict[str, Any]:
+    """:data:`~softdesign.pipeline.layout.RUN_LOG`: each stage's status in this run and its seconds (none for a
+    stage kept or stale from an earlier run), and the stage's own log lines when it ran (e.g. each part's time)."""
+    return {"stages": [{"name": r.name, "status": r.status,
+                        **({} if r.status in (Status.KEPT, Status.STALE) else {"seconds": round(r.seconds, 3)}),
+                        **({"log": r.log} if r.log else {})}
+                       for r in runs]}

@@ -22,7 +22,7 @@ import re
 from pathlib import Path, PurePosixPath
 from typing import Any
 
-from softdesign.pipeline.layout import MANIFEST, REPORT_DIR, STAGE_RECORD
+from softdesign.pipeline.layout import MANIFEST, REPORT_DIR, RUN_LOG, STAGE_RECORD
 
 #: The report's list of the files it wrote, inside ``report/`` and inside each of its temporary folders.
 REPORT_MARKER = ".softdesign-report.json"
@@ -76,7 +76,7 @@ def legacy_report_files(folder: Path) -> list[str]:
 def owned_files(folder: Path) -> set[str]:
     """The paths (POSIX, relative to ``folder``) of the files softdesign wrote in build folder ``folder``."""
     manifest = _json(folder / MANIFEST)
-    own = {MANIFEST}
+    own = {MANIFEST, RUN_LOG}
     for key in ("outputs", "records"):
         entries = manifest.get(key)
         for entry in entries if isinstance(entries, list) else []:

@@ -21,7 +21,7 @@ from softdesign.config import Case
 from softdesign.pipeline import layout
 from softdesign.pipeline.bounds import check_sizes
 from softdesign.pipeline.lock import BuildLock
-from softdesign.pipeline.manifest import build_manifest
+from softdesign.pipeline.manifest import build_manifest, run_log
 from softdesign.pipeline.out_folder import check_out_folder, folder_errors
 from softdesign.pipeline.owned import safe_relative
 from softdesign.pipeline.parallel import jobs_for_build
@@ -103,6 +103,7 @@ def run_stages(
             stages_run = [*stages, *options.later]
             manifest = build_manifest(case, staging.folder, stages_run, runs, results, inputs, input_hashes)
             staging.write_json(layout.MANIFEST, manifest)
+            staging.write_json(layout.RUN_LOG, run_log(runs))
             _check_listed(manifest, staging.written)
             dropped = carry_report(staging, manifest)
             staging.commit()
@@ -134,9 +135,10 @@ def _run_all(
 
 
 def _check_listed(manifest: dict[str, Any], files: dict[str, str]) -> None:
-    """The manifest lists every file of the new folder but itself, with its hash, and nothing else (else a bug)."""
+    """The manifest lists every file of the new folder but itself and the run log, with its hash, and nothing else
+    (else a bug)."""
     listed = {entry["path"]: entry["sha256"] for entry in manifest["outputs"] + manifest["records"]}
-    if listed != {rel: sha for rel, sha in files.items() if rel != layout.MANIFEST}:
+    if listed != {rel: sha for rel, sha in files.items() if rel not in (layout.MANIFEST, layout.RUN_LOG)}:
         raise RuntimeError("the manifest does not list exactly the files of the new build folder")
 
 
@@ -170,7 +172,8 @@ def _run_one(
     staging.write_json(layout.stage_record(stage.name), done)
     seconds = time.perf_counter() - start
     options.progress(f"{stage.name}: done in {seconds:.2f} s")
-    return StageRun(stage.name, key, Status.RAN, seconds, stage.describe(results[stage.name]))
+    result = results[stage.name]
+    return StageRun(stage.name, key, Status.RAN, seconds, stage.describe(result), stage.log(result))
 
 
 def _kept_run(stage: Stage, record: dict[str, Any], key: str, results: Results, staging: Staging) -> StageRun:

@@ -2,7 +2,7 @@
 
 The build runs (cached) through the actuation stage; the section's mesh is
 made (:mod:`softdesign.mechanics.layout_section`) and checked against the
-bounds of :mod:`softdesign.limits_simulate` before any solve; the solve runs
+bounds of :mod:`softdesign.limits.simulate` before any solve; the solve runs
 in a child process with a time and memory limit
 (:func:`~softdesign.pipeline.child.run_in_child`), so a runaway factorization
 fails cleanly.  Nothing is written: the command prints the figures.
@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from softdesign.errors import ConfigError, MeshError, SolveError
-from softdesign.limits_simulate import (
+from softdesign.limits.simulate import (
     MAX_ANGULAR_COUNT,
     MAX_INVERSE_SOLVES,
     MAX_LOAD_STEPS,
@@ -67,7 +67,7 @@ def check_options(o: SimulateOptions) -> None:
     def bound(name: str, value: float, low: float, high: float) -> None:
         if not (math.isfinite(value) and low <= value <= high):
             raise ConfigError(f"simulate {name}: got {value:g}, expected a number in [{low:g}, {high:g}] "
-                              "(softdesign/limits_simulate.py)")
+                              "(softdesign/limits/simulate.py)")
     if (o.pressures_kpa is None) == (o.target_q is None):
         raise ConfigError("simulate: give either --pressures P1,P2,P3 (kPa) or --target q, not both or neither")
     for k, p in enumerate(o.pressures_kpa or ()):
@@ -103,8 +103,8 @@ def solve_in_child(section: Any, law: Any, o: SimulateOptions, target: tuple[flo
 
 def _section_mesh(outcome: Any, o: SimulateOptions) -> Any:
     from softdesign.mechanics.layout_section import layout_section_mesh
+    from softdesign.pipeline.body_spec import body_spec
     from softdesign.pipeline.stages.actuation import actuation_layout
-    from softdesign.pipeline.stages.export import body_spec
 
     kinematics, fit = outcome.results["kinematics"], outcome.results["fit"]
     layout = actuation_layout(outcome.case, kinematics)
@@ -134,7 +134,7 @@ def run_simulate(case_file: Path, out: Path | None, o: SimulateOptions, progress
     nodes = quadratic_node_count(section)
     if nodes > MAX_SECTION_NODES:
         raise ConfigError(f"simulate: section {o.section}'s mesh has {nodes} nodes (quadratic elements), more than "
-                          f"{MAX_SECTION_NODES} (softdesign/limits_simulate.py); raise --size-mm or --layer-mm")
+                          f"{MAX_SECTION_NODES} (softdesign/limits/simulate.py); raise --size-mm or --layer-mm")
     target = None
     if o.target_q is not None:
         arc = fit_links(outcome.results["kinematics"].chain, o.target_q, ARC_SAMPLES)[o.section]

@@ -51,6 +51,7 @@ class Stage:
     describe : result -> short human summary lines
     metrics : result -> JSON-ready figures for the manifest
     figures : result -> {output path: figures} merged into the manifest's outputs
+    log : result -> lines for the run log (``run.log.json``): how the computation went, e.g. each part's time
     """
 
     name: str
@@ -63,6 +64,8 @@ class Stage:
     describe: Callable[[Any], list[str]]
     metrics: Callable[[Any], dict[str, Any]]
     figures: Callable[[Any], dict[str, dict[str, Any]]] = lambda result: {}
+    #: result -> lines of how its computation went (each part's time) for the run log, never an output
+    log: Callable[[Any], list[str]] = lambda result: []
 
 
 @dataclass
@@ -74,6 +77,8 @@ class StageRun:
     status: str  # one of Status
     seconds: float
     lines: list[str] = field(default_factory=list)
+    #: the stage's own log of this run (:attr:`Stage.log`), for the run log
+    log: list[str] = field(default_factory=list)
 
 
 def read_keys(resolved: dict[str, Any], keys: tuple[str, ...]) -> dict[str, Any]:

@@ -14,7 +14,11 @@ What is compared, and against which tolerance (:class:`CheckOptions`):
   pose's ``base_to_tip`` and ``base_to_world`` (where present); the frame
   convention must match.  A pose is matched by its q, one value or one per
   link as the kinematics stage writes it;
-- the fit metrics ``manifest.json: metrics.fit.*_mm`` (``distance_mm``).
+- the fit metrics ``manifest.json: metrics.fit.*_mm`` (residuals: the smaller of ``distance_mm`` and
+  ``rtol`` of the reference plus a floor, :func:`~softdesign.regression.figures.residual_tolerance`);
+- the other stages' figures in the manifests (:mod:`~softdesign.regression.sections`: links, blend, the
+  kinematics' arc check, the design's chain, mould, volume mesh; feasibility by its own module), each within
+  the named tolerance of its row.
 
 When the two manifests name different cases, or the same case built from
 input files of other content (sha256), the report carries a warning: the

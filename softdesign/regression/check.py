@@ -15,12 +15,13 @@ from softdesign.errors import ConfigError, InputDataError
 from softdesign.pipeline.layout import MANIFEST
 from softdesign.regression.feasibility import compare_feasibility
 from softdesign.regression.figures import (
+    RESIDUAL_FLOOR_MM,
     CheckOptions,
     CheckReport,
     Figure,
-    is_number,
     missing_figure,
     read_json,
+    residual_tolerance,
     scalar_figure,
 )
 from softdesign.regression.kinematics import compare_kinematics_files
@@ -30,9 +31,8 @@ from softdesign.regression.sections import compare_sections
 #: Fit metrics compared first, in this order; other ``*_mm`` keys of metrics.fit follow, sorted.
 FIT_KEYS = ("rms_mm", "p95_mm", "p99_mm", "max_mm", "holdout_rms_mm")
 
-#: Fit metrics agree within check's relative tolerance of the reference plus this, mm: far above the round-off of
-#: a fit (1e-13 mm), far below any change of a fit that matters.
-FIT_FLOOR_MM = 1e-6
+#: Fit metrics agree within check's relative tolerance of the reference plus this, mm (they are residuals).
+FIT_FLOOR_MM = RESIDUAL_FLOOR_MM
 
 #: A comparison of the two manifests: (build's, reference's, tolerances, notes to add to) -> figures.
 ManifestComparison = Callable[[dict, dict, CheckOptions, list[str]], list[Figure]]
@@ -76,7 +76,8 @@ def check_build(
 
 #: What check compares in the manifests, in order, after the meshes and kinematics.json: the fit and the
 #: feasibility by their own code, then every section of :data:`softdesign.regression.sections.SECTIONS` (links,
-#: blend, design, mould, volume mesh).  A new stage's figures are a row of that table, or a line here.
+#: blend, the kinematics' arc check, design, mould, volume mesh).  A new stage's figures are a row of that table,
+#: or a line here.
 MANIFEST_COMPARISONS: tuple[tuple[str, ManifestComparison], ...] = (
     ("fit", lambda build, ref, options, notes: compare_fit(build, ref, options.distance_mm, notes, options.rtol)),
     ("feasibility", lambda build, ref, options, notes: compare_feasibility(build, ref, options.distance_mm, notes)),
@@ -138,15 +139,10 @@ def compare_fit(
     keys = [k for k in FIT_KEYS if k in ours or k in theirs]
     keys += sorted(k for k in set(ours) | set(theirs) if k.endswith("_mm") and k not in FIT_KEYS)
     return [
-        scalar_figure("fit", key, ours.get(key), theirs.get(key), _fit_tolerance(theirs.get(key), tolerance_mm, rtol))
+        scalar_figure("fit", key, ours.get(key), theirs.get(key),
+                      residual_tolerance(theirs.get(key), tolerance_mm, rtol, FIT_FLOOR_MM))
         for key in keys
     ]
-
-
-def _fit_tolerance(reference: object, tolerance_mm: float, rtol: float | None) -> float:
-    if rtol is None or not is_number(reference):
-        return tolerance_mm
-    return min(tolerance_mm, rtol * abs(float(reference)) + FIT_FLOOR_MM)
 
 
 def _fit_metrics(manifest: dict, where: str) -> dict | None:

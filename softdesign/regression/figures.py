@@ -18,6 +18,15 @@ from softdesign.meshing.compare import DEFAULT_SAMPLES
 
 Value = float | bool | str | None
 
+#: A residual (how far a fitted or designed thing is from its target: the fit's errors, a design's deviation and
+#: tip error, a link's misfit of one arc) agrees within the smaller of the absolute tolerance and ``rtol`` of the
+#: reference plus this floor, mm: far above the round-off of a rebuild (1e-13 mm), far below any change that
+#: matters.  Residuals are often far below ``distance_mm`` (1e-4 mm on a synthetic vessel, 0.1 mm for a design's
+#: tip), where an absolute tolerance alone would let a change of a percent of them pass unseen.
+RESIDUAL_FLOOR_MM = 1e-6
+#: The same floor for an angle residual, degrees (1.7e-8 rad).
+RESIDUAL_FLOOR_DEG = 1e-6
+
 
 @dataclass(frozen=True)
 class CheckOptions:
@@ -134,6 +143,14 @@ def read_json(path: Path) -> dict:
     if not isinstance(payload, dict):
         raise InputDataError(f"{path}: expected a JSON object, got {type(payload).__name__}")
     return payload
+
+
+def residual_tolerance(reference: Any, absolute: float, rtol: float | None, floor: float) -> float:
+    """A residual's tolerance: the smaller of ``absolute`` and ``rtol * |reference| + floor`` (``absolute`` alone
+    without ``rtol`` or a numeric reference); see :data:`RESIDUAL_FLOOR_MM`."""
+    if rtol is None or not is_number(reference):
+        return absolute
+    return min(absolute, rtol * abs(float(reference)) + floor)
 
 
 def is_number(value: Any) -> TypeGuard[int | float]:

@@ -8,32 +8,51 @@ row of :data:`SECTIONS`.
 
 Either side may lack a block: a reference built before the stage existed
 gives a note (it cannot judge), a build without a block the reference has
-fails, and a block with ``"requested": false`` on both sides (a mould or
-volume mesh the case did not ask for) is not compared.  A figure the
-reference has and the build lacks, or the other way round, fails.
+fails, and a block whose flag (:attr:`Section.asked`) is false on both sides
+(a mould, volume mesh or design the case did not ask for) is not compared.
+A figure the reference has and the build lacks, or the other way round, fails.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
 from typing import Any
 
 from softdesign.regression.feasibility import RHO_KAPPA_TOL, STRETCH_TOL
-from softdesign.regression.figures import CheckOptions, Figure, is_number, missing_figure, scalar_figure
+from softdesign.regression.figures import (
+    RESIDUAL_FLOOR_DEG,
+    RESIDUAL_FLOOR_MM,
+    CheckOptions,
+    Figure,
+    is_number,
+    missing_figure,
+    residual_tolerance,
+    scalar_figure,
+)
 
 #: The named tolerances a figure may use: absolute (mm, rad, or the dimensionless ones) or relative.
-#: ``exact``: the same value (counts, flags, verdicts); ``rtol``: within ``CheckOptions.rtol`` of the reference.
-TOLERANCES = ("distance_mm", "rotation_rad", "rtol", "stretch", "rho_kappa", "exact")
+#: ``exact``: the same value (counts, flags, verdicts); ``rtol``: within ``CheckOptions.rtol`` of the reference;
+#: ``residual_mm``, ``residual_deg``: a residual (how far a designed or fitted thing is from its target), within the
+#: smaller of ``distance_mm`` (``rotation_rad`` in degrees) and ``rtol`` of the reference plus a floor
+#: (:func:`~softdesign.regression.figures.residual_tolerance`): residuals are often far below the absolute
+#: tolerance, where it alone would let a change of a percent of them pass unseen.
+TOLERANCES = ("distance_mm", "rotation_rad", "rtol", "stretch", "rho_kappa", "exact", "residual_mm", "residual_deg")
 
 
 @dataclass(frozen=True)
 class Section:
-    """One row of the table: the check's item, the metrics block and its figures (pointer, tolerance name)."""
+    """One row of the table: the check's item, the metrics block and its figures (pointer, tolerance name).
+
+    ``asked`` names the block's flag that says whether the case asked for the stage: false on both sides, the
+    section is not compared.
+    """
 
     item: str
     block: str
     figures: tuple[tuple[str, str], ...]
+    asked: str = "requested"
 
 
 #: Every manifest section compared by the table (meshes, kinematics.json, fit and feasibility have their own code).
@@ -45,8 +64,13 @@ SECTIONS: tuple[Section, ...] = (
         ("final_path/max_curvature_per_mm", "rtol"), ("initial_length_mm", "distance_mm"),
         ("shortening/min_length_mm", "distance_mm"), ("mode", "exact"),
     )),
-    # the design figures: how far each link's q = 1 centerline is from one constant-curvature arc
-    Section("design", "kinematics", (("links", "exact"), ("arc_check/max_deviation_mm/*", "distance_mm"))),
+    # the kinematics stage's arc check: how far each link's q = 1 centerline is from one constant-curvature arc
+    Section("kinematics", "kinematics", (("links", "exact"), ("arc_check/max_deviation_mm/*", "residual_mm"))),
+    # the design stage's composed chain: its sections, joints (normalized l, as the links' breaks) and residuals
+    Section("design", "design", (
+        ("designed", "exact"), ("links", "exact"), ("meets_tolerance", "exact"), ("breaks/*", "rtol"),
+        ("chain_max_deviation_mm", "residual_mm"), ("tip_error_mm", "residual_mm"), ("tip_error_deg", "residual_deg"),
+    ), asked="designed"),
     Section("mould", "mould", (
         ("requested", "exact"), ("parts/*/volume_mm3", "rtol"), ("parts/*/ok", "exact"), ("parts/*/bodies", "exact"),
         ("cavity/cavity_mm3", "rtol"), ("cavity/cast_mm3", "rtol"), ("cavity/ok", "exact"), ("disjoint/ok", "exact"),
@@ -83,7 +107,7 @@ def compare_section(section: Section, build: dict, reference: dict, options: Che
         return []
     if ours is None:
         return [missing_figure(section.item, f"metrics.{section.block}", in_build=False)]
-    if ours.get("requested") is False and theirs.get("requested") is False:
+    if ours.get(section.asked) is False and theirs.get(section.asked) is False:
         notes.append(f"{section.item}: not asked for on either side: not compared")
         return []
     figures = []
@@ -147,9 +171,20 @@ def _figure(item: str, name: str, value: Any, ref: Any, tolerance: str, options:
     if tolerance == "rtol":
         allowed = options.rtol * abs(float(ref))
         return replace(scalar_figure(item, name, value, ref, allowed), note=f"rtol {options.rtol:g}")
+    if tolerance in ("residual_mm", "residual_deg"):
+        return _residual_figure(item, name, value, ref, tolerance, options)
     absolute = {"distance_mm": options.distance_mm, "rotation_rad": options.rotation_rad, "stretch": STRETCH_TOL,
                 "rho_kappa": RHO_KAPPA_TOL}[tolerance]
     return scalar_figure(item, name, value, ref, absolute)
+
+
+def _residual_figure(item: str, name: str, value: Any, ref: Any, tolerance: str, options: CheckOptions) -> Figure:
+    """A residual within the smaller of the absolute tolerance (mm, or degrees) and rtol of the reference + floor."""
+    absolute, floor, unit = ((options.distance_mm, RESIDUAL_FLOOR_MM, "mm") if tolerance == "residual_mm" else
+                             (math.degrees(options.rotation_rad), RESIDUAL_FLOOR_DEG, "deg"))
+    allowed = residual_tolerance(ref, absolute, options.rtol, floor)
+    note = f"the smaller of {absolute:g} {unit} and rtol {options.rtol:g} of the reference + {floor:g} {unit}"
+    return replace(scalar_figure(item, name, value, ref, allowed), note=note)
 
 
 def _text(value: Any) -> Any:

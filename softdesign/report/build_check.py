@@ -21,7 +21,7 @@ from softdesign.pipeline.store import sha256_file
 
 #: The manifest's top-level keys the report reads, with the JSON type a build writes for each.
 MANIFEST_KEYS: dict[str, type] = {
-    "software": dict, "case": dict, "inputs": list, "stages": list, "timing_s": dict, "metrics": dict,
+    "software": dict, "case": dict, "inputs": list, "stages": list, "metrics": dict,
     "outputs": list,
 }
 
@@ -41,8 +41,8 @@ def check_manifest(root: Path, manifest: Any, fix: str) -> None:
     for key in ("outputs", "stages", "inputs"):
         if not all(isinstance(entry, dict) for entry in manifest[key]):
             raise InputDataError(f"{root / MANIFEST}: {key} holds an entry that is not an object; {fix}")
-    if not all(isinstance(s.get("name"), str) and isinstance(s.get("status"), str) for s in manifest["stages"]):
-        raise InputDataError(f"{root / MANIFEST}: a stage entry lacks its name or status; {fix}")
+    if not all(isinstance(s.get("name"), str) for s in manifest["stages"]):
+        raise InputDataError(f"{root / MANIFEST}: a stage entry lacks its name; {fix}")
 
 
 def changed_since_build(root: Path, manifest: dict[str, Any]) -> list[str]:

@@ -78,7 +78,8 @@ def clustered(vertices: FloatArray, faces: np.ndarray, cell_mm: float) -> tuple[
     """The surface clustered on a grid of cells of ``cell_mm`` (larger when :data:`MAX_CLUSTER_BINS` needs it)."""
     from vtkmodules.vtkFiltersCore import vtkQuadricClustering
 
-    from softdesign.io.vtk_polydata import polydata_from_triangles, triangles_from_polydata
+    from softdesign.io.vtk_polydata import triangles_from_polydata
+    from softdesign.meshing.vtk_triangles import polydata_from_triangles
 
     extent = np.ptp(vertices, axis=0) + cell_mm
     cell = max(cell_mm, float(np.prod(extent) / MAX_CLUSTER_BINS) ** (1.0 / 3.0))
@@ -95,7 +96,8 @@ def clustered(vertices: FloatArray, faces: np.ndarray, cell_mm: float) -> tuple[
 def _quadric_decimation(vertices: FloatArray, faces: np.ndarray, target: int) -> tuple[FloatArray, np.ndarray]:
     from vtkmodules.vtkFiltersCore import vtkQuadricDecimation
 
-    from softdesign.io.vtk_polydata import polydata_from_triangles, triangles_from_polydata
+    from softdesign.io.vtk_polydata import triangles_from_polydata
+    from softdesign.meshing.vtk_triangles import polydata_from_triangles
 
     decimate = vtkQuadricDecimation()
     decimate.SetInputData(polydata_from_triangles(vertices, faces))

@@ -125,7 +125,7 @@ def summary_warnings(data: BuildData, checks: list[Check]) -> list[str]:
     """
     m = data.manifest
     warnings = [f"stale: stage {s['name']} is out of date (its outputs here were built from other inputs or settings); "
-                "run softdesign build" for s in m.get("stages", []) if s.get("status") == "stale"]
+                "run softdesign build" for s in m.get("stages", []) if s.get("stale") is True]
     failed = [c for c in checks if not c.passed]
     if failed:
         names = "; ".join(f"{c.subject}: {c.name}" for c in failed[:5]) + ("; ..." if len(failed) > 5 else "")

@@ -16,7 +16,7 @@ from typing import Any
 
 from softdesign.meshing.checks import VOLUME_RTOL
 from softdesign.pipeline.store import sha256_file
-from softdesign.versions import software_versions
+from softdesign.pipeline.versions import software_versions
 
 #: Euler characteristic each kind of solid must have (see :class:`softdesign.meshing.solids.Solid`).
 EULER_BY_KIND = {"solid": 2, "ported": 2, "hollow": 4}

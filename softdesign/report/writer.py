@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from softdesign.errors import ConfigError
-from softdesign.pipeline.layout import MANIFEST, REPORT_DIR
+from softdesign.pipeline.layout import MANIFEST, REPORT_DIR, RUN_LOG
 from softdesign.pipeline.lock import BuildLock
 from softdesign.pipeline.out_folder import folder_errors
 from softdesign.pipeline.parallel import jobs_for_build, map_items
@@ -407,20 +407,22 @@ def _tables_section(data: BuildData) -> tuple[Section, list[Check]]:
     checks = mesh_checks(data.export_summary) + fit_checks(data.fit.summary if data.fit else None)
     checks += volume_mesh_checks(_volume_summary(data))
     checks += output_checks(data.build_dir, data.manifest)
-    # no times: they differ run to run, and the page is the same bytes for the same build (the times: LOG)
-    stages = [(s["name"], s["status"]) for s in data.manifest.get("stages", [])]
+    # no times or run statuses: they differ run to run, and the page is the same bytes for the same build (they are
+    # in the run log and LOG)
+    stages = [(s["name"], str(s.get("key", ""))[:12], "stale" if s.get("stale") is True else "current")
+              for s in data.manifest.get("stages", [])]
     tables = [
         key_figure_table(key_figures(data.manifest)),
         plain_table("Inputs", ("file (as the case names it)", "sha256", "bytes"), input_rows(data.manifest),
                     ("", "hash", "num")),
         plain_table("Software", ("package", "build (manifest.json)", "this report"), software_rows(data.manifest)),
-        plain_table("Stages of the last run", ("stage", "status"), stages, ("", "")),
+        plain_table("Stages", ("stage", "cache key", "outputs"), stages, ("", "hash", "")),
         *compact_check_tables(checks),
     ]
     notes = [f"ingest: {n}" for n in data.ingest.notes]
     notes += [f"kinematics: warning: {n}" for n in data.manifest.get("metrics", {}).get("kinematics", {})
               .get("arc_check", {}).get("warnings", [])]
-    notes += [f"{s['name']}: {STALE_NOTE}" for s in data.manifest.get("stages", []) if s.get("status") == "stale"]
+    notes += [f"{s['name']}: {STALE_NOTE}" for s in data.manifest.get("stages", []) if s.get("stale") is True]
     return Section("tables", "Figures, inputs, software and checks", notes=notes, tables=tables), checks
 
 
@@ -433,9 +435,23 @@ def _summary(data: BuildData) -> list[str]:
     ]
 
 
+def _run_stages(build_dir: Path) -> list[dict[str, Any]]:
+    """The stage entries of the build's run log (:data:`~softdesign.pipeline.layout.RUN_LOG`); none when it is
+    absent or unreadable (a log: the report does not depend on it)."""
+    try:
+        stages = json.loads((build_dir / RUN_LOG).read_text(encoding="utf-8")).get("stages", [])
+    except (OSError, ValueError, AttributeError):
+        return []
+    return [s for s in stages if isinstance(s, dict) and isinstance(s.get("name"), str)
+            and isinstance(s.get("status"), str) and isinstance(s.get("seconds", 0.0), (int, float))]
+
+
 def run_log(data: BuildData, seconds: dict[str, float]) -> bytes:
-    """:data:`LOG`: the build folder's path, each stage's time in its last run and each report part's, s."""
+    """:data:`LOG`: the build folder's path, each stage's status and time in its last run (from the build's run log)
+    and each report part's time, s."""
     lines = [f"build folder: {Path(os.path.realpath(data.build_dir)).as_posix()}"]
-    lines += [f"stage {name}: {value:.3f} s (last run)" for name, value in data.manifest.get("timing_s", {}).items()]
+    for stage in _run_stages(Path(data.build_dir)):
+        took = f", {stage['seconds']:.3f} s" if "seconds" in stage else ""
+        lines.append(f"stage {stage['name']}: {stage['status']}{took} (last run)")
     lines += [f"report part {name}: {value:.3f} s" for name, value in seconds.items()]
     return ("\n".join(lines) + "\n").encode("utf-8")

@@ -133,7 +133,7 @@ def test_an_integer_key_refuses_bools_and_floats(tmp_path, links, shown):
 def test_counts_above_their_limit_are_refused_by_validate_naming_key_value_and_limit(tmp_path, section, key, limit):
     case = demo_case(tmp_path, **section)
     result = run_limited("validate", str(case))
-    text = assert_refused(result, key, f"must be <= {limit}", "softdesign/limits.py", "2 GiB")
+    text = assert_refused(result, key, f"must be <= {limit}", "softdesign/limits/__init__.py", "2 GiB")
     assert len(text) < 2000
 
 

@@ -119,7 +119,8 @@ def _labelled_y(tmp_path, wall_patch: bool):
     the trunk's wall labelled 9, larger than any cap (as SimVascular models label wall faces)."""
     from vtk.util.numpy_support import numpy_to_vtk
 
-    from softdesign.io.vtk_polydata import polydata_from_triangles, polydata_writer
+    from softdesign.io.vtk_polydata import polydata_writer
+    from softdesign.meshing.vtk_triangles import polydata_from_triangles
     from tests.helpers.vessels import y_bifurcation
 
     vertices, faces, axes = y_bifurcation(4.0, 3.0, 30.0, np.radians(30.0), 0.8)

@@ -9,7 +9,7 @@ import pytest
 from typer.testing import CliRunner
 
 from softdesign.cli import app
-from softdesign.material_data import KPA_PER_UNIT, material_presets
+from softdesign.materials.data import KPA_PER_UNIT, material_presets
 from tests.helpers.cases import write_case
 
 runner = CliRunner()

@@ -15,7 +15,7 @@ from softdesign.errors import InputDataError
 from softdesign.io.polylines_vtp import write_polylines_vtp
 from softdesign.io.vtk_polydata import polydata_arrays, read_polydata
 from softdesign.kinematics import pcc
-from tests.helpers.seed_transforms import rot_z, seed_chain, trans_z
+from tests.helpers.seed_transforms import dh_product, seed_chain
 
 runner = CliRunner()
 
@@ -62,15 +62,6 @@ def test_forward_straight_section_prints_a_pure_translation():
     assert payload["sections"][0]["kappa"] == 0.0
 
 
-def _dh_link(theta: float, d: float, a: float, alpha: float) -> np.ndarray:
-    """A standard D-H link Rz(theta) Tz(d) Tx(a) Rx(alpha), from elementary matrices."""
-    ca, sa = np.cos(alpha), np.sin(alpha)
-    rot_x = np.array([[1, 0, 0, 0], [0, ca, -sa, 0], [0, sa, ca, 0], [0, 0, 0, 1.0]])
-    trans_x = np.eye(4)
-    trans_x[0, 3] = a
-    return rot_z(theta) @ trans_z(d) @ trans_x @ rot_x
-
-
 def test_forward_json_gives_seed_003s_table_1_for_the_first_section_and_rows_that_multiply_to_each_htm():
     payload = forward_json("--lengths", BENDING, "--d", "15")
     first = payload["sections"][0]
@@ -95,9 +86,7 @@ def test_forward_json_gives_seed_003s_table_1_for_the_first_section_and_rows_tha
     np.testing.assert_allclose(got, table_1, rtol=0, atol=EXACT_TOL * length)
     # every section: the rows' D-H links multiply to its HTM (seed eq. 8), and to the five steps of section 3.2
     for section in payload["sections"]:
-        product = np.eye(4)
-        for row in section["dh"]:
-            product = product @ _dh_link(row["theta"], row["d"], row["a"], row["alpha"])
+        product = dh_product(section["dh"])
         np.testing.assert_allclose(product, section["transform"], rtol=0, atol=EXACT_TOL * section["length"])
         steps = seed_chain(section["kappa"], section["phi"], section["length"])
         np.testing.assert_allclose(product, steps, rtol=0, atol=EXACT_TOL * section["length"])

@@ -1,9 +1,9 @@
 """`softdesign check` catches a 1 % change in any stage's figures (issue 35 item 2).
 
-One real build of the demo with a mould and a material (coarse, a few
-seconds), copied as its own reference: it passes.  Then, one stage at a
-time, a figure of that stage in the copy is moved by 1 % and check must fail
-on that stage and nothing else.  The demo does not ask for a volume mesh
+One real build of the demo with a design, a mould and a material (coarse, a
+few seconds), copied as its own reference: it passes.  Then, one stage at a
+time, a figure of that stage in the copy is moved by 1 % (a count by one, a
+flag turned) and check must fail on that stage and nothing else.  The demo does not ask for a volume mesh
 (fTetWild takes minutes and is not deterministic), so the volume-mesh figures
 are a block of the manifest's shape added to both sides; the comparison is
 the same table-driven code either way.
@@ -15,6 +15,7 @@ import json
 import shutil
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -46,6 +47,7 @@ def reference(tmp_path_factory) -> Path:
     case["fit"] = {"knot_spacing_mm": 3.0, "angular_intervals": 12}
     case["export"] = {"q": [0, 1], "spacing_mm": 1.0, "angular_count": 40, "mould": {}}
     case["material"] = {"name": "dragon-skin-30"}
+    case["design"] = {"tolerance_mm": 1.0}  # the design stage's figures (metrics.design); the blend stays linear
     (root / "demo.yaml").write_text(yaml.safe_dump(case), encoding="utf-8")
     build_through(root / "demo.yaml", root / "reference")
     edit_manifest(root / "reference", lambda m: m["metrics"].update(volume_mesh=json.loads(json.dumps(VOLUME_MESH))))
@@ -71,27 +73,42 @@ def scale_kinematics(folder: Path) -> None:
     (folder / "kinematics.json").write_text(json.dumps(document), encoding="utf-8")
 
 
-def times(block: dict, *path: str | int) -> None:
-    """Multiply the number at ``path`` in ``block`` by CHANGE."""
-    for key in path[:-1]:
-        block = block[key]
-    block[path[-1]] *= CHANGE
+def moved(value: Any) -> Any:
+    """A number by CHANGE, a count by one, a flag turned."""
+    if isinstance(value, bool):
+        return not value
+    return value + 1 if isinstance(value, int) else value * CHANGE
 
 
-#: stage -> (how its figures are moved by 1 %, the check's item that must fail)
+def move(block: str, *path: str | int) -> Callable[[Path], None]:
+    """Move the figure at ``metrics.<block>/<path>`` of a build folder's manifest (:func:`moved`)."""
+
+    def edit(manifest: dict) -> None:
+        node = manifest["metrics"][block]
+        for key in path[:-1]:
+            node = node[key]
+        node[path[-1]] = moved(node[path[-1]])
+
+    return lambda folder: edit_manifest(folder, edit)
+
+
+#: injection -> (how one stage's figure is moved, the check's item that must fail): every stage's own figures
 INJECTIONS: dict[str, tuple[Callable[[Path], None], str]] = {
     "meshes": (scale_mesh, "meshes/q_1.000.stl"),
-    "kinematics": (scale_kinematics, "kinematics"),
-    "links": (lambda f: edit_manifest(f, lambda m: times(m["metrics"]["links"], "breaks", 1)), "links"),
-    "blend": (lambda f: edit_manifest(f, lambda m: times(m["metrics"]["blend"], "final_path", "length_mm")), "blend"),
-    "fit": (lambda f: edit_manifest(f, lambda m: times(m["metrics"]["fit"], "rms_mm")), "fit"),
-    "feasibility": (lambda f: edit_manifest(f, lambda m: times(m["metrics"]["feasibility"], "per_q", -1,
-                                                               "stretch_max")), "feasibility"),
-    "design": (lambda f: edit_manifest(f, lambda m: times(m["metrics"]["kinematics"], "arc_check",
-                                                          "max_deviation_mm", 0)), "design"),
-    "mould": (lambda f: edit_manifest(f, lambda m: times(m["metrics"]["mould"], "cavity", "cast_mm3")), "mould"),
-    "volume_mesh": (lambda f: edit_manifest(f, lambda m: times(m["metrics"]["volume_mesh"], "per_q", 0,
-                                                               "volume_mm3")), "volume_mesh"),
+    "kinematics.json": (scale_kinematics, "kinematics"),
+    "kinematics.arc_check": (move("kinematics", "arc_check", "max_deviation_mm", 0), "kinematics"),
+    "links": (move("links", "breaks", 1), "links"),
+    "blend": (move("blend", "final_path", "length_mm"), "blend"),
+    "fit": (move("fit", "rms_mm"), "fit"),
+    "feasibility": (move("feasibility", "per_q", -1, "stretch_max"), "feasibility"),
+    "design.tip_error_mm": (move("design", "tip_error_mm"), "design"),
+    "design.tip_error_deg": (move("design", "tip_error_deg"), "design"),
+    "design.chain_max_deviation_mm": (move("design", "chain_max_deviation_mm"), "design"),
+    "design.breaks": (move("design", "breaks", 1), "design"),
+    "design.links": (move("design", "links"), "design"),
+    "design.meets_tolerance": (move("design", "meets_tolerance"), "design"),
+    "mould": (move("mould", "cavity", "cast_mm3"), "mould"),
+    "volume_mesh": (move("volume_mesh", "per_q", 0, "volume_mm3"), "volume_mesh"),
 }
 
 
@@ -108,6 +125,9 @@ def test_the_build_passes_against_itself_with_every_stage_compared(reference, tm
     items = {f["item"].split(" ")[0] for f in json.loads(result.stdout)["figures"]}
     assert {"meshes/q_1.000.stl", "kinematics", "links", "blend", "fit", "feasibility", "design", "mould",
             "volume_mesh"} <= items
+    design = {f["figure"] for f in json.loads(result.stdout)["figures"] if f["item"] == "design"}
+    assert {"designed", "links", "meets_tolerance", "breaks/1", "chain_max_deviation_mm", "tip_error_mm",
+            "tip_error_deg"} <= design
     assert any(item.startswith("meshes/mould/") for item in items)  # the mould's parts are meshes too
 
 

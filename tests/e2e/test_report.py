@@ -25,6 +25,7 @@ from typer.testing import CliRunner
 
 from softdesign.pipeline.api import build_through
 from softdesign.pipeline.owned import REPORT_MARKER
+from softdesign.pipeline.versions import software_versions
 from softdesign.report.interactive import DISPLAY_TOLERANCE_MM, DIV_ID, JS_NAME
 from softdesign.report.writer import (
     EXPECTED_SIZES,
@@ -35,7 +36,6 @@ from softdesign.report.writer import (
     commit_folder,
     write_report,
 )
-from softdesign.versions import software_versions
 from tests.helpers.cases import write_case
 from tests.helpers.paths import REPO
 
@@ -341,7 +341,7 @@ def test_a_stale_stage_is_noted_on_the_page(demo, tmp_path):
     manifest = json.loads(manifest_file.read_text())
     for stage in manifest["stages"]:
         if stage["name"] == "export":
-            stage["status"] = "stale"
+            stage["stale"] = True
     manifest_file.write_text(json.dumps(manifest))
     write_report(copy, ReportOptions(gif_frames=3))
     text = (copy / REPORT_DIR / PAGE).read_text(encoding="utf-8")

@@ -5,6 +5,9 @@ same bytes on a second build."""
 from __future__ import annotations
 
 import json
+import re
+import subprocess
+import sys
 from pathlib import Path
 
 import meshio
@@ -39,7 +42,14 @@ def test_swept_mesh_of_a_hollow_tube(tmp_path):
     out = tmp_path / "build"
     result = runner.invoke(app, ["build", str(case), "--out", str(out)])
     assert result.exit_code == 0, result.output
+    # a line per part with its time in the build's log (its printed lines), none in the summary (issue 35)
+    assert re.search(r"^  mesh plan: \d+\.\d\d s$", result.output, re.M), result.output
+    assert re.search(r"^  q=0\.050\.\.0\.950 \(19 q\): \d+\.\d\d s$", result.output, re.M), result.output
     summary = json.loads((out / "volume_mesh" / "summary.json").read_text())
+    assert "mesher_s" not in json.dumps(summary) and "seconds" not in json.dumps(summary)
+    run = {row["name"]: row for row in json.loads((out / "run.log.json").read_text())["stages"]}
+    assert re.fullmatch(r"mesh plan: \d+\.\d\d s", run["volume_mesh"]["log"][0]), run["volume_mesh"]
+    assert len(run["volume_mesh"]["log"]) == 4  # the plan, q = 0 and 1, one batch of the morph's samples
     assert summary["deterministic"] and summary["surfaces"] == [
         "skin", "base", "tip", "chamber_wall", "chamber_cap", "port_wall", "port_inlet"]
     for row in summary["per_q"]:
@@ -72,6 +82,7 @@ def test_swept_mesh_of_a_hollow_tube(tmp_path):
     assert runner.invoke(app, ["build", str(case), "--out", str(again)]).exit_code == 0
     for name in ("q_0.000.vtu", "q_0.000.msh", "q_1.000.vtu", "chamber_q_1.000.stl"):
         assert (volume / name).read_bytes() == (again / "meshes" / "volume" / name).read_bytes(), name
+    assert (out / "volume_mesh" / "summary.json").read_bytes() == (again / "volume_mesh" / "summary.json").read_bytes()
 
 
 def test_strict_fails_on_the_3d_stress_alone(tmp_path):
@@ -97,3 +108,74 @@ def test_strict_fails_on_the_3d_stress_alone(tmp_path):
     assert summary["feasible"] is False and "3D stress" in summary["reasons"][0]
     manifest = json.loads((out / "manifest.json").read_text())
     assert "volume_mesh" in json.dumps(manifest) and "stress_max_kpa" in json.dumps(manifest)
+
+
+#: Issue 32: the swept mesh's skin stretches agree with the feasibility stage's within 1 %.
+SKIN_RTOL = 0.01
+
+
+def test_the_demos_skin_stretches_agree_with_the_feasibility_stages(tmp_path):
+    """configs/demo.yaml as it is, with a volume mesh at q = 0.5 and 1: the skin quads' largest and least
+    stretch against the feasibility stage's (its grid converged to 1e-4), within 1 %.
+
+    One pair cannot agree, and the test says why instead of loosening the bound: at q = 0.5 the feasibility's
+    least stretch sits on the tip's end ring (l = 1), where the mesh has no quad centre (the last row's is
+    half a layer inside, in the zone the tip's cut moves); the surface's own least stretch at the mesh's quad
+    centres agrees with the mesh's within 1 %.
+    """
+    import yaml
+
+    from softdesign.config import load_case
+    from softdesign.fitting.strain import principal_stretches, skin_metric
+    from softdesign.meshing.sweep_strain import skin_places
+    from softdesign.pipeline.api import build_through
+    from softdesign.pipeline.stages.volume_sweep import _plan
+    from tests.helpers.paths import REPO
+
+    data = yaml.safe_load((REPO / "configs" / "demo.yaml").read_text())
+    for key in ("centerline", "surface"):
+        data["final"][key] = str((REPO / "configs" / data["final"][key]).resolve())
+    data["export"]["volume_mesh"] = {"q": [0.5, 1.0]}
+    case_file = tmp_path / "demo.yaml"
+    case_file.write_text(yaml.safe_dump(data, sort_keys=False))
+    outcome = build_through(case_file, tmp_path / "build")
+    volume = outcome.results["volume_mesh"].summary["per_q"]
+    feasibility = {row["q"]: row for row in outcome.results["feasibility"].summary["per_q"]}
+    for row in volume:
+        skin, surface = row["strain"], feasibility[row["q"]]
+        np.testing.assert_allclose(skin["skin_stretch_max"], surface["stretch_max"], rtol=SKIN_RTOL)
+        if row["q"] == 1.0:
+            np.testing.assert_allclose(skin["skin_stretch_min"], surface["stretch_min"], rtol=SKIN_RTOL)
+    half = feasibility[0.5]
+    assert half["where"]["stretch_min"]["l"] == 1.0  # the end ring: why q = 0.5's least stretch is not compared
+    case = load_case(case_file)
+    results = outcome.results
+    placed = _plan(case, results["kinematics"], results["fit"], case.export.volume_mesh)
+    l, a = skin_places(placed.mesh)
+    shape, field = results["kinematics"].chain.shape, results["fit"].field
+    _, least = principal_stretches(skin_metric(shape.curve_at(0.0), field, 0.0, l, a, case.frames),
+                                   skin_metric(shape.curve_at(0.5), field, 0.5, l, a, case.frames))
+    np.testing.assert_allclose(volume[0]["strain"]["skin_stretch_min"], least.min(), rtol=SKIN_RTOL)
+
+
+
+
+def test_meshing_and_its_metrics_show_a_bar_on_a_terminal_and_a_line_per_part_with_its_time(tmp_path):
+    """Issue 32 item 5: on a terminal the volume_mesh stage's bar counts its parts (the mesh plan, each q, each
+    batch of the morph's samples, each with its time); the build's printed log has a line per part with its
+    time; a pipe gets no bar."""
+    from tests.e2e.test_export_progress import CODE, _on_a_terminal
+    from tests.helpers.paths import REPO
+
+    case = _swept(tmp_path)
+    code, stdout, screen = _on_a_terminal("build", str(case), "--out", str(tmp_path / "tty"), "--jobs", "1")
+    assert code == 0, screen
+    parts = ["mesh plan", "q=0.000", "q=1.000", r"q=0\.050\.\.0\.950 \(19 q\)"]
+    for done, part in enumerate(parts, start=1):
+        assert re.search(rf"volume_mesh: {part} \(\d+\.\d\d s\) done .*{done}/{len(parts)}", screen), screen
+        assert re.search(rf"^  {part}: \d+\.\d\d s$", stdout, re.M), stdout
+    piped = subprocess.run([sys.executable, "-c", CODE, "build", str(case), "--out", str(tmp_path / "pipe")],
+                           capture_output=True, text=True, cwd=REPO, timeout=600, stdin=subprocess.DEVNULL)
+    assert piped.returncode == 0, piped.stderr
+    assert "\x1b" not in piped.stderr and "mesh plan (" not in piped.stderr
+    assert re.search(r"^  mesh plan: \d+\.\d\d s$", piped.stdout, re.M), piped.stdout

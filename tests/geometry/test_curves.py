@@ -246,7 +246,36 @@ def test_samples_rebuilt_with_their_joints_give_the_same_spline():
         smooth_curve_from_samples(curve.points(curve.l_grid), (3,))
 
 
-def test_a_smoothed_path_makes_no_joint_its_smoothing_moved_the_vertex_off_the_break():
+@pytest.mark.parametrize("smoothing_mm", [0.05, CurveOptions().smoothing_mm])
+def test_a_smoothed_path_keeps_its_joint_sharp_and_through_the_vertex(smoothing_mm):
     points, corner = corner_points()
-    options = CurveOptions(spacing_mm=0.5, smoothing_mm=0.05, end_straight_mm=0.0)
-    assert smooth_curve_from_polyline(points, options, [corner]).joints == ()
+    options = CurveOptions(spacing_mm=0.5, smoothing_mm=smoothing_mm, end_straight_mm=0.0)
+    curve = smooth_curve_from_polyline(points, options, [0.0, corner, 1.0])
+    assert curve.joints == (40,)
+    l_joint, step = curve.l_grid[40], 1e-9
+    assert np.count_nonzero(curve.spline.t == l_joint) == curve.spline.k + 1
+    # both pieces are pinned at the joint's vertex: the joint is the data's corner, not an average of two ends
+    np.testing.assert_allclose(curve.points([l_joint])[0], [0.0, 0.0, 20.0], rtol=0, atol=EXACT_MM)
+    before, after = curve.curvature([l_joint - step, l_joint + step])
+    # the straight piece is smoothed on its own (exactly straight); the quarter circle as one quintic within the
+    # smoothing's allowance: its curvature within 0.5 %, its start tangent within 3e-4 rad (the smoothing's own
+    # error on a 1.55 rad turn, not the corner's: the whole-path smoothing below is 100 times further off)
+    assert before <= 1e-9 and abs(after - 0.1) <= 5e-4
+    t_before, t_after = curve.tangents([l_joint - step, l_joint + step])
+    assert np.linalg.norm(t_before - t_after) <= 3e-4
+    smoothed = smooth_curve_from_polyline(points, options)
+    assert smoothed.joints == () and 0.03 <= smoothed.curvature([l_joint])[0] <= 0.07  # what it was: rounded
+    assert np.linalg.norm(smoothed.points([l_joint])[0] - [0.0, 0.0, 20.0]) > 0.02
+
+
+def test_a_break_near_a_noisy_vertex_is_smoothed_over_as_before():
+    """Noise (0.05 mm) moves the corner vertex's arc length along the path by far more than a joint's 1e-4 spacings:
+    a break at the clean corner's l, or at no vertex, is smoothed over with the rest (same knots, same coefficients)."""
+    points, corner = corner_points()
+    noisy = points + np.random.default_rng(7).normal(0.0, 0.05, points.shape)
+    options = CurveOptions(spacing_mm=0.5, smoothing_mm=0.1, end_straight_mm=0.0)
+    plain = smooth_curve_from_polyline(noisy, options)
+    for breaks in ([0.0, 0.3, 1.0], [0.0, corner, 1.0]):
+        curve = smooth_curve_from_polyline(noisy, options, breaks)
+        assert curve.joints == ()
+        assert np.array_equal(curve.spline.c, plain.spline.c) and np.array_equal(curve.spline.t, plain.spline.t)

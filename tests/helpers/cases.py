@@ -15,6 +15,17 @@ def write_case(folder: Path, name: str = "case", **sections) -> Path:
     return path
 
 
+def case_from(folder: Path, source: Path, extra: dict) -> Path:
+    """A copy of the case file ``source`` in ``folder`` (its input paths made absolute) with ``extra`` over it."""
+    case = yaml.safe_load(source.read_text())
+    for key in ("centerline", "surface"):
+        case["final"][key] = str((source.parent / case["final"][key]).resolve())
+    case.update(extra)
+    out = folder / f"{case['name']}.yaml"
+    out.write_text(yaml.safe_dump(case, sort_keys=False))
+    return out
+
+
 def straight_tube(folder: Path, radius: float = 3.0, length: float = 40.0, scale: float = 1.0) -> tuple[Path, Path]:
     """A straight vessel along z: centerline .vtp (with radius) and capped surface .stl.
 

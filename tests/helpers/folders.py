@@ -23,9 +23,11 @@ def listed_files(folder: Path) -> dict[str, str]:
 
 
 def assert_exactly_as_listed(folder: Path) -> None:
-    """Every file of ``folder`` but the manifest is listed in it with its hash, and nothing listed is missing."""
+    """Every file of ``folder`` but the manifest and the run log is listed in it with its hash, and nothing listed is
+    missing."""
     files = snapshot(folder)
     files.pop("manifest.json")
+    files.pop("run.log.json")
     assert files == listed_files(folder)
 
 

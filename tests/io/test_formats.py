@@ -109,7 +109,7 @@ def test_every_registered_format_round_trips_through_write_and_read(ported, tmp_
 def test_a_legacy_vtk_surface_is_read_like_the_others(ported, tmp_path):
     import vtk
 
-    from softdesign.io.vtk_polydata import polydata_from_triangles
+    from softdesign.meshing.vtk_triangles import polydata_from_triangles
 
     writer = vtk.vtkPolyDataWriter()
     writer.SetInputData(polydata_from_triangles(ported.vertices, ported.faces))

@@ -85,3 +85,24 @@ def test_the_largest_stress_without_the_tensor_is_the_tensor_s(free):
     fast = element_strain(rest, moved.reshape(-1, 3), tets, YEOH, directions).stress_max
     full = np.linalg.eigvalsh(cauchy_stress(YEOH, F, directions))[:, -1]
     np.testing.assert_allclose(fast, full, rtol=1e-9, atol=1e-9 * np.abs(full).max())
+
+
+def test_chunks_and_batches_change_no_bit():
+    """strains on more tetrahedra than a chunk, and on a stack of moved states, gives each tetrahedron's figures
+    exactly as alone (element by element arithmetic), the stack's as each state's."""
+    from softdesign.mechanics.kinematic_stress import STRAIN_CHUNK, _strains, rest_state, strains
+
+    rng = np.random.default_rng(5)
+    F = np.eye(3) + 0.2 * rng.normal(size=(STRAIN_CHUNK + 1000, 3, 3))
+    F = F[np.linalg.det(F) > 0.2]
+    assert len(F) > STRAIN_CHUNK
+    moved = np.einsum("nij,kj->nki", F, TET).reshape(-1, 3)
+    state = rest_state(np.tile(TET, (len(F), 1)), np.arange(4 * len(F)).reshape(-1, 4), rng.normal(size=(len(F), 3)))
+    whole, chunked = _strains(state, moved, YEOH), strains(state, moved, YEOH)
+    for a, b in ((whole.stretches, chunked.stretches), (whole.green_max, chunked.green_max),
+                 (whole.stress_max, chunked.stress_max)):
+        np.testing.assert_array_equal(a, b)
+    stack = strains(state, np.stack([moved, 1.1 * moved]), YEOH)
+    assert stack.stress_max is not None and stack.stretches.shape == (2, len(F), 3)
+    np.testing.assert_array_equal(stack.stretches[0], chunked.stretches)
+    np.testing.assert_array_equal(stack.stress_max[1], strains(state, 1.1 * moved, YEOH).stress_max)

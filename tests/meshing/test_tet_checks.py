@@ -105,7 +105,7 @@ def test_points_inside_a_sphere_and_an_open_surface_refused():
 
 def test_a_size_asking_for_too_many_tetrahedra_is_refused_with_the_smallest_that_fits():
     from softdesign.errors import ConfigError
-    from softdesign.limits_volume import MAX_VOLUME_TETS
+    from softdesign.limits.volume import MAX_VOLUME_TETS
     from softdesign.pipeline.stages.volume_mesh import _check_count
 
     volume = 4313.0  # the demo's body, mm^3

@@ -16,7 +16,7 @@ import yaml
 from typer.testing import CliRunner
 
 from softdesign.cli import app
-from softdesign.versions import software_versions
+from softdesign.pipeline.versions import software_versions
 from tests.helpers.paths import REPO
 
 runner = CliRunner()
@@ -133,15 +133,17 @@ def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tm
     }
     outputs = {o["path"]: o for o in manifest["outputs"]}
     assert all(outputs[m]["watertight"] and outputs[m]["volume_mm3"] > 0 and "stale" not in outputs[m] for m in meshes)
-    assert "export" in manifest["metrics"] and "export" not in manifest["timing_s"]
+    assert "export" in manifest["metrics"] and "timing_s" not in manifest
+    run = {s["name"]: s for s in json.loads((out / "run.log.json").read_text())["stages"]}
+    assert run["export"] == {"name": "export", "status": "kept"} and run["fit"]["status"] == "skipped"
     # A new fit: the meshes on disk were made from the old one, and the manifest says so.
     edit(demo_case, "fit", smoothing=2.0e-5)
     ran, manifest = run_fit()
     assert (ran["fit"], ran["export"], ran["feasibility"]) == ("ran", "stale", "stale")
     outputs = {o["path"]: o for o in manifest["outputs"]}
     assert all(outputs[m]["stale"] is True for m in meshes) and "stale" not in outputs["fit/surface.npz"]
-    assert {"name": "export", "status": "stale"}.items() <= next(
-        s for s in manifest["stages"] if s["name"] == "export").items()
+    assert next(s for s in manifest["stages"] if s["name"] == "export")["stale"] is True
+    assert not any("stale" in s for s in manifest["stages"] if s["name"] in ("ingest", "fit"))
     assert "export" not in manifest["metrics"]
     # A build brings them up to date.
     assert statuses(build(demo_case, out))["export"] == "ran"
@@ -169,11 +171,9 @@ def test_same_inputs_give_the_same_bytes(demo_case, tmp_path):
     assert {"meshes/q_0.000.stl", "meshes/q_1.000.stl", "kinematics.json"} <= listed.keys()
     for name, digest in listed.items():
         assert one[name] == two[name] == digest, name
-    # the manifest differs only by its timing block
-    strip = [json.loads((f / "manifest.json").read_text()) for f in (first, second)]
-    for m in strip:
-        m.pop("timing_s")
-    assert strip[0] == strip[1]
+    # the manifest is the same bytes too: how each run went (statuses, seconds) is in the run log only
+    assert (first / "manifest.json").read_bytes() == (second / "manifest.json").read_bytes()
+    assert {s["name"] for s in json.loads((first / "run.log.json").read_text())["stages"]} == set(STAGES)
 
 
 @pytest.mark.slow
@@ -204,7 +204,10 @@ def test_manifest_records_inputs_case_metrics_and_outputs(demo_case, tmp_path):
     assert manifest["software"] == software_versions()  # the installed versions, keys in order
     assert list(manifest["software"]) == ["softdesign", "python", "numpy", "scipy", "vtk", "trimesh", "manifold3d",
                                           "pydantic"]
-    assert set(manifest["timing_s"]) == set(STAGES)
+    assert "timing_s" not in manifest and [s["name"] for s in manifest["stages"]] == list(STAGES)
+    run = json.loads((out / "run.log.json").read_text())["stages"]
+    assert [(s["name"], s["status"]) for s in run] == [(name, "ran") for name in STAGES]
+    assert all(s["seconds"] >= 0 for s in run)
     fit = manifest["metrics"]["fit"]
     assert 0 < fit["p95_mm"] <= fit["p99_mm"] <= fit["max_mm"] and 0 < fit["rms_mm"] <= fit["max_mm"]
     meshes = [o for o in manifest["outputs"] if o["path"].startswith("meshes/")]
@@ -250,7 +253,7 @@ def killing(*args, **kwargs):
     return original(*args, **kwargs)
 export_stage.mesh_bytes = killing
 from softdesign.cli import app
-from softdesign.versions import software_versions
+from softdesign.pipeline.versions import software_versions
 sys.argv = ["softdesign"] + sys.argv[1:]
 app()
 """

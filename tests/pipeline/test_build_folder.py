@@ -62,13 +62,12 @@ def assert_refused(result: Result, *needles: str) -> None:
 
 
 def contents(folder: Path) -> tuple[dict[str, str], dict]:
-    """The files of a build but its manifest, and the manifest but how its run went (timing, ran or skipped)."""
+    """The files of a build but its manifest and run log (how the run went: seconds, ran or skipped), and the
+    manifest."""
     files = snapshot(folder)
     files.pop("manifest.json")
-    manifest = json.loads((folder / "manifest.json").read_text())
-    manifest.pop("timing_s")
-    manifest["stages"] = [(stage["name"], stage["key"]) for stage in manifest["stages"]]
-    return files, manifest
+    files.pop("run.log.json")
+    return files, json.loads((folder / "manifest.json").read_text())
 
 
 def child_env() -> dict[str, str]:

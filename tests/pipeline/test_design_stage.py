@@ -19,6 +19,7 @@ from softdesign.cli import app
 from softdesign.pipeline.api import build_through
 from softdesign.pipeline.stages.blend import load_blend
 from softdesign.pipeline.stages.design import load_design
+from tests.helpers.cases import case_from as designed_case
 from tests.helpers.paths import DEMO
 from tests.helpers.seed_transforms import seed_chain
 
@@ -49,16 +50,6 @@ def composed_chain(document: dict, step_mm: float = 0.01) -> tuple[list[np.ndarr
         pose = pose @ seed_chain(link["kappa"], link["phi"], link["length"])
         tips.append(pose)
     return tips, np.array(points)
-
-
-def designed_case(folder: Path, source: Path, extra: dict) -> Path:
-    case = yaml.safe_load(source.read_text())
-    for key in ("centerline", "surface"):
-        case["final"][key] = str((source.parent / case["final"][key]).resolve())
-    case.update(extra)
-    out = folder / f"{case['name']}.yaml"
-    out.write_text(yaml.safe_dump(case, sort_keys=False))
-    return out
 
 
 @pytest.fixture(scope="module")

@@ -4,7 +4,9 @@ The centerline is seed 003's chain of constant-curvature sections written as
 VMTK would; the case breaks its links where the sections meet.  The blend
 keeps those joints sharp, so ``kinematics.json``'s link transforms at q = 1
 are the sections' own (improved D-H, seed 003 eq. 8) within the issue's 1e-4
-rad and 1e-4 mm, at the project's default 0.5 mm resampling.
+rad and 1e-4 mm, at the project's default 0.5 mm resampling, interpolated
+(``smoothing_mm: 0``) and at the default smoothing (each piece between joints
+smoothed on its own, pinned at its joints).
 """
 
 from __future__ import annotations
@@ -35,7 +37,8 @@ def section(kappa: float, phi: float, length: float) -> np.ndarray:
 
 
 @pytest.mark.slow
-def test_link_transforms_of_a_case_broken_at_its_joints_are_the_sections(tmp_path):
+@pytest.mark.parametrize("smoothing", [{"smoothing_mm": 0.0}, {}], ids=["interpolated", "default-smoothing"])
+def test_link_transforms_of_a_case_broken_at_its_joints_are_the_sections(tmp_path, smoothing):
     pose, points = np.eye(4), []
     for kappa, phi, length in ARCS:
         points += [(pose @ section(kappa, phi, s))[:3, 3] for s in np.arange(0.0, length - 1e-9, SPACING_MM)]
@@ -46,7 +49,7 @@ def test_link_transforms_of_a_case_broken_at_its_joints_are_the_sections(tmp_pat
     total = sum(length for _, _, length in ARCS)
     breaks = [0.0, *(float(b) for b in np.cumsum([a[2] for a in ARCS])[:-1] / total), 1.0]
     case = {"name": "arcs", "units": "mm", "final": {"centerline": "arcs.vtp"},
-            "resample": {"spacing_mm": SPACING_MM, "smoothing_mm": 0.0, "end_straight_mm": 0.0},
+            "resample": {"spacing_mm": SPACING_MM, "end_straight_mm": 0.0, **smoothing},
             "links": {"breaks": breaks}, "export": {"q": [0, 1]}}
     (tmp_path / "arcs.yaml").write_text(yaml.safe_dump(case), encoding="utf-8")
     outcome = build_through(tmp_path / "arcs.yaml", tmp_path / "build", target="kinematics")
@@ -62,6 +65,12 @@ def test_link_transforms_of_a_case_broken_at_its_joints_are_the_sections(tmp_pat
         assert abs(np.linalg.norm(rotvec_from_rotation(got[:3, :3])) - kappa * length) <= ANGLE_TOL
         assert abs(np.linalg.norm(got[:3, 3]) - np.linalg.norm(expected[:3, 3])) <= MM_TOL
         assert abs(link["length"] - length) <= MM_TOL
+    # the chain's end frame from its base, composed from the links: the same bend and reach as the sections'
+    tip = np.linalg.multi_dot([np.array(link["transform"]) for link in final["links"]])
+    expected_tip = np.linalg.multi_dot([section(*arc) for arc in ARCS])
+    bend = np.linalg.norm(rotvec_from_rotation(tip[:3, :3]))
+    assert abs(bend - np.linalg.norm(rotvec_from_rotation(expected_tip[:3, :3]))) <= ANGLE_TOL
+    assert abs(np.linalg.norm(tip[:3, 3]) - np.linalg.norm(expected_tip[:3, 3])) <= MM_TOL
     # the joints are kept with the blend's samples: the kinematics re-run on the loaded blend are the same bits
     case["export"]["q"] = [0, 0.5, 1]
     (tmp_path / "arcs.yaml").write_text(yaml.safe_dump(case), encoding="utf-8")

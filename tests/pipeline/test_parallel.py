@@ -18,8 +18,8 @@ from softdesign.pipeline.parallel import MAX_JOBS, available_cores, checked_jobs
 from tests.helpers.paths import REPO
 
 runner = CliRunner()
-#: Manifest keys that differ between two runs of the same build whatever the jobs (README: timing only).
-RUN_KEYS = ("timing_s",)
+#: The one file that differs between two runs of the same build whatever the jobs: how the run went.
+RUN_LOG = "run.log.json"
 
 
 def _pid_and_square(q: float) -> tuple[int, float]:
@@ -75,7 +75,9 @@ def test_jobs_that_is_not_a_whole_number_is_refused(tmp_path):
 
 
 def _files(folder: Path) -> dict[str, bytes]:
-    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+    files = {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+    assert b'"seconds"' in files.pop(RUN_LOG)
+    return files
 
 
 @pytest.mark.slow
@@ -97,11 +99,8 @@ def test_a_build_is_the_same_bytes_with_one_and_two_jobs(tmp_path):
     assert sorted(one) == sorted(two)
     meshes = [name for name in one if name.startswith("meshes/")]
     assert len(meshes) == 5 * (3 + 3)  # per q: 3 formats, and one STL per region (wall, two caps)
+    assert one["manifest.json"] == two["manifest.json"]
     manifests = [json.loads(files.pop("manifest.json")) for files in (one, two)]
-    for manifest in manifests:
-        for key in RUN_KEYS:
-            manifest.pop(key)
-    assert manifests[0] == manifests[1]
     vertices = [o["vertices"] for o in manifests[0]["outputs"] if re.fullmatch(r"meshes/q_[0-9.]+\.stl", o["path"])]
     assert len(vertices) == 5
     assert sum(vertices) >= 2 * VERTICES_PER_WORKER  # so that export, too, ran on two workers

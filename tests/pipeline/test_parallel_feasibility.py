@@ -12,9 +12,9 @@ from softdesign.config import load_case
 from softdesign.meshing.skin_stretch import make_grid
 from softdesign.meshing.wall import FD_STEP_MM
 from softdesign.pipeline.api import build_through
+from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.parallel import jobs_for_build
 from softdesign.pipeline.stage_order import STAGES
-from softdesign.pipeline.stages.export import body_spec
 from softdesign.pipeline.stages.feasibility import _Body, run_feasibility
 from tests.helpers.cases import write_case
 from tests.helpers.paths import REPO

@@ -1,4 +1,4 @@
-"""softdesign.versions: the one place that says which software a build ran with."""
+"""softdesign.pipeline.versions: the one place that says which software a build ran with."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import platform
 from importlib import metadata
 
 from softdesign import __version__
-from softdesign.versions import NOT_INSTALLED, software_versions
+from softdesign.pipeline.versions import NOT_INSTALLED, software_versions
 
 #: The keys every manifest records, in order.
 RECORDED = ["softdesign", "python", "numpy", "scipy", "vtk", "trimesh", "manifold3d", "pydantic"]

@@ -21,7 +21,7 @@ def _data(manifest):
 
 def test_every_kind_of_warning_is_listed_stale_first_and_the_verdicts_causes_are_not_repeated():
     manifest = {
-        "stages": [{"name": "fit", "status": "ran"}, {"name": "export", "status": "stale"}],
+        "stages": [{"name": "fit"}, {"name": "export", "stale": True}],
         "metrics": {
             "feasibility": {"feasible": False, "reasons": ["q=1.000: wall 0.400 mm < min_wall_mm 1 (x) at link 2",
                                                            "q=1.000: skin stretch 3.1 > max_stretch 2.8 (x)"]},
@@ -42,7 +42,7 @@ def test_every_kind_of_warning_is_listed_stale_first_and_the_verdicts_causes_are
 def test_the_fit_s_coverage_warnings_are_named_in_the_banner():
     # issue 29: a held stretch longer than a diameter, an all-wall p95 above its stated fraction of the radius
     held = "no wall seen all round over 30.0 mm at 0.0-30.0 mm from the inlet, longer than the local diameter 6.0 mm"
-    manifest = {"stages": [{"name": "fit", "status": "ran"}],
+    manifest = {"stages": [{"name": "fit"}],
                 "metrics": {"fit": {"max_rho_kappa": 0.3, "flags": ["unseen_stretch_longer_than_diameter"],
                                     "warnings": [held]},
                             "kinematics": {"arc_check": {"warnings": []}}}}
@@ -50,7 +50,7 @@ def test_the_fit_s_coverage_warnings_are_named_in_the_banner():
 
 
 def test_a_clean_build_has_no_warning_and_says_so():
-    manifest = {"stages": [{"name": "fit", "status": "ran"}],
+    manifest = {"stages": [{"name": "fit"}],
                 "metrics": {"feasibility": {"feasible": None, "reasons": ["no material"]},
                             "fit": {"max_rho_kappa": 0.3}, "kinematics": {"arc_check": {"warnings": []}}}}
     assert summary_warnings(_data(manifest), [Check("a", "b", "c", "d", True)]) == []  # type: ignore[arg-type]

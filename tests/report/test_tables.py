@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from softdesign.pipeline.versions import software_versions
 from softdesign.report.tables import REPORT_PACKAGES, software_rows
-from softdesign.versions import software_versions
 
 
 def test_software_rows_show_what_the_build_recorded_beside_what_draws_the_page():

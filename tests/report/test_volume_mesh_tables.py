@@ -8,7 +8,7 @@ from softdesign.report.volume_mesh_tables import volume_mesh_checks, volume_mesh
 def row(**changes):
     figures = {"q": 0.0, "tets": 15157, "volume_rel_error": -0.00293, "volume_rtol": 0.01,
                "chamber_centroids_inside": 0, "min_dihedral_deg": 12.56, "max_dihedral_deg": 153.8,
-               "max_radius_edge": 2.96, "size_mm": 2.0, "mean_edge_mm": 1.19, "mesher_s": 460.8,
+               "max_radius_edge": 2.96, "size_mm": 2.0, "mean_edge_mm": 1.19,
                "min_tet_volume_mm3": 0.0058}
     return {**figures, **changes}
 

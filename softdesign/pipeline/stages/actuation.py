@@ -31,14 +31,16 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from softdesign.errors import ConfigError
+from softdesign.io.format_names import q_label
 from softdesign.kinematics.chamber_lengths import chamber_lengths_from_arc
 from softdesign.kinematics.pcc_fit import fit_links
 from softdesign.meshing.body import body_sections
 from softdesign.meshing.chamber_layout import ChamberLayout, analytic_walls, chamber_angles, plan_layout
 from softdesign.meshing.chamber_walls import Wall, chamber_lengths_mm, ring_walls, skin_walls
 from softdesign.meshing.chambers import measured_skin_walls
+from softdesign.meshing.sweep_layout import check_resolvable, layout_holes
+from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import export_workers
-from softdesign.pipeline.layout import q_label
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.fit import FitResult
@@ -208,8 +210,6 @@ def _skin(kinematics: KinematicsResult, fit: FitResult, layout: ChamberLayout, g
 def _meshed(case: Case, kinematics: KinematicsResult, fit: FitResult, layout: ChamberLayout) -> list[Wall]:
     """At every export q (on the build's worker processes), the thinnest skin over chambers and feeds measured
     on the meshes the export makes."""
-    from softdesign.pipeline.stages.export import body_spec  # export imports this stage's layout
-
     e, spec = case.export, body_spec(case, fit)
 
     def at(q: float) -> list[Wall]:
@@ -270,12 +270,24 @@ def layout_document(layout: ChamberLayout) -> dict[str, Any]:
     }
 
 
+def _check_sweep(case: Case, fit: FitResult, layout: ChamberLayout) -> None:
+    """The swept volume mesher's check of the layout (:func:`~softdesign.meshing.sweep_layout.check_resolvable`),
+    made here too so that a layout it cannot mesh is refused before the export, mould and volume stages run."""
+    volume = case.export.volume_mesh
+    if volume is None or volume.mesher != "sweep":
+        return
+    a = np.linspace(0.0, 2.0 * np.pi, case.export.angular_count, endpoint=False)
+    scale = float(np.median(fit.field.evaluate_grid(0.0, np.linspace(0.0, 1.0, 65), a)))
+    check_resolvable(layout, layout_holes(layout, scale, case.export.angular_count), scale)
+
+
 def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult) -> ActuationResult | None:
     """Layout (or refusal), the lengths table, the walls and extensions and their verdict; None without actuation."""
     layout = actuation_layout(case, kinematics)
     if layout is None:
         return None
     sections = check_layout(layout, section_radii(fit, layout))
+    _check_sweep(case, fit, layout)
     grid = q_grid(case)
     rows, reference = _rows_at(kinematics, layout, 0.0, 0.0 in case.export.q_values(), None)
     for q, export in grid:

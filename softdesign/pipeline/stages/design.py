@@ -6,12 +6,15 @@ resamples it, with rotation-minimizing frames from the blend's base normal;
 the core is :mod:`softdesign.kinematics.chain_design`.
 
 Kept in the build folder: ``design/summary.json`` (:func:`design_document`,
-what ``softdesign design --json`` prints) and ``design/profile.npz`` (the
-deviation along l and the chain's points, for the report).
+what ``softdesign design --json`` prints: per section its arc and seed 003's
+improved-D-H rows) and ``design/profile.npz`` (the deviation along l and the
+chain's points, for the report).
 
 For other stages and helpers: :func:`load_design` gives a :class:`DesignResult`
 whose :meth:`DesignResult.sections` lists each section's l range, kappa,
-phi, L, theta and base and tip frames (4x4, world).
+phi, L, theta and base and tip frames (4x4, world), and
+:meth:`DesignResult.sections_at` the sections at one q per section as
+``blend: pcc`` bends them (their HTMs and D-H rows, for kinematics.json).
 """
 
 from __future__ import annotations
@@ -22,10 +25,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from softdesign.errors import ConfigError
 from softdesign.geometry.curves import SmoothCurve, smooth_curve_from_polyline, smooth_curve_from_samples
 from softdesign.geometry.frames import base_normal_from_tangent, framed_curve
+from softdesign.kinematics import pcc
 from softdesign.kinematics.chain_design import METHOD, ChainOptions, ChainTarget, design_chain
 from softdesign.kinematics.pcc_chain import arcs_from_w, dense_chain_points, section_poses
 from softdesign.pipeline import layout
@@ -38,7 +43,7 @@ from softdesign.types import FloatArray, Pose
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 1
+VERSION = 2  # 2: each section's D-H rows (dh) and the dh_convention in design/summary.json
 #: Below this bending angle (rad) a section is reported straight: kappa and phi 0 (phi is rounding noise there).
 STRAIGHT_THETA_RAD = 1e-9
 #: Spacing of the chain's points kept for the report, mm.
@@ -52,7 +57,8 @@ CONVENTION = (
     "kappa = phi = 0. l_start, l_end are normalized l of the q = 1 centerline, at the joints' arc-length fractions of "
     "the chain. max_deviation_mm: the largest true distance between the composed chain and the centerline, both "
     "ways (target samples to the chain, chain points to the centerline); tip_error_mm: chain tip to the "
-    "centerline's end; tip_error_deg: angle between their tangents"
+    "centerline's end; tip_error_deg: angle between their tangents. dh: the section's five improved D-H rows "
+    "(dh_convention), whose product is the section's transform inv(base frame) @ tip_frame"
 )
 
 
@@ -107,6 +113,31 @@ class DesignResult:
                         bases[j], np.array(k["tip_frame"], float), k["max_deviation_mm"])
                 for j, k in enumerate(self.document["links"])]
 
+    def sections_at(self, q: npt.ArrayLike) -> list[dict[str, Any]]:
+        """Every section at its q (one per section) as ``blend: pcc`` bends it: curvature q * kappa, plane phi, L.
+
+        Each is ``{"index", "q", "kappa", "phi", "length", "theta", "dh", "transform"}``: the arc
+        (:func:`arc_document`) and its HTM (4x4, the section's tip in its base frame, seed 003).
+        """
+        q = np.broadcast_to(np.asarray(q, float), self.lengths.shape)
+        sections = []
+        for j, link in enumerate(self.document["links"]):
+            arc = arc_document(float(q[j]) * link["kappa"], link["phi"], link["length"])
+            transform = pcc.transform_from_arc(arc["kappa"], arc["phi"], arc["length"]) + 0.0  # -0.0 written as 0.0
+            sections.append({"index": link["index"], "q": float(q[j]), **arc, "transform": transform.tolist()})
+        return sections
+
+
+def arc_document(kappa: float, phi: float, length: float) -> dict[str, Any]:
+    """One section's ``kappa, phi, length, theta`` (1/mm, rad, mm, rad) and seed 003's D-H rows ``dh``.
+
+    Below :data:`STRAIGHT_THETA_RAD` of bending a section is straight: kappa = phi = 0.
+    """
+    straight = kappa * length < STRAIGHT_THETA_RAD
+    kappa, phi = (0.0, 0.0) if straight else (float(kappa), float(phi))
+    return {"kappa": kappa, "phi": phi, "length": float(length), "theta": kappa * float(length),
+            "dh": pcc.dh_rows(kappa, phi, float(length))}
+
 
 def final_curve(case: Case, ingest: IngestResult) -> SmoothCurve:
     """The q = 1 centerline exactly as the blend stage builds it (smoothed, resampled, rebuilt from its samples)."""
@@ -157,20 +188,10 @@ def run_design(case: Case, ingest: IngestResult) -> DesignResult | None:
 def design_document(chain: Any, options: ChainOptions) -> dict[str, Any]:
     """The JSON document of a :class:`~softdesign.kinematics.chain_design.ChainDesign` (see ``CONVENTION``)."""
     kappa, phi = arcs_from_w(chain.w)
-    links = []
-    for j in range(len(chain.length)):
-        straight = kappa[j] * chain.length[j] < STRAIGHT_THETA_RAD
-        links.append({
-            "index": j,
-            "l_start": float(chain.breaks[j]),
-            "l_end": float(chain.breaks[j + 1]),
-            "kappa": 0.0 if straight else float(kappa[j]),
-            "phi": 0.0 if straight else float(phi[j]),
-            "length": float(chain.length[j]),
-            "theta": 0.0 if straight else float(kappa[j] * chain.length[j]),
-            "tip_frame": chain.tips[j].tolist(),
-            "max_deviation_mm": float(chain.section_deviation_mm[j]),
-        })
+    links = [{"index": j, "l_start": float(chain.breaks[j]), "l_end": float(chain.breaks[j + 1]),
+              **arc_document(float(kappa[j]), float(phi[j]), float(chain.length[j])),
+              "tip_frame": chain.tips[j].tolist(), "max_deviation_mm": float(chain.section_deviation_mm[j])}
+             for j in range(len(chain.length))]
     return {
         "tolerance_mm": options.tolerance_mm,
         "tip_tolerance_mm": options.tip_tolerance_mm,
@@ -187,6 +208,7 @@ def design_document(chain: Any, options: ChainOptions) -> dict[str, Any]:
         "searched": [{"links": k, "worst_mm": worst} for k, worst in chain.tried],
         "method": METHOD,
         "convention": CONVENTION,
+        "dh_convention": pcc.DH_CONVENTION,
     }
 
 

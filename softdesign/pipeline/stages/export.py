@@ -32,12 +32,12 @@ from softdesign.io.pvd import pvd_bytes
 from softdesign.meshing.body import body_breaks, body_sections, body_stations
 from softdesign.meshing.chambers import build_actuated
 from softdesign.meshing.checks import check_solid
-from softdesign.meshing.end_cut import end_cuts_from_record
 from softdesign.meshing.morph_body import MorphSurfaces, morph_surfaces
 from softdesign.meshing.regions import RegionPiece, split_by_region
 from softdesign.meshing.solids import Solid, build_solid
-from softdesign.meshing.volume import BodySpec, integrate_body
+from softdesign.meshing.volume import integrate_body
 from softdesign.pipeline import layout
+from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import export_workers
 from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.output_frame import base_pose, frame_record, moved_points, moved_vectors, output_pose
@@ -82,13 +82,6 @@ def mesh_name(q: float, fmt: str) -> str:
 def region_name(q: float, piece: RegionPiece) -> str:
     """``meshes/q_0.500/wall.stl``: one folder per q, so ``meshes/q_*.stl`` stays the solids."""
     return layout.region_path(q, piece.name)
-
-
-def body_spec(case: Case, fit: FitResult | None = None) -> BodySpec:
-    """The case's export keys as a solid specification, with the fit's end cuts when ``fit`` is given."""
-    e = case.export
-    spec = BodySpec(offset_mm=e.offset_mm, wall_mm=e.wall_mm or 0.0, port_mm=e.port_mm or 0.0)
-    return spec if fit is None else replace(spec, end_cuts=end_cuts_from_record(fit.summary.get("end_cut")))
 
 
 def solid_at(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case) -> ExportedMesh:

@@ -44,11 +44,11 @@ from softdesign.meshing.skin_stretch import (
 from softdesign.meshing.tessellate import ring_points
 from softdesign.meshing.volume import BodySpec
 from softdesign.meshing.wall import FD_STEP_MM, offset_metric, port_wall_mm, thinnest, wall_map
+from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import meshes_at_once
 from softdesign.pipeline.feasibility_judge import judge
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
-from softdesign.pipeline.stages.export import body_spec
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging

@@ -3,7 +3,9 @@
 ``kinematics.json`` (at the top of the build folder) holds, per export q and
 per link, the transform S_T_E = inv(F(q, l_s)) F(q, l_e) (4x4, mm), its POE
 split, the link's arc length, stretch and curvature range, and the chain's
-base_to_tip.  Conventions are written into the file itself.
+base_to_tip.  A ``blend: pcc`` build (the design's chain) adds per pose the
+design's sections at that q with seed 003's improved-D-H rows
+(``pcc_sections``).  Conventions are written into the file itself.
 """
 
 from __future__ import annotations
@@ -17,25 +19,35 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from softdesign.geometry.frames import FramedSpline
+from softdesign.kinematics import pcc
 from softdesign.kinematics.arc_check import arc_check_metrics, arc_misses, link_arcs_at_final_shape
 from softdesign.kinematics.links import LinkChain, LinkReport
 from softdesign.kinematics.poe import PoeSplit
 from softdesign.pipeline import layout
 from softdesign.pipeline.parallel import map_per_q
 from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.design import DesignResult
 from softdesign.pipeline.stages.links import LinksResult
 from softdesign.pipeline.store import Staging
 
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 1
+VERSION = 2  # 2: blend: pcc builds carry the design's sections at each pose (pcc_sections, pcc_convention)
 CONVENTION = (
     "F(q, l) = [[N B T c], [0 0 0 1]]; transform = S_T_E = inv(F(q, l_start)) F(q, l_end), "
     "mapping end-frame coordinates into start-frame coordinates; "
     "S_T_E = exp(xi1 theta1) exp(omega theta2): translation theta1 (mm) along unit xi1 (in {S}), "
     "then rotation theta2 in [0, pi] (rad) about unit omega (null when theta2 = 0); "
     "base_to_tip = product of the link transforms in link order (the tip frame in link 1's {S})"
+)
+#: The pcc_sections of a blend: pcc build (written only there).
+PCC_CONVENTION = (
+    "blend: pcc: each pose's pcc_sections are the design's sections (design/summary.json) at the pose's q of their "
+    "link: an arc of curvature q * kappa, plane phi and length L; transform is the section's HTM (its tip frame in "
+    "its base frame, seed 003: Rz(phi) Ry(theta/2) Tz(chord) Ry(theta/2) Rz(-phi)) and dh its rows (dh: "
+    + pcc.DH_CONVENTION + "); the links' transforms are measured on the built centerline's frames, which follow "
+    "the chain as resampled"
 )
 
 
@@ -106,14 +118,22 @@ def _at_q(chain: LinkChain, q: float) -> tuple[dict[str, Any], dict[str, Any], F
     return shape_figures(chain, q), pose_document(chain, q), chain.shape.curve_at(q)
 
 
-def run_kinematics(case: Case, links: LinksResult) -> KinematicsResult:
-    """Link transforms and POE at every export q (one q per worker process at a time, results in q order)."""
+def run_kinematics(case: Case, links: LinksResult, design: DesignResult | None = None) -> KinematicsResult:
+    """Link transforms and POE at every export q (one q per worker process at a time, results in q order).
+
+    A ``blend: pcc`` chain (its links are the design's sections) adds the sections' arcs, HTMs and D-H rows.
+    """
     chain = links.chain
     q_values = case.export.q_values()
     per_q = map_per_q(lambda q: _at_q(chain, q), q_values)
     for q, (_, _, curve) in zip(q_values, per_q, strict=True):
         chain.shape.keep_curve(q, curve)  # export and feasibility then use them, as when built here
-    document = {
+    poses = [pose for _, pose, _ in per_q]
+    pcc_design = design if chain.shape.mode == "pcc" else None  # the chain's links are its sections
+    if pcc_design is not None:
+        for pose in poses:
+            pose["pcc_sections"] = pcc_design.sections_at(pose["q"])
+    document: dict[str, Any] = {
         "frames": case.frames,
         "convention": CONVENTION,
         "units": {"length": "mm", "angle": "rad"},
@@ -122,7 +142,8 @@ def run_kinematics(case: Case, links: LinksResult) -> KinematicsResult:
             for j in range(chain.count)
         ],
         "per_q": [figures for figures, _, _ in per_q],
-        "poses": [pose for _, pose, _ in per_q],
+        "poses": poses,
+        **({"pcc_convention": PCC_CONVENTION} if pcc_design is not None else {}),
     }
     return KinematicsResult(chain, document)
 
@@ -163,8 +184,8 @@ STAGE = Stage(
     name="kinematics",
     version=VERSION,
     reads=("frames", "export.q", "export.frames"),
-    upstream=("links",),
-    compute=lambda case, results: run_kinematics(case, results["links"]),
+    upstream=("links", "design"),
+    compute=lambda case, results: run_kinematics(case, results["links"], results["design"]),
     write=write_kinematics,
     load=lambda build_dir, results: load_kinematics(build_dir, results["links"]),
     describe=describe_kinematics,

@@ -27,10 +27,10 @@ from softdesign.meshing.mould import MouldSpec
 from softdesign.meshing.mould_cores import make_actuated_mould
 from softdesign.meshing.mould_make import MouldMesh, make_mould
 from softdesign.pipeline import layout
+from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.output_frame import base_pose, moved_points, moved_vectors, output_pose
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.actuation import actuation_layout
-from softdesign.pipeline.stages.export import body_spec
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging

@@ -44,23 +44,24 @@ from softdesign.config import VolumeMesh as VolumeMeshSpec
 from softdesign.errors import ConfigError
 from softdesign.io.formats import mesh_bytes
 from softdesign.io.volume_formats import VOLUME_FORMATS, NamedSets, volume_mesh_bytes
-from softdesign.limits_volume import MAX_VOLUME_TETS, MESHER_MEMORY_BYTES
+from softdesign.limits.volume import MAX_VOLUME_TETS, MESHER_MEMORY_BYTES
 from softdesign.meshing.body import body_sections
 from softdesign.meshing.chamber import chamber_surface
 from softdesign.meshing.tet_checks import REGULAR_TET_FACTOR, check_tet_mesh, expected_tets
 from softdesign.meshing.tetmesh import TetSettings, tetrahedralize
 from softdesign.meshing.topology import mesh_topology
 from softdesign.pipeline import layout
+from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.child import run_in_child
 from softdesign.pipeline.output_frame import base_pose, moved_points, output_pose
 from softdesign.pipeline.stage import Stage
-from softdesign.pipeline.stages.export import body_spec, solid_at
+from softdesign.pipeline.stages.export import solid_at
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 from softdesign.types import FloatArray, IntArray
 
-VERSION = 3  # 3: export.frame (the meshes in the patient's or the base frame)
+VERSION = 4  # 3: export.frame (the meshes in the patient's or the base frame); 4: VTK's .vtu, no times in the summary
 #: The function the child process runs: (vertices, faces, TetSettings) -> (points, tets).  A module attribute,
 #: so that a test can put a crashing or hanging stand-in in its place.
 MESHER = tetrahedralize
@@ -85,6 +86,9 @@ class VolumeMeshResult:
 
     meshes: tuple[TetBody, ...]
     summary: dict[str, Any]
+    #: a line per part with its time: printed with the stage's description and kept in the build folder's run log
+    #: (run.log.json), never in an output, which depends on the inputs alone (issue 35)
+    log: tuple[str, ...] = ()
 
 
 def _check_count(volume_mm3: float, size_mm: float, q: float) -> None:
@@ -94,12 +98,14 @@ def _check_count(volume_mm3: float, size_mm: float, q: float) -> None:
         raise ConfigError(
             f"export.volume_mesh.size_mm: {size_mm:g} mm asks for about {count:.3g} tetrahedra in the body's "
             f"{volume_mm3:.1f} mm3 at q={q:.3f}, more than the limit of {MAX_VOLUME_TETS} "
-            f"(softdesign/limits_volume.py); use size_mm >= {np.ceil(least * 1000) / 1000:g} mm"
+            f"(softdesign/limits/volume.py); use size_mm >= {np.ceil(least * 1000) / 1000:g} mm"
         )
 
 
-def mesh_body(case: Case, kinematics: KinematicsResult, fit: FitResult, q: float) -> tuple[TetBody, dict[str, Any]]:
-    """The checked tetrahedral mesh of the body at ``q`` and its figures (MeshError when a check fails)."""
+def mesh_body(case: Case, kinematics: KinematicsResult, fit: FitResult,
+              q: float) -> tuple[TetBody, dict[str, Any], float]:
+    """The checked tetrahedral mesh of the body at ``q``, its figures (MeshError when a check fails) and the
+    mesher's seconds."""
     vm = case.export.volume_mesh or VolumeMeshSpec()
     body = solid_at(kinematics, fit, q, case)
     volume = float(body.figures["volume_mm3"])
@@ -119,9 +125,8 @@ def mesh_body(case: Case, kinematics: KinematicsResult, fit: FitResult, q: float
                                   memory_bytes=MESHER_MEMORY_BYTES)
     seconds = time.perf_counter() - start
     figures = check_tet_mesh(points, tets, volume, chamber, f"volume mesh at q={q:.3f}")
-    figures.update({"q": q, "size_mm": vm.size_mm, "envelope_mm": vm.envelope_mm, "mesher_s": round(seconds, 3),
-                    "body_kind": body.solid.kind})
-    return TetBody(q, points, tets, chamber), figures
+    figures.update({"q": q, "size_mm": vm.size_mm, "envelope_mm": vm.envelope_mm, "body_kind": body.solid.kind})
+    return TetBody(q, points, tets, chamber), figures, seconds
 
 
 def _chamber_figures(q: float, chamber: tuple[FloatArray, IntArray]) -> dict[str, Any]:
@@ -141,10 +146,12 @@ def run_volume_mesh(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
     if vm.mesher == "sweep":
         swept = _run_sweep(case, kinematics, fit)
         return VolumeMeshResult(tuple(_moved(m, pose) for m in swept.meshes), {**swept.summary,
-                                                                               "output_frame": case.export.frame})
-    meshes, files, per_q = [], {}, []
+                                                                               "output_frame": case.export.frame},
+                                swept.log)
+    meshes, files, per_q, log = [], {}, [], []
     for q in vm.q:
-        mesh, figures = mesh_body(case, kinematics, fit, q)
+        mesh, figures, seconds = mesh_body(case, kinematics, fit, q)
+        log.append(f"q={q:.3f}: fTetWild {seconds:.1f} s")
         meshes.append(mesh)
         per_q.append(figures)
         for suffix in VOLUME_FORMATS:
@@ -155,12 +162,12 @@ def run_volume_mesh(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
               "meshio": metadata.version("meshio")}
     summary = {"requested": True, "spec": vm.model_dump(mode="json"), "mesher": mesher,
                "deterministic": False, "per_q": per_q, "files": files, "output_frame": case.export.frame}
-    return VolumeMeshResult(tuple(_moved(m, pose) for m in meshes), summary)
+    return VolumeMeshResult(tuple(_moved(m, pose) for m in meshes), summary, tuple(log))
 
 
 def _run_sweep(case: Case, kinematics: KinematicsResult, fit: FitResult) -> VolumeMeshResult:
     """The swept mesher's meshes, files and figures (:mod:`softdesign.pipeline.stages.volume_sweep`)."""
-    from softdesign.pipeline.stages.volume_sweep import material_of, run_sweep
+    from softdesign.pipeline.stages.volume_sweep import material_of, part_lines, run_sweep
 
     vm = case.export.volume_mesh or VolumeMeshSpec()
     run = run_sweep(case, kinematics, fit)
@@ -182,12 +189,12 @@ def _run_sweep(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Volu
                "mesher": {"name": "sweep: softdesign.meshing.sweep_mesh, one mesh of the parameter domain",
                           "meshio": metadata.version("meshio")},
                "deterministic": True, "surfaces": list(first.groups) + list(first.lids),
-               "node_sets": ["base_nodes"], "per_q": run.per_q, "morph": run.morph, "parts": run.parts,
+               "node_sets": ["base_nodes"], "per_q": run.per_q, "morph": run.morph,
                "material": {"name": material.name, "max_stretch": material.max_stretch,
                             "tensile_strength_kpa": material.tensile_strength_kpa,
                             "law": None if material.law is None else material.law.kind},
                "feasible": (not run.reasons) if judged else None, "reasons": run.reasons, "files": files}
-    return VolumeMeshResult(tuple(meshes), summary)
+    return VolumeMeshResult(tuple(meshes), summary, tuple(part_lines(run.parts)))
 
 
 def _moved(mesh: TetBody, pose: np.ndarray | None) -> TetBody:
@@ -227,15 +234,15 @@ def load_volume_mesh(build_dir: Path) -> VolumeMeshResult:
 
 
 def describe_volume_mesh(result: VolumeMeshResult) -> list[str]:
-    """One line per tetrahedral mesh and per chamber surface."""
+    """A line per part with its time (when computed in this run), then per tetrahedral mesh and chamber surface."""
     s = result.summary
     if not s["requested"]:
         return ["no export.volume_mesh in the case file: no volume mesh"]
     if s.get("deterministic"):
         from softdesign.pipeline.stages.volume_sweep import describe_sweep
 
-        return describe_sweep(s)
-    lines = []
+        return [*result.log, *describe_sweep(s)]
+    lines = list(result.log)
     for name, f in s["files"].items():
         if name.endswith(".msh"):
             continue
@@ -248,7 +255,7 @@ def describe_volume_mesh(result: VolumeMeshResult) -> list[str]:
         lines.append(
             f"{name} (and .msh): {f['tets']} tets, volume {f['volume_mm3']:.2f} mm3 "
             f"({100 * f['volume_rel_error']:+.3f}% vs body){chamber}, min dihedral {f['min_dihedral_deg']:.2f} deg, "
-            f"max radius-edge {f['max_radius_edge']:.2f}, {f['mesher_s']:.1f} s")
+            f"max radius-edge {f['max_radius_edge']:.2f}")
     return lines
 
 
@@ -265,4 +272,5 @@ STAGE = Stage(
     describe=describe_volume_mesh,
     metrics=lambda result: {k: v for k, v in result.summary.items() if k != "files"},
     figures=lambda result: result.summary["files"] if result.summary["requested"] else {},
+    log=lambda result: list(result.log),
 )

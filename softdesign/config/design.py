@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from softdesign.config_types import FiniteFloat, Integer
+from softdesign.config.types import FiniteFloat, Integer
 
 #: Most sections a design may search: each k is one joint optimisation (about 0.1 to 0.5 s).
 MAX_DESIGN_LINKS = 40

@@ -31,13 +31,13 @@ from pydantic import (
     model_validator,
 )
 
-from softdesign.config_actuation import Actuation
-from softdesign.config_material import CustomMaterial
-from softdesign.config_types import FiniteFloat, Integer
-from softdesign.design_config import Design, pcc_blend_problems
+from softdesign.config.actuation import Actuation
+from softdesign.config.design import Design, pcc_blend_problems
+from softdesign.config.material import CustomMaterial
+from softdesign.config.types import FiniteFloat, Integer
 from softdesign.errors import ConfigError
 from softdesign.io.case_yaml import parse_case_yaml, read_case_text
-from softdesign.io.format_names import MESH_FORMATS
+from softdesign.io.format_names import MESH_FORMATS, q_label
 from softdesign.limits import (
     MAX_ANGULAR_COUNT,
     MAX_ANGULAR_INTERVALS,
@@ -47,7 +47,7 @@ from softdesign.limits import (
     MAX_LINKS,
     MEMORY_BUDGET_TEXT,
 )
-from softdesign.limits_shape import (
+from softdesign.limits.shape import (
     MAX_INITIAL_LENGTH_MM,
     MAX_INITIAL_RADIUS_MM,
     MAX_OFFSET_MM,
@@ -55,11 +55,10 @@ from softdesign.limits_shape import (
     MIN_INITIAL_RADIUS_MM,
     size_bound,
 )
-from softdesign.limits_volume import MAX_MESHER_SECONDS, MAX_VOLUME_MESHES, MIN_TET_SIZE_MM
+from softdesign.limits.volume import MAX_MESHER_SECONDS, MAX_VOLUME_MESHES, MIN_TET_SIZE_MM
 from softdesign.materials import MaterialLimits, PresetName, resolve_material
 from softdesign.meshing.mould_spec import MIN_MOULD_WALL_MM
 from softdesign.meshing.volume_tolerance import MIN_ANGULAR_COUNT, VOLUME_RTOL
-from softdesign.pipeline.layout import q_label
 
 
 class _Section(BaseModel):
@@ -387,7 +386,7 @@ class Material(_Section):
 
     name: PresetName | None = None
     """A preset (softdesign materials lists them with their sources)."""
-    #: a material of the user's own, every figure given (softdesign/config_material.py); not with ``name``
+    #: a material of the user's own, every figure given (softdesign/config/material.py); not with ``name``
     custom: CustomMaterial | None = None
     """Your own material: every key required."""
     max_stretch: float | None = Field(None, gt=1.0, le=100.0)
@@ -677,7 +676,7 @@ def _describe(loc: tuple[Any, ...], item: Mapping[str, Any]) -> str:
     got = "" if kind == "missing" else f", got {_shown(item.get('input'))}"
     reason = f": {_RANGE_REASONS[field]}" if field in _RANGE_REASONS and kind in _TEMPLATES else ""
     if field in _LIMITED and kind in ("less_than_equal", "too_long"):
-        reason = f": a limit of softdesign/limits.py that keeps a build within {MEMORY_BUDGET_TEXT} of memory"
+        reason = f": a limit of softdesign/limits/__init__.py that keeps a build within {MEMORY_BUDGET_TEXT} of memory"
     return f"{field} {text}{got}{reason}"
 
 

@@ -1,7 +1,7 @@
 """Material limits a design is judged against: presets for the elastomers soft actuators are made of.
 
 The presets are data, ``softdesign/data/materials.yaml`` (read by
-:mod:`softdesign.material_data`): each datasheet value with its document and
+:mod:`softdesign.materials.data`): each datasheet value with its document and
 table, a hyperelastic law with its source, and the rules stated there: a
 silicone's ``max_stretch`` is ``1 + design_fraction x elongation at break``
 (half: the datasheet's elongation is one pull of a dumbbell to failure, an
@@ -21,7 +21,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 from typing import Any, Literal, get_args
 
-from softdesign.material_data import MaterialPreset, material_presets
+from softdesign.materials.data import MaterialPreset, material_presets
 
 #: The preset names the case file accepts (``material.name``); :data:`PRESETS` has one entry for each.
 PresetName = Literal[

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from softdesign.config_types import FiniteFloat
+from softdesign.config.types import FiniteFloat
 
 if TYPE_CHECKING:  # numpy stays out of `softdesign validate`
     from softdesign.meshing.chamber_layout import ActuationSpec
