@@ -39,6 +39,11 @@ Start-up
 Volume mesh
     The volume_mesh stage alone (pipelines/bench_volume.py, issue 32): the
     sample case solid, hollow and chambered and the aorta, CPU s against 10 s.
+
+Simulate
+    ``softdesign simulate`` on section 0 of the sample case with chambers and of the aorta, forward and inverse,
+    against issue 33's 60 s each (pipelines/bench_simulate.py).
+
 Report
     ``softdesign report`` against a forced ``softdesign build`` of the same
     case, fresh processes with the cores available (issue 17: the report no
@@ -76,8 +81,8 @@ if TYPE_CHECKING:
 REPO = Path(__file__).resolve().parents[1]
 DEMO_CASE = REPO / "configs" / "demo.yaml"
 AORTA_DIR = REPO.parent / "shared" / "data" / "vmtk-aorta"
-STAGE_NAMES = ("ingest", "design", "blend", "links", "kinematics", "fit", "actuation", "export", "mould", "volume_mesh",
-               "feasibility")
+STAGE_NAMES = ("ingest", "design", "blend", "links", "kinematics", "fit", "simulate", "actuation", "export", "mould",
+               "volume_mesh", "feasibility")
 
 #: Targets of the scaled case (issue 5, item 9).  The build/floor ratio on 2 cores, restated in round 3: 4x (2x
 #: would need compiled kernels or subsampled fits).
@@ -671,6 +676,7 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
     emit(volume_lines() + [""])
     emit(centerline_lines() + [""])
     emit(design_lines() + [""])
+    emit(simulate_lines() + [""])
     plan = synthetic_plan(scratch, args.triangles, args.frames)
     results = run_synthetic(plan, scratch, args.jobs)
     largest = next(c for c in plan if (c.triangles, c.frames) == (max(args.triangles), min(args.frames)))
@@ -730,6 +736,15 @@ def design_lines() -> list[str]:
     if done.returncode not in (0, 1):  # 1: a target missed, which its lines say
         raise RuntimeError(f"bench_design.py failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
     return ["design stage (issue 30), CPU s of the core per case and tolerance:"] + done.stdout.splitlines()
+
+
+def simulate_lines() -> list[str]:
+    """`softdesign simulate` on a demo section and an aorta section against 60 s (pipelines/bench_simulate.py)."""
+    done = subprocess.run([sys.executable, str(REPO / "pipelines" / "bench_simulate.py")],
+                          capture_output=True, text=True, cwd=REPO)
+    if done.returncode not in (0, 1):  # 1: a target missed, which its lines say
+        raise RuntimeError(f"bench_simulate.py failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
+    return ["simulate (issue 33):"] + done.stdout.splitlines()
 
 
 def parse_counts(text: str) -> list[int]:

@@ -4,7 +4,8 @@ Cases (the swept mesher, ``export.volume_mesh.q`` 0, 0.5 and 1 unless said):
 the sample case solid (configs/demo.yaml); hollow (``wall_mm: 1``, ``port_mm:
 1.2``); chambered (configs/actuator.yaml: three chambers per section with their
 feeds, q = 0 as the case asks); and the VMTK aorta (path 0, when
-../shared/data is there).  Each case's stages before volume_mesh are built
+../shared/data is there) solid, hollow as the demo, and chambered as
+configs/actuator.yaml (four sections of three chambers).  Each case's stages before volume_mesh are built
 once, untimed, into a temporary folder; then the volume_mesh stage alone
 (compute: the mesh, its checks, the 3D strain at each q and over the morph's
 q samples; write: the .vtu, .msh and cavity files) runs in this process,
@@ -13,7 +14,7 @@ machine's other load does not count: the target is judged on them) and as
 wall seconds.  ``--jobs`` as ``softdesign build`` (default 1: CPU time does
 not depend on it).
 
-Usage: ``python pipelines/bench_volume.py [--jobs N] [--only solid,hollow,chambered,aorta]``;
+Usage: ``python pipelines/bench_volume.py [--jobs N] [--only CASE,...]`` (CASES below);
 ``make bench`` runs it after the build benchmark (pipelines/bench.py).
 """
 
@@ -36,7 +37,7 @@ REPO = Path(__file__).resolve().parents[1]
 AORTA_DIR = REPO.parent / "shared" / "data" / "vmtk-aorta"
 #: Issue 32: a volume mesh in at most this many seconds per case (CPU s of the stage).
 TARGET_S = 10.0
-CASES = ("solid", "hollow", "chambered", "aorta")
+CASES = ("solid", "hollow", "chambered", "aorta", "aorta-hollow", "aorta-chambered")
 #: ``export`` keys each case adds to its case file.
 VOLUME_Q = {"volume_mesh": {"q": [0.0, 0.5, 1.0]}}
 
@@ -45,13 +46,19 @@ def case_data(name: str) -> dict[str, Any] | None:
     """The case file of benchmark case ``name`` as data, its inputs absolute (None: the aorta's data is absent)."""
     import yaml
 
-    if name == "aorta":
+    if name.startswith("aorta"):
         if not AORTA_DIR.is_dir():
             return None
-        return {"name": "aorta", "units": "mm",
-                "final": {"centerline": str(AORTA_DIR / "aorta-centerline.vtp"),
-                          "surface": str(AORTA_DIR / "aorta-surface.stl"), "path": 0},
-                "export": {"q": [0.0, 0.5, 1.0], **VOLUME_Q}, "material": {"name": "ecoflex-00-30"}}
+        data: dict[str, Any] = {
+            "name": name, "units": "mm",
+            "final": {"centerline": str(AORTA_DIR / "aorta-centerline.vtp"),
+                      "surface": str(AORTA_DIR / "aorta-surface.stl"), "path": 0},
+            "export": {"q": [0.0, 0.5, 1.0], **VOLUME_Q}, "material": {"name": "ecoflex-00-30"}}
+        if name == "aorta-hollow":
+            data["export"].update({"wall_mm": 1.0, "port_mm": 1.2})
+        if name == "aorta-chambered":  # configs/actuator.yaml's layout: four sections, three chambers each
+            data.update({"links": {"count": 4}, "actuation": {}})
+        return data
     source = REPO / "configs" / ("actuator.yaml" if name == "chambered" else "demo.yaml")
     data = yaml.safe_load(source.read_text(encoding="utf-8"))
     for key in ("centerline", "surface"):

@@ -21,6 +21,9 @@ LayerOpt = Annotated[float, typer.Option("--layer-mm", help="Layer spacing along
 TimeoutOpt = Annotated[float, typer.Option("--timeout", help="Longest time the solve may take, s.")]
 FigureOpt = Annotated[Path | None, typer.Option(
     "--figure", help="Also draw the deformed centerline, its arcs and the convergence to this .png file.")]
+WriteOpt = Annotated[bool, typer.Option(
+    "--write", help="With --target: build with simulate enabled for this section and q, so that the build's "
+    "actuation.csv carries the pressures found (as `simulate: {enabled: true}` does in build).")]
 MaxPressureOpt = Annotated[float, typer.Option("--max-pressure", help="Upper bound of the inverse search, kPa.")]
 
 PRESSURES_FIX = "give three numbers in kPa separated by commas, e.g. --pressures 40,0,0"
@@ -64,6 +67,8 @@ def _print(payload: dict[str, Any]) -> None:
         typer.echo(f"target q={t['q']:g}: error mm {', '.join(f'{e:.4f}' for e in t['error_mm'])} "
                    f"({'converged' if t['converged'] else 'NOT converged'}: {t['how']})")
     typer.echo("leaves out: " + "; ".join(payload["leaves_out"]))
+    if "written" in payload:
+        typer.echo(f"written to {payload['written']} (pressure_kpa, model estimates)")
 
 
 def simulate(
@@ -77,23 +82,26 @@ def simulate(
     max_pressure: MaxPressureOpt = 300.0,
     timeout: TimeoutOpt = 600.0,
     figure: FigureOpt = None,
+    write: WriteOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
     """Solve one section under chamber pressures (hyperelastic finite elements), or find the pressures for a q.
 
     The section's base is clamped and each chamber's wall carries its pressure on the deformed surface. It
     reports the best arc through the deformed centerline, each chamber's length, the largest stretch and stress
-    and the convergence; with --target, the pressures whose arc best matches the design at q.
+    and the convergence; with --target, the pressures whose arc best matches the design at q, and with --write
+    also into the build folder's actuation.csv (labelled as model estimates).
     """
 
     def action() -> None:
-        from softdesign.pipeline.simulate_run import SimulateOptions, run_simulate
+        from softdesign.pipeline.simulate_command import run_simulate, write_to_table
+        from softdesign.pipeline.simulate_run import SimulateOptions
 
         _check_figure_path(figure)
         values = None if pressures is None else pressures_from_text(pressures)
         options = SimulateOptions(section, values, target, size_mm, layer_mm, max_pressure_kpa=max_pressure,
                                   timeout_s=timeout)
-        result = run_simulate(case_file, out, options, note)
+        result = (write_to_table if write else run_simulate)(case_file, out, options, note)
         if figure is not None:
             from softdesign.io.atomic import write_bytes_atomically
             from softdesign.report.simulate_figures import simulate_figure_png

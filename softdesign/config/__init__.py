@@ -34,6 +34,7 @@ from pydantic import (
 from softdesign.config.actuation import Actuation
 from softdesign.config.design import Design, pcc_blend_problems
 from softdesign.config.material import CustomMaterial
+from softdesign.config.simulate import Simulate
 from softdesign.config.types import FiniteFloat, Integer
 from softdesign.errors import ConfigError
 from softdesign.io.case_yaml import parse_case_yaml, read_case_text
@@ -453,6 +454,9 @@ class Case(_Section):
     #: seed 003's three chambers per section with their feed lines, built into the body (issue 31)
     actuation: Actuation | None = None
     """Seed 003's three chambers per section, with their feed lines, cut into the body."""
+    #: chamber pressures per section and q by finite elements in the build (the simulate stage; issue 33)
+    simulate: Simulate | None = None
+    """Estimate each section's chamber pressures for given q in the build (finite elements; off unless enabled)."""
 
     _base: Path = PrivateAttr(default_factory=Path.cwd)
 
@@ -526,6 +530,14 @@ class Case(_Section):
             raise ValueError("actuation's chambers and export.wall_mm's single hollow chamber are two designs of "
                              "the cavity; drop export.wall_mm (and port_mm) or drop actuation")
         return actuation
+
+    @field_validator("simulate")
+    @classmethod
+    def _simulate_needs_chambers(cls, simulate: Simulate | None, info: ValidationInfo) -> Simulate | None:
+        if simulate is not None and simulate.enabled and info.data.get("actuation") is None:
+            raise ValueError("simulate.enabled solves the actuation chambers' pressures; add an actuation: block "
+                             "(and a material:) or set enabled: false")
+        return simulate
 
     @field_validator("name")
     @classmethod

@@ -113,8 +113,8 @@ class BlendedShape:
     frames: FrameMode
     base_normal: FloatArray
     _intrinsic: _Intrinsic | None = field(default=None, repr=False)
-    #: mode "pcc": c(q, .) at the ``l_grid`` samples as a function of q (:func:`sampled_shape`)
-    _sampler: Callable[[float], FloatArray] | None = field(default=None, repr=False, compare=False)
+    #: mode "pcc": c(q, .) as a function of q (:func:`sampled_shape`)
+    _sampler: Callable[[float], SmoothCurve] | None = field(default=None, repr=False, compare=False)
     # c(q, .) and its frames are pure functions of q; links, stats and exports ask for the
     # same q many times, so each is built once (the shape is immutable)
     _smooth: dict[float, SmoothCurve] = field(default_factory=dict, repr=False, compare=False)
@@ -127,7 +127,7 @@ class BlendedShape:
         if q not in self._smooth:
             a, w = self._segment(q)
             if self._sampler is not None:
-                self._smooth[q] = smooth_curve_from_samples(self._sampler(q))
+                self._smooth[q] = self._sampler(q)
             elif self._intrinsic is None:  # mode "linear": blend_shapes prepares the data of "intrinsic" only
                 self._smooth[q] = _linear(self.keys[a], self.keys[a + 1], w)
             else:
@@ -241,14 +241,15 @@ def blend_shapes(
 
 
 def sampled_shape(
-    final: SmoothCurve, sampler: Callable[[float], FloatArray], mode: BlendMode, frames: FrameMode = "rmf"
+    final: SmoothCurve, sampler: Callable[[float], SmoothCurve], mode: BlendMode, frames: FrameMode = "rmf"
 ) -> BlendedShape:
-    """A shape whose c(q, .) is ``sampler(q)`` ((m, 3) mm at ``final.l_grid``, equal arc length), splined per q.
+    """A shape whose c(q, .) is ``sampler(q)`` (l in [0, 1] proportional to arc length, as ``final``'s).
 
     ``final`` is the centerline the wall is fitted around (:meth:`BlendedShape.target_curve`); the keys are
-    ``sampler(0)`` and ``final``.  The pipeline builds ``pcc`` this way (each section's curvature scaled by q).
+    ``sampler(0)`` and ``final``.  The pipeline builds ``pcc`` this way (each section's curvature scaled by q,
+    splined per section with its joints kept: :func:`~softdesign.geometry.curve_joints.grid_with_joints`).
     """
-    initial = smooth_curve_from_samples(sampler(0.0))
+    initial = sampler(0.0)
     base_normal = base_normal_from_tangent(final.tangents([0.0])[0])
     return BlendedShape(np.array([0.0, 1.0]), (initial, final), mode, frames, base_normal, None, sampler)
 

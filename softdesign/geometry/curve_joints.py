@@ -24,9 +24,17 @@ need), whose end tangent is off the arc's by 1.3e-6 rad for a 0.5 rad turn,
 0.1 mm smoothing, measured).  Issue 35's 1e-4 rad at the default smoothing thus
 holds for sections turning up to about 1.2 rad; ``resample.smoothing_mm: 0``
 interpolates each piece (5e-9 rad on the same arcs).
+
+A curve known piece by piece (``blend: pcc``: each designed section an exact
+arc at every q) has its joints at the design's breaks, which need not be
+samples of a uniform grid: :func:`grid_with_joints` makes a grid uniform on
+each piece with every break a sample, and the curve is the pieces'
+interpolants (5e-9 rad of end tangent on the demo's sections).
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
@@ -84,3 +92,41 @@ def pieces_spline(l_grid: FloatArray, samples: Points, joints: tuple[int, ...], 
              for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
     knots = np.concatenate([parts[0].t] + [part.t[degree + 1 :] for part in parts[1:]])
     return BSpline(knots, np.concatenate([part.c for part in parts]), degree)
+
+
+def grid_with_joints(breaks: FloatArray, count: int, degree: int) -> tuple[FloatArray, tuple[int, ...]]:
+    """Sample parameters (m,) with every break a sample, uniform on each piece, and the joints' indices.
+
+    Parameters
+    ----------
+    breaks : (k + 1,) strictly increasing normalized l, 0 first and 1 last
+    count : samples of the uniform grid the pieces are no coarser than (spacing 1 / (count - 1) in l)
+    degree : each piece gets at least this many intervals (a piece of :func:`pieces_spline`)
+
+    The breaks are kept bit for bit: a link whose ends are breaks starts and ends on samples.
+    """
+    spacing = 1.0 / (count - 1)
+    pieces: list[FloatArray] = []
+    ends: list[int] = []  # index of each piece's last sample
+    for a, b in zip(breaks[:-1], breaks[1:], strict=True):
+        intervals = max(degree, math.ceil((b - a) / spacing - 1e-9))
+        pieces.append(np.linspace(a, b, intervals + 1)[:-1])
+        ends.append((ends[-1] if ends else 0) + intervals)
+    return np.concatenate([*pieces, breaks[-1:]]), tuple(ends[:-1])
+
+
+def checked_grid(l_grid: FloatArray, count: int) -> FloatArray:
+    """``l_grid`` as (count,) float, checked: strictly increasing from 0 to 1.
+
+    Raises
+    ------
+    GeometryError
+        Another shape, or not strictly increasing from 0 to 1.
+    """
+    l_grid = np.asarray(l_grid, float)
+    if l_grid.shape != (count,) or l_grid[0] != 0.0 or l_grid[-1] != 1.0 or np.any(np.diff(l_grid) <= 0.0):
+        raise GeometryError(
+            f"curve samples: expected their l as {count} values strictly increasing from 0 to 1, got shape "
+            f"{l_grid.shape}" + (f" from {l_grid[0]:.6g} to {l_grid[-1]:.6g}" if l_grid.size else "")
+        )
+    return l_grid

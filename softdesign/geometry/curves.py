@@ -33,7 +33,7 @@ import numpy.typing as npt
 from scipy.interpolate import BSpline, PPoly, make_interp_spline, splprep
 
 from softdesign.errors import ConfigError, GeometryError
-from softdesign.geometry.curve_joints import joint_cuts, pieces_spline
+from softdesign.geometry.curve_joints import checked_grid, joint_cuts, pieces_spline
 from softdesign.types import POINT_TOL_MM, FloatArray, Points
 
 #: Degree of the spline in l (5: torsion, a third derivative, is still C2).
@@ -183,9 +183,24 @@ class SmoothCurve:
         k = np.clip(np.searchsorted(self.l_grid, l, side="right") - 1, 0, len(self.l_grid) - 2)
         return table[k] + _speed_integral(self.pieces, self.l_grid[k], l)
 
+    @cached_property
+    def uniform(self) -> bool:
+        """True when ``l_grid`` is ``linspace(0, 1, m)`` (every curve but one on a grid of pieces)."""
+        return bool(np.array_equal(self.l_grid, np.linspace(0.0, 1.0, len(self.l_grid))))
+
     def dense_l(self) -> FloatArray:
-        """Uniform evaluation grid containing ``l_grid``: DENSE_PER_INTERVAL per interval, steps <= DENSE_STEP_MM."""
+        """Evaluation grid containing ``l_grid``: DENSE_PER_INTERVAL per interval, steps <= DENSE_STEP_MM.
+
+        Uniform on a uniform ``l_grid``; on a grid of pieces (:func:`smooth_curve_from_samples` given ``l_grid``)
+        each interval is divided alike, so every joint is a dense sample and no Taylor chord crosses it.
+        """
         intervals = len(self.l_grid) - 1
+        if not self.uniform:
+            widest = float(np.max(np.diff(self.l_grid)))
+            factor = max(DENSE_PER_INTERVAL, int(np.ceil(self.length * widest / DENSE_STEP_MM)))
+            steps = np.linspace(0.0, 1.0, factor + 1)[:-1]
+            inner = self.l_grid[:-1, None] + np.diff(self.l_grid)[:, None] * steps
+            return np.concatenate([inner.ravel(), self.l_grid[-1:]])
         factor = max(DENSE_PER_INTERVAL, int(np.ceil(self.length / intervals / DENSE_STEP_MM)))
         # a dense point may sit one ulp off its sample (a knot): a Taylor chord from it then uses the
         # neighbouring polynomial piece, which costs ~1e-13 mm (measured on the aorta), i.e. nothing
@@ -245,7 +260,9 @@ def checked_l(l: npt.ArrayLike) -> FloatArray:
     return np.clip(l, 0.0, 1.0)
 
 
-def smooth_curve_from_samples(samples: npt.ArrayLike, joints: tuple[int, ...] = ()) -> SmoothCurve:
+def smooth_curve_from_samples(
+    samples: npt.ArrayLike, joints: tuple[int, ...] = (), l_grid: FloatArray | None = None
+) -> SmoothCurve:
     """Quintic interpolating spline through samples taken at equal arc length.
 
     Parameters
@@ -253,6 +270,8 @@ def smooth_curve_from_samples(samples: npt.ArrayLike, joints: tuple[int, ...] = 
     samples : (m, 3) float, mm, m >= 6, at l = linspace(0, 1, m)
     joints : increasing indices of samples where the curve may turn its curvature sharply: the spline is
         a separate interpolant on each piece between them (>= 6 samples each), joined at the shared sample
+    l_grid : (m,) the samples' l instead of linspace(0, 1, m), with ``joints``: uniform on each piece between
+        joints (:func:`~softdesign.geometry.curve_joints.grid_with_joints`), so joints at any l (a PCC chain's)
 
     Every call with the same m and joints gives the same knot vector, so spline
     coefficients of such curves blend exactly.
@@ -263,7 +282,7 @@ def smooth_curve_from_samples(samples: npt.ArrayLike, joints: tuple[int, ...] = 
             f"curve samples: expected an (m, 3) array with m >= {DEGREE + 1}, got shape {samples.shape}; "
             "resample with more points (resample.count or a smaller resample.spacing_mm)"
         )
-    l_grid = np.linspace(0.0, 1.0, len(samples))
+    l_grid = np.linspace(0.0, 1.0, len(samples)) if l_grid is None else checked_grid(l_grid, len(samples))
     if joints:
         spline = pieces_spline(l_grid, samples, joints, DEGREE)
     else:

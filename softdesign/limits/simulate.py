@@ -19,6 +19,8 @@ MAX_LOAD_STEPS = 64
 MAX_NEWTON_ITERATIONS = 50
 #: Forward solves of one inverse search.
 MAX_INVERSE_SOLVES = 40
+#: q values of a build's simulate block (each one inverse per section).
+MAX_SIMULATE_Q = 11
 #: Nodes of one section's quadratic mesh.
 MAX_SECTION_NODES = 12_000
 #: The smallest element and layer size, mm.

@@ -241,7 +241,8 @@ def _with_cuts(mesh: SweptMesh, ref: SweepReference, curve0: FramedSpline, field
 
 
 def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec: BodySpec, angular_count: int,
-              size_mm: float, layout: ChamberLayout | None = None) -> tuple[SweptMesh, SweepReference]:
+              size_mm: float, layout: ChamberLayout | None = None,
+              reference_l: FloatArray | None = None) -> tuple[SweptMesh, SweepReference]:
     """The swept mesh of the body and its reference, laid out on the body at q = 0 (the cast state).
 
     Parameters
@@ -254,6 +255,9 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
     angular_count : nodes on the outer circle and on the chamber's and port's circles (the export's angles)
     size_mm : the largest edge inside the section, mm
     layout : issue 31's chambers and feeds (a solid body's), or None
+    reference_l : (m,) float, the l at which the section's scale and the chamber's reference radius are taken
+        (None: ``layers``); layers graded finer somewhere (:mod:`softdesign.meshing.sweep_grading`) pass their
+        even grid, so that where the layers crowd does not move the reference section
 
     The chamber's reference radius is the median ratio of the chamber's to the outer section's radius
     at q = 0 (so the depth coordinate is about uniform); the port's is its radius over the chamber's
@@ -263,14 +267,16 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
     from softdesign.meshing.sweep_mesh import Hole, swept_disk
 
     a = angle_grid(angular_count)
+    even = layers if reference_l is None else np.asarray(reference_l, float)
     rho = field.evaluate_grid(0.0, layers, a)
-    size = size_mm / float(np.median(rho))
+    scale = float(np.median(field.evaluate_grid(0.0, even, a)))
+    size = size_mm / scale
     if layout is not None:
         if spec.wall_mm > 0:
             raise MeshError("volume mesh: actuation chambers and export.wall_mm's single chamber together; give one")
         # the core must stay inside the skin at every q: the thinnest radius over the morph, not at q = 0 alone
         thinnest = min(float(np.min(field.evaluate_grid(q, layers, a))) for q in CORE_Q_SAMPLES)
-        holes, ref = holes_from_layout(layout, float(np.median(rho)), thinnest, angular_count)
+        holes, ref = holes_from_layout(layout, scale, thinnest, angular_count)
         mesh = swept_disk(angular_count, holes, size, layers)
         return mesh, _with_cuts(mesh, ref, curve0, field, spec, angular_count)
     if spec.wall_mm == 0:
@@ -280,9 +286,7 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
     sections = sections_on_grid(curve0, 0.0, layers, rho, field.evaluate_grid(0.0, layers, a, dl=1))
     outer = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
     inner = sweep_from_sections(sections, spec.offset_mm - spec.wall_mm, spec.min_radius_mm, field="wall_mm")
-    within = (layers >= ends[0]) & (layers <= ends[1])
-    ratio = np.linalg.norm(inner.xy[within], axis=-1) / np.linalg.norm(outer.xy[within], axis=-1)
-    rc = float(np.median(ratio)) if ratio.size else 0.5
+    rc = _chamber_ratio(layers if reference_l is None else even, ends, outer, inner, layers)
     holes = [Hole("chamber", Circle((0.0, 0.0), rc, angular_count), (float(ends[0]), float(ends[1])))]
     if spec.port_mm > 0:
         base = int(np.argmin(np.abs(layers - ends[0])))
@@ -295,6 +299,14 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
     mesh = swept_disk(angular_count, holes, size, layers)
     j = [int(np.argmin(np.abs(mesh.l - e))) for e in ends]
     return mesh, _with_cuts(mesh, SweepReference(rc, (j[0], j[1])), curve0, field, spec, angular_count)
+
+
+def _chamber_ratio(even: FloatArray, ends: FloatArray, outer: Sweep, inner: Sweep, layers: FloatArray) -> float:
+    """The median ratio of the chamber's to the outer section's radius over the layers at ``even`` (each one of
+    ``layers``) within the chamber's ends ``ends`` (2,) l; 0.5 when none is."""
+    picked = np.isin(layers, even) & (layers >= ends[0]) & (layers <= ends[1])
+    ratio = np.linalg.norm(inner.xy[picked], axis=-1) / np.linalg.norm(outer.xy[picked], axis=-1)
+    return float(np.median(ratio)) if ratio.size else 0.5
 
 
 #: The q at which the thinnest radius is looked for, for the rigid core of a chambered body.

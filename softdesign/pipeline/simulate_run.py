@@ -1,24 +1,22 @@
-"""``softdesign simulate``: one section of a chambered body solved under chamber pressures, or for a designed arc.
+"""One section of a chambered body solved under chamber pressures, or for a designed arc: the pieces that
+``softdesign simulate`` (:mod:`softdesign.pipeline.simulate_command`) and the build's simulate stage share.
 
-The build runs (cached) through the actuation stage; the section's mesh is
-made (:mod:`softdesign.mechanics.layout_section`) and checked against the
-bounds of :mod:`softdesign.limits.simulate` before any solve; the solve runs
-in a child process with a time and memory limit
+The section's mesh is made (:mod:`softdesign.mechanics.layout_section`) and
+checked against the bounds of :mod:`softdesign.limits.simulate` before any
+solve; the solve runs in a child process with a time and memory limit
 (:func:`~softdesign.pipeline.child.run_in_child`), so a runaway factorization
-fails cleanly.  Nothing is written: the command prints the figures.
+fails cleanly; :func:`payload` gives its figures as JSON.
 """
 
 from __future__ import annotations
 
 import math
-import time
-from dataclasses import dataclass
-from pathlib import Path
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
-from softdesign.errors import ConfigError, MeshError, SolveError
+from softdesign.errors import ConfigError
 from softdesign.limits.simulate import (
     MAX_ANGULAR_COUNT,
     MAX_INVERSE_SOLVES,
@@ -29,7 +27,6 @@ from softdesign.limits.simulate import (
     MAX_SIMULATE_SECONDS,
     MIN_ANGULAR_COUNT,
     MIN_SIZE_MM,
-    SIMULATE_MEMORY_BYTES,
 )
 
 #: What the model leaves out, stated with every answer.
@@ -101,52 +98,34 @@ def solve_in_child(section: Any, law: Any, o: SimulateOptions, target: tuple[flo
     return {"result": found.section, "inverse": found}
 
 
-def _section_mesh(outcome: Any, o: SimulateOptions) -> Any:
+def inverses_in_child(section: Any, law: Any, o: SimulateOptions,
+                      targets: list[tuple[float, tuple[float, float, float]]]) -> list[dict[str, Any]]:
+    """The worker of the build's simulate stage: :func:`solve_in_child`'s inverse for each (q, target arc)."""
+    return [solve_in_child(section, law, replace(o, target_q=q), target) for q, target in targets]
+
+
+def section_mesh_of(case: Any, kinematics: Any, fit: Any, section: int, size_mm: float, angular_count: int,
+                    layer_mm: float) -> Any:
+    """Section ``section``'s (0 at the base) mesh at q = 0 (ConfigError without chambers or for a bad index)."""
     from softdesign.mechanics.layout_section import layout_section_mesh
     from softdesign.pipeline.body_spec import body_spec
     from softdesign.pipeline.stages.actuation import actuation_layout
 
-    kinematics, fit = outcome.results["kinematics"], outcome.results["fit"]
-    layout = actuation_layout(outcome.case, kinematics)
+    layout = actuation_layout(case, kinematics)
     if layout is None:
         raise ConfigError("simulate: the case has no actuation chambers; add an `actuation:` block")
-    if not 0 <= o.section < layout.sections:
-        raise ConfigError(f"simulate --section: got {o.section}, the body has sections 0 to {layout.sections - 1}")
+    if not 0 <= section < layout.sections:
+        raise ConfigError(f"simulate --section: got {section}, the body has sections 0 to {layout.sections - 1}")
     curve0 = kinematics.chain.shape.curve_at(0.0)
-    return layout_section_mesh(curve0, fit.field, body_spec(outcome.case), layout, o.section, o.size_mm,
-                               o.angular_count, o.layer_mm)
+    return layout_section_mesh(curve0, fit.field, body_spec(case), layout, section, size_mm, angular_count, layer_mm)
 
 
-def run_simulate(case_file: Path, out: Path | None, o: SimulateOptions, progress: Any) -> dict[str, Any]:
-    """Build through actuation, mesh the section, solve it in a child process; the figures as a dict."""
-    from softdesign.kinematics.pcc_fit import fit_links
-    from softdesign.pipeline.api import build_through
-    from softdesign.pipeline.child import run_in_child
-    from softdesign.pipeline.stages.volume_sweep import material_of
-
-    check_options(o)
-    start = time.perf_counter()
-    outcome = build_through(case_file, out, "actuation", progress=progress)
-    material = material_of(outcome.case)
-    if material.law is None:
-        raise ConfigError(f"{case_file}: simulate needs material.name (a preset with a law) or material.custom")
-    section = _section_mesh(outcome, o)
+def check_node_count(section: Any, index: int, fix: str) -> None:
+    """Refuse (ConfigError) a section mesh beyond MAX_SECTION_NODES, before its solve."""
     nodes = quadratic_node_count(section)
     if nodes > MAX_SECTION_NODES:
-        raise ConfigError(f"simulate: section {o.section}'s mesh has {nodes} nodes (quadratic elements), more than "
-                          f"{MAX_SECTION_NODES} (softdesign/limits/simulate.py); raise --size-mm or --layer-mm")
-    target = None
-    if o.target_q is not None:
-        arc = fit_links(outcome.results["kinematics"].chain, o.target_q, ARC_SAMPLES)[o.section]
-        target = (arc.kappa, arc.phi, arc.length)
-    what = f"the finite-element solve of section {o.section} ({nodes} nodes)"
-    fix = "raise --size-mm or --layer-mm, lower the pressures, or raise --timeout"
-    try:
-        answer = run_in_child(solve_in_child, (section, material.law, o, target), o.timeout_s, what, fix,
-                              SIMULATE_MEMORY_BYTES)
-    except MeshError as err:  # the child's failures, a non-converging solve among them
-        raise SolveError(str(err)) from err
-    return payload(o, section, material, answer, target, time.perf_counter() - start)
+        raise ConfigError(f"simulate: section {index}'s mesh has {nodes} nodes (quadratic elements), more than "
+                          f"{MAX_SECTION_NODES} (softdesign/limits/simulate.py); {fix}")
 
 
 def quadratic_node_count(section: Any) -> int:

@@ -22,13 +22,14 @@ from softdesign.pipeline.stages import (
     kinematics,
     links,
     mould,
+    simulate,
     volume_mesh,
 )
 
 #: Every stage, in build order.
 STAGES: list[Stage] = [
-    ingest.STAGE, design.STAGE, blend.STAGE, links.STAGE, kinematics.STAGE, fit.STAGE, actuation.STAGE,
-    export.STAGE, mould.STAGE, volume_mesh.STAGE, feasibility.STAGE,
+    ingest.STAGE, design.STAGE, blend.STAGE, links.STAGE, kinematics.STAGE, fit.STAGE, simulate.STAGE,
+    actuation.STAGE, export.STAGE, mould.STAGE, volume_mesh.STAGE, feasibility.STAGE,
 ]
 
 

@@ -35,6 +35,7 @@ from softdesign.report import (
     morph_figures,
     mould_figures,
     profile_figures,
+    simulate_panel,
     stretch_figures,
     surface_figures,
 )
@@ -92,6 +93,7 @@ EXPECTED_SIZES = {
     mould_figures.NAME: mould_figures.PIXEL_SIZE,
     profile_figures.NAME: pixel_size(profile_figures.SIZE_IN),
     actuation_figures.NAME: pixel_size(actuation_figures.SIZE_IN),
+    simulate_panel.NAME: pixel_size(simulate_panel.SIZE_IN),
 }
 
 
@@ -304,6 +306,10 @@ def report_sections(
     actuation = run(actuation_figures.NAME, lambda: actuation_figures.actuation_picture(data))
     if actuation is not None:
         sections.insert(5, Section("actuation", "Actuation: chambers, feeds, lengths", pictures=[actuation]))
+    simulated = run(simulate_panel.NAME, lambda: simulate_panel.simulate_picture(data))
+    if simulated is not None:
+        at = next(k for k, s in enumerate(sections) if s.anchor in ("actuation", "tables")) + 1
+        sections.insert(at, Section("simulate", "What pressure bends it: simulated sections", pictures=[simulated]))
     fabrication = _fabrication_section(data, run)
     if fabrication is not None:
         sections.insert(-2, fabrication)

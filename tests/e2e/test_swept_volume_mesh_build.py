@@ -119,9 +119,12 @@ def test_the_demos_skin_stretches_agree_with_the_feasibility_stages(tmp_path):
     stretch against the feasibility stage's (its grid converged to 1e-4), within 1 %.
 
     One pair cannot agree, and the test says why instead of loosening the bound: at q = 0.5 the feasibility's
-    least stretch sits on the tip's end ring (l = 1), where the mesh has no quad centre (the last row's is
-    half a layer inside, in the zone the tip's cut moves); the surface's own least stretch at the mesh's quad
-    centres agrees with the mesh's within 1 %.
+    least stretch sits on the tip's end ring (l = 1).  The layers graded by the skin's stretch bring the last
+    quad centre 0.065 mm from it, where the surface's least stretch is 0.6887 against 0.6858 at l = 1
+    (+0.42 %); but the mesh's last row is the material the tip's cut plane moves (the export's cut body, not
+    the uncut surface feasibility measures), 0.7177 there; the next row, outside the cut, agrees with the
+    surface (0.6938 against 0.6942).  So the surface's own least stretch at the mesh's quad centres is
+    compared with the mesh's instead, within 1 %.
     """
     import yaml
 
@@ -156,6 +159,35 @@ def test_the_demos_skin_stretches_agree_with_the_feasibility_stages(tmp_path):
     _, least = principal_stretches(skin_metric(shape.curve_at(0.0), field, 0.0, l, a, case.frames),
                                    skin_metric(shape.curve_at(0.5), field, 0.5, l, a, case.frames))
     np.testing.assert_allclose(volume[0]["strain"]["skin_stretch_min"], least.min(), rtol=SKIN_RTOL)
+
+
+def test_the_aortas_skin_stretches_agree_with_the_feasibility_stages(tmp_path, aorta_dir):
+    """The VMTK aorta (path 0, pipelines/bench_volume.py's case) at the default settings, a volume mesh at q =
+    0.5 and 1: the skin's largest and least stretch on the mesh against the feasibility stage's, within 1 %.
+
+    The extremes are a narrow peak 2.5 mm from the base (at q = 1 the stretch rises from 1.29 to 1.59 and falls
+    to 1.38 within 1.2 mm); even layers 1.9 mm apart gave 1.417 (-10.8 %), the layers graded by the skin's
+    stretch (softdesign/meshing/sweep_grading.py) meet it.
+    """
+    import yaml
+
+    from softdesign.pipeline.api import build_through
+
+    data = {"name": "aorta", "units": "mm",
+            "final": {"centerline": str(aorta_dir / "aorta-centerline.vtp"),
+                      "surface": str(aorta_dir / "aorta-surface.stl"), "path": 0},
+            "export": {"q": [0.0, 0.5, 1.0], "volume_mesh": {"q": [0.5, 1.0]}}, "material": {"name": "ecoflex-00-30"}}
+    case_file = tmp_path / "aorta.yaml"
+    case_file.write_text(yaml.safe_dump(data, sort_keys=False))
+    feasibility = build_through(case_file, tmp_path / "build", target="feasibility").results["feasibility"]
+    surface = {row["q"]: row for row in feasibility.summary["per_q"]}
+    volume = build_through(case_file, tmp_path / "build", target="volume_mesh").results["volume_mesh"]
+    rows = volume.summary["per_q"]
+    assert [row["q"] for row in rows] == [0.5, 1.0]
+    for row in rows:
+        skin, expected = row["strain"], surface[row["q"]]
+        np.testing.assert_allclose(skin["skin_stretch_max"], expected["stretch_max"], rtol=SKIN_RTOL)
+        np.testing.assert_allclose(skin["skin_stretch_min"], expected["stretch_min"], rtol=SKIN_RTOL)
 
 
 

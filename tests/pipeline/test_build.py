@@ -20,8 +20,8 @@ from softdesign.pipeline.versions import software_versions
 from tests.helpers.paths import REPO
 
 runner = CliRunner()
-STAGES = ["ingest", "design", "blend", "links", "kinematics", "fit", "actuation", "export", "mould", "volume_mesh",
-          "feasibility"]
+STAGES = ["ingest", "design", "blend", "links", "kinematics", "fit", "simulate", "actuation", "export", "mould",
+          "volume_mesh", "feasibility"]
 
 
 def snapshot(folder: Path) -> dict[str, str]:
@@ -70,13 +70,13 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     edit(demo_case, "fit", smoothing=2.0e-5)
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
-        "fit": "ran",
+        "fit": "ran", "simulate": "ran",
         "actuation": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
     edit(demo_case, "export", q=[0, 0.5, 1])
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "ran",
-        "fit": "skipped",
+        "fit": "skipped", "simulate": "ran",
         "actuation": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
     # The mesh formats are read by export (and the mould's formats): kinematics, the fit and the feasibility
@@ -84,7 +84,7 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     edit(demo_case, "export", formats=["stl", "ply"])
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
-        "fit": "skipped",
+        "fit": "skipped", "simulate": "skipped",
         "actuation": "skipped", "export": "ran", "mould": "ran", "volume_mesh": "skipped", "feasibility": "skipped",
     }
     # A mould is read by the mould stage and by the fit (which turns the end cuts into the mould's parting
@@ -92,7 +92,7 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     edit(demo_case, "export", mould={"margin_mm": 8})
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
-        "fit": "ran",
+        "fit": "ran", "simulate": "ran",
         "actuation": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
     assert (out / "meshes" / "mould" / "half_a.ply").is_file()
@@ -101,14 +101,15 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     edit(demo_case, "links", count=None, breaks=[0, 0.4, 1])
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "design": "skipped", "blend": "ran", "links": "ran", "kinematics": "ran",
-        "fit": "ran", "actuation": "ran",
+        "fit": "ran", "simulate": "ran", "actuation": "ran",
         "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
     }
     # A material is read by the verdicts alone (feasibility, the chambers' actuation, the volume mesh's 3D stress
-    # and stretch): every surface mesh stays (the demo declares ecoflex-00-30).
+    # and stretch) and by the simulate stage's law (off here: it runs and does nothing): every surface mesh stays
+    # (the demo declares ecoflex-00-30).
     edit(demo_case, "material", name="dragon-skin-10")
-    assert statuses(build(demo_case, out)) == {**dict.fromkeys(STAGES, "skipped"), "actuation": "ran",
-                                               "volume_mesh": "ran",
+    assert statuses(build(demo_case, out)) == {**dict.fromkeys(STAGES, "skipped"), "simulate": "ran",
+                                               "actuation": "ran", "volume_mesh": "ran",
                                                "feasibility": "ran"}
     assert statuses(build(demo_case, out, "--force")) == dict.fromkeys(STAGES, "ran")
 
@@ -128,7 +129,7 @@ def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tm
     ran, manifest = run_fit()
     assert ran == {
         "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
-        "fit": "skipped",
+        "fit": "skipped", "simulate": "kept",
         "actuation": "kept", "export": "kept", "mould": "kept", "volume_mesh": "kept", "feasibility": "kept",
     }
     outputs = {o["path"]: o for o in manifest["outputs"]}

@@ -33,6 +33,9 @@ COMPOSE_TOL = 1e-9
 #: (d kappa < 1: the demo's sections bend at most 0.2 /mm) gives them back.
 D_MM = 2.0
 COLUMNS = ("theta", "d", "a", "alpha")
+#: Issue 35 item 4: a link's S_T_E (measured on the built centerline's frames) against its section's exact HTM.
+JOINT_TOL_RAD = 1e-4
+JOINT_TOL_MM = 1e-4
 
 
 @pytest.fixture(scope="module")
@@ -107,6 +110,38 @@ def test_the_rows_agree_with_pcc_forward_for_the_same_sections(build, pose):
         design = read(build, "design/summary.json")
         tip2base = np.linalg.inv(design["base_frame"]) @ np.array(design["links"][-1]["tip_frame"])
         np.testing.assert_allclose(payload["transform"], tip2base, rtol=0, atol=COMPOSE_TOL)
+
+
+def link_errors(kinematics: dict) -> list[tuple[float, float, float]]:
+    """Per pose: its q, and the largest rotation (rad) and translation (mm) from a link's transform to its section's."""
+    out = []
+    for pose in kinematics["poses"]:
+        angle = distance = 0.0
+        for link, section in zip(pose["links"], pose["pcc_sections"], strict=True):
+            measured, exact = np.array(link["transform"]), np.array(section["transform"])
+            cos = 0.5 * (np.trace(measured[:3, :3].T @ exact[:3, :3]) - 1.0)
+            angle = max(angle, float(np.arccos(np.clip(cos, -1.0, 1.0))))
+            distance = max(distance, float(np.linalg.norm(measured[:3, 3] - exact[:3, 3])))
+        out.append((pose["q"][0], angle, distance))
+    return out
+
+
+def test_each_links_transform_is_its_sections_exact_htm_at_every_q(build):
+    """The sections' joints are kept (each section its own spline, every break a sample): before they were,
+    the corners were rounded, 0.21 mm and 0.0127 rad off at q = 1 (0.12 mm, 0.0064 rad at q = 0.5)."""
+    errors = link_errors(read(build, "kinematics.json"))
+    assert [q for q, _, _ in errors] == [0.0, 0.5, 1.0]
+    for q, angle, distance in errors:
+        assert angle <= JOINT_TOL_RAD and distance <= JOINT_TOL_MM, f"q = {q}: {angle:.3g} rad, {distance:.3g} mm"
+
+
+def test_the_joints_are_kept_at_a_coarser_resampling(tmp_path):
+    """At 1 mm samples the rounded corners were 0.36 mm and 0.023 rad off at q = 1."""
+    case = case_from(tmp_path, DEMO, {"design": {"tolerance_mm": 1.0}, "blend": "pcc",
+                                      "resample": {"spacing_mm": 1.0, "smoothing_mm": 0.05, "end_straight_mm": 0.0}})
+    build_through(case, tmp_path / "build", target="kinematics")
+    for q, angle, distance in link_errors(read(tmp_path / "build", "kinematics.json")):
+        assert angle <= JOINT_TOL_RAD and distance <= JOINT_TOL_MM, f"q = {q}: {angle:.3g} rad, {distance:.3g} mm"
 
 
 def test_a_build_without_blend_pcc_has_no_sections_in_kinematics_json(tmp_path):

@@ -42,6 +42,7 @@ from softdesign.meshing.sweep_layout import check_resolvable, layout_holes
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import export_workers
 from softdesign.pipeline.parallel import map_items
+from softdesign.pipeline.simulate_estimates import ESTIMATE_COLUMNS, SimulateResult, estimate_cells
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
@@ -50,7 +51,7 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:
     from softdesign.config import Case
 
-VERSION = 2  # 2: one reason per cause (a kind of wall, a bound of extension)
+VERSION = 3  # 2: one reason per cause (a kind of wall, a bound of extension); 3: the simulate stage's pressures
 SUMMARY = "actuation/summary.json"
 TABLE = "actuation.csv"
 #: The dense q grid's size (q = 0, 0.05, ..., 1).
@@ -86,10 +87,11 @@ def actuation_layout(case: Case, kinematics: KinematicsResult) -> ChamberLayout 
 
 
 def q_grid(case: Case) -> list[tuple[float, bool]]:
-    """(q, is an export q) for the dense grid and the export q values, sorted, once per file label."""
+    """(q, is an export q) for the dense grid, the export q values and the simulated ones, sorted, once per label."""
     export = case.export.q_values()
     chosen = {q_label(q): (q, True) for q in export}
-    for q in np.linspace(0.0, 1.0, DENSE_Q):
+    simulated = case.simulate.q if case.simulate is not None and case.simulate.enabled else []
+    for q in [*np.linspace(0.0, 1.0, DENSE_Q), *simulated]:
         chosen.setdefault(q_label(float(q)), (float(q), False))
     return sorted(chosen.values())
 
@@ -170,13 +172,36 @@ def _rows_at(kinematics: KinematicsResult, layout: ChamberLayout, q: float, expo
     return rows, lengths
 
 
-def table_text(rows: list[dict[str, Any]]) -> str:
-    """actuation.csv: a header, then one row per (q, section, chamber); floats as repr (exact round trip)."""
+def table_text(rows: list[dict[str, Any]], estimates: bool = False) -> str:
+    """actuation.csv: a header, then one row per (q, section, chamber); floats as repr (exact round trip).
+
+    ``estimates``: add the simulate stage's columns (:data:`~softdesign.pipeline.simulate_estimates.ESTIMATE_COLUMNS`),
+    empty in the rows it did not solve.
+    """
+    columns = COLUMNS + (ESTIMATE_COLUMNS if estimates else ())
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(COLUMNS)
-    writer.writerows([[repr(float(r[k])) if isinstance(r[k], float) else r[k] for k in COLUMNS] for r in rows])
+    writer.writerow(columns)
+    writer.writerows([[_cell(r.get(k)) for k in columns] for r in rows])
     return buffer.getvalue()
+
+
+def _cell(value: Any) -> Any:
+    """A table cell: a float as repr, None (an estimate not solved) as empty."""
+    if value is None:
+        return ""
+    return repr(float(value)) if isinstance(value, float) else value
+
+
+def _add_estimates(rows: list[dict[str, Any]], simulated: SimulateResult | None) -> None:
+    """Put the simulate stage's pressures into the rows it solved (the rest get None), when there is a stage result."""
+    if simulated is None:
+        return
+    for r in rows:
+        cells = estimate_cells(simulated, r["q"], r["section"])
+        r["pressure_kpa"] = None if cells is None else float(cells["pressure_kpa"][r["chamber"] - 1])
+        r["pressure_arc_error_mm"] = None if cells is None else cells["pressure_arc_error_mm"]
+        r["pressure_source"] = None if cells is None else cells["pressure_source"]
 
 
 def _extensions(kinematics: KinematicsResult, layout: ChamberLayout, grid: list[float]) -> list[dict[str, Any]]:
@@ -281,8 +306,10 @@ def _check_sweep(case: Case, fit: FitResult, layout: ChamberLayout) -> None:
     check_resolvable(layout, layout_holes(layout, scale, case.export.angular_count), scale)
 
 
-def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult) -> ActuationResult | None:
-    """Layout (or refusal), the lengths table, the walls and extensions and their verdict; None without actuation."""
+def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult,
+                  simulated: SimulateResult | None = None) -> ActuationResult | None:
+    """Layout (or refusal), the lengths table (with the simulate stage's pressures), the walls and extensions and
+    their verdict; None without actuation."""
     layout = actuation_layout(case, kinematics)
     if layout is None:
         return None
@@ -293,6 +320,7 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult) -> A
     for q, export in grid:
         if q != 0.0:
             rows += _rows_at(kinematics, layout, q, export, reference)[0]
+    _add_estimates(rows, simulated)
     qs = [q for q, _ in grid]
     walls = ring_walls(layout) + _skin(kinematics, fit, layout, qs, case.export.offset_mm)
     walls += _meshed(case, kinematics, fit, layout)
@@ -320,7 +348,7 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult) -> A
                   "normal planes (chamber-skin, feed-skin at every q; between tubes constant over q), and at every "
                   "export q the skin over each tube measured on the mesh (end caps included)",
     }
-    return ActuationResult(summary, table_text(rows))
+    return ActuationResult(summary, table_text(rows, estimates=simulated is not None))
 
 
 def write_actuation(result: ActuationResult | None, staging: Staging) -> None:
@@ -365,8 +393,8 @@ STAGE = Stage(
     version=VERSION,
     reads=("actuation", "export.q", "export.frames", "export.offset_mm", "export.spacing_mm", "export.angular_count",
            "material"),
-    upstream=("kinematics", "fit"),
-    compute=lambda case, results: run_actuation(case, results["kinematics"], results["fit"]),
+    upstream=("kinematics", "fit", "simulate"),
+    compute=lambda case, results: run_actuation(case, results["kinematics"], results["fit"], results["simulate"]),
     write=write_actuation,
     load=lambda build_dir, results: load_actuation(build_dir),
     describe=describe_actuation,

@@ -17,7 +17,9 @@ import numpy as np
 
 from softdesign.errors import ConfigError
 from softdesign.geometry.blend import BlendedShape, BlendMode, Shortening, blend_shapes, sampled_shape
+from softdesign.geometry.curve_joints import grid_with_joints
 from softdesign.geometry.curves import (
+    DEGREE,
     SmoothCurve,
     smooth_curve_from_polyline,
     smooth_curve_from_samples,
@@ -41,7 +43,8 @@ if TYPE_CHECKING:  # only annotations: the report loads stage results without th
 #: 4: ``blend: pcc`` (the designed chain, each section's curvature q * kappa at constant length).
 #: 5: sharp joints at explicit link breaks (``joints`` in blend/curves.npz when there are any).
 #: 6: the torsion reported where the curvature is at least a fifth of its largest (TORSION_REL_FLOOR), not noise.
-VERSION = 6
+#: 7: ``blend: pcc`` keeps its sections' joints: each section splined on its own, every break a sample.
+VERSION = 7
 
 
 @dataclass(frozen=True)
@@ -95,15 +98,18 @@ def pcc_shape(final: SmoothCurve, design: DesignResult, frames: FrameMode) -> Bl
     """c(q, .): each designed section an arc of its own length, curvature q * kappa, plane phi, composed from the base.
 
     The target's l maps onto the chain by arc-length fraction (the design's breaks are the joints' fractions), so
-    c(q, l) is the chain's point at arc length ``l * sum(L)``.
+    c(q, l) is the chain's point at arc length ``l * sum(L)``.  The samples are the target's spacing or finer, with
+    every break a sample and a joint: each section is its own interpolant, so the curvature's jump between sections
+    is kept, not smoothed, and a link's frames at its breaks are its section's (issue 35 item 4).
     """
     from softdesign.kinematics.pcc_chain import chain_points_at
 
     base, w, lengths = design.base2world, design.w, design.lengths
-    s = final.l_grid * float(np.sum(lengths))
+    l_grid, joints = grid_with_joints(design.breaks, len(final.l_grid), DEGREE)
+    s = l_grid * float(np.sum(lengths))
 
-    def sampler(q: float) -> np.ndarray:
-        return chain_points_at(base, q * w, lengths, s)
+    def sampler(q: float) -> SmoothCurve:
+        return smooth_curve_from_samples(chain_points_at(base, q * w, lengths, s), joints, l_grid)
 
     return sampled_shape(final, sampler, "pcc", frames)
 

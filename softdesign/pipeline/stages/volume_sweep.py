@@ -2,9 +2,9 @@
 
 ``export.volume_mesh.mesher: sweep`` (the default).  The mesh
 (:mod:`softdesign.meshing.sweep_mesh`) is laid out once on the body at q = 0,
-layers ``size_mm`` apart in arc length but at most ``LAYER_ASPECT`` skin
-edges (the finest grid of the q values meshed, every link joint a layer), the section's nodes on the export's
-angles, its inside at ``size_mm``; :mod:`softdesign.meshing.sweep_body` places it at each q.
+its layers from :mod:`softdesign.pipeline.stages.volume_layers` (even, then
+graded by the skin's stretch), the section's nodes on the export's angles,
+its inside at ``size_mm``; :mod:`softdesign.meshing.sweep_body` places it at each q.
 Checks at each q: every tetrahedron positive (else MeshError naming the
 worst one's section, l, angle and depth), the volume within
 ``VOLUME_RTOL`` of the export's surface mesh at that q, the boundary
@@ -25,11 +25,9 @@ import numpy as np
 
 from softdesign.config import Case
 from softdesign.config import VolumeMesh as VolumeMeshSpec
-from softdesign.errors import ConfigError, MeshError
-from softdesign.limits.volume import MAX_VOLUME_TETS
+from softdesign.errors import MeshError
 from softdesign.mechanics.kinematic_stress import ElementStrain, RestState, rest_inverses, rest_state, strains
 from softdesign.mechanics.laws import HyperelasticLaw
-from softdesign.meshing.body import export_l_grid
 from softdesign.meshing.skin_stretch import morph_samples
 from softdesign.meshing.sweep_body import SweepReference, place_mesh, plan_mesh
 from softdesign.meshing.sweep_mesh import SweptMesh
@@ -42,12 +40,9 @@ from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.stages.export import solid_at
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
+from softdesign.pipeline.stages.volume_layers import swept_layers
 from softdesign.types import FloatArray
 
-#: Largest layer spacing in skin edges: prisms taller than 3 edges split into needles (the demo hollow at 2 mm
-#: layers over 0.36 mm skin edges: 26 % of tets under 10 degrees of dihedral, 3.4 degrees the least; at 1 mm:
-#: 1.3 %, 6.3 degrees).
-LAYER_ASPECT = 3.0
 #: Tetrahedra times q values of the morph's samples in one batch: one task of a worker and one part of the log
 #: (its q measured one at a time, about 60 B a tetrahedron in flight: the strain works in chunks); a mesh larger
 #: than this is one q a batch.
@@ -56,8 +51,6 @@ MORPH_BATCH_VALUES = 2_000_000
 MORPH_WORKERS_VALUES = 4_000_000
 #: Tetrahedra measured at once by the quality figures (:func:`_measures`).
 QUALITY_CHUNK = 16_384
-#: Triangles of a section per node about (Euler: 2 per inside node), for the count bound before meshing.
-TRIANGLES_PER_NODE = 2.0
 
 
 @dataclass(frozen=True)
@@ -78,31 +71,6 @@ class Material:
     max_stretch: float | None
     tensile_strength_kpa: float | None
     name: str
-
-
-def layer_spacing_mm(case: Case, fit: FitResult, size_mm: float) -> float:
-    """The layers' spacing: ``size_mm``, at most ``LAYER_ASPECT`` skin edges (2 pi rho / angular_count at the
-    median radius at q = 0), so that no prism is much taller than its base is wide."""
-    rho = float(np.median(fit.field.evaluate_grid(0.0, np.linspace(0.0, 1.0, 33), [0.0, 0.5 * np.pi, np.pi])))
-    return min(size_mm, LAYER_ASPECT * 2.0 * np.pi * rho / case.export.angular_count)
-
-
-def _layers(case: Case, kinematics: KinematicsResult, fit: FitResult, vm: VolumeMeshSpec) -> FloatArray:
-    shape, spacing = kinematics.chain.shape, layer_spacing_mm(case, fit, vm.size_mm)
-    grids = [export_l_grid(shape.curve_at(q), fit.field, spacing) for q in sorted({0.0, *vm.q})]
-    return max(grids, key=len)
-
-
-def _check_count(layers: FloatArray, case: Case, fit: FitResult, size_mm: float) -> None:
-    na = case.export.angular_count
-    rho = float(np.median(fit.field.evaluate_grid(0.0, layers[:: max(1, len(layers) // 16)], [0.0])))
-    inside = np.pi * rho**2 / (0.5 * np.sqrt(3.0) * min(size_mm, 2 * np.pi * rho / na) ** 2)
-    count = 3.0 * (len(layers) - 1) * TRIANGLES_PER_NODE * (na + inside)
-    if count > MAX_VOLUME_TETS:
-        raise ConfigError(
-            f"export.volume_mesh: the swept mesh would hold about {count:.3g} tetrahedra ({len(layers)} layers of "
-            f"{na} angles at size_mm {size_mm:g}), more than the limit of {MAX_VOLUME_TETS} "
-            "(softdesign/limits/volume.py); raise size_mm or lower export.angular_count")
 
 
 Places = tuple[Any, FloatArray, FloatArray, FloatArray]
@@ -276,10 +244,10 @@ def actuation_layout_of(case: Case, kinematics: KinematicsResult) -> Any:
 
 def _plan(case: Case, kinematics: KinematicsResult, fit: FitResult, vm: VolumeMeshSpec) -> _Placed:
     e, spec, shape = case.export, body_spec(case, fit), kinematics.chain.shape
-    layers = _layers(case, kinematics, fit, vm)
-    _check_count(layers, case, fit, vm.size_mm)
+    layers, even = swept_layers(case, kinematics, fit, vm)
     layout = actuation_layout_of(case, kinematics)
-    mesh, ref = plan_mesh(shape.curve_at(0.0), fit.field, layers, spec, e.angular_count, vm.size_mm, layout)
+    mesh, ref = plan_mesh(shape.curve_at(0.0), fit.field, layers, spec, e.angular_count, vm.size_mm, layout,
+                          even)
     rest = place_mesh(mesh, ref, shape.curve_at(0.0), fit.field, 0.0, spec, e.angular_count)
     inverses = rest_inverses(rest, mesh.tets)
     state = rest_state(rest, mesh.tets, free_directions(mesh, rest, inverses), inverses)

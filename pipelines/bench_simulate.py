@@ -1,0 +1,111 @@
+"""Benchmark of `softdesign simulate` (issue 33): one section of the sample case and of the aorta, against 60 s.
+
+Cases: configs/actuator.yaml (the sample vessel with seed 003's chambers) and
+the VMTK aorta (path 0 of ../shared/data/vmtk-aorta, when present) with
+``actuation: {}``, each at section 0 (the base, the thickest and the one every
+feed line runs through).  Each case is first built through actuation (untimed:
+the command then finds its build cached) and then run as a fresh process of
+the console script, as a user runs it, timed wall clock from start to exit:
+
+- the forward solve, ``--pressures FORWARD_KPA`` (one chamber), default mesh;
+- the inverse, ``--target 1`` (the pressures that reach the designed arc at
+  q = 1), default mesh, stopped by ``--timeout`` a little past the target so a
+  slow search counts as missed without running for its default ten minutes.
+
+Each line gives the section mesh's nodes, the pressures, the remaining arc
+error (the inverse), the largest principal stress against the tensile
+strength, the command's wall time and the verdict against :data:`TARGET_S`.
+Exit 1 when a target is missed (its lines say which).
+
+Usage: ``python pipelines/bench_simulate.py``; ``make bench`` runs it after the
+build benchmark (pipelines/bench.py).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+AORTA_DIR = REPO.parent / "shared" / "data" / "vmtk-aorta"
+#: Issue 33: `simulate` on a demo section and an aorta section in at most this long each on 2 cores, s.
+TARGET_S = 60.0
+#: The forward solve's pressures, kPa (chamber 1 only: the section bends away from it).
+FORWARD_KPA = "20,0,0"
+#: The inverse's --timeout: past the target, so a miss is measured as one, but bounded, s.
+INVERSE_TIMEOUT_S = 2.0 * TARGET_S
+SECTION = 0
+
+
+def case_files(folder: Path) -> list[tuple[str, Path]]:
+    """(label, case file) of the sample case with chambers and, when present, the aorta with chambers."""
+    import yaml
+
+    cases = [("demo (configs/actuator.yaml)", REPO / "configs" / "actuator.yaml")]
+    if AORTA_DIR.is_dir():
+        aorta = {"name": "aorta", "final": {"centerline": str(AORTA_DIR / "aorta-centerline.vtp"),
+                                            "surface": str(AORTA_DIR / "aorta-surface.stl"), "path": 0},
+                 "export": {"q": [0, 1]}, "actuation": {}, "material": {"name": "ecoflex-00-30"}}
+        path = folder / "aorta.yaml"
+        path.write_text(yaml.safe_dump(aorta, sort_keys=False), encoding="utf-8")
+        cases.append(("aorta (path 0)", path))
+    return cases
+
+
+def softdesign() -> list[str]:
+    """The console script beside this Python (as a user runs it)."""
+    return [str(Path(sys.executable).with_name("softdesign"))]
+
+
+def run(args: list[str]) -> tuple[float, dict | None, str]:
+    """Wall seconds of ``softdesign simulate ARGS --json``, its JSON (None when it failed) and its last error line."""
+    start = time.perf_counter()
+    done = subprocess.run([*softdesign(), "simulate", *args, "--json"], capture_output=True, text=True, cwd=REPO)
+    seconds = time.perf_counter() - start
+    if done.returncode != 0:
+        return seconds, None, (done.stderr.strip().splitlines() or ["(no message)"])[-1]
+    return seconds, json.loads(done.stdout), ""
+
+
+def line(label: str, mode: str, seconds: float, payload: dict | None, error: str) -> tuple[str, bool]:
+    """One row: the figures and the verdict (a failed run misses the target)."""
+    ok = payload is not None and seconds <= TARGET_S
+    verdict = f"target <= {TARGET_S:g} s: {'met' if ok else 'MISSED'}"
+    if payload is None:
+        return f"{label:<28} {mode:<18} {seconds:7.1f} s  failed: {error[:160]}  {verdict}", ok
+    strength = payload["tensile_strength_kpa"]
+    stress = f"stress {payload['max_stress_kpa']:.0f}" + (f"/{strength:.0f} kPa" if strength else " kPa")
+    arc = ""
+    if "target" in payload:
+        arc = f", arc error {math.hypot(*payload['target']['error_mm']):.3f} mm" + (
+            "" if payload["target"]["converged"] else " (not converged)")
+    pressures = ",".join(f"{p:.1f}" for p in payload["pressures_kpa"])
+    return (f"{label:<28} {mode:<18} {seconds:7.1f} s  {payload['mesh']['nodes']:>6} nodes, p {pressures} kPa{arc}, "
+            f"{stress}  {verdict}"), ok
+
+
+def main() -> int:
+    from softdesign.pipeline.api import build_through
+
+    missed = False
+    print(f"softdesign simulate, section {SECTION}, default mesh (--size-mm 1.5 --layer-mm 4), wall s of the command:")
+    with tempfile.TemporaryDirectory(prefix="softdesign-bench-simulate-") as scratch:
+        for k, (label, case) in enumerate(case_files(Path(scratch))):
+            out = Path(scratch) / f"build-{k}"
+            build_through(case, out, "actuation")  # untimed: the command finds it cached
+            common = [str(case), "--out", str(out), "--section", str(SECTION)]
+            for mode, extra in ((f"--pressures {FORWARD_KPA}", ["--pressures", FORWARD_KPA]),
+                                ("--target 1", ["--target", "1", "--timeout", f"{INVERSE_TIMEOUT_S:g}"])):
+                text, ok = line(label, mode, *run(common + extra))
+                missed |= not ok
+                print(text, flush=True)
+    return 1 if missed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
