@@ -79,7 +79,7 @@ def simulate(
     out: OutOpt = None,
     size_mm: SizeOpt = 3.0,
     layer_mm: LayerOpt = 8.0,
-    max_pressure: MaxPressureOpt = 300.0,
+    max_pressure: MaxPressureOpt = 100.0,
     timeout: TimeoutOpt = 600.0,
     figure: FigureOpt = None,
     write: WriteOpt = False,

@@ -50,7 +50,7 @@ class Simulate(BaseModel):
     """Spacing of a section mesh's layers along the centerline, mm."""
     angular_count: Integer = Field(12, ge=MIN_ANGULAR_COUNT, le=MAX_ANGULAR_COUNT)
     """Nodes on a section mesh's outer circle."""
-    max_pressure_kpa: FiniteFloat = Field(300.0, ge=1.0, le=MAX_PRESSURE_KPA)
+    max_pressure_kpa: FiniteFloat = Field(100.0, ge=1.0, le=MAX_PRESSURE_KPA)
     """Upper bound of the pressure search, kPa."""
     max_solves: Integer = Field(16, ge=1, le=MAX_INVERSE_SOLVES)
     """Forward solves one inverse (one section, one q) may take."""

@@ -54,7 +54,7 @@ class SimulateOptions:
     angular_count: int = 12
     load_steps: int = 2
     max_iterations: int = 12
-    max_pressure_kpa: float = 300.0
+    max_pressure_kpa: float = 100.0
     max_solves: int = 16
     timeout_s: float = 600.0
 
