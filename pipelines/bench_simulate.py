@@ -93,7 +93,7 @@ def main() -> int:
     from softdesign.pipeline.api import build_through
 
     missed = False
-    print(f"softdesign simulate, section {SECTION}, default mesh (--size-mm 1.5 --layer-mm 4), wall s of the command:")
+    print(f"softdesign simulate, section {SECTION}, default mesh (--size-mm 3 --layer-mm 8), wall s of the command:")
     with tempfile.TemporaryDirectory(prefix="softdesign-bench-simulate-") as scratch:
         for k, (label, case) in enumerate(case_files(Path(scratch))):
             out = Path(scratch) / f"build-{k}"

@@ -44,13 +44,13 @@ class Simulate(BaseModel):
     """The q values whose pressures are estimated, each in [0, 1], at least 0.001 apart (default [1])."""
     sections: list[Integer] | None = Field(None, min_length=1, max_length=MAX_LINKS)
     """The sections to solve, numbered from 1 at the base as in actuation.csv (default: every section)."""
-    size_mm: FiniteFloat = Field(1.5, ge=MIN_SIZE_MM, le=MAX_SIMULATE_SIZE_MM)
+    size_mm: FiniteFloat = Field(3.0, ge=MIN_SIZE_MM, le=MAX_SIMULATE_SIZE_MM)
     """Element size in a section's cross-section, mm."""
-    layer_mm: FiniteFloat = Field(4.0, ge=MIN_SIZE_MM, le=MAX_SIMULATE_SIZE_MM)
+    layer_mm: FiniteFloat = Field(8.0, ge=MIN_SIZE_MM, le=MAX_SIMULATE_SIZE_MM)
     """Spacing of a section mesh's layers along the centerline, mm."""
-    angular_count: Integer = Field(24, ge=MIN_ANGULAR_COUNT, le=MAX_ANGULAR_COUNT)
+    angular_count: Integer = Field(12, ge=MIN_ANGULAR_COUNT, le=MAX_ANGULAR_COUNT)
     """Nodes on a section mesh's outer circle."""
-    max_pressure_kpa: FiniteFloat = Field(300.0, ge=1.0, le=MAX_PRESSURE_KPA)
+    max_pressure_kpa: FiniteFloat = Field(100.0, ge=1.0, le=MAX_PRESSURE_KPA)
     """Upper bound of the pressure search, kPa."""
     max_solves: Integer = Field(16, ge=1, le=MAX_INVERSE_SOLVES)
     """Forward solves one inverse (one section, one q) may take."""

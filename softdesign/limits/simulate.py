@@ -2,11 +2,12 @@
 
 A section's solve factors a sparse matrix (SuperLU) once per Newton
 iteration; its fill, and so its time and memory, grows faster than the node
-count (3D).  Measured on the loaded 2-core machine: 800 nodes 0.55 s per
-factorization, 2,350 nodes about 3 s, 5,500 nodes about 9 s, each with a few
-hundred MB.  MAX_SECTION_NODES keeps one solve within SIMULATE_MEMORY_BYTES
-(the child's address space) and minutes, and is checked on the mesh before
-the solve starts.
+count (3D).  Measured (CPU time, quadratic tetrahedra, on the loaded 2-core
+machine): 3,270 nodes 0.6 s per factorization, 7,392 nodes 9.7 s (43 M
+entries in the factors, about 0.5 GB), 10,840 nodes 19.6 s.
+MAX_SECTION_NODES (nodes of the quadratic mesh: corners and edge midpoints)
+keeps one solve within SIMULATE_MEMORY_BYTES (the child's address space) and
+minutes, and is checked on the mesh before the solve starts.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ MAX_NEWTON_ITERATIONS = 50
 MAX_INVERSE_SOLVES = 40
 #: q values of a build's simulate block (each one inverse per section).
 MAX_SIMULATE_Q = 11
-#: Nodes of one section's mesh.
+#: Nodes of one section's quadratic mesh.
 MAX_SECTION_NODES = 12_000
 #: The smallest element and layer size, mm.
 MIN_SIZE_MM = 0.2

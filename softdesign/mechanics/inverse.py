@@ -137,8 +137,7 @@ class _Evaluations:
         u, result = self.state(p)
         prepared = self.prepared
         du = pressure_sensitivity(prepared.problem, u, p)
-        tets = prepared.problem.mesh.tets[prepared.elements]
-        d_centerline = np.stack([np.einsum("na,nai->ni", prepared.weights, d[tets]) for d in du])
+        d_centerline = np.stack([prepared.centerline_motion(d) for d in du])
         jacobian = _arc_jacobian(result.centerline, prepared.fractions, d_centerline)
         return np.diag([0.5 * self.target[2], 0.5 * self.target[2], 1.0]) @ jacobian
 

@@ -3,7 +3,10 @@
 At a load factor ``t`` the residual is ``R(u) = f_int(u) - t f_p(u)`` with the
 follower pressure forces ``f_p`` of :mod:`softdesign.mechanics.pressure`, and
 the Newton matrix is its consistent derivative ``K(u) - t dF_p/dx`` restricted
-to the free unknowns.  The volumetric part of that matrix couples each node
+to the free unknowns.  A section is solved in quadratic tetrahedra with a mean
+dilatation per element (:mod:`softdesign.mechanics.quadratic`): that matrix is
+as sparse as the mesh and is factored as it is (SuperLU).  For linear
+tetrahedra (average nodal pressure), the volumetric part couples each node
 with its neighbours' neighbours; the step is solved instead from the
 equivalent augmented system with one volume unknown ``q`` per node
 (:class:`~softdesign.mechanics.assembly.Tangent`)::
@@ -18,7 +21,8 @@ residual is below ``rtol`` times the free pressure load of that step (plus
 ``atol``).  A step that does not converge in ``max_iterations``, or whose trial
 turns an element inside out, is halved, at most ``max_cutbacks`` times over the
 solve; past that the solve stops with a :class:`~softdesign.errors.SolveError`
-naming the step, the load factor and the residual: never a silent answer.
+naming the step, the load factor and the residual: never a silent answer.  A
+step that converged in ``EASY_STEP_ITERATIONS`` or fewer doubles the next.
 """
 
 from __future__ import annotations
@@ -40,6 +44,13 @@ from softdesign.mechanics.assembly import (
 )
 from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.pressure import pressure_load
+from softdesign.mechanics.quadratic import (
+    QuadraticMesh,
+    quadratic_force,
+    quadratic_force_and_tangent,
+    quadratic_state,
+)
+from softdesign.mechanics.quadratic_pressure import quadratic_pressure_load
 from softdesign.mechanics.tets import TetMesh
 from softdesign.types import FloatArray, IntArray
 
@@ -70,14 +81,14 @@ class PressureProblem:
 
     Attributes
     ----------
-    mesh : the reference mesh
+    mesh : the reference mesh: linear tetrahedra (average nodal pressure) or quadratic ones (mean dilatation)
     law : the material
     fixed : (3V,) bool, unknowns held at zero displacement
-    faces : (F, 3) int, wall triangles, normals out of the cavity
+    faces : (F, 3) int, wall triangles (F, 6 for a quadratic mesh), normals out of the cavity
     face_cavity : (F,) int, which cavity (index into the pressures) each face bounds
     """
 
-    mesh: TetMesh
+    mesh: TetMesh | QuadraticMesh
     law: HyperelasticLaw
     fixed: np.ndarray
     faces: IntArray
@@ -94,20 +105,37 @@ class SolveRecord:
     cutbacks: int = 0
 
 
+def check_admissible(problem: PressureProblem, u: FloatArray) -> None:
+    """Raise InvertedElementError when the displacement ``u`` turns an element inside out."""
+    if isinstance(problem.mesh, QuadraticMesh):
+        quadratic_state(problem.mesh, problem.law, u)
+    else:
+        volumetric_state(problem.mesh, problem.law, u)
+
+
 def _residual(problem: PressureProblem, u: FloatArray, face_pressure: FloatArray, tangent: bool
               ) -> tuple[FloatArray, FloatArray, Tangent | None]:
     """Residual (3V,), the pressure load (3V,) and, if asked, the Newton matrix at displacement ``u`` (V, 3)."""
-    state = volumetric_state(problem.mesh, problem.law, u)
-    positions = problem.mesh.points + u
+    mesh, law, positions = problem.mesh, problem.law, problem.mesh.points + u
+    if isinstance(mesh, QuadraticMesh):
+        state_q = quadratic_state(mesh, law, u)
+        f_p, dfp = quadratic_pressure_load(positions, problem.faces, face_pressure, tangent)
+        if not tangent or dfp is None:
+            return quadratic_force(mesh, law, state_q) - f_p, f_p, None
+        f_int, K_q = quadratic_force_and_tangent(mesh, law, state_q)
+        return f_int - f_p, f_p, Tangent(K_q - dfp, sp.csr_matrix((0, mesh.dof_count)), np.zeros(0))
+    state = volumetric_state(mesh, law, u)
     f_p, dfp = pressure_load(positions, problem.faces, face_pressure, tangent)
     if not tangent or dfp is None:
-        return internal_force(problem.mesh, problem.law, state) - f_p, f_p, None
-    f_int, K = force_and_tangent(problem.mesh, problem.law, state)
+        return internal_force(mesh, law, state) - f_p, f_p, None
+    f_int, K = force_and_tangent(mesh, law, state)
     return f_int - f_p, f_p, Tangent(K.K - dfp, K.G, K.compliance)
 
 
 def factor_tangent(tangent: Tangent, free: np.ndarray) -> Callable[[FloatArray], FloatArray]:
     """The solver ``r (3V,) -> du (3V,)`` of the Newton matrix on the free unknowns (fixed ones get 0)."""
+    if tangent.G.shape[0] == 0:  # no volume unknowns (quadratic elements): the matrix itself
+        return _direct_solver(sp.csc_matrix(tangent.K[free][:, free]), free)
     G = sp.csr_matrix(tangent.G[:, free])
     volume_block = sp.csr_matrix(sp.diags(-tangent.compliance))
     blocks = [[sp.csr_matrix(tangent.K[free][:, free]), sp.csr_matrix(G.T)], [G, volume_block]]
@@ -123,6 +151,19 @@ def factor_tangent(tangent: Tangent, free: np.ndarray) -> Callable[[FloatArray],
     return solve
 
 
+def _direct_solver(matrix: sp.csc_matrix, free: np.ndarray) -> Callable[[FloatArray], FloatArray]:
+    lu = spla.splu(matrix, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+
+    def solve(r: FloatArray) -> FloatArray:
+        du = np.zeros(len(free))
+        du[free] = lu.solve(r[free])
+        return du
+
+    return solve
+
+
+#: A load step that converged in this many Newton iterations or fewer doubles the next step's length.
+EASY_STEP_ITERATIONS = 5
 #: Halvings of a Newton update that turns an element inside out before the update is taken as it is.
 UPDATE_HALVINGS = 4
 
@@ -132,7 +173,7 @@ def _admissible(problem: PressureProblem, u: FloatArray, du: FloatArray) -> Floa
     for k in range(UPDATE_HALVINGS + 1):
         trial = u + du / 2**k
         try:
-            volumetric_state(problem.mesh, problem.law, trial)
+            check_admissible(problem, trial)
         except InvertedElementError:
             continue
         return trial
@@ -170,7 +211,7 @@ def _predicted(problem: PressureProblem, u: FloatArray, t: float, target: float,
         return u
     guess = u + (target - t) / (t - previous[0]) * (u - previous[1])
     try:
-        volumetric_state(problem.mesh, problem.law, guess)
+        check_admissible(problem, guess)
     except InvertedElementError:
         return u
     return guess
@@ -213,6 +254,8 @@ def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: N
         record.load_factors.append(t)
         record.iterations.append(len(history))
         record.residuals.append(history)
+        if len(history) <= EASY_STEP_ITERATIONS:
+            dt *= 2.0  # an easy step: the next one may be twice as long
     return u, record
 
 
@@ -230,6 +273,7 @@ def pressure_sensitivity(problem: PressureProblem, u: FloatArray, pressures: Flo
     positions = problem.mesh.points + u
     out = []
     for c in range(len(pressures)):
-        unit, _ = pressure_load(positions, problem.faces, (problem.face_cavity == c).astype(float), False)
+        load = quadratic_pressure_load if isinstance(problem.mesh, QuadraticMesh) else pressure_load
+        unit, _ = load(positions, problem.faces, (problem.face_cavity == c).astype(float), False)
         out.append(solve(unit).reshape(-1, 3))
     return np.stack(out)

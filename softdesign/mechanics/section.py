@@ -2,17 +2,19 @@
 
 A section's mesh (:class:`SectionMesh`) is the unloaded body as cast, with its
 base face's nodes fixed and each chamber's wall triangles named.  The solve
-(:func:`simulate_section`) gives the displacement; from it:
+(:func:`simulate_section`) is in quadratic tetrahedra made from it
+(:mod:`softdesign.mechanics.quadratic`: a wall one element thick bends, and
+the curvature converges under refinement) and gives the displacement; from it:
 
 - the deformed centerline: the reference centerline's points carried by the
-  displacement interpolated in the element that holds each one;
+  displacement interpolated (quadratically) in the element that holds each one;
 - the best arc through it (:func:`softdesign.kinematics.pcc_fit.fit_arc`, in the
   section's base frame: z along the centerline's tangent, x along N, y along
   B) and how far it misses (max and RMS over the centerline's points, mm);
 - each chamber's length: the polyline through the centroids of its wall nodes,
   level by level along the reference centerline's arc length;
-- the largest principal stretch and the largest principal Cauchy stress of any
-  element, and where.
+- the largest principal stretch and the largest principal Cauchy stress at any
+  quadrature point, and in which element.
 """
 
 from __future__ import annotations
@@ -23,9 +25,16 @@ import numpy as np
 
 from softdesign.errors import MeshError
 from softdesign.kinematics.pcc_fit import arc_points, fit_arc, trapezoid_weights
-from softdesign.mechanics.assembly import volumetric_state
 from softdesign.mechanics.laws import HyperelasticLaw, cauchy_stress
 from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord, solve_pressures
+from softdesign.mechanics.quadratic import (
+    QuadraticMesh,
+    quadratic_faces,
+    quadratic_fixed,
+    quadratic_mesh,
+    quadratic_state,
+    shape_values,
+)
 from softdesign.mechanics.tets import TetMesh, make_tet_mesh
 from softdesign.types import FloatArray, IntArray
 
@@ -103,10 +112,15 @@ def check_section(section: SectionMesh) -> TetMesh:
 
 
 def section_problem(section: SectionMesh, law: HyperelasticLaw) -> PressureProblem:
-    """The pressure problem of a section: base nodes fixed in every direction, walls loaded per chamber."""
-    mesh = check_section(section)
-    fixed = np.repeat(section.base, 3)
-    return PressureProblem(mesh, law, fixed, np.asarray(section.wall_faces, np.int64),
+    """The pressure problem of a section in quadratic tetrahedra (:mod:`softdesign.mechanics.quadratic`).
+
+    The section's linear tetrahedra get a node at each edge's middle; the base
+    nodes (corners and the midpoints between them) are fixed in every
+    direction and each chamber's wall carries its pressure on 6-node faces.
+    """
+    mesh = quadratic_mesh(check_section(section))
+    fixed = quadratic_fixed(mesh, np.repeat(section.base[:, None], 3, axis=1)).ravel()
+    return PressureProblem(mesh, law, fixed, quadratic_faces(mesh, np.asarray(section.wall_faces, np.int64)),
                            np.asarray(section.face_chamber, np.int64))
 
 
@@ -154,13 +168,18 @@ def arc_of(centerline: FloatArray, fractions: FloatArray) -> tuple[float, float,
 
 
 def _stress_figures(problem: PressureProblem, u: FloatArray) -> tuple[float, float, FloatArray]:
-    state = volumetric_state(problem.mesh, problem.law, u)
-    stretch = np.sqrt(np.linalg.eigvalsh(np.einsum("eki,ekj->eij", state.F, state.F))[:, -1])
-    sigma = cauchy_stress(problem.law, state.F, state.element_pressure)
+    """Largest principal stretch and Cauchy stress (kPa) over the quadrature points, and that element's centroid."""
+    mesh = problem.mesh
+    assert isinstance(mesh, QuadraticMesh)
+    state = quadratic_state(mesh, problem.law, u)
+    E, Q = state.J.shape
+    F = state.F.reshape(E * Q, 3, 3)
+    stretch = np.sqrt(np.linalg.eigvalsh(np.einsum("eki,ekj->eij", F, F))[:, -1])
+    sigma = cauchy_stress(problem.law, F, np.repeat(state.pressure, Q))
     principal = np.linalg.eigvalsh(sigma)[:, -1]
-    worst = int(np.argmax(principal))
-    at = problem.mesh.points[problem.mesh.tets[worst]].mean(axis=0)
-    return float(stretch.max()), float(principal[worst]), at
+    worst = int(np.argmax(principal)) // Q
+    at = mesh.linear.points[mesh.linear.tets[worst]].mean(axis=0)
+    return float(stretch.max()), float(principal.max()), at
 
 
 @dataclass(frozen=True)
@@ -173,16 +192,22 @@ class PreparedSection:
     weights: FloatArray  #: (n, 4) their barycentric weights
     fractions: FloatArray  #: (n,) arc-length fraction of each centerline point, 0 to 1
 
+    def centerline_motion(self, u: FloatArray) -> FloatArray:
+        """The displacement (n, 3) mm of the centerline's points under nodal ``u`` (N, 3) mm (the elements' shapes)."""
+        mesh = self.problem.mesh
+        assert isinstance(mesh, QuadraticMesh)
+        return np.einsum("na,nai->ni", shape_values(self.weights), u[mesh.cells[self.elements]])
+
     def carried_centerline(self, u: FloatArray) -> FloatArray:
-        """The centerline (n, 3) mm carried by the displacement ``u`` (V, 3) mm."""
-        corners = u[self.problem.mesh.tets[self.elements]]
-        return self.section.centerline + np.einsum("na,nai->ni", self.weights, corners)
+        """The centerline (n, 3) mm carried by the displacement ``u`` (N, 3) mm."""
+        return self.section.centerline + self.centerline_motion(u)
 
 
 def prepare_section(section: SectionMesh, law: HyperelasticLaw) -> PreparedSection:
     """Check a section and locate its centerline (MeshError when either is wrong)."""
     problem = section_problem(section, law)
-    elements, weights = locate(problem.mesh, section.centerline)
+    assert isinstance(problem.mesh, QuadraticMesh)
+    elements, weights = locate(problem.mesh.linear, section.centerline)
     steps = np.linalg.norm(np.diff(section.centerline, axis=0), axis=1)
     fractions = np.concatenate([[0.0], np.cumsum(steps)]) / steps.sum()
     return PreparedSection(section, problem, elements, weights, fractions)
@@ -195,8 +220,9 @@ def measure_section(prepared: PreparedSection, u: FloatArray, pressures: FloatAr
     kappa, phi, length, arc_max, arc_rms = arc_of(centerline, prepared.fractions)
     stretch, stress, at = _stress_figures(prepared.problem, u)
     section = prepared.section
+    corners = section.points + u[:len(section.points)]
     return SectionResult(np.asarray(pressures, float), centerline, kappa, phi, length, arc_max, arc_rms,
-                         chamber_lengths(section, section.points + u), chamber_lengths(section, section.points),
+                         chamber_lengths(section, corners), chamber_lengths(section, section.points),
                          stretch, stress, at, record)
 
 

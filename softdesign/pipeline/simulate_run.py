@@ -49,12 +49,12 @@ class SimulateOptions:
     section: int
     pressures_kpa: tuple[float, ...] | None
     target_q: float | None
-    size_mm: float = 1.5
-    layer_mm: float = 4.0
-    angular_count: int = 24
+    size_mm: float = 3.0
+    layer_mm: float = 8.0
+    angular_count: int = 12
     load_steps: int = 2
     max_iterations: int = 12
-    max_pressure_kpa: float = 300.0
+    max_pressure_kpa: float = 100.0
     max_solves: int = 16
     timeout_s: float = 600.0
 
@@ -122,9 +122,18 @@ def section_mesh_of(case: Any, kinematics: Any, fit: Any, section: int, size_mm:
 
 def check_node_count(section: Any, index: int, fix: str) -> None:
     """Refuse (ConfigError) a section mesh beyond MAX_SECTION_NODES, before its solve."""
-    if len(section.points) > MAX_SECTION_NODES:
-        raise ConfigError(f"simulate: section {index}'s mesh has {len(section.points)} nodes, more than "
+    nodes = quadratic_node_count(section)
+    if nodes > MAX_SECTION_NODES:
+        raise ConfigError(f"simulate: section {index}'s mesh has {nodes} nodes (quadratic elements), more than "
                           f"{MAX_SECTION_NODES} (softdesign/limits/simulate.py); {fix}")
+
+
+def quadratic_node_count(section: Any) -> int:
+    """Nodes of the section's quadratic mesh: its corners and one per edge."""
+    from softdesign.mechanics.quadratic import edge_midpoints
+
+    tets = np.asarray(section.tets, np.int64)
+    return len(section.points) + len(edge_midpoints(tets, len(section.points))[0])
 
 
 def payload(o: SimulateOptions, section: Any, material: Any, answer: dict[str, Any],
@@ -136,8 +145,10 @@ def payload(o: SimulateOptions, section: Any, material: Any, answer: dict[str, A
         "material": {"name": material.name, "law": material.law.kind, "c1_kpa": material.law.c1,
                      "c2_kpa": material.law.c2, "c3_kpa": material.law.c3, "bulk_kpa": material.law.bulk_kpa,
                      "source": material.law.source},
-        "formulation": "linear tetrahedra, average nodal pressure (near-incompressible), follower pressure",
-        "mesh": {"nodes": len(section.points), "tets": len(section.tets), "size_mm": o.size_mm,
+        "formulation": ("quadratic (10-node) tetrahedra, mean dilatation per element (near-incompressible), "
+                        "follower pressure on 6-node faces"),
+        "mesh": {"nodes": len(section.points), "tets": len(section.tets),
+                 "quadratic_nodes": quadratic_node_count(section), "size_mm": o.size_mm,
                  "layer_mm": o.layer_mm, "angular_count": o.angular_count},
         "pressures_kpa": [round(float(p), 6) for p in r.pressures_kpa],
         "arc": {"kappa_per_mm": r.kappa, "phi_rad": r.phi, "length_mm": r.length,

@@ -15,7 +15,7 @@ from tests.fitting.test_fit_strain import _constant_field
 
 RADIUS_MM, LENGTH_MM = 5.0, 40.0
 SPEC = ActuationSpec(distance_mm=2.5, diameter_mm=2.0, feed_diameter_mm=0.5, end_wall_mm=1.5, first_angle_deg=90.0)
-#: the chamber circles have 12 nodes: an inscribed polygon holds 1 - sin(h)/h = 4.5 % less than the circle,
+#: the chamber circles have 8 nodes: an inscribed polygon holds 1 - sin(h)/h = 10 % less than the circle,
 #: the outer one (24 nodes) 1.1 % less; the volume is compared with the polygons' to the swept mesher's accuracy
 VOLUME_RTOL = 1e-3
 
@@ -43,7 +43,7 @@ def test_section_volume_frame_and_chambers() -> None:
     chambers = layout.section_chambers(1)
     half = LENGTH_MM / 2
     chamber_length = (chambers[0].l_end - chambers[0].l_start) * LENGTH_MM
-    expected = _polygon_area(RADIUS_MM, 24) * half - 3 * _polygon_area(1.0, 12) * chamber_length
+    expected = _polygon_area(RADIUS_MM, 24) * half - 3 * _polygon_area(1.0, 8) * chamber_length
     np.testing.assert_allclose(mesh.volumes.sum(), expected, rtol=VOLUME_RTOL)
     # in the section's base frame: the base at z = 0, the centerline along +z, the tip at the section's length
     np.testing.assert_allclose(section.points[section.base, 2], 0.0, atol=1e-9)

@@ -1,4 +1,8 @@
-"""Known answer: a thick-walled neo-Hookean tube inflated in plane strain (tests/helpers/tube_analytic.py)."""
+"""Known answer: a thick-walled neo-Hookean tube inflated in plane strain (tests/helpers/tube_analytic.py).
+
+Solved in the sections' formulation: quadratic tetrahedra with a mean dilatation per element
+(:mod:`softdesign.mechanics.quadratic`), near-incompressible (kappa / mu = 1000).
+"""
 
 from __future__ import annotations
 
@@ -8,6 +12,7 @@ import pytest
 from softdesign.errors import SolveError
 from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.newton import NewtonSettings, PressureProblem, solve_pressures
+from softdesign.mechanics.quadratic import quadratic_faces, quadratic_fixed, quadratic_mesh
 from softdesign.mechanics.tets import boundary_faces, make_tet_mesh
 from tests.helpers.fe_meshes import quarter_tube
 from tests.helpers.tube_analytic import inflation_pressure, lame_displacement
@@ -16,23 +21,24 @@ INNER, OUTER, HEIGHT = 5.0, 10.0, 1.0
 MU = 40.0
 #: near-incompressible: kappa / mu = 1000 (Poisson's ratio 0.4995)
 LAW = HyperelasticLaw("neo-hookean", MU / 2, 0.0, 0.0, 1000 * MU, "test")
-#: The default test mesh: 8 radial, 16 angular divisions of a quarter tube, one layer.
-DEFAULT_COUNTS = (8, 16, 1)
+#: The default test mesh: 4 radial, 8 angular divisions of a quarter tube, one layer (quadratic elements).
+DEFAULT_COUNTS = (4, 8, 1)
 #: The issue's bound on the analytic inflation relation.
 INFLATION_RTOL = 0.02
 
 
 def _problem(counts: tuple[int, int, int]) -> tuple[np.ndarray, PressureProblem]:
     points, tets = quarter_tube(INNER, OUTER, HEIGHT, counts)
-    mesh = make_tet_mesh(points, tets)
-    faces = boundary_faces(mesh.tets)
+    linear = make_tet_mesh(points, tets)
+    mesh = quadratic_mesh(linear)
+    faces = boundary_faces(linear.tets)
     on_inner = np.all(np.isclose(np.hypot(points[faces][..., 0], points[faces][..., 1]), INNER), axis=1)
-    wall = faces[on_inner][:, [0, 2, 1]]  # normals out of the cavity, into the material
+    wall = quadratic_faces(mesh, faces[on_inner][:, [0, 2, 1]])  # normals out of the cavity, into the material
     fixed = np.zeros(points.shape, bool)
     fixed[:, 2] = True  # plane strain
     fixed[np.isclose(points[:, 0], 0.0), 0] = True  # symmetry planes
     fixed[np.isclose(points[:, 1], 0.0), 1] = True
-    return points, PressureProblem(mesh, LAW, fixed.ravel(), wall, np.zeros(len(wall), np.int64))
+    return points, PressureProblem(mesh, LAW, quadratic_fixed(mesh, fixed).ravel(), wall, np.zeros(len(wall), np.int64))
 
 
 def _inflate(counts: tuple[int, int, int], pressure: float) -> float:
@@ -41,7 +47,7 @@ def _inflate(counts: tuple[int, int, int], pressure: float) -> float:
     u, record = solve_pressures(problem, np.array([pressure]), NewtonSettings(load_steps=4))
     assert all(h[-1] < 1e-6 for h in record.residuals)
     nodes = np.isclose(np.hypot(points[:, 0], points[:, 1]), INNER)
-    x = points[nodes] + u[nodes]
+    x = points[nodes] + u[: len(points)][nodes]
     return float(np.hypot(x[:, 0], x[:, 1]).mean())
 
 
@@ -52,17 +58,19 @@ def test_tube_follows_the_analytic_inflation(pressure: float) -> None:
     assert abs(inflation_pressure(MU, INNER, OUTER, a) / pressure - 1) < INFLATION_RTOL
 
 
+@pytest.mark.slow
 def test_tube_inflation_converges_under_refinement() -> None:
-    errors = [abs(inflation_pressure(MU, INNER, OUTER, _inflate((n, 2 * n, 1), 20.0)) / 20.0 - 1) for n in (2, 4, 8)]
+    # measured relative errors at 20 kPa: 4.6 %, 0.77 %, 0.15 % on 1, 2, 4 radial divisions (rates 2.6 and 2.3)
+    errors = [abs(inflation_pressure(MU, INNER, OUTER, _inflate((n, 2 * n, 1), 20.0)) / 20.0 - 1) for n in (1, 2, 4)]
     assert errors[0] > errors[1] > errors[2]
-    assert errors[1] / errors[2] > 2.0  # at least first order; measured about 5 (second order) at this size
+    assert errors[1] / errors[2] > 4.0  # at least second order
 
 
 def test_tube_small_pressure_is_lame() -> None:
     pressure = 0.05  # 0.1 % hoop strain: the linear limit
     a = _inflate(DEFAULT_COUNTS, pressure)
     expected = lame_displacement(MU, LAW.bulk_kpa, INNER, OUTER, pressure, INNER)
-    # the mesh's error at this size is ~1 % (the polygonal inner wall); the analytic and linear answers agree to 1e-3
+    # measured 0.6 % below (the polygonal inner wall); the analytic and linear answers agree to 1e-3
     assert abs((a - INNER) / expected - 1) < INFLATION_RTOL
 
 
