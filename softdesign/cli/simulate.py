@@ -11,9 +11,11 @@ import typer
 from softdesign.cli.common import CaseArg, JsonOpt, OutOpt, emit_json, finite_number, note, run_guarded
 from softdesign.errors import ConfigError
 
-SectionOpt = Annotated[int, typer.Option("--section", help="The section (link) to solve, 0 at the base.")]
+SectionOpt = Annotated[int, typer.Option(
+    "--section", help="The section (link) to solve, numbered from 1 at the base (as actuation.csv and "
+    "simulate.sections number them).")]
 PressuresOpt = Annotated[str | None, typer.Option(
-    "--pressures", help="Chamber pressures P1,P2,P3 in kPa (chambers 0, 1, 2 of the section).")]
+    "--pressures", help="Chamber pressures P1,P2,P3 in kPa (chambers 1, 2, 3 of the section, as actuation.csv).")]
 TargetOpt = Annotated[float | None, typer.Option(
     "--target", help="Find the pressures whose section best matches the designed arc at this q.")]
 SizeOpt = Annotated[float, typer.Option("--size-mm", help="Element size in the cross-section, mm.")]
@@ -73,7 +75,7 @@ def _print(payload: dict[str, Any]) -> None:
 
 def simulate(
     case_file: CaseArg,
-    section: SectionOpt = 0,
+    section: SectionOpt = 1,
     pressures: PressuresOpt = None,
     target: TargetOpt = None,
     out: OutOpt = None,
@@ -98,8 +100,11 @@ def simulate(
         from softdesign.pipeline.simulate_run import SimulateOptions
 
         _check_figure_path(figure)
+        if section < 1:
+            raise ConfigError(f"simulate --section: got {section}; sections are numbered from 1 at the base, as "
+                              "actuation.csv numbers them")
         values = None if pressures is None else pressures_from_text(pressures)
-        options = SimulateOptions(section, values, target, size_mm, layer_mm, max_pressure_kpa=max_pressure,
+        options = SimulateOptions(section - 1, values, target, size_mm, layer_mm, max_pressure_kpa=max_pressure,
                                   timeout_s=timeout)
         result = (write_to_table if write else run_simulate)(case_file, out, options, note)
         if figure is not None:

@@ -40,12 +40,12 @@ def run_simulate(case_file: Path, out: Path | None, o: SimulateOptions, progress
         raise ConfigError(f"{case_file}: simulate needs material.name (a preset with a law) or material.custom")
     section = section_mesh_of(outcome.case, outcome.results["kinematics"], outcome.results["fit"], o.section,
                               o.size_mm, o.angular_count, o.layer_mm)
-    check_node_count(section, o.section, "raise --size-mm or --layer-mm")
+    check_node_count(section, o.section + 1, "raise --size-mm or --layer-mm")
     target = None
     if o.target_q is not None:
         arc = fit_links(outcome.results["kinematics"].chain, o.target_q, ARC_SAMPLES)[o.section]
         target = (arc.kappa, arc.phi, arc.length)
-    what = f"the finite-element solve of section {o.section} ({len(section.points)} nodes)"
+    what = f"the finite-element solve of section {o.section + 1} ({len(section.points)} nodes)"
     fix = "raise --size-mm or --layer-mm, lower the pressures, or raise --timeout"
     try:
         answer = run_in_child(solve_in_child, (section, material.law, o, target), o.timeout_s, what, fix,
@@ -61,7 +61,7 @@ def write_to_table(case_file: Path, out: Path | None, o: SimulateOptions, progre
     The case file's ``simulate:`` block (or the defaults) with ``enabled: true``, ``q: [q]``, ``sections:
     [section + 1]`` and the command's mesh, bound and time: the simulate stage solves it and the actuation stage
     writes the pressures into the build folder's actuation.csv, the build's manifest recording that case.  The
-    figures are the stage's for that section (as :func:`payload`, section numbered from 0 as --section).
+    figures are the stage's for that section (as :func:`payload`, section numbered from 1, as --section).
     """
     from softdesign.config import load_case
     from softdesign.config.simulate import Simulate
@@ -81,6 +81,6 @@ def write_to_table(case_file: Path, out: Path | None, o: SimulateOptions, progre
     outcome = build_through(case_file, out, "actuation", progress=progress,
                             case=case.model_copy(update={"simulate": Simulate.model_validate(settings)}))
     solve = dict(outcome.results["simulate"].summary["solves"][0])
-    solve.update(section=o.section, seconds=round(time.perf_counter() - start, 2),
+    solve.update(section=o.section + 1, seconds=round(time.perf_counter() - start, 2),
                  written=str(outcome.build_dir / "actuation.csv"))
     return solve

@@ -46,6 +46,7 @@ ARC_SAMPLES = 65
 class SimulateOptions:
     """The command's choices (kPa, mm, s), each checked by :func:`check_options` before work."""
 
+    #: the section, 0 at the base (the command line and every output number sections from 1)
     section: int
     pressures_kpa: tuple[float, ...] | None
     target_q: float | None
@@ -115,7 +116,8 @@ def section_mesh_of(case: Any, kinematics: Any, fit: Any, section: int, size_mm:
     if layout is None:
         raise ConfigError("simulate: the case has no actuation chambers; add an `actuation:` block")
     if not 0 <= section < layout.sections:
-        raise ConfigError(f"simulate --section: got {section}, the body has sections 0 to {layout.sections - 1}")
+        raise ConfigError(f"simulate --section: got {section + 1}, the body has sections 1 to {layout.sections} "
+                          "(numbered from 1 at the base)")
     curve0 = kinematics.chain.shape.curve_at(0.0)
     return layout_section_mesh(curve0, fit.field, body_spec(case), layout, section, size_mm, angular_count, layer_mm)
 
@@ -141,7 +143,7 @@ def payload(o: SimulateOptions, section: Any, material: Any, answer: dict[str, A
     """The JSON-ready figures of a solve."""
     r, inverse = answer["result"], answer["inverse"]
     out: dict[str, Any] = {
-        "section": o.section,
+        "section": o.section + 1,
         "material": {"name": material.name, "law": material.law.kind, "c1_kpa": material.law.c1,
                      "c2_kpa": material.law.c2, "c3_kpa": material.law.c3, "bulk_kpa": material.law.bulk_kpa,
                      "source": material.law.source},

@@ -31,6 +31,7 @@ def test_help_names_the_options() -> None:
     (["--pressures", "10,0,0", "--timeout", "1e9"], "--timeout"),
     (["--pressures", "10,0,0", "--figure", "out.svg"], "expected a .png file"),
     (["--pressures", "10,0,0", "--figure", "no/such/folder/out.png"], "does not exist"),
+    (["--pressures", "10,0,0", "--section", "0"], "numbered from 1 at the base"),
 ])
 def test_bad_options_exit_2_before_any_work(args: list[str], message: str, tmp_path) -> None:
     result = runner.invoke(app, ["simulate", str(DEMO), "--out", str(tmp_path / "build"), *args])

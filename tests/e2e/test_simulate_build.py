@@ -37,7 +37,7 @@ def demo_case(folder: Path, actuation: bool) -> Path:
 
 def test_one_chamber_bends_the_demo_section_away_from_it(tmp_path: Path) -> None:
     case = demo_case(tmp_path, actuation=True)
-    result = runner.invoke(app, ["simulate", str(case), "--out", str(tmp_path / "build"), "--section", "0",
+    result = runner.invoke(app, ["simulate", str(case), "--out", str(tmp_path / "build"), "--section", "1",
                                  "--pressures", "5,0,0", "--timeout", "1800", "--json"])
     assert result.exit_code == 0, result.output
     payload = json.loads(result.stdout)

@@ -126,8 +126,8 @@ def test_simulate_write_puts_one_sections_pressures_in_the_table(tmp_path: Path)
     options = SimulateOptions(1, None, 0.5, size_mm=4.0, layer_mm=10.0, angular_count=8, max_pressure_kpa=50.0,
                               max_solves=1)
     solve = write_to_table(case, tmp_path / "build", options, lambda line: None)
-    assert solve["section"] == 1 and solve["q"] == 0.5 and solve["written"].endswith("actuation.csv")
+    assert solve["section"] == 2 and solve["q"] == 0.5 and solve["written"].endswith("actuation.csv")
     _, table = rows(tmp_path / "build" / "actuation.csv")
     solved = [r for r in table if r["pressure_kpa"]]
-    assert [(float(r["q"]), r["section"]) for r in solved] == [(0.5, "2")] * 3  # --section 1 is section 2
+    assert [(float(r["q"]), r["section"]) for r in solved] == [(0.5, "2")] * 3  # 0-based in the options
     assert [float(r["pressure_kpa"]) for r in solved] == pytest.approx(solve["pressures_kpa"], abs=0)

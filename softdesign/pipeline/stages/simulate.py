@@ -79,7 +79,7 @@ def _meshes(case: Case, kinematics: KinematicsResult, fit: FitResult) -> dict[in
     meshes = {}
     for i in _sections(case, layout.sections):
         meshes[i] = section_mesh_of(case, kinematics, fit, i, s.size_mm, s.angular_count, s.layer_mm)
-        check_node_count(meshes[i], i, "raise simulate.size_mm or simulate.layer_mm")
+        check_node_count(meshes[i], i + 1, "raise simulate.size_mm or simulate.layer_mm")
     return meshes
 
 
