@@ -287,8 +287,9 @@ class VolumeMesh(_Section):
     #: the q values to mesh: [0] (the state the actuator is cast in, which a simulator deforms) by default
     q: list[FiniteFloat] = Field([0.0], min_length=1, max_length=MAX_VOLUME_MESHES)
     """The q values to mesh (default [0], the state the actuator is cast in)."""
-    #: target edge length of the tetrahedra (sweep: the largest edge inside the section, and the layers' spacing
-    #: along the body, at most 3 skin edges; its skin's nodes are on the export's angles)
+    #: target edge length of the tetrahedra (sweep: the largest edge inside the section, pi D / size_mm nodes on a
+    #: chamber's or feed's circle, and the layers' spacing along the body, halved where it would invert a
+    #: tetrahedron or miss the volume; its skin's nodes are on the export's angles)
     size_mm: FiniteFloat = Field(2.0, ge=MIN_TET_SIZE_MM, le=50.0)
     """Target edge length of the tetrahedra, mm."""
     #: largest distance of the mesh's boundary from the body's surface
