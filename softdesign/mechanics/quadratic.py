@@ -189,9 +189,14 @@ def quadratic_force(mesh: QuadraticMesh, law: HyperelasticLaw, state: QuadraticS
     return summed(cell_dofs(mesh.cells), forces.reshape(E, 30), mesh.dof_count)
 
 
-def quadratic_force_and_tangent(mesh: QuadraticMesh, law: HyperelasticLaw, state: QuadraticState
-                                ) -> tuple[FloatArray, sp.csr_matrix]:
-    """Internal forces (3N,) mN and their exact derivative (3N, 3N) mN/mm (see the module's docstring)."""
+def quadratic_force_and_tangent(mesh: QuadraticMesh, law: HyperelasticLaw, state: QuadraticState,
+                                element_pressure: FloatArray | None = None) -> tuple[FloatArray, sp.csr_matrix]:
+    """Internal forces (3N,) mN and their derivative (3N, 3N) mN/mm (see the module's docstring).
+
+    The derivative is exact with ``element_pressure`` None; given (E,) kPa, the geometric part of the
+    volume takes that pressure instead of ``U'(theta)`` (the mixed Newton matrix of
+    :mod:`softdesign.mechanics.newton`, whose element pressures are updated by their linearization).
+    """
     E, Q = mesh.weights.shape
     P_iso, A_iso = isochoric_tangent(law, state.F.reshape(E * Q, 3, 3))
     dv = _volume_gradient(mesh, state)
@@ -203,7 +208,8 @@ def quadratic_force_and_tangent(mesh: QuadraticMesh, law: HyperelasticLaw, state
     K = (B @ A @ B.transpose(0, 2, 1)).reshape(E, Q, 30, 30).sum(axis=1)
     # geometric part of the volume: p_e sum_q w J (g_ai g_bk - g_ak g_bi), and U''/V_e dv (x) dv
     g = state.spatial_grads.reshape(E * Q, 10, 3)
-    wJ = (mesh.weights * state.J * state.pressure[:, None]).reshape(E * Q, 1, 1)
+    pressure = state.pressure if element_pressure is None else element_pressure
+    wJ = (mesh.weights * state.J * pressure[:, None]).reshape(E * Q, 1, 1)
     gg = np.einsum("nai,nbk->naibk", g, g).reshape(E * Q, 30, 30)
     swap = np.einsum("nak,nbi->naibk", g, g).reshape(E * Q, 30, 30)
     K += (wJ * (gg - swap)).reshape(E, Q, 30, 30).sum(axis=1)
@@ -215,6 +221,17 @@ def quadratic_force_and_tangent(mesh: QuadraticMesh, law: HyperelasticLaw, state
     cols = np.broadcast_to(dofs[:, None, :], (E, 30, 30)).ravel()
     tangent = sp.csr_matrix((K.ravel(), (rows, cols)), shape=(n, n))
     return summed(dofs, forces.reshape(E, 30), n), tangent
+
+
+def linearized_pressure(mesh: QuadraticMesh, law: HyperelasticLaw, state: QuadraticState, step: FloatArray
+                        ) -> FloatArray:
+    """Element pressures (E,) kPa after the displacement ``step`` (N, 3) mm from ``state``, to first order.
+
+    ``U'(theta) + U'' (dv_e/dx . step) / V_e`` with ``U'' = kappa``: the pressure unknown of the mixed
+    Newton method, updated by its linearization rather than from the new (overshooting) volume.
+    """
+    change = np.einsum("eai,eai->e", _volume_gradient(mesh, state), step[mesh.cells]) / mesh.volumes
+    return np.asarray(state.pressure + law.bulk_kpa * change, np.float64)
 
 
 def quadratic_deformation(mesh: QuadraticMesh, law: HyperelasticLaw, displacement: FloatArray

@@ -9,6 +9,7 @@ import pytest
 from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.quadratic import (
     QuadraticMesh,
+    linearized_pressure,
     midpoint_nodes,
     quadratic_faces,
     quadratic_force,
@@ -88,3 +89,30 @@ def test_shape_functions_interpolate_quadratics_exactly() -> None:
     np.testing.assert_allclose(got, field(where), atol=1e-12)
     with pytest.raises(ValueError, match="not an edge"):
         midpoint_nodes(mesh, np.array([[0, len(mesh.linear.points) - 1]]))
+
+
+def test_linearized_pressure_is_first_order_in_the_step() -> None:
+    """The mixed method's pressure after a step misses U'(theta) of the stepped state by O(step^2)."""
+    mesh, u = _mesh_and_displacement()
+    state = quadratic_state(mesh, LAW, u)
+    direction = np.random.default_rng(11).standard_normal(mesh.points.shape)
+    misses = []
+    for scale in (1e-3, 5e-4):
+        exact = quadratic_state(mesh, LAW, u + scale * direction).pressure
+        misses.append(np.abs(linearized_pressure(mesh, LAW, state, scale * direction) - exact).max())
+        change = np.abs(exact - state.pressure).max()
+        assert misses[-1] < 0.05 * change  # far better than keeping the old pressure
+    assert 3.5 < misses[0] / misses[1] < 4.5  # second order: half the step, a quarter of the miss
+
+
+def test_the_mixed_tangent_takes_the_given_element_pressures() -> None:
+    """With its own pressures U'(theta) given, the matrix is the exact one; others change only the geometric part."""
+    mesh, u = _mesh_and_displacement()
+    state = quadratic_state(mesh, LAW, u)
+    _, exact = quadratic_force_and_tangent(mesh, LAW, state)
+    _, same = quadratic_force_and_tangent(mesh, LAW, state, state.pressure.copy())
+    _, other = quadratic_force_and_tangent(mesh, LAW, state, state.pressure + 100.0)
+    assert abs(exact - same).max() == 0.0
+    difference = other - exact
+    assert abs(difference).max() > 0.0
+    assert abs(difference - difference.T).max() <= 1e-9 * abs(difference).max()  # p sum w J (g g - g g): symmetric
