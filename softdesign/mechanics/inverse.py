@@ -110,7 +110,8 @@ class _Evaluations:
     def state(self, p: FloatArray) -> tuple[FloatArray, SectionResult]:
         key = np.asarray(p, float).tobytes()
         if key not in self.states:
-            u, record = solve_pressures(self.prepared.problem, p, self.newton, start=self.last)
+            u, record = solve_pressures(self.prepared.problem, p, self.newton, start=self.last,
+                                        solver=self.prepared.solver)
             self.solves += 1
             self.last = (u, np.array(p, float))
             self.states[key] = (u, measure_section(self.prepared, u, p, record))
@@ -136,7 +137,7 @@ class _Evaluations:
     def jacobian(self, p: FloatArray) -> FloatArray:
         u, result = self.state(p)
         prepared = self.prepared
-        du = pressure_sensitivity(prepared.problem, u, p)
+        du = pressure_sensitivity(prepared.problem, u, p, prepared.solver)
         d_centerline = np.stack([prepared.centerline_motion(d) for d in du])
         jacobian = _arc_jacobian(result.centerline, prepared.fractions, d_centerline)
         return np.diag([0.5 * self.target[2], 0.5 * self.target[2], 1.0]) @ jacobian

@@ -19,13 +19,14 @@ the curvature converges under refinement) and gives the displacement; from it:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from softdesign.errors import MeshError
 from softdesign.kinematics.pcc_fit import arc_points, fit_arc, trapezoid_weights
 from softdesign.mechanics.laws import HyperelasticLaw, cauchy_stress
+from softdesign.mechanics.linear_solve import TangentSolver
 from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord, solve_pressures
 from softdesign.mechanics.quadratic import (
     QuadraticMesh,
@@ -191,6 +192,7 @@ class PreparedSection:
     elements: IntArray  #: (n,) the element holding each centerline point
     weights: FloatArray  #: (n, 4) their barycentric weights
     fractions: FloatArray  #: (n,) arc-length fraction of each centerline point, 0 to 1
+    solver: TangentSolver = field(default_factory=TangentSolver)  #: keeps the order of its Newton matrices
 
     def centerline_motion(self, u: FloatArray) -> FloatArray:
         """The displacement (n, 3) mm of the centerline's points under nodal ``u`` (N, 3) mm (the elements' shapes)."""
@@ -241,5 +243,5 @@ def simulate_section(section: SectionMesh, law: HyperelasticLaw, pressures: Floa
     if pressures.shape != (section.chamber_count,):
         raise ValueError(f"expected {section.chamber_count} pressures, got shape {pressures.shape}")
     prepared = prepare_section(section, law)
-    u, record = solve_pressures(prepared.problem, pressures, settings)
+    u, record = solve_pressures(prepared.problem, pressures, settings, solver=prepared.solver)
     return measure_section(prepared, u, pressures, record)
