@@ -211,9 +211,10 @@ def write_volume_mesh(result: VolumeMeshResult, staging: Staging) -> None:
     """Stage every mesh in .vtu and .msh, every chamber as STL, and the figures."""
     if not result.summary["requested"]:
         return
+    memo: dict[str, str] = {}  # the swept mesh's .msh elements, the same at every q, are formatted once
     for mesh in result.meshes:
         for suffix in VOLUME_FORMATS:
-            data = volume_mesh_bytes(mesh.points, mesh.tets, suffix, mesh.sets)
+            data = volume_mesh_bytes(mesh.points, mesh.tets, suffix, mesh.sets, memo)
             staging.write_bytes(layout.volume_mesh_path(mesh.q, suffix), data)
         if mesh.cavities is not None:
             for name, (points, faces) in mesh.cavities.items():  # only the cavity's own nodes, not every node
