@@ -319,8 +319,9 @@ def holes_from_layout(layout: ChamberLayout, scale_mm: float, rho_min_mm: float,
                       size_mm: float) -> tuple[list[Hole], SweepReference]:
     """Issue 31's chambers and feeds as holes of the reference section, and the rigid core holding them.
 
-    Chamber (section i, chamber j) is ``s{i}_c{j}`` (surfaces ``s{i}_c{j}_wall``, ``_cap``); its feed
-    ``s{i}_c{j}_feed`` belongs to the same cavity and opens at the base (``s{i}_c{j}_feed_inlet``).
+    Chamber j of section i (both counted from 1 at the base, as actuation.csv) is ``s{i}_c{j}`` (surfaces
+    ``s{i}_c{j}_wall``, ``_cap``); its feed ``s{i}_c{j}_feed`` belongs to the same cavity and opens at the base
+    (``s{i}_c{j}_feed_inlet``).
     ``scale_mm`` (R0) is mm per reference unit, ``rho_min_mm`` the thinnest section's radius over the morph,
     ``size_mm`` the element size the circles' nodes follow (:func:`~softdesign.meshing.sweep_layout.circle_nodes`).
     """

@@ -76,7 +76,7 @@ class TetBody:
     tets: IntArray
     chamber: tuple[FloatArray, IntArray] | None
     sets: NamedSets | None = None
-    #: every cavity's closed surface by name (sweep: ``chamber``, or ``s0_c1`` ... with their feeds)
+    #: every cavity's closed surface by name (sweep: ``chamber``, or ``s1_c1`` ... with their feeds)
     cavities: dict[str, tuple[FloatArray, IntArray]] | None = None
 
 
