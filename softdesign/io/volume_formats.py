@@ -52,7 +52,8 @@ class NamedSets:
     tet_data: dict[str, np.ndarray] = field(default_factory=dict)
 
 
-def volume_mesh_bytes(points: np.ndarray, tets: np.ndarray, suffix: str, sets: NamedSets | None = None) -> bytes:
+def volume_mesh_bytes(points: np.ndarray, tets: np.ndarray, suffix: str, sets: NamedSets | None = None,
+                      memo: dict[str, str] | None = None) -> bytes:
     """The file of a tetrahedral mesh, ``suffix`` ``vtu`` or ``msh``, with its named sets (module notes).
 
     Parameters
@@ -60,6 +61,8 @@ def volume_mesh_bytes(points: np.ndarray, tets: np.ndarray, suffix: str, sets: N
     points : (P, 3) float, mm
     tets : (T, 4) int, VTK order
     sets : named surfaces, node sets and per-tetrahedron figures, or None (the tetrahedra alone)
+    memo : a dict the caller keeps between the meshes of one build: ``.msh``'s element text, formatted once per
+        connectivity (:func:`~softdesign.io.volume_text.msh22_ascii`); the bytes are the same with or without
     """
     if suffix not in VOLUME_FORMATS:
         raise ValueError(f"volume mesh format must be one of {', '.join(VOLUME_FORMATS)}, got {suffix!r}")
@@ -74,7 +77,7 @@ def volume_mesh_bytes(points: np.ndarray, tets: np.ndarray, suffix: str, sets: N
         dims = [3] + [2] * len(triangles) + [0] * len(sets.node_sets)
         groups = {name: (tag, dim) for name, (_, _, tag), dim in
                   zip(["body", *names, *sets.node_sets], blocks, dims, strict=True)}
-        return msh22_ascii(points, blocks, groups if len(blocks) > 1 else {})
+        return msh22_ascii(points, blocks, groups if len(blocks) > 1 else {}, memo)
     faces = np.concatenate(triangles) if triangles else np.zeros((0, 3), np.int64)
     cell_data: dict[str, np.ndarray] = {}
     if triangles:

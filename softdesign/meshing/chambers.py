@@ -22,6 +22,7 @@ cavity, subtracted from the body once.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
@@ -123,6 +124,13 @@ def carve_cavities(body: TubeMesh, cavities: Sequence[Cavity], max_rho_kappa: fl
     return Solid(vertices, faces, regions, 2, "actuated", max_rho_kappa)
 
 
+@functools.lru_cache(maxsize=4)
+def _gauss_legendre(nodes: int) -> tuple[FloatArray, FloatArray]:
+    """Gauss-Legendre nodes and weights on [-1, 1], (nodes,) each, made once (numpy's leggauss solves an
+    eigenproblem: 0.15 s of the aorta's three surface meshes with chambers went to remaking them)."""
+    return np.polynomial.legendre.leggauss(nodes)
+
+
 def axis_lengths(curve: FramedSpline, l_start: float, l_end: float, distance: float, angle: float,
                  nodes: int = 64) -> float:
     """Length of the offset curve ``c + distance (cos angle N + sin angle B)`` over [l_start, l_end], mm.
@@ -130,7 +138,7 @@ def axis_lengths(curve: FramedSpline, l_start: float, l_end: float, distance: fl
     ``|d/ds offset| = 1 - distance (k1 cos angle + k2 sin angle)`` in the RMF (the offset's tangent is T);
     Gauss-Legendre on ``nodes`` points per link-free interval (the integrand is smooth there).
     """
-    x, w = np.polynomial.legendre.leggauss(nodes)
+    x, w = _gauss_legendre(nodes)
     l = 0.5 * (l_end - l_start) * (x + 1.0) + l_start
     k = curvature_components(curve, l, curve.frames(l))
     stretch = 1.0 - distance * (k[:, 0] * np.cos(angle) + k[:, 1] * np.sin(angle))

@@ -39,8 +39,11 @@ import numpy as np
 from softdesign.errors import MeshError
 from softdesign.types import FloatArray, IntArray
 
-#: Local size grows by this factor per ring away from a circle.
-GROWTH = 1.25
+#: Local size grows by this factor per ring away from a circle.  1.4 rather than 1.25: the aorta with chambers
+#: (24 circles of 12 and 16 nodes in one section) 2464 -> 2076 triangles, 361k -> 297k tetrahedra, its least
+#: dihedral angle 1.40 -> 1.42 degrees at q = 0 and 1.24 -> 1.38 at q = 1 (the layers' needles, not the
+#: section's), its largest radius-edge ratio 16.7 -> 15.4; the least section angle 20.4 -> 20.3 degrees.
+GROWTH = 1.4
 #: A candidate closer than this fraction of the smaller local size to a kept point is dropped.
 KEEP_FRACTION = 0.7
 #: Fewest nodes on a hole's circle.

@@ -151,6 +151,31 @@ def cut_targets(points: FloatArray, s: FloatArray, outward: FloatArray, plane: C
     return np.asarray(s[:, None] + shift[None, :] * weight[:, None], np.float64)
 
 
+def crease_targets(points: FloatArray, s: FloatArray, outward: FloatArray, plane: CutPlane, name: str,
+                   thickness: float) -> FloatArray:
+    """:func:`cut_targets` for a swept volume mesh, whose layers should keep the end ring: (n, m) arc lengths.
+
+    Where the plane lies past the end ring, the body's material map has a crease at the ring: the generator's
+    surface (which deforms with q) meets its straight continuation (which moves rigidly with the end frame,
+    :func:`along_generators`).  A row of skin quads across the crease averages the two, so here the last ring
+    goes into ``plane`` as in :func:`cut_targets`, the ring before it onto the end ring (arc ``s[-1]``, the
+    crease) wherever that leaves the last row at least ``thickness`` mm thick, else ``thickness`` short of the
+    plane (also where the plane shortens the generator); the ring before that moves with it (the row next to the
+    end ring keeps its length) and the ``ZONE_FACTOR`` x largest move before are re-spaced to follow, as the
+    module notes re-space the end zone.  Needs n >= 3 rings.
+    """
+    ends = cut_targets(points, s, outward, plane, name)[-1]
+    ring = np.minimum(s[-1], ends - thickness)
+    shift = ring - s[-2]
+    zone = ZONE_FACTOR * float(np.max(np.abs(shift)))
+    if s[-3] - zone < MAX_ZONE_FRACTION * s[-1]:
+        raise MeshError(f"{name}: the volume mesh's layer before the end would move {np.max(np.abs(shift)):.3f} mm, "
+                        f"too far for a body {s[-1]:.3f} mm long; set fit.end_cut: normal")
+    # the ring before it moves with it (the row next to the end ring keeps its length), the zone before re-spaced
+    weight = np.clip((s[:-1] - (s[-3] - zone)) / zone, 0.0, 1.0) if zone > 0 else np.zeros(len(s) - 1)
+    return np.asarray(np.vstack([s[:-1, None] + shift[None, :] * weight[:, None], ends[None, :]]), np.float64)
+
+
 def _shifts(f: FloatArray, s: FloatArray, along: float, name: str) -> FloatArray:
     """Per generator, the arc length from the end ring to where its signed distance ``f`` (n, na) is 0."""
     last = f[-1]

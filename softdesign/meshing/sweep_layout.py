@@ -38,10 +38,16 @@ def circle_nodes(diameter_mm: float, size_mm: float, least: int) -> int:
     return max(least, int(np.ceil(np.pi * diameter_mm / size_mm)))
 
 
+def chamber_name(section: int, chamber: int) -> str:
+    """``s1_c1``: the cavity of chamber ``chamber`` of section ``section`` (both 0-based in the layout), counted
+    from 1 at the base as actuation.csv, ``simulate --section`` and every other output count them."""
+    return f"s{section + 1}_c{chamber + 1}"
+
+
 def layout_holes(layout: ChamberLayout, scale_mm: float, size_mm: float) -> list[Hole]:
     """The layout's chambers and feeds as holes of the reference section (``scale_mm`` mm per unit), each
     circle with :func:`circle_nodes` at ``size_mm`` (the volume mesh's element size, mm), before any
-    grading."""
+    grading; named by :func:`chamber_name`."""
 
     def circle(distance: float, angle: float, diameter: float, least: int) -> Circle:
         return Circle((distance * np.cos(angle) / scale_mm, distance * np.sin(angle) / scale_mm),
@@ -49,10 +55,10 @@ def layout_holes(layout: ChamberLayout, scale_mm: float, size_mm: float) -> list
 
     holes = []
     for c in layout.chambers:
-        holes.append(Hole(f"s{c.section}_c{c.index}", circle(c.distance_mm, c.angle, c.diameter_mm,
+        holes.append(Hole(chamber_name(c.section, c.index), circle(c.distance_mm, c.angle, c.diameter_mm,
                                                              MIN_CHAMBER_NODES), (c.l_start, c.l_end)))
     for f in layout.feeds:
-        name = f"s{f.section}_c{f.chamber}"
+        name = chamber_name(f.section, f.chamber)
         holes.append(Hole(f"{name}_feed", circle(f.ring_mm, f.angle, f.diameter_mm, MIN_FEED_NODES),
                           (f.l_start, f.l_end), cavity=name))
     return holes

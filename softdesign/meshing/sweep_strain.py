@@ -9,9 +9,11 @@ wall, are such surfaces): ``G^-T grad t`` with G the map from the parameter
 domain to the body at q = 0.
 
 Where
-    section (the link, 0-based), l, angle (rad, of the reference point about
-    the centerline from N) and depth: 0 at the skin, 1 at the axis of a solid
-    body or at the chamber's wall of a hollow one, of the tetrahedron's centroid.
+    section (the link, counted from 1 at the base as actuation.csv and
+    ``simulate --section`` count it), l, angle (rad, of the reference point
+    about the centerline from N) and depth: 0 at the skin, 1 at the axis of a
+    solid body or at the chamber's wall of a hollow one, of the tetrahedron's
+    centroid.
 Skin
     The in-plane principal stretches at the centre of each skin quad (two
     layers by two angles) from the central differences of its corners at
@@ -37,7 +39,8 @@ from softdesign.types import FloatArray, IntArray
 
 @dataclass(frozen=True)
 class Extreme:
-    """A largest value and where: ``value`` at section, l, angle (rad), depth (0 skin .. 1 axis or chamber)."""
+    """A largest value and where: ``value`` at section (from 1 at the base), l, angle (rad), depth (0 skin .. 1
+    axis or chamber)."""
 
     value: float
     section: int
@@ -68,13 +71,14 @@ def free_directions(mesh: SweptMesh, rest: FloatArray, inverses: FloatArray | No
 
 
 def tet_places(mesh: SweptMesh, ref: SweepReference, link_of) -> tuple[IntArray, FloatArray, FloatArray, FloatArray]:
-    """Section (link), l, angle and depth of every tetrahedron's centroid in the parameter domain."""
+    """Section (link, from 1 at the base), l, angle and depth of every tetrahedron's centroid in the parameter
+    domain (``link_of``: l -> the 0-based link, as the radius field's)."""
     centroid = mesh.reference_points()[mesh.tets].mean(axis=1)
     t = np.linalg.norm(centroid[:, :2], axis=1)
     inner = ref.chamber_radius
     depth = np.clip((1.0 - t) / (1.0 - inner), 0.0, 1.0)
     angle = np.mod(np.arctan2(centroid[:, 1], centroid[:, 0]), 2.0 * np.pi)
-    return np.asarray(link_of(centroid[:, 2]), np.int64), centroid[:, 2], angle, depth
+    return np.asarray(link_of(centroid[:, 2]), np.int64) + 1, centroid[:, 2], angle, depth
 
 
 def extreme_of(values: FloatArray, places: tuple[IntArray, FloatArray, FloatArray, FloatArray]) -> Extreme:

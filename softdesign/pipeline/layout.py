@@ -126,5 +126,5 @@ def chamber_surface_path(q: float) -> str:
 
 
 def cavity_surface_path(q: float, cavity: str) -> str:
-    """``meshes/volume/s0_c1_q_0.000.stl``: one cavity's closed surface (a chamber with its feed) at q."""
+    """``meshes/volume/s1_c1_q_0.000.stl``: one cavity's closed surface (a chamber with its feed) at q."""
     return f"{MESHES_DIR}/volume/{cavity}_{q_label(q)}.stl"

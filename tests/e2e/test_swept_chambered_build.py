@@ -69,8 +69,13 @@ def check_chambered(out: Path, sections: int) -> None:
     boundary named once, each chamber's surface closed with its analytic volume within 1 % (q = 0, straight)."""
     summary = json.loads((out / "volume_mesh" / "summary.json").read_text())
     names = summary["surfaces"]
-    assert {f"s{i}_c{j}_wall" for i in range(sections) for j in range(3)} <= set(names)
-    assert {f"s{i}_c{j}_feed_inlet" for i in range(sections) for j in range(3)} <= set(names)
+    # sections and chambers counted from 1 at the base, as actuation.csv and simulate --section count them
+    assert {f"s{i}_c{j}_wall" for i in range(1, sections + 1) for j in range(1, 4)} <= set(names)
+    assert {f"s{i}_c{j}_feed_inlet" for i in range(1, sections + 1) for j in range(1, 4)} <= set(names)
+    assert not any(n.startswith("s0_") or "_c0_" in n for n in names)
+    places = [w for row in summary["per_q"] for w in row["worst"].values()] + [
+        e for e in summary["morph"].values() if isinstance(e, dict)]
+    assert places and all(1 <= e["section"] <= sections for e in places)
     for row in summary["per_q"]:
         assert row["min_tet_volume_mm3"] > 0 and abs(row["volume_rel_error"]) <= VOLUME_RTOL
     volume = out / "meshes" / "volume"
@@ -86,7 +91,7 @@ def check_chambered(out: Path, sections: int) -> None:
     # the straight q = 0 body's length: its sections' arcs (l is arc length over it)
     body_mm = sum(float(r["arc_length_mm"]) for r in rows if r["chamber"] == "1")
     for chamber in layout["chambers"]:
-        name = f"s{chamber['section'] - 1}_c{chamber['chamber'] - 1}"
+        name = f"s{chamber['section']}_c{chamber['chamber']}"  # the actuation stage's numbers, as they are
         v, f = read_mesh(volume / f"{name}_q_0.000.stl")
         topology = mesh_topology(v, f)
         assert topology.watertight and topology.winding_consistent

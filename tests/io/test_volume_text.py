@@ -75,3 +75,16 @@ def test_vtu_reads_back_exactly_with_its_arrays(tmp_path):
     assert np.isnan(mesh.cell_data_dict["stretch_max"]["triangle"]).all()
     np.testing.assert_array_equal(np.flatnonzero(mesh.point_data["base_nodes"]), [0, 1, 2, 3])
     assert volume_mesh_bytes(points, tets, "vtu", sets) == data
+
+
+def test_msh_element_memo_changes_no_byte_and_keys_on_the_connectivity():
+    points, tets, sets = named_cube()
+    memo: dict[str, str] = {}
+    first = volume_mesh_bytes(points, tets, "msh", sets, memo)
+    assert first == volume_mesh_bytes(points, tets, "msh", sets) and len(memo) == 1
+    moved = points * 2.0  # another q: the same elements, other nodes
+    assert volume_mesh_bytes(moved, tets, "msh", sets, memo) == volume_mesh_bytes(moved, tets, "msh", sets)
+    assert len(memo) == 1
+    flipped = tets[:, [0, 2, 1, 3]]  # another connectivity: formatted anew, not the memo's text
+    assert volume_mesh_bytes(points, flipped, "msh", sets, memo) == volume_mesh_bytes(points, flipped, "msh", sets)
+    assert len(memo) == 2

@@ -15,7 +15,7 @@ import pytest
 
 from softdesign.errors import MeshError
 from softdesign.meshing.checks import check_solid
-from softdesign.meshing.end_cut import cut_ends, cut_planes, end_cuts_from_record
+from softdesign.meshing.end_cut import CutPlane, crease_targets, cut_ends, cut_planes, cut_targets, end_cuts_from_record
 from softdesign.meshing.solids import build_solid
 from softdesign.meshing.tessellate import Region, TubeSections, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec, integrate_body
@@ -131,3 +131,28 @@ def test_a_plane_the_body_cannot_reach_is_refused_naming_the_end():
     sections = Body(straight_line(8.0), 3.0).sections(17, 48)
     with pytest.raises(MeshError, match="tip end's cut plane .* too far for a body 8.000 mm long"):
         build_solid(sections, BodySpec(end_cuts=(None, tilted(30.0, 0.0, 1.0))))
+
+
+def test_the_volume_meshs_layer_before_the_end_lies_on_the_end_ring_where_the_plane_passes_it():
+    """crease_targets on a straight tube's generators (rings every 0.25 mm, a plane through the end's centre
+    tilted 8 deg): the last ring in the plane as cut_targets puts it; the ring before it exactly on the end
+    ring (the crease) where the plane lies at least ``thickness`` past it, ``thickness`` short of the plane
+    elsewhere; every generator still increasing; the rings far from the end where they were."""
+    r, m, thickness = 3.0, 32, 0.1
+    s = np.arange(0.0, 20.0 + 1e-9, 0.25)
+    angles = 2.0 * np.pi * np.arange(m) / m
+    ring = np.column_stack([r * np.cos(angles), r * np.sin(angles), np.zeros(m)])
+    points = ring[None, :, :] + s[:, None, None] * np.array([0.0, 0.0, 1.0])
+    normal = np.array(tilted(8.0, 0.7, 1.0)[:3])
+    plane = CutPlane(np.array([0.0, 0.0, s[-1]]), normal / np.linalg.norm(normal))
+    outward = np.array([0.0, 0.0, 1.0])
+    plain = cut_targets(points, s, outward, plane, "tip")
+    got = crease_targets(points, s, outward, plane, "tip", thickness)
+    np.testing.assert_array_equal(got[-1], plain[-1])
+    past = plain[-1] - s[-1]  # how far the plane lies past the end ring along each generator
+    assert (past >= thickness).any() and (past < thickness).any()
+    np.testing.assert_array_equal(got[-2][past >= thickness], s[-1])
+    np.testing.assert_allclose(got[-2][past < thickness], plain[-1][past < thickness] - thickness, rtol=0, atol=1e-12)
+    assert np.all(np.diff(got, axis=0) > 0) and np.all(got[-1] - got[-2] >= thickness - 1e-12)
+    far = s < s[-1] - 2.0
+    np.testing.assert_array_equal(got[far], np.repeat(s[far, None], m, axis=1))

@@ -142,9 +142,11 @@ def test_chambers_and_feeds_of_a_layout_are_exact_circles_closed_cavities(bent):
     rest = place_mesh(mesh, ref, shape.curve_at(0.0), field, 0.0, spec, NA)
     moved = place_mesh(mesh, ref, shape.curve_at(1.0), field, 1.0, spec, NA)
     assert _volumes(rest, mesh.tets).min() > 0 and _volumes(moved, mesh.tets).min() > 0
-    assert "s1_c2_wall" in mesh.groups and "s1_c2_feed_inlet" in mesh.lids
+    # counted from 1 at the base, as actuation.csv: section 2's (0-based 1) third chamber (0-based 2)
+    assert "s2_c3_wall" in mesh.groups and "s2_c3_feed_inlet" in mesh.lids
+    assert not any(name.startswith(("s0_", "s1_c0", "s2_c0")) for name in [*mesh.groups, *mesh.lids])
     for chamber in layout.chambers:
-        name = f"s{chamber.section}_c{chamber.index}"
+        name = f"s{chamber.section + 1}_c{chamber.index + 1}"
         topology = mesh_topology(rest, mesh.cavity_surface(name))
         assert topology.watertight and topology.winding_consistent
         feed = next(f for f in layout.feeds if (f.section, f.chamber) == (chamber.section, chamber.index))

@@ -70,7 +70,7 @@ def test_many_sections_mesh_with_every_cavity_closed(sections, diameter, feed):
     # the solid's volume: the rest body's cylinder less every cavity (a straight body at q = 0)
     cavities = 0.0
     for chamber in layout.chambers:
-        name = f"s{chamber.section}_c{chamber.index}"
+        name = f"s{chamber.section + 1}_c{chamber.index + 1}"
         assert f"{name}_wall" in mesh.groups and f"{name}_feed_inlet" in mesh.lids
         topology = mesh_topology(rest, mesh.cavity_surface(name))
         assert topology.watertight and topology.winding_consistent

@@ -11,6 +11,7 @@ from softdesign.meshing.tet_quality import (
     boundary_faces,
     dihedral_angles,
     radius_edge_ratios,
+    tet_measures,
     tet_quality,
     tet_volumes,
 )
@@ -102,3 +103,26 @@ def test_bad_shapes_are_refused():
         tet_volumes(REGULAR, np.array([[0, 1, 2, 4]]))
     with pytest.raises(ValueError, match="at least one"):
         tet_quality(REGULAR, np.zeros((0, 4), np.int64))
+
+
+def test_the_one_pass_measures_are_the_separate_figures():
+    """tet_measures (the swept mesher's figures) against tet_volumes, dihedral_angles and radius_edge_ratios on
+    random tetrahedra of either orientation, a regular one, slivers and needles: the same to round-off; a flat
+    one gives an infinite radius-edge ratio, as radius_edge_ratios does."""
+    rng = np.random.default_rng(7)
+    points = np.concatenate([rng.normal(size=(400, 3)), REGULAR, [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]],
+                             [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 1e-6]], [[0, 0, 0], [1e-3, 0, 0], [0, 1e-3, 0],
+                                                                               [0, 0, 50.0]]])
+    tets = np.arange(len(points)).reshape(-1, 4)
+    volumes, least, largest, ratio = tet_measures(points, tets)
+    with np.errstate(invalid="ignore"):  # the flat one's normals are 0 there
+        angles = dihedral_angles(points, tets)
+    np.testing.assert_allclose(volumes, tet_volumes(points, tets), rtol=1e-12, atol=1e-15)
+    finite = np.abs(volumes) > 1e-12
+    # arccos near 1 amplifies the cosine's round-off to about 1e-16 / angle: 1e-10 rad for the 1e-6 rad sliver
+    np.testing.assert_allclose(least[finite], angles.min(axis=1)[finite], rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(largest[finite], angles.max(axis=1)[finite], rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(ratio[finite], radius_edge_ratios(points, tets)[finite], rtol=1e-9)
+    assert (volumes < 0).any() and (volumes > 0).any()
+    assert np.isinf(ratio[~finite]).all() and np.isinf(radius_edge_ratios(points, tets)[~finite]).all()
+    np.testing.assert_allclose(least[100], np.arccos(1 / 3), rtol=0, atol=EXACT)  # the regular one

@@ -61,7 +61,8 @@ from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 from softdesign.types import FloatArray, IntArray
 
-VERSION = 4  # 3: export.frame (the meshes in the patient's or the base frame); 4: VTK's .vtu, no times in the summary
+VERSION = 5  # 3: export.frame (the meshes in the patient's or the base frame); 4: VTK's .vtu, no times in the summary;
+# 5: the swept section's GROWTH 1.4, sections and chambers named from 1, a solid body's end layers at its crease
 #: The function the child process runs: (vertices, faces, TetSettings) -> (points, tets).  A module attribute,
 #: so that a test can put a crashing or hanging stand-in in its place.
 MESHER = tetrahedralize
@@ -76,7 +77,7 @@ class TetBody:
     tets: IntArray
     chamber: tuple[FloatArray, IntArray] | None
     sets: NamedSets | None = None
-    #: every cavity's closed surface by name (sweep: ``chamber``, or ``s0_c1`` ... with their feeds)
+    #: every cavity's closed surface by name (sweep: ``chamber``, or ``s1_c1`` ... with their feeds)
     cavities: dict[str, tuple[FloatArray, IntArray]] | None = None
 
 
@@ -211,9 +212,10 @@ def write_volume_mesh(result: VolumeMeshResult, staging: Staging) -> None:
     """Stage every mesh in .vtu and .msh, every chamber as STL, and the figures."""
     if not result.summary["requested"]:
         return
+    memo: dict[str, str] = {}  # the swept mesh's .msh elements, the same at every q, are formatted once
     for mesh in result.meshes:
         for suffix in VOLUME_FORMATS:
-            data = volume_mesh_bytes(mesh.points, mesh.tets, suffix, mesh.sets)
+            data = volume_mesh_bytes(mesh.points, mesh.tets, suffix, mesh.sets, memo)
             staging.write_bytes(layout.volume_mesh_path(mesh.q, suffix), data)
         if mesh.cavities is not None:
             for name, (points, faces) in mesh.cavities.items():  # only the cavity's own nodes, not every node
