@@ -1,10 +1,12 @@
 """The bounds of ``softdesign simulate``: pressures, load steps, iterations, mesh size, time and memory of a solve.
 
-A section's solve factors a sparse matrix (SuperLU) once per Newton
-iteration; its fill, and so its time and memory, grows faster than the node
-count (3D).  Measured (CPU time, quadratic tetrahedra, on the loaded 2-core
-machine): 3,270 nodes 0.6 s per factorization, 7,392 nodes 9.7 s (43 M
-entries in the factors, about 0.5 GB), 10,840 nodes 19.6 s.
+A section's solve factors a sparse matrix (SuperLU, in METIS's nested-dissection
+order) once per Newton iteration; its fill, and so its time and memory, grows
+faster than the node count (3D).  Measured (CPU time, quadratic tetrahedra, on
+the 2-core machine): the sample case's base section, 6,428 nodes, 1.4 s per
+factorization and 14.7 M entries in the factors (about 0.2 GB); before the
+METIS order, SuperLU's own orders took 0.6 s at 3,270 nodes, 7.0 s at 6,428,
+9.7 s at 7,392 (43 M entries) and 19.6 s at 10,840.
 MAX_SECTION_NODES (nodes of the quadratic mesh: corners and edge midpoints)
 keeps one solve within SIMULATE_MEMORY_BYTES (the child's address space) and
 minutes, and is checked on the mesh before the solve starts.

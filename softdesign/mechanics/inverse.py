@@ -104,14 +104,16 @@ class _Evaluations:
         self.target, self.newton, self.tolerance_mm = target, newton, tolerance_mm
         self.states: dict[bytes, tuple[FloatArray, SectionResult]] = {}
         self.last: tuple[FloatArray, FloatArray] | None = None
+        self.rates: dict[bytes, FloatArray] = {}  # du/dp (k, V, 3) where the Jacobian was taken
         self.solves = 0
         self.failed: list[str] = []
 
     def state(self, p: FloatArray) -> tuple[FloatArray, SectionResult]:
         key = np.asarray(p, float).tobytes()
         if key not in self.states:
+            rate = None if self.last is None else self.rates.get(self.last[1].tobytes())
             u, record = solve_pressures(self.prepared.problem, p, self.newton, start=self.last,
-                                        solver=self.prepared.solver)
+                                        solver=self.prepared.solver, start_rate=rate)
             self.solves += 1
             self.last = (u, np.array(p, float))
             self.states[key] = (u, measure_section(self.prepared, u, p, record))
@@ -138,6 +140,7 @@ class _Evaluations:
         u, result = self.state(p)
         prepared = self.prepared
         du = pressure_sensitivity(prepared.problem, u, p, prepared.solver)
+        self.rates[np.asarray(p, float).tobytes()] = du
         d_centerline = np.stack([prepared.centerline_motion(d) for d in du])
         jacobian = _arc_jacobian(result.centerline, prepared.fractions, d_centerline)
         return np.diag([0.5 * self.target[2], 0.5 * self.target[2], 1.0]) @ jacobian
