@@ -274,7 +274,7 @@ def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: N
                     f"last residual {last}; lower the pressures (a chamber that balloons past its largest "
                     "pressure has no equilibrium beyond it) or take more load steps")
             record.cutbacks += 1
-            dt /= 2.0
+            dt = (target - t) / 2.0  # half the step tried (dt may have run past the end)
             continue
         previous = (t, u)
         u, t, step = new_u, target, step + 1
