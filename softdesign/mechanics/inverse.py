@@ -146,6 +146,17 @@ class _Evaluations:
         return np.diag([0.5 * self.target[2], 0.5 * self.target[2], 1.0]) @ jacobian
 
 
+def _reach(runs: _Evaluations, kappa: float, converged: bool) -> str:
+    """When the search fell short: the largest curvature any converged solve reached, at which pressures, and how
+    many trials found no equilibrium (past a chamber's ballooning limit there is none to solve)."""
+    if converged or not runs.states:
+        return ""
+    reached = max(runs.states.values(), key=lambda state: state[1].kappa)[1]
+    text = (f"; the largest bend reached: curvature {reached.kappa:.4g} 1/mm (the target's {kappa:.4g}) at "
+            f"{', '.join(f'{p:.1f}' for p in reached.pressures_kpa)} kPa")
+    return text + (f"; {len(runs.failed)} trials found no equilibrium" if runs.failed else "")
+
+
 def find_pressures(section: SectionMesh, law: HyperelasticLaw, target: tuple[float, float, float],
                    settings: InverseSettings, newton: NewtonSettings) -> InverseResult:
     """The pressures (k,) kPa whose section best matches the arc ``target`` = (kappa 1/mm, phi rad, L mm).
@@ -172,5 +183,5 @@ def find_pressures(section: SectionMesh, law: HyperelasticLaw, target: tuple[flo
     conditioning = np.linalg.svd(runs.jacobian(p), compute_uv=False)
     failed = f"; {len(runs.failed)} trial solves did not converge (a step back each)" if runs.failed else ""
     why = (f"{message} ({runs.solves} forward solves{failed}; the weighted Jacobian's singular values "
-           f"{', '.join(f'{v:.3g}' for v in conditioning)} mm/kPa)")
+           f"{', '.join(f'{v:.3g}' for v in conditioning)} mm/kPa){_reach(runs, target[0], converged)}")
     return InverseResult(p, result, error, runs.solves, converged, why)

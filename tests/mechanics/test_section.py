@@ -4,6 +4,7 @@ the curvature's convergence under refinement (quadratic tetrahedra, :mod:`softde
 from __future__ import annotations
 
 import functools
+import re
 
 import numpy as np
 import pytest
@@ -104,6 +105,10 @@ def test_an_unreachable_arc_is_reported_not_converged() -> None:
     assert np.linalg.norm(found.error_mm) > 1.0
     assert "did not converge" in found.stopped_because
     assert found.section.record.load_factors[-1] == 1.0  # the pressures returned are a converged equilibrium
+    reached = re.search(r"the largest bend reached: curvature ([0-9.e+-]+) 1/mm \(the target's 0\.05\)",
+                        found.stopped_because)
+    assert reached is not None, found.stopped_because
+    assert found.section.kappa <= float(reached.group(1)) * (1 + 1e-3) < 0.05
 
 
 #: Element sizes of the refinement study, mm (the helper's three-fold lattice; 2 mm is the default above).
