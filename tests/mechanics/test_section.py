@@ -4,6 +4,7 @@ the curvature's convergence under refinement (quadratic tetrahedra, :mod:`softde
 from __future__ import annotations
 
 import functools
+import os
 
 import numpy as np
 import pytest
@@ -12,7 +13,9 @@ from softdesign.errors import MeshError
 from softdesign.mechanics.inverse import InverseSettings, find_pressures
 from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.newton import NewtonSettings
+from softdesign.mechanics.refine import refine_section
 from softdesign.mechanics.section import SectionMesh, SectionResult, check_section, simulate_section
+from softdesign.types import FloatArray
 from tests.helpers.fe_meshes import three_chamber_section
 
 #: Ecoflex-like neo-Hookean: mu 40 kPa, kappa / mu = 1000.
@@ -106,26 +109,66 @@ def test_an_unreachable_arc_is_reported_not_converged() -> None:
     assert found.section.record.load_factors[-1] == 1.0  # the pressures returned are a converged equilibrium
 
 
-#: Element sizes of the refinement study, mm (the helper's three-fold lattice; 2 mm is the default above).
-REFINEMENT_MM = (2.0, 1.5, 1.25)
-#: A small pressure: one load step each, the curvature still well above the solver's tolerance.
-REFINEMENT_KPA = 5.0
-#: Largest spread of the curvature over the three meshes, relative (linear tetrahedra: 48 % at 30 kPa).
-CURVATURE_SPREAD = 0.08
+#: The pressure of the refinement studies: small, so one load step each, the curvature well above the solver's
+#: tolerance.
+STUDY_KPA = 5.0
+#: The cheap study (in the suite): square chambers (4 nodes a hole, turned a quarter of their spacing so Delaunay
+#: has no ties), 4 mm across, one 17 mm layer along the chambers: 342 tets, 664 / 4,468 / 32,452 quadratic
+#: nodes at h, h/2, h/4, solved in 0.3, 5 and 192 s (2 cores).
+CHEAP_STUDY = {"size": 4.0, "axial_size": 17.0, "ring_turn": 0.25, "ring_count": 4}
+#: The full study (opt-in: SOFTDESIGN_FULL_STUDY=1): octagonal chambers, 4 mm across, 8.5 mm along: 648 tets,
+#: 1,224 / 8,372 / 61,188 quadratic nodes, solved in 0.6, 14 and 557 s.
+FULL_STUDY = {"size": 4.0, "axial_size": 8.5, "ring_turn": 0.25}
+#: The observed order's band in the full study.  The chambers' cap edges are re-entrant (270 degrees in the
+#: material: the displacement goes as r^(2/3) there) and so are the octagons' corners (225 degrees, r^(4/5)); the
+#: energy error then falls as h^(2/3) whatever the element's degree, and a smooth functional of the displacement
+#: (the centerline is far from those edges) at about twice that, 4/3 (duality), against 3 for quadratic elements
+#: on a smooth problem.  The band runs from the energy rate (slower would not be the discretisation converging)
+#: to the smooth L2 rate (faster would be a cancellation, not convergence).  Measured: 1.12.
+ORDER_BAND = (2.0 / 3.0, 3.0)
+
+
+def _study(coarse: SectionMesh) -> tuple[FloatArray, FloatArray]:
+    """Curvature (3,) 1/mm and the bending direction's error from the side opposite chamber 0 (3,) rad,
+    at the coarse section and its one and two red refinements (:mod:`softdesign.mechanics.refine`)."""
+    results = [simulate_section(coarse if level == 0 else refine_section(coarse, level), LAW,
+                                np.array([STUDY_KPA, 0.0, 0.0]), NewtonSettings(load_steps=1)) for level in range(3)]
+    opposite = coarse.chamber_angles[0] + np.pi
+    return np.array([r.kappa for r in results]), np.array([_angle_between(r.phi, opposite) for r in results])
+
+
+def _observed_order(kappas: FloatArray) -> tuple[float, float]:
+    """Observed order p = log2((k_h - k_h/2) / (k_h/2 - k_h/4)) and the Richardson extrapolation, 1/mm."""
+    first, second = np.diff(kappas)
+    order = float(np.log2(first / second))
+    return order, float(kappas[2] + second / (2.0**order - 1.0))
 
 
 @pytest.mark.slow
-def test_curvature_stays_within_8_percent_under_refinement() -> None:
-    # measured (1/mm) at 5 kPa: 1.7613e-4, 1.7550e-4, 1.8701e-4 at 2, 1.5, 1.25 mm and 1.9879e-4 at 1 mm (14 k
-    # nodes, 2.5 min: not run here); the direction 1.35, 0.52, 0.03 and 0.09 deg off.  The lattices are not nested
-    # (each size its own jittered Delaunay); from 1.5 to 1 mm the changes are +6.6 % and +6.3 % for equal steps in
-    # h: about first order, not yet asymptotic (the note of issue 33).  Linear tetrahedra spread 48 % at 30 kPa.
-    results = [simulate_section(three_chamber_section(size=size, **SHAPE), LAW,
-                                np.array([REFINEMENT_KPA, 0.0, 0.0]), NewtonSettings(load_steps=1))
-               for size in REFINEMENT_MM]
-    kappas = np.array([r.kappa for r in results])
-    assert np.ptp(kappas) < CURVATURE_SPREAD * kappas[-1]
-    chamber = _section().chamber_angles[0]
-    errors = [_angle_between(r.phi, chamber + np.pi) for r in results]
-    assert errors[0] > errors[1] > errors[2]  # the direction converges
-    assert errors[-1] < np.deg2rad(0.5)
+def test_curvature_converges_under_nested_refinement() -> None:
+    # nested meshes on one faceted geometry, so the changes are the discretisation error alone.  Measured
+    # (1/mm): 1.11582e-4, 1.06485e-4, 1.02168e-4; the changes -5.10e-6 then -4.32e-6: p = 0.24, Richardson
+    # 0.78e-4 (not to be trusted at that order).  This coarse start (one 17 mm layer, square chambers) is not in
+    # the asymptotic range yet, so no order band is asserted here (the full study below asserts one): only
+    # that the curvature converges monotonically, and which way it bends (the turned squares are not mirror
+    # symmetric about the chamber's plane, so the limit need not be exactly opposite: 2.79, 0.20, 1.02 deg off).
+    kappas, phi_errors = _study(three_chamber_section(**CHEAP_STUDY, **SHAPE))
+    first, second = np.diff(kappas)
+    assert first * second > 0 and abs(second) < abs(first)
+    assert np.all(phi_errors[1:] < PHI_TOL_RAD)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(os.environ.get("SOFTDESIGN_FULL_STUDY") != "1",
+                    reason="about 10 minutes on 2 cores; set SOFTDESIGN_FULL_STUDY=1")
+def test_curvature_converges_at_the_expected_order_on_the_full_study() -> None:
+    # measured (1/mm): 1.58751e-4, 1.63366e-4, 1.65492e-4; changes +4.62e-6 then +2.13e-6: p = 1.12 (theory 4/3,
+    # see ORDER_BAND), Richardson 1.6731e-4, the finest 1.1 % below it; the direction 2.22, 0.17, 0.03 deg off.
+    kappas, phi_errors = _study(three_chamber_section(**FULL_STUDY, **SHAPE))
+    first, second = np.diff(kappas)
+    assert first * second > 0 and abs(second) < abs(first)
+    order, extrapolated = _observed_order(kappas)
+    assert ORDER_BAND[0] < order < ORDER_BAND[1]
+    assert abs(kappas[2] - extrapolated) < abs(kappas[2] - kappas[1])
+    assert phi_errors[0] > phi_errors[1] > phi_errors[2]  # the direction converges to the side opposite
+    assert phi_errors[2] < np.deg2rad(0.5)
