@@ -118,6 +118,7 @@ def refine_section(section: SectionMesh, levels: int = 1) -> SectionMesh:
 
 
 def _refine_once(section: SectionMesh) -> SectionMesh:
+    """One red refinement of ``section`` and its named sets."""
     V = len(section.points)
     points, tets, edges = refine_tets(np.asarray(section.points, float), np.asarray(section.tets, np.int64))
     base = np.concatenate([section.base, section.base[edges[:, 0]] & section.base[edges[:, 1]]])
