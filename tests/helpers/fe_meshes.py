@@ -53,8 +53,8 @@ def quarter_tube(inner: float, outer: float, height: float, counts: tuple[int, i
     return points, oriented(points, grid_tets(counts))
 
 
-def symmetric_disc_with_holes(radius: float, distance: float, hole_radius: float, first_angle: float, size: float
-                              ) -> tuple[FloatArray, IntArray, IntArray]:
+def symmetric_disc_with_holes(radius: float, distance: float, hole_radius: float, first_angle: float, size: float,
+                              ring_turn: float = 0.0, ring_count: int = 0) -> tuple[FloatArray, IntArray, IntArray]:
     """A disc triangulated with three-fold symmetry, three holes at ``first_angle + 0, 120, 240`` rad.
 
     One 120-degree sector's nodes (outer circle, its hole's circle and centre,
@@ -63,16 +63,18 @@ def symmetric_disc_with_holes(radius: float, distance: float, hole_radius: float
     node of sector s, so any order of nodes by index is the same in every
     sector.  The Delaunay triangulation of this point set is checked to map onto
     itself under the rotation.  Returns points (P, 2) mm, triangles (T, 3)
-    counter-clockwise, and each triangle's hole (T,), -1 for material.
+    counter-clockwise, and each triangle's hole (T,), -1 for material.  ``ring_turn`` turns each hole's
+    nodes by that fraction of their spacing: off the sector's mirror line, so that a coarse lattice (few
+    jittered nodes between the circles) has no four co-circular nodes for Delaunay to split either way.
+    ``ring_count`` nodes on each hole (0: by ``size``, at least 8).
     """
     from scipy.spatial import Delaunay
 
     hole = distance * np.array([np.cos(first_angle), np.sin(first_angle)])
     count = 3 * max(4, int(np.ceil(2 * np.pi * radius / size / 3)))
     outer = radius * _unit(first_angle - np.pi / 3 + (np.arange(count // 3) + 0.5) * 2 * np.pi / count)
-    ring = hole + hole_radius * _unit(first_angle + 2 * np.pi * np.arange(max(8, int(np.ceil(2 * np.pi * hole_radius
-                                                                                                / size)))) / max(
-        8, int(np.ceil(2 * np.pi * hole_radius / size))))
+    ring_count = ring_count or max(8, int(np.ceil(2 * np.pi * hole_radius / size)))
+    ring = hole + hole_radius * _unit(first_angle + 2 * np.pi * (np.arange(ring_count) + ring_turn) / ring_count)
     span = np.arange(-int(radius / size) - 2, int(radius / size) + 3)
     i, j = (g.ravel() for g in np.meshgrid(span, span, indexing="ij"))
     lattice = size * np.stack([i + 0.5 * j, j * np.sqrt(3) / 2], axis=1)
@@ -144,18 +146,23 @@ def extrude(points2: FloatArray, triangles: IntArray, z: FloatArray, alternate: 
 
 
 def three_chamber_section(radius: float, distance: float, chamber_diameter: float, length: float,
-                          end_wall: float, size: float, first_angle: float = np.pi / 2) -> SectionMesh:
+                          end_wall: float, size: float, first_angle: float = np.pi / 2,
+                          axial_size: float | None = None, ring_turn: float = 0.0, ring_count: int = 0
+                          ) -> SectionMesh:
     """A straight section (cylinder along +z) with closed cylindrical chambers, as a SectionMesh.
 
     The chambers' axes are at ``distance`` mm from the centerline at ``first_angle`` + 0, 120, 240 degrees;
     each runs from ``end_wall`` to ``length - end_wall``.  ``size`` is the target
-    edge, mm (cross-section and levels).  For the tests only: the pipeline's
-    sections come from the parametric volume mesher.
+    edge, mm (cross-section, and levels unless ``axial_size`` is given); ``ring_turn`` and ``ring_count`` as in
+    :func:`symmetric_disc_with_holes`.  For the tests only: the pipeline's sections come from the parametric
+    volume mesher.
     """
     angles = first_angle + np.array([0.0, 2 * np.pi / 3, 4 * np.pi / 3])
-    p2, tri, labels = symmetric_disc_with_holes(radius, distance, chamber_diameter / 2, first_angle, size)
+    p2, tri, labels = symmetric_disc_with_holes(radius, distance, chamber_diameter / 2, first_angle, size, ring_turn,
+                                                ring_count)
     stops = [0.0, end_wall, length - end_wall, length]
-    runs = [np.linspace(a, b, max(2, round((b - a) / size) + 1)) for a, b in zip(stops[:-1], stops[1:], strict=True)]
+    step = size if axial_size is None else axial_size
+    runs = [np.linspace(a, b, max(2, round((b - a) / step) + 1)) for a, b in zip(stops[:-1], stops[1:], strict=True)]
     z = np.unique(np.concatenate(runs))
     points, tets = extrude(p2, tri, z)
     level_mid = 0.5 * (z[:-1] + z[1:])
