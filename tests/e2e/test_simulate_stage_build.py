@@ -3,7 +3,7 @@ estimates, a forward solve at those pressures gives back the arc error the table
 report draws it, and without it actuation.csv keeps its columns and rows.
 
 Kept small so that it runs in seconds: the demo's first section only, q = 1 only, a coarse mesh (4 mm, layers
-10 mm, 8 nodes around: 546 corner nodes) and one search evaluation (``max_solves: 1``: the pressures are the
+10 mm, 8 nodes around: 450 corner nodes) and one search evaluation (``max_solves: 1``: the pressures are the
 search's start, 10 % of ``max_pressure_kpa`` each).  It checks the plumbing and the honesty of the reported error,
 not how close the inverse gets (tests/mechanics and issue 33's note do that).
 """
@@ -11,6 +11,7 @@ not how close the inverse gets (tests/mechanics and issue 33's note do that).
 from __future__ import annotations
 
 import csv
+import json
 import math
 from pathlib import Path
 
@@ -66,10 +67,12 @@ def test_the_pressures_are_in_actuation_csv_labelled_as_model_estimates(built: t
     assert tuple(header) == COLUMNS + ESTIMATE_COLUMNS
     solved = [r for r in table if float(r["q"]) == 1.0 and r["section"] == "1"]
     assert [r["chamber"] for r in solved] == ["1", "2", "3"]
+    mesh = json.loads((build_dir / "simulate" / "summary.json").read_text())["solves"][0]["mesh"]
+    assert mesh["size_mm"] == 4 and mesh["nodes"] > 0
     for r in solved:
         assert float(r["pressure_kpa"]) == pytest.approx(10.0)  # one evaluation: the start, 10 % of 100 kPa
         assert "model estimate" in r["pressure_source"] and "ecoflex-00-30" in r["pressure_source"]
-        assert "546 nodes" in r["pressure_source"] and "size 4 mm" in r["pressure_source"]
+        assert f"section mesh {mesh['nodes']} nodes {mesh['tets']} tets, size 4 mm" in r["pressure_source"]
     others = [r for r in table if r not in solved]
     assert others and all(r[c] == "" for r in others for c in ESTIMATE_COLUMNS)
 
