@@ -35,7 +35,7 @@ from softdesign.config.actuation import Actuation
 from softdesign.config.design import Design, pcc_blend_problems
 from softdesign.config.material import CustomMaterial
 from softdesign.config.simulate import Simulate
-from softdesign.config.types import FiniteFloat, Integer
+from softdesign.config.types import FiniteFloat, Integer, q_in_range
 from softdesign.errors import ConfigError
 from softdesign.io.case_yaml import parse_case_yaml, read_case_text
 from softdesign.io.format_names import MESH_FORMATS, q_label
@@ -302,9 +302,7 @@ class VolumeMesh(_Section):
     @field_validator("q")
     @classmethod
     def _q_in_range(cls, values: list[float]) -> list[float]:
-        bad = [v for v in values if not 0.0 <= v <= 1.0]
-        if bad:
-            raise ValueError(f"q values must lie in [0, 1], got {bad}")
+        q_in_range(values)
         labels = [q_label(v) for v in values]
         if len(set(labels)) != len(labels):
             raise ValueError(f"give each q once, at least 0.001 apart (files are named with three decimals), "

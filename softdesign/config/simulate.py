@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-from softdesign.config.types import FiniteFloat, Integer
+from softdesign.config.types import FiniteFloat, Integer, q_in_range
 from softdesign.limits import MAX_LINKS
 from softdesign.limits.simulate import (
     MAX_ANGULAR_COUNT,
@@ -60,9 +60,7 @@ class Simulate(BaseModel):
     @field_validator("q")
     @classmethod
     def _q_in_range(cls, values: list[float]) -> list[float]:
-        bad = [v for v in values if not 0.0 <= v <= 1.0]
-        if bad:
-            raise ValueError(f"q values must lie in [0, 1], got {bad}")
+        q_in_range(values)
         ordered = sorted(values)
         if any(b - a < Q_RESOLUTION for a, b in zip(ordered, ordered[1:], strict=False)):
             raise ValueError(f"give each q once, at least 0.001 apart (actuation.csv's rows), got {values}")

@@ -1,4 +1,4 @@
-"""The number types of the case file's schema: finite floats and true integers.
+"""The number types of the case file's schema: finite floats and true integers (and q lists' range).
 
 Every numeric key of the case file is one of these two, so ``softdesign
 validate`` refuses what would otherwise reach the numeric core: NaN, inf and
@@ -26,3 +26,11 @@ def _not_a_bool(value: Any) -> Any:
 FiniteFloat = Annotated[float, BeforeValidator(_not_a_bool), AllowInfNan(False)]
 #: An integer written as one: bools, floats and strings are refused.
 Integer = Annotated[int, Strict()]
+
+
+def q_in_range(values: list[float]) -> list[float]:
+    """``values`` when each lies in [0, 1] (ValueError naming those that do not), for a list of q values."""
+    bad = [v for v in values if not 0.0 <= v <= 1.0]
+    if bad:
+        raise ValueError(f"q values must lie in [0, 1], got {bad}")
+    return values
