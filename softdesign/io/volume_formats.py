@@ -11,9 +11,18 @@ is VTK's, which is Gmsh's for linear tetrahedra.
 Named sets (:class:`NamedSets`, the swept mesher's): each named surface's
 triangles follow the tetrahedra as cells of their own; in ``.vtu`` the cell
 array ``surface`` holds each cell's surface number (-1 for a tetrahedron,
-numbers in the order of ``NamedSets.surfaces``, their names in the summary),
-a point array per node set is 1 on its nodes, and
-per-tetrahedron figures are cell arrays (NaN on the triangles); in ``.msh``
+numbers in the order of ``NamedSets.surfaces``), a point array per node set is
+1 on its nodes, and per-tetrahedron figures are cell arrays (NaN on the
+triangles).  The ``.vtu`` names its codes in a field-data table
+(:func:`surface_name_table`): one integer array per name, ``[code, dimension]``
+(``body``: ``[-1, 3]``, each surface ``[k, 2]``).  That is the form meshio gives
+a Gmsh file's physical names (``mesh.field_data``), so a meshio user reads the
+names of either file the same way, and ParaView lists field data under the
+file's Information and in the spreadsheet view.  A table and not one 0/1 array
+per set: the chambered demo has 39 surfaces, and an array each would add 39
+numbers per cell to an ASCII file; and not VTK's string array (as the ``.vtp``
+export's ``RegionNames``), which meshio's ``.vtu`` reader refuses
+(``Illegal data type 'String'``), losing the whole file.  In ``.msh``
 the body is physical group 1 (``body``, dimension 3), each surface a
 physical group of dimension 2 numbered from 2, each node set a group of
 dimension 0 (point elements), all named in ``$PhysicalNames``.  The writing is
@@ -83,6 +92,7 @@ def volume_mesh_bytes(points: np.ndarray, tets: np.ndarray, suffix: str, sets: N
     if triangles:
         ids = np.concatenate([np.full(len(t), k, np.int64) for k, t in enumerate(triangles)])
         cell_data["surface"] = np.concatenate([np.full(len(tets), -1, np.int64), ids])
+    field_data = surface_name_table(names) if triangles else {}
     for name, values in sets.tet_data.items():
         cell_data[name] = np.concatenate([np.asarray(values, np.float64), np.full(len(faces), np.nan)])
     point_data = {}
@@ -91,7 +101,17 @@ def volume_mesh_bytes(points: np.ndarray, tets: np.ndarray, suffix: str, sets: N
         flag = np.zeros(len(points), np.uint8)
         flag[np.asarray(nodes, np.int64).ravel()] = 1
         point_data[name] = flag
-    return vtu_ascii(points, tets, faces, cell_data, point_data)
+    return vtu_ascii(points, tets, faces, cell_data, point_data, field_data)
+
+
+def surface_name_table(names: list[str]) -> dict[str, np.ndarray]:
+    """The ``.vtu``'s field data naming its ``surface`` codes: name -> ``[code, dimension]`` (int64, (2,)).
+
+    ``body`` is the tetrahedra's -1 (dimension 3); surface k (in ``NamedSets.surfaces`` order) is k, dimension 2.
+    """
+    table = {"body": np.array([-1, 3], np.int64)}
+    table.update({name: np.array([k, 2], np.int64) for k, name in enumerate(names)})
+    return table
 
 
 def read_volume_mesh(path: str | Path) -> tuple[np.ndarray, np.ndarray]:

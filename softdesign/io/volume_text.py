@@ -89,7 +89,7 @@ def _elements(blocks: Blocks) -> str:
 
 
 def vtu_ascii(points: np.ndarray, tets: np.ndarray, triangles: np.ndarray, cell_data: dict[str, np.ndarray],
-              point_data: dict[str, np.ndarray]) -> bytes:
+              point_data: dict[str, np.ndarray], field_data: dict[str, np.ndarray] | None = None) -> bytes:
     """XML ``.vtu`` with inline ASCII data, by VTK: tetrahedra then ``triangles``, and the arrays.
 
     Parameters
@@ -99,6 +99,7 @@ def vtu_ascii(points: np.ndarray, tets: np.ndarray, triangles: np.ndarray, cell_
     triangles : (S, 3) int (may be empty)
     cell_data : name -> (T + S,) array (int64 or float64)
     point_data : name -> (P,) uint8
+    field_data : name -> (k,) int64, arrays of the whole file (the names of the ``surface`` codes)
     """
     from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
     from vtkmodules.vtkCommonCore import vtkPoints
@@ -117,7 +118,8 @@ def vtu_ascii(points: np.ndarray, tets: np.ndarray, triangles: np.ndarray, cell_
                   numpy_to_vtkIdTypeArray(np.concatenate([tets.ravel(), triangles.ravel()]), deep=True))
     types = np.concatenate([np.full(len(tets), VTK_TETRA), np.full(len(triangles), VTK_TRIANGLE)]).astype(np.uint8)
     grid.SetCells(numpy_to_vtk(types, deep=True), cells)
-    for target, arrays in ((grid.GetCellData(), cell_data), (grid.GetPointData(), point_data)):
+    for target, arrays in ((grid.GetCellData(), cell_data), (grid.GetPointData(), point_data),
+                           (grid.GetFieldData(), field_data or {})):
         for name, values in arrays.items():
             array = numpy_to_vtk(np.ascontiguousarray(values), deep=True)
             array.SetName(name)

@@ -65,3 +65,31 @@ def test_unknown_suffix_and_empty_files_are_refused(tmp_path):
         read_volume_mesh(bad)
     with pytest.raises(InputDataError, match="unknown volume mesh format"):
         read_volume_mesh(tmp_path / "mesh.stl")
+
+
+def test_vtu_names_its_surface_codes_for_meshio(tmp_path):
+    import meshio
+
+    from softdesign.io.volume_formats import NamedSets
+
+    points, tets = cube()
+    # two named surfaces of the cube: the face z = low (two triangles) and the face z = high (two triangles)
+    low = np.flatnonzero(np.isclose(points[:, 2], points[:, 2].min()))
+    high = np.flatnonzero(np.isclose(points[:, 2], points[:, 2].max()))
+    surfaces = {"base": np.array([low[[0, 1, 3]], low[[0, 3, 2]]]), "tip": np.array([high[[0, 1, 3]],
+                                                                                      high[[0, 3, 2]]])}
+    path = tmp_path / "named.vtu"
+    path.write_bytes(volume_mesh_bytes(points, tets, "vtu", NamedSets(surfaces=surfaces)))
+    mesh = meshio.read(path)
+    # meshio's own form for a Gmsh file's physical names: name -> [code, dimension]
+    assert {name: value.tolist() for name, value in mesh.field_data.items()} == {
+        "body": [-1, 3], "base": [0, 2], "tip": [1, 2]}
+    codes = mesh.cell_data_dict["surface"]
+    np.testing.assert_array_equal(codes["tetra"], np.full(len(tets), -1))
+    for name, triangles in surfaces.items():  # the cells a name's code selects are that surface's triangles
+        chosen = codes["triangle"] == mesh.field_data[name][0]
+        np.testing.assert_array_equal(mesh.cells_dict["triangle"][chosen], triangles)
+    # without named surfaces there are no codes to name
+    plain = tmp_path / "plain.vtu"
+    plain.write_bytes(volume_mesh_bytes(points, tets, "vtu"))
+    assert meshio.read(plain).field_data == {}
