@@ -54,6 +54,10 @@ LABEL_FLATNESS_REL = 0.02
 #: touching it: a cap closes the vessel, so it is as wide as the lumen behind it (an elliptic end reaches
 #: about 1.3); a wall face is much wider or much narrower than the lumen it lines.
 LABEL_RADIUS_RANGE = (0.5, 1.5)
+#: The reason a labelled face is refused when it bends: a wall face, not a cap (said once for all of them).
+NOT_PLANAR = "not planar"
+#: Most wall labels the note lists by number.
+MAX_LISTED_LABELS = 12
 #: A side branch found by farthest-point sweeps must reach this many radii beyond the paths so far.
 BRANCH_MIN_RADII = 3.0
 #: How far behind a graph extremity its width is measured, as a fraction of the graph's longest path.
@@ -71,13 +75,16 @@ def choose_inlet(openings: tuple[Opening, ...], inlet: FloatArray | None) -> int
 
 def caps_from_regions(
     vertices: FloatArray, faces: IntArray, regions: npt.ArrayLike, graph: VoronoiGraph
-) -> tuple[tuple[Opening, ...], tuple[str, ...]]:
-    """Caps of a labelled surface, by label order, and a note for each label that is not taken.
+) -> tuple[tuple[Opening, ...], tuple[str, ...], str | None]:
+    """Caps of a labelled surface, by label order; a warning for each label refused as a cap; the wall labels.
 
     The label of largest area is the wall.  Every other label is a cap only if it is planar (within
     LABEL_FLATNESS_REL of its diameter), disc-like (DISC_FILL of the disc spanning it) and as wide as the
-    vessel it closes (LABEL_RADIUS_RANGE of the widest inscribed sphere touching it); a label that fails
-    is ignored, and its note names it, its area and the reason.
+    vessel it closes (LABEL_RADIUS_RANGE of the widest inscribed sphere touching it).  A label that is not
+    planar bends with the vessel: it is a wall face, as SimVascular labels them, which is expected, so all
+    of them are said once ("N face labels are walls, not openings", the third value, None when there are
+    none).  A planar label refused for another reason may be a cap that was missed: its warning names it,
+    its area and the reason.
 
     Parameters
     ----------
@@ -91,16 +98,29 @@ def caps_from_regions(
     labels = np.unique(regions)
     totals = np.array([areas[regions == label].sum() for label in labels])
     wall = labels[int(np.argmax(totals))]
-    caps, notes = [], []
+    caps, notes, walls = [], [], []
     for label in labels[labels != wall]:
         chosen = regions == label
         reason = label_not_a_cap(vertices, faces[chosen], float(areas[chosen].sum()), graph)
         if reason is None:
             caps.append(_patch_opening(vertices, faces[chosen], areas[chosen]))
+        elif reason.startswith(NOT_PLANAR):
+            walls.append(int(label))
         else:
-            notes.append(f"face label {int(label)} ({float(areas[chosen].sum()):.1f} mm^2) is not taken as an "
+            notes.append(f"face label {int(label)} ({float(areas[chosen].sum()):.3g} mm^2) is not taken as an "
                          f"opening: {reason}")
-    return tuple(caps), tuple(notes)
+    return tuple(caps), tuple(notes), _walls_note(walls)
+
+
+def _walls_note(walls: list[int]) -> str | None:
+    """'3 face labels are walls, not openings (labels 4, 5, 9: ...)', or None without such labels."""
+    if not walls:
+        return None
+    head = "1 face label is a wall, not an opening" if len(walls) == 1 else (
+        f"{len(walls)} face labels are walls, not openings")
+    listed = ", ".join(map(str, walls[:MAX_LISTED_LABELS])) + (", ..." if len(walls) > MAX_LISTED_LABELS else "")
+    return (f"{head} (label{'s' if len(walls) > 1 else ''} {listed}: {NOT_PLANAR}, they bend with the vessel "
+            f"by more than {100 * LABEL_FLATNESS_REL:.0f} % of their width, as a cap does not)")
 
 
 def label_not_a_cap(vertices: FloatArray, faces: IntArray, area: float, graph: VoronoiGraph) -> str | None:
@@ -112,8 +132,8 @@ def label_not_a_cap(vertices: FloatArray, faces: IntArray, area: float, graph: V
     normal = np.linalg.svd(centred, full_matrices=False)[2][-1]
     bow = float(np.abs(centred @ normal).max())
     if bow > LABEL_FLATNESS_REL * diameter:
-        return (f"not planar (its points leave their plane by {bow:.2f} mm, {100 * bow / diameter:.1f} % of its "
-                f"{diameter:.1f} mm width; a cap stays within {100 * LABEL_FLATNESS_REL:.0f} %)")
+        return (f"{NOT_PLANAR} (its points leave their plane by {bow:.3g} mm, {100 * bow / diameter:.3g} % of its "
+                f"{diameter:.3g} mm width; a cap stays within {100 * LABEL_FLATNESS_REL:.0f} %)")
     if area < DISC_FILL * np.pi * (diameter / 2.0) ** 2:
         return (f"not disc-like (it covers {100 * area / (np.pi * diameter**2 / 4):.0f} % of the disc spanning it, "
                 f"a cap at least {100 * DISC_FILL:.0f} %)")

@@ -137,7 +137,8 @@ def extract_centerlines(
         continued.append(reached.continued_mm)
         short.append(reached.short_mm)
     return Centerlines(tuple(paths), tuple(radii), kind, inlet, tuple(outlets), len(graph.points),
-                       closed.notes + tuple(f"warning: {where}: {line}" for line in ends.notes),
+                       closed.notes + tuple(f"{where}: {line}" for line in ends.facts)
+                       + tuple(f"warning: {where}: {line}" for line in ends.notes),
                        tuple(continued), tuple(short))
 
 
@@ -149,8 +150,9 @@ class _Ends:
     inlet: FloatArray
     outlets: list[FloatArray]
     seeds: list[int]
-    notes: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()  # warnings
     centres: tuple[bool, ...] = ()  # inlet, then each outlet: an opening's (or cap's) centre, to be reached
+    facts: tuple[str, ...] = ()  # notes that are no warning (the wall labels)
 
 
 def _targets(ends: _Ends, options: CenterlineOptions, k: int) -> EndTargets:
@@ -183,13 +185,13 @@ def _endpoints(closed: ClosedSurface, graph: VoronoiGraph, options: CenterlineOp
 
     A given outlet within an opening (nearer its centre than the opening's radius) is that opening's centre.
     """
-    kind, candidates, notes = _candidates(closed, graph, options)
+    kind, candidates, notes, facts = _candidates(closed, graph, options)
     if len(candidates) == 0 and not options.outlets:
         ends = graph_extremities(graph)
         inlet_id = ends[0] if options.inlet is None else seed_vertex(graph, closed.vertices, options.inlet)
         ends = [e for e in ends if e != inlet_id] if options.inlet is None else ends[1:]
         points = [graph.points[e] for e in ends]
-        return _Ends("graph extremities", graph.points[inlet_id], points, [inlet_id, *ends], notes)
+        return _Ends("graph extremities", graph.points[inlet_id], points, [inlet_id, *ends], notes, facts=facts)
     if candidates:
         first = choose_inlet(candidates, options.inlet)
         inlet, centres = candidates[first].centre, [True]
@@ -211,7 +213,7 @@ def _endpoints(closed: ClosedSurface, graph: VoronoiGraph, options: CenterlineOp
             "clip the vessel open at both ends, or give --inlet x,y,z and --outlet x,y,z"
         )
     seeds = [seed_vertex(graph, closed.vertices, point) for point in [inlet, *outlets]]
-    return _Ends(kind if not options.outlets else "given", inlet, outlets, seeds, notes, tuple(centres))
+    return _Ends(kind if not options.outlets else "given", inlet, outlets, seeds, notes, tuple(centres), facts)
 
 
 def _opening_at(point: FloatArray, openings: tuple[Opening, ...]) -> Opening | None:
@@ -223,24 +225,27 @@ def _opening_at(point: FloatArray, openings: tuple[Opening, ...]) -> Opening | N
 
 def _candidates(
     closed: ClosedSurface, graph: VoronoiGraph, options: CenterlineOptions
-) -> tuple[str, tuple[Opening, ...], tuple[str, ...]]:
-    """The openings, else the labelled caps, else the flat caps (empty when there are fewer than two); notes.
+) -> tuple[str, tuple[Opening, ...], tuple[str, ...], tuple[str, ...]]:
+    """The openings, else the labelled caps, else the flat caps (empty when there are fewer than two); warnings;
+    notes that are no warning.
 
-    Labels that are not caps are ignored (the notes say which and why); when fewer than two labels are
-    caps, the flat caps are looked for as on an unlabelled surface.
+    Labels that are not caps are ignored (the warnings say which and why, the wall labels once); when fewer
+    than two labels are caps, the flat caps are looked for as on an unlabelled surface.
     """
     if closed.openings:
-        return "openings", closed.openings, ()
+        return "openings", closed.openings, (), ()
     regions = options.regions
     notes: tuple[str, ...] = ()
+    facts: tuple[str, ...] = ()
     if regions is not None and len(regions) == len(closed.faces) and len(np.unique(regions)) > 1:
-        labelled, notes = caps_from_regions(closed.vertices, closed.faces, regions, graph)
+        labelled, notes, walls = caps_from_regions(closed.vertices, closed.faces, regions, graph)
+        facts = () if walls is None else (walls,)
         if len(labelled) >= 2:
-            return "face regions", labelled, notes
+            return "face regions", labelled, notes, facts
         notes += (f"fewer than two face labels are caps ({len(labelled)}); the endpoints are looked for as on an "
                   "unlabelled surface",)
     caps = planar_caps(closed.vertices, closed.faces)
-    return ("planar caps", caps, notes) if len(caps) >= 2 else ("graph extremities", (), notes)
+    return ("planar caps", caps, notes, facts) if len(caps) >= 2 else ("graph extremities", (), notes, facts)
 
 
 def points_from_user(values: list[tuple[float, float, float]], scale: float) -> tuple[Points, ...]:

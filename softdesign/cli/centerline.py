@@ -105,7 +105,7 @@ def _payload(result: Any, output: Path, units: str, seconds: float) -> dict[str,
                 "centerline_id": k,
                 "outlet": [round(float(v) * back, 6) for v in result.outlets[k]],
                 "points": int(len(points)),
-                "length": round(float(_length(points)) * back, 6),
+                "length": round(float(_polyline_length(points)) * back, 6),
                 "radius_range": [round(float(radius.min()) * back, 6), round(float(radius.max()) * back, 6)],
                 "continued": [round(v * back, 6) for v in result.continued_mm[k]],
                 "short_of_opening": [round(v * back, 6) for v in result.short_mm[k]],
@@ -117,17 +117,25 @@ def _payload(result: Any, output: Path, units: str, seconds: float) -> dict[str,
     }
 
 
-def _length(points) -> float:
+def _polyline_length(points) -> float:
     import numpy as np
 
     return float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum())
 
 
 def _short(short: list[float], units: str) -> str:
-    """'; the inlet stops 1.2 mm short of its opening's centre' when an end could not reach it."""
-    parts = [f"the {end} stops {value:.2f} {units} short of its opening's centre (the straight run would leave "
+    """'; the inlet stops 1.2 mm short of its opening's centre' when an end could not reach it (``short`` in units)."""
+    parts = [f"the {end} stops {_length(value, units)} short of its opening's centre (the straight run would leave "
              "the surface)" for end, value in zip(("inlet", "outlet"), short, strict=True) if value > 0.0]
     return "; " + "; ".join(parts) if parts else ""
+
+
+def _length(value: float, units: str) -> str:
+    """A length of the payload (in ``units``) as messages print it (:func:`softdesign.lengths.length_text`)."""
+    from softdesign.lengths import length_text
+    from softdesign.types import UNIT_SCALE_TO_MM
+
+    return length_text(value * UNIT_SCALE_TO_MM[units], units)
 
 
 def _print(payload: dict[str, Any]) -> None:
@@ -135,8 +143,9 @@ def _print(payload: dict[str, Any]) -> None:
     typer.echo(f"endpoints from {payload['endpoints']}; inlet at {payload['inlet']} {units}")
     for path in payload["paths"]:
         lo, hi = path["radius_range"]
-        typer.echo(f"  centerline {path['centerline_id']}: {path['points']} points, {path['length']:.2f} {units}, "
-                   f"radius {lo:.3f} .. {hi:.3f} {units}, to {path['outlet']}")
-        typer.echo(f"    ends continued straight past the Voronoi diagram by {path['continued'][0]:.2f} (inlet) and "
-                   f"{path['continued'][1]:.2f} {units} (outlet)" + _short(path["short_of_opening"], units))
+        typer.echo(f"  centerline {path['centerline_id']}: {path['points']} points, {_length(path['length'], units)}, "
+                   f"radius {_length(lo, units)} to {_length(hi, units)}, to {path['outlet']} {units}")
+        typer.echo(f"    ends continued straight past the Voronoi diagram by {_length(path['continued'][0], units)} "
+                   f"(inlet) and {_length(path['continued'][1], units)} (outlet)"
+                   + _short(path["short_of_opening"], units))
     typer.echo(f"wrote {payload['output']} ({payload['seconds']:.2f} s)")

@@ -69,11 +69,14 @@ def extraction_summary(extracted: Centerlines) -> dict[str, Any]:
     }
 
 
-def continuation_note(extracted: Centerlines) -> str:
-    """How far each extracted path's ends were continued straight past the Voronoi diagram, for the ingest notes."""
-    ends = "; ".join(f"path {k}: {a:.2f} mm at the inlet, {b:.2f} mm at the outlet"
+def continuation_note(extracted: Centerlines, units: str = "mm") -> str:
+    """How far each extracted path's ends were continued straight past the Voronoi diagram, for the ingest notes
+    (lengths in the case's ``units``, with mm beside them otherwise)."""
+    from softdesign.lengths import length_text
+
+    ends = "; ".join(f"path {k}: {length_text(a, units)} at the inlet, {length_text(b, units)} at the outlet"
                      for k, (a, b) in enumerate(extracted.continued_mm))
-    short = [f"path {k} stops {max(gap):.2f} mm short of an opening's centre (the straight run would leave the "
-             "surface)" for k, gap in enumerate(extracted.short_mm) if max(gap) > 0.0]
+    short = [f"path {k} stops {length_text(max(gap), units)} short of an opening's centre (the straight run would "
+             "leave the surface)" for k, gap in enumerate(extracted.short_mm) if max(gap) > 0.0]
     return (f"extracted centerline: the ends continued straight past the Voronoi diagram to the openings' centres "
             f"(a rounded end: to the centre of the sphere touching its tip): {ends}" + "".join(f"; {s}" for s in short))

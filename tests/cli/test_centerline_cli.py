@@ -55,6 +55,36 @@ def test_units_cm_writes_in_the_surface_units(tmp_path):
     np.testing.assert_allclose(np.median(line.radius), 0.3, rtol=0.01, atol=0)  # 3 mm = 0.3 cm
 
 
+def test_lengths_are_printed_with_three_figures_and_mm_beside_other_units(tmp_path):
+    """Issue 43 item 8: the 40 mm tube in m printed "0.04 m" and "continued by 0.00 m"; now "0.04xx m (4x.x mm)"."""
+    import re
+
+    surface = _tube_file(tmp_path, scale=0.001)  # the tube in m
+    out = tmp_path / "cl.vtp"
+    result = runner.invoke(app, ["centerline", str(surface), "--units", "m", "--output", str(out)])
+    assert result.exit_code == 0, result.output
+    line = next(t for t in result.output.splitlines() if "centerline 0:" in t)
+    in_m, in_mm = re.search(r"points, ([0-9.]+) m \(([0-9.]+) mm\)", line).groups()
+    assert len(re.sub(r"^0\.0*", "", in_m)) == 3  # three significant figures in m ...
+    np.testing.assert_allclose(float(in_m) * 1000.0, float(in_mm), rtol=0, atol=0.5)  # ... the same length in mm
+    radius = re.search(r"radius ([0-9.]+) m \(([0-9.]+) mm\)", line)
+    np.testing.assert_allclose(float(radius.group(2)), 3.0, rtol=0, atol=0.1)  # the tube's 3 mm radius, in mm
+    ends = next(t for t in result.output.splitlines() if "ends continued" in t)
+    assert re.search(r"by [0-9.]+ m \([0-9.]+ mm\) \(inlet\) and [0-9.]+ m \([0-9.]+ mm\) \(outlet\)", ends), ends
+    assert not re.search(r"[0-9] m\b(?! \()", result.output)  # every length in m has its mm beside it
+
+
+def test_lengths_in_mm_are_not_repeated():
+    from softdesign.lengths import length_text
+
+    assert length_text(70.31, "mm") == "70.3 mm"
+    assert length_text(70.31, "m") == "0.0703 m (70.3 mm)"
+    assert length_text(70.31, "cm") == "7.03 cm (70.3 mm)"
+    assert length_text(1234.0, "mm") == "1230 mm"  # no exponent
+    assert length_text(40.0, "m") == "0.0400 m (40.0 mm)"  # the zeros that are figures stay
+    assert length_text(0.0, "m") == "0.00 m (0.00 mm)"
+
+
 def test_inlet_option_and_bad_point(tmp_path):
     surface = _tube_file(tmp_path)
     out = tmp_path / "cl.vtp"
@@ -114,9 +144,10 @@ def test_help():
     assert result.exit_code == 0 and "--outlet" in result.output
 
 
-def _labelled_y(tmp_path, wall_patch: bool):
+def _labelled_y(tmp_path, wall_patch: bool, wall_patches: int = 1):
     """The capped Y with CellEntityIds: wall 1, the three flat ends 2, 3, 4, and with ``wall_patch`` a patch of
-    the trunk's wall labelled 9, larger than any cap (as SimVascular models label wall faces)."""
+    the trunk's wall labelled 9, larger than any cap (as SimVascular models label wall faces), cut along the
+    trunk into ``wall_patches`` labels 9, 10, ..."""
     from vtk.util.numpy_support import numpy_to_vtk
 
     from softdesign.io.vtk_polydata import polydata_writer
@@ -131,7 +162,8 @@ def _labelled_y(tmp_path, wall_patch: bool):
         labels[end] = label
     if wall_patch:  # half the trunk's wall from z = -25 to -10: 188 mm^2 against the trunk cap's 50
         patch = (labels == 1) & (centroids[:, 0] > 0.0) & (centroids[:, 2] > -25.0) & (centroids[:, 2] < -10.0)
-        labels[patch] = 9
+        labels[patch] = 9 + np.minimum(((centroids[patch, 2] + 25.0) / 15.0 * wall_patches).astype(int),
+                                       wall_patches - 1)
     poly = polydata_from_triangles(vertices, faces)
     array = numpy_to_vtk(labels, deep=True)
     array.SetName("CellEntityIds")
@@ -160,14 +192,25 @@ def test_a_labelled_wall_face_is_not_taken_for_an_opening(tmp_path):
     result = runner.invoke(app, ["centerline", str(surface), "--output", str(out), "--json"])
     assert result.exit_code == 0, result.output
     assert '"endpoints": "face regions"' in result.output
-    # the warning names the face and the reason, with the figures behind it
-    assert "warning:" in result.output and "face label 9 (" in result.output and "not planar" in result.output
-    assert "face label 2" not in result.output and "face label 3" not in result.output
+    # a wall label is expected: said once, no warning
+    assert "1 face label is a wall, not an opening (label 9: not planar" in result.output
+    assert "warning:" not in result.output and "face label 2" not in result.output
     network = read_centerline_network(out)
     assert len(network.polylines) == 2  # two outlets: the branch caps, not the patch
     for line in network.polylines:  # from the trunk's cap centre, (0, 0, -30), to a branch cap's centre
         np.testing.assert_allclose(line.points[0], [0.0, 0.0, -30.0], rtol=0, atol=0.2)
         assert line.points[-1, 2] > 20.0
+
+
+def test_many_wall_labels_are_reported_once(tmp_path):
+    """Issue 43 item 8: a SimVascular model's wall faces gave one warning each; they are one note."""
+    surface = _labelled_y(tmp_path, wall_patch=True, wall_patches=3)
+    result = runner.invoke(app, ["centerline", str(surface), "--output", str(tmp_path / "cl.vtp"), "--json"])
+    assert result.exit_code == 0, result.output
+    assert result.output.count("face label") == 1, result.output
+    assert "3 face labels are walls, not openings (labels 9, 10, 11: not planar" in result.output
+    assert "warning:" not in result.output
+    assert len(read_centerline_network(tmp_path / "cl.vtp").polylines) == 2
 
 
 def test_label_checks_name_each_reason():

@@ -95,7 +95,7 @@ def run_ingest(case: Case) -> IngestResult:
     others = tuple(p for p in all_paths(network, Orientation(inlet=path.points[0])) if p.index != path.index)
     notes = list(network.notes) + list(path.notes)
     if extracted is not None:
-        notes += [*extracted.notes, continuation_note(extracted)]
+        notes += [*extracted.notes, continuation_note(extracted, case.units)]
     vertices, faces, info = _final_surface(case, path, scale)
     inlet_rule = path.notes[-1]
     path, backbone = regularized_path(case, path, vertices, others)
