@@ -10,7 +10,7 @@ edge); two decimals of a metre (``0.07 m``) said nothing.
 
 from __future__ import annotations
 
-import numpy as np
+import math
 
 from softdesign.types import UNIT_SCALE_TO_MM
 
@@ -24,8 +24,11 @@ def figures(value: float, count: int = LENGTH_FIGURES) -> str:
     No exponent (``1.23e+03`` reads badly beside a viewer's numbers); zeros that are figures stay, so
     ``0.0400 m`` says it is known to a tenth of a millimetre.
     """
-    text = str(np.format_float_positional(float(value), precision=count, unique=False, fractional=False, trim="k"))
-    return text.rstrip(".")
+    value = float(f"{float(value):.{count - 1}e}")  # rounded first, so that 9.996 gives 10.0, not 10.00
+    if value == 0.0 or not math.isfinite(value):
+        return f"{value:.{count - 1}f}" if value == 0.0 else str(value)
+    decimals = count - 1 - math.floor(math.log10(abs(value)))
+    return f"{value:.{decimals}f}" if decimals >= 0 else f"{value:.0f}"
 
 
 def length_text(value_mm: float, units: str) -> str:

@@ -43,9 +43,10 @@ def init(
 
     def action() -> None:
         from softdesign.cli.schema import schema_text
+        from softdesign.geometry.path_survey import MAIN_PATH_RULE
         from softdesign.io.atomic import write_bytes_atomically
         from softdesign.pipeline.case_template import SCHEMA_FILE, init_case_text
-        from softdesign.pipeline.inspect_inputs import inspect_inputs
+        from softdesign.pipeline.inspect_inputs import inspect_inputs, inspection_path_lines
 
         _check_output(output, [p for p in (surface, centerline) if p is not None], force)
         inspection = inspect_inputs(surface, centerline, units)
@@ -59,11 +60,16 @@ def init(
         except OSError as err:
             raise ConfigError(f"--output {output}: cannot write it ({err.strerror or err}); choose a writable path"
                               ) from err
+        for line in inspection.notes:
+            note(line)
         if inspection.guess is not None:
             note(f"units: {inspection.units}, guessed from the sizes ({inspection.guess.evidence[0]}, ...); "
                  "give --units to say otherwise")
-        for p in inspection.paths:
-            note(f"  path {p.index}: {p.length:.4g} {inspection.units}")
+        for line in inspection_path_lines(inspection):
+            note(f"  {line}")
+        if len(inspection.paths) > 1:
+            note(f"path: {inspection.main}, the main vessel, {MAIN_PATH_RULE}; the case file's comments name the "
+                 "alternatives")
         typer.echo(f"wrote {output}; build it with: softdesign build {output}")
 
     run_guarded(action)

@@ -1,8 +1,11 @@
 """The commented case file ``softdesign init`` writes for a user's own vessel files.
 
 Every key it sets is one a newcomer is likely to change; the comments say
-what each does and list what the files hold (paths with their lengths and
-radius ranges, the openings), so the file is its own first documentation.
+what each does and list what the files hold (each path with its length, its
+radius at the inlet and at the end, where it leaves the others and the
+opening it ends at), so the file is its own first documentation.  ``path``
+is the main vessel by :data:`~softdesign.geometry.path_survey.MAIN_PATH_RULE`
+(the path of largest lumen volume), and the comment names the alternatives.
 Paths are written relative to the case file's folder, as the case file
 reads them.  The first line names the case file's JSON Schema
 (``softdesign schema``) for editors that complete and check YAML
@@ -14,6 +17,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from softdesign.geometry.path_survey import MAIN_PATH_RULE
 from softdesign.pipeline.inspect_inputs import Inspection
 
 #: The file beside the case that holds the case file's JSON Schema (written by ``init``).
@@ -39,8 +43,8 @@ def init_case_text(inspection: Inspection, case_path: Path, name: str) -> str:
 
     unit = inspection.units
     scale = UNIT_SCALE_TO_MM[unit]
-    first = inspection.paths[0]
-    links = min(MAX_INIT_LINKS, max(1, round(first.length * scale / LINK_LENGTH_MM)))
+    main = inspection.main_path
+    links = min(MAX_INIT_LINKS, max(1, round(main.length * scale / LINK_LENGTH_MM)))
     folder = case_path.parent
     centerline = "auto" if inspection.centerline is None else _relative(inspection.centerline, folder)
     inlet = ", ".join(f"{v:.6g}" for v in inspection.inlet)
@@ -55,7 +59,8 @@ def init_case_text(inspection: Inspection, case_path: Path, name: str) -> str:
         "final:                      # the patient's shape, q = 1",
         f"  centerline: {centerline}" + ("   # extracted from the surface at ingest" if centerline == "auto" else ""),
         f"  surface: {_relative(inspection.surface, folder)}",
-        "  path: 0                   # which path the actuator follows; the files hold:",
+        f"  path: {inspection.main}                   # which path the actuator follows; proposed: the main vessel, "
+        + MAIN_PATH_RULE,
         *_path_comments(inspection),
         f"  inlet: [{inlet}]   # l = 0, where the actuator is mounted: the end nearest this point",
         "initial: {kind: straight}   # the insertion shape, q = 0",
@@ -80,12 +85,11 @@ def _units_comment(inspection: Inspection) -> list[str]:
 
 
 def _path_comments(inspection: Inspection) -> list[str]:
-    unit = inspection.units
-    out = []
-    for p in inspection.paths:
-        size = f"{p.length:.4g} {unit} long"
-        if p.radius is not None:
-            size += f", radius {p.radius.min():.3g} to {p.radius.max():.3g} {unit}"
-        end = ", ".join(f"{v:.4g}" for v in p.points[-1])
-        out.append(f"  #   path {p.index}: {size}, ends at [{end}]")
-    return out
+    """The rule's alternatives, then every path of the files in words (``softdesign.pipeline.path_text``)."""
+    from softdesign.pipeline.path_text import alternatives_line, path_lines
+    from softdesign.types import UNIT_SCALE_TO_MM
+
+    alternatives = alternatives_line(inspection.facts, inspection.main)
+    head = [] if alternatives is None else [f"  #   {alternatives}; the files hold:"]
+    lines = path_lines(inspection.facts, inspection.units, UNIT_SCALE_TO_MM[inspection.units], inspection.main)
+    return head + [f"  #   {line}" for line in lines]

@@ -26,7 +26,7 @@ from softdesign.types import UNIT_SCALE_TO_MM
 
 if TYPE_CHECKING:
     from softdesign.config import Case
-    from softdesign.geometry.network import SelectedPath
+    from softdesign.geometry.network import CenterlineNetwork, SelectedPath
 
 
 def open_inputs(case: Case) -> list[str]:
@@ -76,7 +76,25 @@ def _centerline(case: Case, key: str, path: Path) -> tuple[SelectedPath, list[st
         f"{radius}",
         f"  {_extent(points, case.units)}",
         *(f"  {note}" for note in network.notes),
+        *(_paths_described(case, network, index) if key == "final.centerline" else []),
     ]
+
+
+def _paths_described(case: Case, network: CenterlineNetwork, index: int) -> list[str]:
+    """Every path in words, the main vessel by init's rule marked; whether ``final.path`` is it (issue 43)."""
+    from softdesign.geometry.network import all_paths
+    from softdesign.geometry.path_survey import MAIN_PATH_RULE, main_path, survey_paths
+    from softdesign.pipeline.path_text import path_lines
+    from softdesign.pipeline.surface_radius import with_surface_radius
+
+    measured = with_surface_radius(case, network)  # as ingest measures a missing radius
+    facts = survey_paths([(p.index, p.points, p.radius) for p in all_paths(measured)])
+    main = main_path(facts)
+    lines = [f"  {line}" for line in path_lines(facts, case.units, 1.0, main)]
+    if len(facts) > 1:
+        chosen = "is the main vessel" if index == main else f"is not the main vessel: path {main} is"
+        lines.append(f"  final.path {index} {chosen} (by init's rule, {MAIN_PATH_RULE})")
+    return lines
 
 
 def _surface(case: Case, key: str, path: Path, final: SelectedPath | None) -> list[str]:

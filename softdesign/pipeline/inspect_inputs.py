@@ -4,7 +4,11 @@ With a centerline file, its paths are read as a build reads them (each
 oriented by the build's own rule, so the proposed inlet is where the build
 would start).  With a surface alone, the centerlines are extracted as
 ``final.centerline: auto`` would extract them, so what is listed is what the
-build will get.  The unit is guessed from the sizes
+build will get.  Every path is described (length, radius at the inlet and
+at the end, where it leaves the others, the opening it ends at) and the main
+vessel is proposed by :func:`softdesign.geometry.path_survey.main_path`'s rule
+(the path of largest lumen volume); a centerline without radii is measured
+against the surface for it.  The unit is guessed from the sizes
 (:func:`softdesign.geometry.units_guess.guess_units`) unless the user gives
 it; an ambiguous guess is refused with the evidence.
 """
@@ -17,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from softdesign.errors import ConfigError
+from softdesign.geometry.path_survey import PathFacts, main_path, survey_paths
 from softdesign.geometry.units_guess import UnitGuess, guess_units
 from softdesign.types import UNIT_SCALE_TO_MM, FloatArray, Points
 
@@ -58,6 +63,9 @@ class Inspection:
     openings : (k, 3) float -- the path ends: the inlet first, then each path's far end
     units : the files' unit, given or guessed
     guess : the evidence for it (None when the user gave it)
+    facts : what each path is, in the files' unit, in the order of ``paths``
+    main : the ``path`` value proposed: the main vessel
+    notes : what extracting the centerlines said (the wall labels, warnings), as the build's ingest says it
     """
 
     surface: Path
@@ -66,11 +74,19 @@ class Inspection:
     openings: FloatArray
     units: str
     guess: UnitGuess | None
+    facts: tuple[PathFacts, ...] = ()
+    main: int = 0
+    notes: tuple[str, ...] = ()
+
+    @property
+    def main_path(self) -> PathSummary:
+        """The path proposed (the main vessel)."""
+        return next(p for p in self.paths if p.index == self.main)
 
     @property
     def inlet(self) -> FloatArray:
-        """The proposed inlet: where the first path starts, (3,) in the files' unit."""
-        return self.paths[0].points[0]
+        """The proposed inlet: where the main vessel starts, (3,) in the files' unit."""
+        return self.main_path.points[0]
 
 
 def inspect_inputs(surface: Path, centerline: Path | None, units: str | None) -> Inspection:
@@ -83,7 +99,7 @@ def inspect_inputs(surface: Path, centerline: Path | None, units: str | None) ->
     InputDataError
         A file that cannot be read as a surface or a centerline.
     """
-    paths = _centerline_paths(centerline) if centerline is not None else _extracted_paths(surface)
+    paths, notes = (_centerline_paths(centerline), ()) if centerline is not None else _extracted_paths(surface)
     guess = None
     if units is None:
         radii = [p.median_radius for p in paths]
@@ -93,7 +109,28 @@ def inspect_inputs(surface: Path, centerline: Path | None, units: str | None) ->
             raise ConfigError(_ambiguous(guess))
         units = guess.units
     openings = np.array([paths[0].points[0]] + [p.points[-1] for p in paths], float)
-    return Inspection(surface, centerline, tuple(paths), openings, units, guess)
+    facts = survey_paths(_with_radii(paths, surface))
+    return Inspection(surface, centerline, tuple(paths), openings, units, guess, tuple(facts), main_path(facts),
+                      notes)
+
+
+def _with_radii(paths: list[PathSummary], surface: Path) -> list[tuple[int, Points, FloatArray | None]]:
+    """The paths for the survey; a path without radii gets its distance to ``surface`` (read in its own unit)."""
+    if all(p.radius is not None for p in paths):
+        return [(p.index, p.points, p.radius) for p in paths]
+    from softdesign.io.surface import read_surface
+    from softdesign.meshing.compare import squared_distances
+
+    vertices, faces = read_surface(surface)  # the files' own numbers, as the centerline's
+    return [(p.index, p.points, p.radius if p.radius is not None
+             else np.sqrt(squared_distances(p.points, vertices, faces))) for p in paths]
+
+
+def inspection_path_lines(inspection: Inspection) -> list[str]:
+    """Every path in words, the main vessel marked (:func:`softdesign.pipeline.path_text.path_lines`)."""
+    from softdesign.pipeline.path_text import path_lines
+
+    return path_lines(inspection.facts, inspection.units, UNIT_SCALE_TO_MM[inspection.units], inspection.main)
 
 
 def _centerline_paths(centerline: Path) -> list[PathSummary]:
@@ -104,7 +141,7 @@ def _centerline_paths(centerline: Path) -> list[PathSummary]:
     return [PathSummary(p.index, p.points, p.radius) for p in all_paths(network)]
 
 
-def _extracted_paths(surface: Path) -> list[PathSummary]:
+def _extracted_paths(surface: Path) -> tuple[list[PathSummary], tuple[str, ...]]:
     from softdesign.centerline.extract import CenterlineOptions, extract_centerlines
     from softdesign.io.centerline_vtp import read_face_regions
     from softdesign.io.surface import read_surface
@@ -112,7 +149,8 @@ def _extracted_paths(surface: Path) -> list[PathSummary]:
     vertices, faces = read_surface(surface)
     options = CenterlineOptions(regions=read_face_regions(surface))
     result = extract_centerlines(vertices, faces, options, str(surface))
-    return [PathSummary(k, p, r) for k, (p, r) in enumerate(zip(result.paths, result.radii, strict=True))]
+    paths = [PathSummary(k, p, r) for k, (p, r) in enumerate(zip(result.paths, result.radii, strict=True))]
+    return paths, result.notes
 
 
 def _ambiguous(guess: UnitGuess) -> str:
