@@ -32,7 +32,7 @@ import numpy as np
 from softdesign.geometry.frames import FramedSpline
 from softdesign.meshing.body import curvature_components
 from softdesign.meshing.chamber_layout import Chamber, ChamberLayout, Feed, offset_points
-from softdesign.meshing.solids import Solid, _regions_after, checked, cut_body, manifold_from_mesh
+from softdesign.meshing.solids import Solid, _regions_after, checked, cut_body, manifold_from_mesh, welded_as_written
 from softdesign.meshing.tessellate import Region, Sweep, TubeMesh, TubeSections, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec
 from softdesign.types import FloatArray
@@ -40,6 +40,10 @@ from softdesign.types import FloatArray
 #: Polygon sides of a chamber's and a feed's section.
 CHAMBER_SEGMENTS = 32
 FEED_SEGMENTS = 16
+#: A feed's polygon is turned by half a chamber step: coaxial with its chamber, its vertices would otherwise
+#: run along the spokes of the chamber's fan-triangulated end (16 of the 32 angles), and the boolean would cut
+#: faces of a few 1e-6 mm there, which single precision (STL) folds to zero area (issue 43).
+FEED_PHASE = np.pi / CHAMBER_SEGMENTS
 #: How far a feed reaches out of the base plane, mm, at least (the base cut's lean is added).
 FEED_EXTENSION_MM = 1.0
 #: Gauss-Legendre nodes per ring interval for the analytic cavity volume.
@@ -70,16 +74,21 @@ def _grid(l_body: FloatArray, l_start: float, l_end: float) -> FloatArray:
 
 
 def _tube(curve: FramedSpline, q: float, l: FloatArray, distance: float, angle: float, diameter: float,
-          segments: int, before_mm: float = 0.0) -> Sweep:
-    """A tube of ``diameter`` about the offset curve over ``l``; ``before_mm`` > 0 prepends a straight ring."""
+          segments: int, before_mm: float = 0.0, phase: float = 0.0) -> Sweep:
+    """A tube of ``diameter`` about the offset curve over ``l``; ``before_mm`` > 0 starts it ``before_mm`` before
+    ``l[0]`` along -T, in place of the ring at ``l[0]``.
+
+    The ring at ``l[0]`` (the base, l = 0) is dropped then: it would lie in the base cap's plane, and the boolean
+    cuts the tube there into faces of a few 1e-7 mm that single precision (STL) folds to zero area, leaving
+    non-manifold edges once coincident vertices are merged (issue 43).  The tube runs straight from outside
+    the base to the first ring inside.  ``phase`` turns the polygon's vertices by that angle, rad.
+    """
     centers, frames = curve.points(l), curve.frames(l)
     s = curve.curve.arc_length(l)
     if before_mm > 0.0:
-        centers = np.concatenate([[centers[0] - before_mm * frames[0][:, 2]], centers])
-        frames = np.concatenate([frames[:1], frames])
-        s = np.concatenate([[s[0] - before_mm], s])
-        l = np.concatenate([[l[0]], l])
-    t = 2.0 * np.pi * np.arange(segments) / segments
+        centers = np.concatenate([[centers[0] - before_mm * frames[0][:, 2]], centers[1:]])
+        s = np.concatenate([[s[0] - before_mm], s[1:]])
+    t = 2.0 * np.pi * np.arange(segments) / segments + phase
     r = area_radius(0.5 * diameter, segments)
     ring = np.column_stack([distance * np.cos(angle) + r * np.cos(t), distance * np.sin(angle) + r * np.sin(t)])
     xy = np.broadcast_to(ring, (len(l), segments, 2)).copy()
@@ -93,11 +102,23 @@ def cavity_sweeps(curve: FramedSpline, q: float, layout: ChamberLayout, l_body: 
                   _tube(curve, q, _grid(l_body, c.l_start, c.l_end), c.distance_mm, c.angle, c.diameter_mm,
                         CHAMBER_SEGMENTS))
            for c in layout.chambers]
+    starts = {(c.section, c.index): c.l_start for c in layout.chambers}
     out += [Cavity("feed", f.section, f.chamber,
-                   _tube(curve, q, _grid(l_body, f.l_start, f.l_end), f.ring_mm, f.angle, f.diameter_mm,
-                         FEED_SEGMENTS, before_mm=feed_extension_mm))
+                   _tube(curve, q, _clear_of(_grid(l_body, f.l_start, f.l_end), starts[f.section, f.chamber], l_body),
+                         f.ring_mm, f.angle, f.diameter_mm, FEED_SEGMENTS, before_mm=feed_extension_mm,
+                         phase=FEED_PHASE))
             for f in layout.feeds]
     return tuple(out)
+
+
+def _clear_of(l: FloatArray, plane_l: float, l_body: FloatArray) -> FloatArray:
+    """The rings ``l`` less any within a quarter ring of ``plane_l`` (a chamber's flat proximal end, which the feed
+    crosses): a ring there would put the feed's vertices a hair from that plane, and the boolean's faces between
+    them fold to zero area in single precision (issue 43).  The two ends of ``l`` are kept."""
+    gap = 0.25 * float(np.min(np.diff(l_body)))
+    near = np.abs(l - plane_l) < gap
+    near[[0, -1]] = False
+    return l[~near]
 
 
 def carve_cavities(body: TubeMesh, cavities: Sequence[Cavity], max_rho_kappa: float, label: str) -> Solid:
@@ -120,7 +141,7 @@ def carve_cavities(body: TubeMesh, cavities: Sequence[Cavity], max_rho_kappa: fl
         tubes.append(manifold)
     union = checked(m3.Manifold.batch_boolean(tubes, m3.OpType.Add), f"{label}: chambers and feeds")
     result = checked(body_manifold - union, f"{label}: actuated body")
-    vertices, faces, regions = _regions_after(result, sources)
+    vertices, faces, regions = welded_as_written(*_regions_after(result, sources))
     return Solid(vertices, faces, regions, 2, "actuated", max_rho_kappa)
 
 

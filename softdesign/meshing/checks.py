@@ -4,6 +4,12 @@ The figures (watertight, winding_consistent, vertex_manifold, shells,
 bodies and voids, euler, volume, area) are defined and measured in
 :mod:`softdesign.meshing.topology`; here they are held against what a solid
 must be, with degenerate faces (vertices (V, 3) mm, faces (F, 3) int).
+
+As written (issue 43): STL, PLY and glTF keep float32 coordinates, and a
+slicer or a user's check merges coincident vertices (trimesh's
+``process=True``).  :func:`written_defects` rounds the vertices to float32,
+merges those that coincide and counts the faces of zero area and the edges
+shared by more than two faces (non-manifold); a solid must have none of either.
 """
 
 from __future__ import annotations
@@ -40,6 +46,8 @@ class MeshReport:
     area: float
     volume_expected: float | None = None
     volume_rel_error: float | None = None
+    zero_area_faces: int = 0
+    nonmanifold_edges: int = 0
 
     def as_dict(self) -> dict[str, object]:
         """Plain JSON-ready values."""
@@ -84,6 +92,31 @@ def _mean_squared_edge(p0: FloatArray, p1: FloatArray, p2: FloatArray) -> float:
     return float(np.mean(edge_sq))
 
 
+def written_defects(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> tuple[int, int]:
+    """(zero-area faces, non-manifold edges: shared by more than two faces) of the mesh as written in float32 and
+    read with coincident vertices merged (see the module notes); both 0 for a 2-manifold whose vertices stay
+    apart in float32 (an open surface's boundary edges are no concern here: watertight says that).
+
+    Parameters
+    ----------
+    vertices : (V, 3) float, mm
+    faces : (F, 3) int
+    """
+    rounded = np.asarray(vertices, np.float32).astype(np.float64)
+    faces = np.asarray(faces, np.int64).reshape(-1, 3)
+    if not faces.size:
+        return 0, 0
+    inverse = np.unique(rounded, axis=0, return_inverse=True)[1].reshape(-1)
+    merged = inverse[faces]
+    corners = rounded[faces]
+    doubled = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+    zero = int(np.sum(doubled == 0.0))
+    edges = np.sort(np.concatenate([merged[:, [0, 1]], merged[:, [1, 2]], merged[:, [2, 0]]]), axis=1)
+    edges = edges[edges[:, 0] != edges[:, 1]]  # a folded face's point-edge is no edge
+    counts = np.unique(edges, axis=0, return_counts=True)[1]
+    return zero, int(np.sum(counts > 2))
+
+
 def inspect_mesh(
     vertices: npt.ArrayLike, faces: npt.ArrayLike, volume_expected: float | None = None
 ) -> MeshReport:
@@ -103,6 +136,7 @@ def inspect_mesh(
     corners = corner_planes(np.asarray(vertices, float), np.asarray(faces, np.int64))
     degenerate = topology.face_areas <= DEGENERATE_AREA_FRACTION * _mean_squared_edge(*corners)
     rel = None if volume_expected is None else topology.volume / volume_expected - 1.0
+    zero_area, nonmanifold = written_defects(vertices, faces)
     return MeshReport(
         vertices=topology.vertices,
         faces=topology.faces,
@@ -118,6 +152,8 @@ def inspect_mesh(
         area=topology.area,
         volume_expected=None if volume_expected is None else float(volume_expected),
         volume_rel_error=None if rel is None else float(rel),
+        zero_area_faces=zero_area,
+        nonmanifold_edges=nonmanifold,
     )
 
 
@@ -131,6 +167,9 @@ def _failures(report: MeshReport, expected: Expectation) -> list[str]:
         problems.append("a vertex joins separate fans of faces (not a 2-manifold)")
     if report.degenerate_faces:
         problems.append(f"{report.degenerate_faces} degenerate (zero-area) faces")
+    if report.zero_area_faces or report.nonmanifold_edges:
+        problems.append(f"as written in single precision (STL) with coincident vertices merged: "
+                        f"{report.zero_area_faces} zero-area faces, {report.nonmanifold_edges} non-manifold edges")
     if report.bodies != expected.bodies:
         problems.append(f"{report.bodies} bodies ({report.shells} shells), expected {expected.bodies}")
     if report.euler != expected.euler:

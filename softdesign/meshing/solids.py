@@ -114,6 +114,28 @@ def checked(manifold: m3.Manifold, label: str) -> m3.Manifold:
 Labels = npt.NDArray[np.int8]
 
 
+def welded_as_written(vertices: FloatArray, faces: IntArray, regions: Labels) -> tuple[FloatArray, IntArray, Labels]:
+    """The mesh as single precision writes it (STL, PLY, glTF): coordinates rounded to float32, vertices that
+    then coincide merged, the faces that fold to a point or a segment dropped (with their regions).
+
+    manifold3d cuts faces wherever two inputs cross; where a crossing falls a hair (1e-5 mm) from an input's
+    vertex or edge, it leaves an edge that float32 (about 1.5e-5 mm at 250 mm from the origin) folds to a point:
+    two zero-area faces and, once a slicer merges coincident vertices, non-manifold edges and zero-volume parts
+    (issue 43).  Merging here collapses that edge, as manifold3d's own edge collapse would; the caller's checks
+    then judge the mesh that is written.
+    """
+    rounded = np.asarray(vertices, np.float32).astype(np.float64)
+    unique, inverse = np.unique(rounded, axis=0, return_inverse=True)
+    if len(unique) == len(rounded):
+        return rounded, faces, regions
+    order = np.unique(inverse, return_index=True)[1]  # keep the first vertex's position in the file order
+    rank = np.empty(len(order), np.int64)
+    rank[np.argsort(order)] = np.arange(len(order))
+    merged = rank[inverse.reshape(-1)][faces]
+    keep = (merged[:, 0] != merged[:, 1]) & (merged[:, 1] != merged[:, 2]) & (merged[:, 2] != merged[:, 0])
+    return rounded[np.sort(order)], merged[keep], regions[keep]
+
+
 def _regions_after(manifold: m3.Manifold, sources: dict[int, Labels]) -> tuple[FloatArray, IntArray, Labels]:
     """Vertices, faces and region labels of a boolean result, regions traced through runs and face ids."""
     mesh = manifold.to_mesh64()

@@ -17,6 +17,7 @@ from softdesign.io.formats import FORMATS, read_mesh
 from softdesign.meshing.compare import MeshDifference, compare_meshes
 from softdesign.pipeline.layout import MESHES_DIR
 from softdesign.regression.figures import CheckOptions, Figure, is_number, missing_figure, read_json
+from softdesign.types import FloatArray, IntArray
 
 #: Every registered mesh format is compared by geometry.
 MESH_SUFFIXES = tuple(f.suffix for f in FORMATS.values())
@@ -93,7 +94,19 @@ def compare_mesh_folders(
             figures.append(Figure(name, "readable", None, None, False, note=str(err)))
             continue
         figures += mesh_figures(name, difference, options, golden.get(name, DecimationError()))
+        figures += written_figures(name, *mesh)
     return figures
+
+
+def written_figures(name: str, vertices: FloatArray, faces: IntArray) -> list[Figure]:
+    """The build's mesh as a slicer reads it (float32, coincident vertices merged): its zero-area faces and
+    non-manifold edges, each must be 0 (:func:`softdesign.meshing.checks.written_defects`)."""
+    from softdesign.meshing.checks import written_defects
+
+    zero, nonmanifold = written_defects(vertices, faces)
+    note = "in the build, as written in single precision with coincident vertices merged; must be 0"
+    return [Figure(name, key, float(value), 0.0, value == 0, build=value, note=note)
+            for key, value in (("zero_area_faces", zero), ("nonmanifold_edges", nonmanifold))]
 
 
 def mesh_figures(name: str, diff: MeshDifference, options: CheckOptions, allowance: DecimationError) -> list[Figure]:

@@ -210,3 +210,29 @@ def test_topology_checks_agree_with_their_definitions(fault):
         report = inspect_mesh(v, f)
         got = (report.watertight, report.winding_consistent, report.vertex_manifold, report.shells, report.euler)
         assert got == _reference_topology(f, len(v))
+
+
+def test_a_face_folded_by_single_precision_is_counted_and_welded():
+    """Issue 43: a vertex 1e-9 mm from another is the same point in float32; the check counts the folded faces
+    and the non-manifold edges a slicer sees, and welding collapses that edge into a closed 2-manifold."""
+    from softdesign.meshing.checks import written_defects
+    from softdesign.meshing.solids import welded_as_written
+
+    # the cube 200 mm from the origin, as a patient's coordinates are (float32 keeps about 1.5e-5 mm there);
+    # split its edge 0-1 at a point 1e-9 mm from vertex 0: faces [0, 1, 3] and [0, 5, 1] become four
+    n = len(CUBE_VERTICES)
+    cube = CUBE_VERTICES + 200.0
+    vertices = np.vstack([cube, cube[0] + 1e-9 * (cube[1] - cube[0])])
+    faces = np.vstack([CUBE_FACES[[1, 2, 3, 4, 6, 7, 8, 9, 10, 11]],
+                       [[0, n, 3], [n, 1, 3], [0, 5, n], [n, 5, 1]]])
+    report = inspect_mesh(vertices, faces)
+    assert report.watertight and report.vertex_manifold and report.degenerate_faces == 0  # sound in float64
+    # as written: [0, n, 3] and [0, 5, n] fold; edges 0-3 and 0-5 are then shared by three faces each
+    assert written_defects(vertices, faces) == (2, 2)
+    assert (report.zero_area_faces, report.nonmanifold_edges) == (2, 2)
+    with pytest.raises(MeshError, match="2 zero-area faces, 2 non-manifold edges"):
+        check_solid(vertices, faces)
+    welded = welded_as_written(vertices, faces, np.arange(len(faces), dtype=np.int8))
+    assert len(welded[1]) == len(faces) - 2 and welded[2].tolist() == [*range(10), 11, 13]
+    checked = check_solid(welded[0], welded[1], Expectation(volume=8.0))
+    assert (checked.zero_area_faces, checked.nonmanifold_edges, checked.euler) == (0, 0, 2)

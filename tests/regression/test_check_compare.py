@@ -129,7 +129,9 @@ def test_mesh_folders_are_compared_in_every_format(tmp_path, fmt):
     assert mesh_names(tmp_path / "build") == {f"meshes/q_0.000.{fmt}"}
     figures = compare_mesh_folders(tmp_path / "build", tmp_path / "reference", CheckOptions(samples=2000), {})
     by_name = {figure.figure: figure for figure in figures}
-    assert set(by_name) == {"distance_max_mm", "distance_rms_mm", "volume_rel_change", "area_rel_change", "watertight"}
+    assert set(by_name) == {"distance_max_mm", "distance_rms_mm", "volume_rel_change", "area_rel_change", "watertight",
+                            "zero_area_faces", "nonmanifold_edges"}
+    assert by_name["zero_area_faces"].build == 0 and by_name["nonmanifold_edges"].build == 0
     assert all(figure.passed for figure in figures) and by_name["watertight"].build is True
     # float32 files (STL, glTF) round the box's corners by ~1e-6 mm
     np.testing.assert_allclose(by_name["distance_max_mm"].change, shift, rtol=0, atol=1e-5)
@@ -149,3 +151,32 @@ def test_pose_difference_known_translation_and_angles():
     tiny[:3, :3] = pose[:3, :3] @ rotation_about([0, 0, 1], 1e-8)
     # atan2 resolves 1e-8 rad to rounding; acos((trace - 1) / 2) would give 0 or ~1.5e-8.
     np.testing.assert_allclose(pose_difference(tiny, pose)[1], 1e-8, rtol=0, atol=1e-14)
+
+
+def test_check_counts_what_a_slicer_sees_in_the_build(tmp_path):
+    """Issue 43: a mesh whose two vertices fold to one in float32 is flagged, whatever the reference holds."""
+    v, f = box()
+    for folder in ("build", "reference"):
+        (tmp_path / folder / "meshes").mkdir(parents=True)
+        write_mesh(tmp_path / folder / "meshes" / "q_0.000.stl", v, f)
+    # the build's box with one face split at a point 1e-9 mm from its corner: apart in float64, one in float32
+    corner = v[f[0, 0]] + 1e-9 * (v[f[0, 1]] - v[f[0, 0]])
+    split_v = np.vstack([v, corner])
+    n = len(v)
+    a, b, c = f[0]
+    split_f = np.vstack([f[1:], [[a, n, c], [n, b, c]]])
+    other = [k for k in range(1, len(f)) if {a, b} <= set(f[k])]
+    assert other  # the face across edge (a, b) is split at the same point, so the float64 mesh stays closed
+    g = split_f[other[0] - 1]
+    d = next(x for x in g if x not in (a, b))
+    split_f = np.vstack([np.delete(split_f, other[0] - 1, axis=0), [[b, n, d], [n, a, d]]])
+    from softdesign.meshing.checks import written_defects
+    from softdesign.meshing.topology import mesh_topology
+
+    assert mesh_topology(split_v, split_f).watertight and written_defects(split_v, split_f)[0] == 2
+    write_mesh(tmp_path / "build" / "meshes" / "q_0.000.stl", split_v, split_f)
+    figures = {fig.figure: fig for fig in compare_mesh_folders(tmp_path / "build", tmp_path / "reference",
+                                                              CheckOptions(samples=2000), {})}
+    got = (figures["zero_area_faces"].build, figures["nonmanifold_edges"].build)
+    # the two folded faces, and their edges to c and to d, each now shared by three faces
+    assert got == (2, 2) and not figures["zero_area_faces"].passed and not figures["nonmanifold_edges"].passed, got
