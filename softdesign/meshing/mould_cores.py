@@ -52,7 +52,7 @@ from softdesign.meshing.mould_checks import (
 )
 from softdesign.meshing.mould_frame import PartingFrame, parting_frame
 from softdesign.meshing.mould_make import Mould, MouldMesh, checks_passed
-from softdesign.meshing.solids import checked, cut_body, manifold_from_mesh
+from softdesign.meshing.solids import checked, cut_body, manifold_from_mesh, welded_as_written
 from softdesign.meshing.tessellate import Region, Sweep, TubeMesh, TubeSections, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec
 from softdesign.types import FloatArray
@@ -153,8 +153,10 @@ def make_actuated_mould(sections: TubeSections, body_spec: BodySpec, spec: Mould
     meshes = []
     for part_name, part in named:
         mesh = part.transform(to_world).to_mesh64()
-        meshes.append(MouldMesh(part_name, np.asarray(mesh.vert_properties, float)[:, :3].copy(),
-                                np.asarray(mesh.tri_verts, np.int64).copy()))
+        faces = np.asarray(mesh.tri_verts, np.int64)
+        vertices, faces, _ = welded_as_written(np.asarray(mesh.vert_properties, float)[:, :3], faces,
+                                               np.zeros(len(faces), np.int8))  # as STL keeps it (issue 43)
+        meshes.append(MouldMesh(part_name, vertices, faces.copy()))
     return Mould(tuple(meshes), figures)
 
 

@@ -29,7 +29,14 @@ from softdesign.meshing.mould_checks import (
     shared_volume,
 )
 from softdesign.meshing.mould_frame import PartingFrame, parting_frame
-from softdesign.meshing.solids import build_solid, cut_body, cut_chamber, manifold_from_mesh, port_lean_mm
+from softdesign.meshing.solids import (
+    build_solid,
+    cut_body,
+    cut_chamber,
+    manifold_from_mesh,
+    port_lean_mm,
+    welded_as_written,
+)
 from softdesign.meshing.tessellate import Region, TubeSections, sweep_from_sections
 from softdesign.meshing.volume import BodySpec
 from softdesign.types import FloatArray, IntArray
@@ -148,8 +155,10 @@ def make_mould(sections: TubeSections, body_spec: BodySpec, spec: MouldSpec,
     meshes = []
     for part_name, part in named:
         mesh = part.transform(to_world).to_mesh64()
-        meshes.append(MouldMesh(part_name, np.asarray(mesh.vert_properties, float)[:, :3].copy(),
-                                np.asarray(mesh.tri_verts, np.int64).copy()))
+        faces = np.asarray(mesh.tri_verts, np.int64)
+        vertices, faces, _ = welded_as_written(np.asarray(mesh.vert_properties, float)[:, :3], faces,
+                                               np.zeros(len(faces), np.int8))  # as STL keeps it (issue 43)
+        meshes.append(MouldMesh(part_name, vertices, faces.copy()))
     return Mould(tuple(meshes), figures)
 
 

@@ -115,8 +115,9 @@ Labels = npt.NDArray[np.int8]
 
 
 def welded_as_written(vertices: FloatArray, faces: IntArray, regions: Labels) -> tuple[FloatArray, IntArray, Labels]:
-    """The mesh as single precision writes it (STL, PLY, glTF): coordinates rounded to float32, vertices that
-    then coincide merged, the faces that fold to a point or a segment dropped (with their regions).
+    """The mesh as single precision writes it (STL, PLY, glTF): vertices that coincide once rounded to float32
+    merged into the first of them (kept in float64), the faces that fold to a point or a segment dropped (with
+    their regions); the arrays themselves when nothing coincides.
 
     manifold3d cuts faces wherever two inputs cross; where a crossing falls a hair (1e-5 mm) from an input's
     vertex or edge, it leaves an edge that float32 (about 1.5e-5 mm at 250 mm from the origin) folds to a point:
@@ -124,16 +125,16 @@ def welded_as_written(vertices: FloatArray, faces: IntArray, regions: Labels) ->
     (issue 43).  Merging here collapses that edge, as manifold3d's own edge collapse would; the caller's checks
     then judge the mesh that is written.
     """
-    rounded = np.asarray(vertices, np.float32).astype(np.float64)
+    rounded = np.asarray(vertices, np.float32)
     unique, inverse = np.unique(rounded, axis=0, return_inverse=True)
     if len(unique) == len(rounded):
-        return rounded, faces, regions
-    order = np.unique(inverse, return_index=True)[1]  # keep the first vertex's position in the file order
+        return vertices, faces, regions  # nothing folds: the mesh as it was, to the last bit
+    order = np.unique(inverse, return_index=True)[1]  # of those that coincide, the first in the file's order
     rank = np.empty(len(order), np.int64)
     rank[np.argsort(order)] = np.arange(len(order))
     merged = rank[inverse.reshape(-1)][faces]
     keep = (merged[:, 0] != merged[:, 1]) & (merged[:, 1] != merged[:, 2]) & (merged[:, 2] != merged[:, 0])
-    return rounded[np.sort(order)], merged[keep], regions[keep]
+    return np.asarray(vertices, np.float64)[np.sort(order)], merged[keep], regions[keep]
 
 
 def _regions_after(manifold: m3.Manifold, sources: dict[int, Labels]) -> tuple[FloatArray, IntArray, Labels]:
@@ -283,6 +284,6 @@ def carve_chamber(body: TubeMesh, cavity: TubeMesh, outer: Sweep, chamber: Sweep
         sources[port_id] = np.array([Region.PORT], np.int8)
         hollow = hollow - port
     result = checked(hollow, f"{label}: hollow body")
-    vertices, faces, regions = _regions_after(result, sources)
+    vertices, faces, regions = welded_as_written(*_regions_after(result, sources))
     kind, euler = ("ported", 2) if spec.port_mm > 0 else ("hollow", 4)
     return Solid(vertices, faces, regions, euler, kind, outer.max_rho_kappa)
