@@ -40,6 +40,9 @@ def open_inputs(case: Case) -> list[str]:
     from softdesign.pipeline.inputs import input_fields
 
     lines: list[str] = []
+    if case.final.centerline == "auto":  # extracting takes seconds; init shows what it gives
+        lines.append("final.centerline auto: extracted from final.surface at ingest; softdesign init SURFACE lists "
+                     "its paths and proposes the main vessel")
     final: SelectedPath | None = None
     for key, path in input_fields(case):
         if key.endswith("centerline"):

@@ -99,6 +99,8 @@ def test_arch_surface_in_cm_proposes_the_descending_aorta(tmp_path):
     np.testing.assert_allclose(end, trunk[-1] / 10.0, rtol=0, atol=1.3)  # cm: within the 10 mm radius
     assert "cm (" in listed[0]  # lengths in cm with mm beside
     assert data["units"] == "cm" and load_case(case).final.path == main
+    checked = runner.invoke(app, ["validate", str(case)])  # says where the paths come from, without extracting
+    assert checked.exit_code == 0 and "final.centerline auto: extracted from final.surface at ingest" in checked.output
 
 
 def test_labelled_root_with_coronaries_proposes_the_aorta(tmp_path):
