@@ -8,6 +8,7 @@ chambered body at q = 0.5 and 1 had zero-area faces where the feeds cross the ch
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -42,6 +43,9 @@ def _check_every_q(case: Path, out: Path) -> None:
 
     result = runner.invoke(app, ["export", str(case), "--out", str(out)])
     assert result.exit_code == 0, result.output
+    summary = json.loads((out / "export" / "summary.json").read_text())["meshes"]
+    assert len(summary) == len(QS)
+    assert all((m["zero_area_faces"], m["nonmanifold_edges"]) == (0, 0) for m in summary.values()), summary
     for q in QS:
         path = out / "meshes" / f"q_{q:.3f}.stl"
         raw = trimesh.load(path, process=False)

@@ -51,7 +51,8 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 4  # 2: .glb in metres (glTF's unit), metrics.export.units; 3: .pvd time series, morph.glb; 4: frame
+VERSION = 5  # 2: .glb in metres (glTF's unit), metrics.export.units; 3: .pvd time series, morph.glb; 4: frame
+# 5: chambered feeds clear of the base and chamber-end planes, meshes welded and checked as float32 writes them
 
 
 @dataclass(frozen=True)
@@ -112,6 +113,8 @@ def solid_at(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case)
         "area_expected_mm2": integral.area,
         "watertight": report.watertight,
         "winding_consistent": report.winding_consistent,
+        "zero_area_faces": report.zero_area_faces,
+        "nonmanifold_edges": report.nonmanifold_edges,
         "bodies": report.bodies,
         "euler": report.euler,
         "max_rho_kappa": solid.max_rho_kappa,

@@ -44,7 +44,7 @@ if TYPE_CHECKING:  # only annotations: the report loads stage results without th
 #: joined into paths; extracted centerlines reach the openings (issue 29).
 #: 7: the backbone's reach uses the wall's fold radius; a turn no smoothing brings below the target is warned
 #: about, not refused (issue 29).
-VERSION = 7
+VERSION = 8  # 8: lengths in the notes in the case's unit (mm beside), wall face labels said once
 
 
 @dataclass(frozen=True)

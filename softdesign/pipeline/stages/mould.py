@@ -35,7 +35,7 @@ from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 
-VERSION = 2  # 2: export.frame (the parts in the patient's or the base frame)
+VERSION = 3  # 2: export.frame (the parts in the patient's or the base frame); 3: parts welded as float32 writes them
 
 
 @dataclass(frozen=True)
