@@ -74,7 +74,7 @@ class PathFacts:
     ----------
     index : the ``final.path`` value of the path
     length : arc length
-    radius_inlet, radius_end : inscribed radius at its first and last point
+    radius_inlet, radius_end : inscribed radius at its two ends (the largest within reach: module notes)
     leaves : (other path's index, arc length from the inlet where it parts from it), or None for a single path
     opening : the opening it ends at, from 1 (0 is the inlet)
     end : (3,) float -- its last point
