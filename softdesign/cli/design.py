@@ -21,10 +21,11 @@ from softdesign.cli.common import (
     CaseArg,
     JsonOpt,
     OutOpt,
+    ReplaceOpt,
     case_inputs,
+    check_output_file,
     emit_json,
     note,
-    refuse_overwriting_inputs,
     run_guarded,
 )
 from softdesign.config.design import MAX_DESIGN_LINKS
@@ -111,6 +112,7 @@ def design(
         "--output", help="The designed case file to write [default: <case>-designed.yaml beside the case].")] = None,
     json_out: JsonOpt = False,
     out: OutOpt = None,
+    force: ReplaceOpt = False,
 ) -> None:
     """The fewest constant-curvature sections, composed from the base frame, within the bounds of the centerline.
 
@@ -141,14 +143,12 @@ def design(
         if d is not None:
             spacing_from_text(d, None)  # numbers > 0: fail before building
         target = output if output is not None else case_file.with_name(f"{case_file.stem}-designed.yaml")
-        if not target.parent.is_dir():
-            raise ConfigError(f"--output {target}: the folder {target.parent} does not exist; create it first")
         if target.is_dir():
             raise ConfigError(f"--output {target}: is a folder, expected the case file to write; name a file in it, "
                               f"e.g. {target / (case_file.stem + '-designed.yaml')}")
         if target.resolve() == case_file.resolve():
             raise ConfigError(f"--output {target}: is the case file itself; write the design to another file")
-        refuse_overwriting_inputs("--output", target, case_inputs(case_file))
+        check_output_file("--output", target, force, case_inputs(case_file))
         case = _case_with_design(case_file, {
             "tolerance_mm": tolerance_mm, "tip_tolerance_mm": tip_tolerance_mm,
             "tip_tolerance_deg": tip_tolerance_deg, "max_links": max_links, "min_link_mm": min_link_mm})
