@@ -191,6 +191,7 @@ def _write_case(case_file: Path, target: Path, breaks: list[float], case: Case, 
     """The case file's text with the design: block used, blend: pcc and the design's breaks (the rest kept)."""
     from softdesign.io.atomic import write_bytes_atomically
     from softdesign.io.case_edit import breaks_text, case_text_with_keys, rounded_breaks
+    from softdesign.io.case_yaml import read_case_text
 
     assert case.design is not None
     block = {k: v for k, v in case.design.model_dump().items() if v is not None}
@@ -203,8 +204,8 @@ def _write_case(case_file: Path, target: Path, breaks: list[float], case: Case, 
     if problems:  # the case's own q = 0 shape or keyframes: keep its blend, say why
         del updates["blend"]
         note(f"note: {target} keeps blend: {case.blend}: " + "; ".join(problems))
-    text = case_file.read_text(encoding="utf-8")
-    new_text, kept = case_text_with_keys(text, updates, case_file.parent, target.parent)
+    text = read_case_text(case_file)
+    new_text, kept = case_text_with_keys(text, updates, case_file.parent, target.parent, case_file)
     try:
         write_bytes_atomically(target, new_text.encode("utf-8"))
     except OSError as err:
