@@ -9,12 +9,14 @@ the distance lists ``--d``/``--pcc-d``) are the only ones; they raise
 
 from __future__ import annotations
 
+import errno
 import inspect
 import json
 import math
 import os
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Any, TypeVar
 
@@ -83,6 +85,36 @@ def run_guarded(action: Callable[[], T]) -> T:
         # folder (or an output file) is the previous one, whole
         typer.echo(INTERRUPTED, err=True)
         raise typer.Exit(code=130) from None
+
+
+#: Why an output cannot be written that is no bug: a full disk or quota, a device that refuses (/dev/full), a file
+#: too large for its file system, an I/O error.
+_UNWRITABLE = {errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EFBIG}
+
+
+@contextmanager
+def unwritable_output() -> Iterator[None]:
+    """Output that cannot be written (``> /dev/full``, a full disk): one line on stderr and exit 1, no traceback.
+
+    Standard output is flushed inside the block, so that what a command printed fails here rather than in the
+    interpreter's exit; it is then pointed at the null device, so that the exit does not try again.
+    """
+    try:
+        try:
+            yield
+        finally:
+            sys.stdout.flush()
+    except OSError as err:
+        if err.errno not in _UNWRITABLE:
+            raise
+        where = os.fsdecode(err.filename) if err.filename is not None else "the standard output"
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError, AttributeError):
+            pass
+        sys.stderr.write(f"error: cannot write {where} ({err.strerror or err}); free space on that disk or write "
+                         "the output elsewhere\n")
+        raise SystemExit(1) from None
 
 
 def finite_number(text: str, what: str, fix: str) -> float:
