@@ -100,3 +100,34 @@ def test_an_actuation_table_is_held_to_the_readings_bounds(tmp_path):
     result = runner.invoke(app, ["pcc", "reconstruct", str(many), "--shapes-dir", str(tmp_path / "s")])
     assert_refused(result, "many.csv line", f"sections 1 to {MAX_SECTIONS}")
     assert not (tmp_path / "s").exists()
+
+
+def _tube_stl(path, triangles: int) -> None:
+    """A binary STL of an open straight tube (radius 5 mm, 200 mm) with at least ``triangles`` triangles."""
+    around = 128
+    rings = -(-triangles // (2 * around))
+    theta = np.linspace(0.0, 2.0 * np.pi, around, endpoint=False)
+    z = np.linspace(0.0, 200.0, rings + 1)
+    vertices = np.stack([np.broadcast_to(5.0 * np.cos(theta), (rings + 1, around)),
+                         np.broadcast_to(5.0 * np.sin(theta), (rings + 1, around)),
+                         np.broadcast_to(z[:, None], (rings + 1, around))], axis=-1).reshape(-1, 3)
+    a = (np.arange(rings)[:, None] * around + np.arange(around)).ravel()
+    b = (np.arange(rings)[:, None] * around + (np.arange(around) + 1) % around).ravel()
+    faces = np.concatenate([np.stack([a, b, a + around], 1), np.stack([b, b + around, a + around], 1)])
+    corners = vertices[faces].astype("<f4")
+    record = np.zeros(len(faces), dtype=[("normal", "<f4", 3), ("corners", "<f4", (3, 3)), ("attr", "<u2")])
+    record["corners"] = corners
+    path.write_bytes(bytes(80) + np.uint32(len(faces)).tobytes() + record.tobytes())
+
+
+def test_centerline_extraction_refuses_a_surface_over_its_stated_limit_before_the_work(tmp_path):
+    from softdesign.centerline.closing import MAX_TRIANGLES
+
+    surface = tmp_path / "tube.stl"
+    _tube_stl(surface, 999_000)  # the attack's tube: within the old 1M limit, it took 5.3 GB and 320 s
+    for args in (["centerline", str(surface), "--output", str(tmp_path / "c.vtp")],
+                 ["init", str(surface), "--output", str(tmp_path / "case.yaml"), "--units", "mm"]):
+        result, seconds = _timed(args)
+        assert_refused(result, "tube.stl", f"expected 32 to {MAX_TRIANGLES:,}", "decimate it")
+        assert seconds < REFUSED_WITHIN_S, seconds
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["tube.stl"]
