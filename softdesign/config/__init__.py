@@ -59,7 +59,12 @@ from softdesign.limits.shape import (
 from softdesign.limits.volume import MAX_MESHER_SECONDS, MAX_VOLUME_MESHES, MIN_TET_SIZE_MM
 from softdesign.materials import MaterialLimits, PresetName, resolve_material
 from softdesign.meshing.mould_spec import MIN_MOULD_WALL_MM
-from softdesign.meshing.volume_tolerance import MIN_ANGULAR_COUNT, VOLUME_RTOL
+from softdesign.meshing.volume_tolerance import (
+    MAX_CAVITY_SHARE,
+    MIN_ANGULAR_COUNT,
+    MIN_ANGULAR_COUNT_WITH_CAVITIES,
+    VOLUME_RTOL,
+)
 
 
 class _Section(BaseModel):
@@ -528,6 +533,12 @@ class Case(_Section):
         if actuation is None:  # a default is not validated: only a key given as null (a bare `actuation:`) is
             raise ValueError("is empty (a bare `actuation:` line), which would mean no chambers; write "
                              "`actuation: {}` for the default chambers, or remove the line for a body without them")
+        if isinstance(export, Export) and export.angular_count < MIN_ANGULAR_COUNT_WITH_CAVITIES:
+            raise ValueError(f"needs export.angular_count of at least {MIN_ANGULAR_COUNT_WITH_CAVITIES}, got "
+                             f"{export.angular_count}: the chambers leave less solid to hold the body polygon's "
+                             "missing area, and the mesh volume check fails (up to "
+                             f"{MAX_CAVITY_SHARE:.0%} of a section in chambers and feeds); raise "
+                             f"export.angular_count to {MIN_ANGULAR_COUNT_WITH_CAVITIES}")
         if isinstance(export, Export) and export.wall_mm is not None:
             raise ValueError("actuation's chambers and export.wall_mm's single hollow chamber are two designs of "
                              "the cavity; drop export.wall_mm (and port_mm) or drop actuation")

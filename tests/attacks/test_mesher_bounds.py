@@ -1,0 +1,33 @@
+"""Issue 45, valid inputs that ended as "a bug in the mesher": a key the mesher cannot honour is refused by the
+schema (exit 2) with the value that works, derived from the mesh it needs.
+"""
+
+from __future__ import annotations
+
+import pytest
+from typer.testing import CliRunner
+
+from softdesign.cli import app
+from softdesign.meshing.volume_tolerance import MIN_ANGULAR_COUNT, MIN_ANGULAR_COUNT_WITH_CAVITIES
+from tests.helpers.attacks import BUILD_TIMEOUT_S, assert_refused, demo_case, run_limited
+
+runner = CliRunner()
+
+
+def test_chambers_need_more_vertices_around_than_a_plain_body(tmp_path):
+    assert MIN_ANGULAR_COUNT_WITH_CAVITIES > MIN_ANGULAR_COUNT
+    export = {"q": [0, 1], "angular_count": MIN_ANGULAR_COUNT, "spacing_mm": 1.0}
+    plain = demo_case(tmp_path, name="plain", export=export)
+    assert runner.invoke(app, ["validate", str(plain)]).exit_code == 0
+    chambered = demo_case(tmp_path, name="chambered", export=export, actuation={})
+    result = runner.invoke(app, ["validate", str(chambered)])
+    assert_refused(result, "actuation", f"export.angular_count to {MIN_ANGULAR_COUNT_WITH_CAVITIES}")
+
+
+@pytest.mark.slow
+def test_the_chambered_demo_builds_at_the_bound(tmp_path):
+    # the demo with chambers at 37 sides failed the volume check by 0.503 % (exit 1, "refine the tessellation")
+    export = {"q": [0, 1], "angular_count": MIN_ANGULAR_COUNT_WITH_CAVITIES, "spacing_mm": 1.0}
+    case = demo_case(tmp_path, export=export, actuation={})
+    result = run_limited("build", str(case), "--out", str(tmp_path / "b"), "--jobs", "1", timeout=BUILD_TIMEOUT_S)
+    assert result.returncode == 0, result.stderr
