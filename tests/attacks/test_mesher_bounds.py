@@ -31,3 +31,19 @@ def test_the_chambered_demo_builds_at_the_bound(tmp_path):
     case = demo_case(tmp_path, export=export, actuation={})
     result = run_limited("build", str(case), "--out", str(tmp_path / "b"), "--jobs", "1", timeout=BUILD_TIMEOUT_S)
     assert result.returncode == 0, result.stderr
+
+
+def test_vertices_merge_within_a_tolerance_in_mm_whatever_the_files_unit(tmp_path):
+    from softdesign.io.formats import MERGE_TOLERANCE_MM
+    from softdesign.io.surface import read_surface
+
+    # two triangles whose corners at 0 and 5e-9 are 5e-9 file units apart: in metres that is 5e-6 mm, far above the
+    # tolerance (two vertices); in mm it is below it (one vertex)
+    gap = 5e-9
+    assert gap * 1000.0 > 100 * MERGE_TOLERANCE_MM > gap
+    path = tmp_path / "two.obj"
+    corners = [(0.0, 0.0, 0.0), (1e-3, 0.0, 0.0), (0.0, 1e-3, 0.0), (gap, 0.0, 0.0), (1e-3, 1e-3, 0.0)]
+    path.write_text("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in corners) + "f 1 2 3\nf 4 5 3\n")
+    metres, _ = read_surface(path, 1000.0)
+    millimetres, _ = read_surface(path, 1.0)
+    assert (len(metres), len(millimetres)) == (5, 4)
