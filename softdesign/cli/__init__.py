@@ -21,7 +21,7 @@ import typer
 from softdesign.cli.build import blend, build, export, fit, ingest, kinematics, links, mould, validate
 from softdesign.cli.centerline import centerline
 from softdesign.cli.check import check
-from softdesign.cli.common import list_whole_first_paragraphs
+from softdesign.cli.common import list_whole_first_paragraphs, unwritable_output
 from softdesign.cli.design import design
 from softdesign.cli.init import init
 from softdesign.cli.materials import materials
@@ -84,7 +84,8 @@ def main() -> None:
     """
     one_blas_thread()  # before any command loads numpy
     try:
-        app()
+        with unwritable_output():  # > /dev/full: one line and exit 1
+            app()
     finally:
         gc.freeze()
 

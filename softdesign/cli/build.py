@@ -43,12 +43,13 @@ KINEMATICS_LINK_KEYS = ("index", "l_start", "l_end", "length", "transform", "poe
 
 def _run(case_file: Path, out: Path | None, target: str | None, force: bool, jobs: int | None = 1):
     """Load the case and run the stages through ``target`` (every stage when None); ``jobs`` None: every core."""
+    from softdesign.cli.common import note
     from softdesign.cli.item_bar import build_progress
     from softdesign.pipeline.api import build_through
     from softdesign.pipeline.item_progress import items_told_to
     from softdesign.pipeline.parallel import checked_jobs
 
-    workers = checked_jobs(jobs)
+    workers = checked_jobs(jobs, note=note)
     with build_progress() as (stage_line, per_mesh), items_told_to(per_mesh):  # the mesh bar: on a terminal only
         outcome = build_through(case_file, out, target, force, progress=stage_line, jobs=workers)
     _warn_arc_misses(case_file, outcome.results)

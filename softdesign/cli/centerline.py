@@ -8,7 +8,7 @@ from typing import Annotated, Any, Literal
 
 import typer
 
-from softdesign.cli.common import JsonOpt, emit_json, note, point_from_text, refuse_overwriting_inputs, run_guarded
+from softdesign.cli.common import JsonOpt, ReplaceOpt, check_output_file, emit_json, note, point_from_text, run_guarded
 from softdesign.errors import ConfigError
 
 SurfaceArg = Annotated[
@@ -40,6 +40,7 @@ def centerline(
     outlet: OutletOpt = None,
     output: CenterlineOutputOpt = Path("centerline.vtp"),
     json: JsonOpt = False,
+    force: ReplaceOpt = False,
 ) -> None:
     """Compute VMTK-style centerlines (one polyline per outlet, MaximumInscribedSphereRadius) from a surface."""
 
@@ -55,15 +56,12 @@ def centerline(
         if output.suffix.lower() != ".vtp":
             raise ConfigError(f"--output {output}: expected a .vtp file (VMTK's centerline format), got "
                               f"'{output.suffix or '(no suffix)'}'")
-        if not output.parent.is_dir():
-            raise ConfigError(f"--output {output}: the folder {output.parent} does not exist; create it first")
-        refuse_overwriting_inputs("--output", output, [surface])
         scale = UNIT_SCALE_TO_MM[units]
-        options = CenterlineOptions(
-            inlet=None if inlet is None else _mm(point_from_text(inlet, "--inlet"), scale),
-            outlets=tuple(_mm(point_from_text(text, "--outlet"), scale) for text in outlet or []),
-            regions=read_face_regions(surface) if surface.is_file() else None,
-        )
+        inlet_mm = None if inlet is None else _mm(point_from_text(inlet, "--inlet"), scale)
+        outlets_mm = tuple(_mm(point_from_text(text, "--outlet"), scale) for text in outlet or [])
+        check_output_file("--output", output, force, [surface])
+        options = CenterlineOptions(inlet=inlet_mm, outlets=outlets_mm,
+                                    regions=read_face_regions(surface) if surface.is_file() else None)
         start = time.perf_counter()
         vertices, faces = read_surface(surface, scale)
         result = extract_centerlines(vertices, faces, options, str(surface))

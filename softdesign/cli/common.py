@@ -9,12 +9,14 @@ the distance lists ``--d``/``--pcc-d``) are the only ones; they raise
 
 from __future__ import annotations
 
+import errno
 import inspect
 import json
 import math
 import os
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Any, TypeVar
 
@@ -27,6 +29,8 @@ T = TypeVar("T")
 CaseArg = Annotated[Path, typer.Argument(help="The case file (YAML).", show_default=False)]
 OutOpt = Annotated[Path | None, typer.Option("--out", "-o", help="Build folder [default: build/<name>].")]
 ForceOpt = Annotated[bool, typer.Option("--force", help="Redo every stage, ignoring the cache.")]
+#: ``--force`` of a command that writes a file with ``--output`` and builds nothing.
+ReplaceOpt = Annotated[bool, typer.Option("--force", help="Replace the --output file if it exists.")]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")]
 QOpt = Annotated[
     str,
@@ -81,6 +85,36 @@ def run_guarded(action: Callable[[], T]) -> T:
         # folder (or an output file) is the previous one, whole
         typer.echo(INTERRUPTED, err=True)
         raise typer.Exit(code=130) from None
+
+
+#: Why an output cannot be written that is no bug: a full disk or quota, a device that refuses (/dev/full), a file
+#: too large for its file system, an I/O error.
+_UNWRITABLE = {errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EFBIG}
+
+
+@contextmanager
+def unwritable_output() -> Iterator[None]:
+    """Output that cannot be written (``> /dev/full``, a full disk): one line on stderr and exit 1, no traceback.
+
+    Standard output is flushed inside the block, so that what a command printed fails here rather than in the
+    interpreter's exit; it is then pointed at the null device, so that the exit does not try again.
+    """
+    try:
+        try:
+            yield
+        finally:
+            sys.stdout.flush()
+    except OSError as err:
+        if err.errno not in _UNWRITABLE:
+            raise
+        where = os.fsdecode(err.filename) if err.filename is not None else "the standard output"
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError, AttributeError):
+            pass
+        sys.stderr.write(f"error: cannot write {where} ({err.strerror or err}); free space on that disk or write "
+                         "the output elsewhere\n")
+        raise SystemExit(1) from None
 
 
 def finite_number(text: str, what: str, fix: str) -> float:
@@ -213,6 +247,31 @@ def refuse_overwriting_inputs(option: str, target: Path, inputs: list[Path]) -> 
         if same:
             raise ConfigError(f"{option} {target}: is {item}, an input of this case, which writing would overwrite; "
                               "write to another file")
+
+
+def check_output_file(option: str, target: Path, force: bool, inputs: list[Path] | tuple[Path, ...] = ()) -> None:
+    """Refuse, before any work, an output file ``target`` that writing would damage (ConfigError with the fix).
+
+    Refused: a target that exists and is not a regular file (a device, a FIFO, a folder, a link); one of the
+    ``inputs``; a target inside a softdesign build folder (only ``build`` writes there, and a file it did not
+    write makes every rebuild refuse the folder), even with ``--force``; an existing file without ``force``.
+    """
+    from softdesign.io.atomic import check_replaceable
+    from softdesign.pipeline.out_folder import build_folder_holding
+
+    if os.path.isdir(target) and not os.path.islink(target):
+        raise ConfigError(f"{option} {target}: is a folder, expected the name of the file to write")
+    check_replaceable(target)
+    if not target.parent.is_dir():
+        raise ConfigError(f"{option} {target}: the folder {target.parent} does not exist; create it first")
+    refuse_overwriting_inputs(option, target, list(inputs))
+    build_dir = build_folder_holding(target.parent)
+    if build_dir is not None:
+        raise ConfigError(f"{option} {target}: is inside the build folder {build_dir}, which only `softdesign build` "
+                          "writes (a file it did not write there makes every rebuild refuse the folder); "
+                          "write it outside the build folder")
+    if os.path.lexists(target) and not force:
+        raise ConfigError(f"{option} {target}: already exists; give --force to replace it, or another name")
 
 
 def case_inputs(case_file: Path) -> list[Path]:

@@ -21,10 +21,11 @@ from softdesign.cli.common import (
     CaseArg,
     JsonOpt,
     OutOpt,
+    ReplaceOpt,
     case_inputs,
+    check_output_file,
     emit_json,
     note,
-    refuse_overwriting_inputs,
     run_guarded,
 )
 from softdesign.config.design import MAX_DESIGN_LINKS
@@ -111,6 +112,7 @@ def design(
         "--output", help="The designed case file to write [default: <case>-designed.yaml beside the case].")] = None,
     json_out: JsonOpt = False,
     out: OutOpt = None,
+    force: ReplaceOpt = False,
 ) -> None:
     """The fewest constant-curvature sections, composed from the base frame, within the bounds of the centerline.
 
@@ -141,14 +143,12 @@ def design(
         if d is not None:
             spacing_from_text(d, None)  # numbers > 0: fail before building
         target = output if output is not None else case_file.with_name(f"{case_file.stem}-designed.yaml")
-        if not target.parent.is_dir():
-            raise ConfigError(f"--output {target}: the folder {target.parent} does not exist; create it first")
         if target.is_dir():
             raise ConfigError(f"--output {target}: is a folder, expected the case file to write; name a file in it, "
                               f"e.g. {target / (case_file.stem + '-designed.yaml')}")
         if target.resolve() == case_file.resolve():
             raise ConfigError(f"--output {target}: is the case file itself; write the design to another file")
-        refuse_overwriting_inputs("--output", target, case_inputs(case_file))
+        check_output_file("--output", target, force, case_inputs(case_file))
         case = _case_with_design(case_file, {
             "tolerance_mm": tolerance_mm, "tip_tolerance_mm": tip_tolerance_mm,
             "tip_tolerance_deg": tip_tolerance_deg, "max_links": max_links, "min_link_mm": min_link_mm})
@@ -191,6 +191,7 @@ def _write_case(case_file: Path, target: Path, breaks: list[float], case: Case, 
     """The case file's text with the design: block used, blend: pcc and the design's breaks (the rest kept)."""
     from softdesign.io.atomic import write_bytes_atomically
     from softdesign.io.case_edit import breaks_text, case_text_with_keys, rounded_breaks
+    from softdesign.io.case_yaml import read_case_text
 
     assert case.design is not None
     block = {k: v for k, v in case.design.model_dump().items() if v is not None}
@@ -203,8 +204,8 @@ def _write_case(case_file: Path, target: Path, breaks: list[float], case: Case, 
     if problems:  # the case's own q = 0 shape or keyframes: keep its blend, say why
         del updates["blend"]
         note(f"note: {target} keeps blend: {case.blend}: " + "; ".join(problems))
-    text = case_file.read_text(encoding="utf-8")
-    new_text, kept = case_text_with_keys(text, updates, case_file.parent, target.parent)
+    text = read_case_text(case_file)
+    new_text, kept = case_text_with_keys(text, updates, case_file.parent, target.parent, case_file)
     try:
         write_bytes_atomically(target, new_text.encode("utf-8"))
     except OSError as err:

@@ -5,12 +5,12 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import typer
 
-from softdesign.cli.common import note, run_guarded
-from softdesign.errors import ConfigError
+from softdesign.cli.common import check_output_file, note, run_guarded
+from softdesign.errors import ConfigError, SoftdesignError
 
 InitSurfaceArg = Annotated[
     Path, typer.Argument(help="The vessel surface (.stl .ply .obj .vtp .vtk), open at its ends or capped.",
@@ -44,7 +44,7 @@ def init(
     def action() -> None:
         from softdesign.cli.schema import schema_text
         from softdesign.geometry.path_survey import MAIN_PATH_RULE
-        from softdesign.io.atomic import write_bytes_atomically
+        from softdesign.io.atomic import atomic_target, write_bytes_atomically
         from softdesign.pipeline.case_template import SCHEMA_FILE, init_case_text
         from softdesign.pipeline.inspect_inputs import inspect_inputs, inspection_path_lines
 
@@ -56,7 +56,9 @@ def init(
         try:
             if not schema_path.exists() or _is_our_schema(schema_path):
                 write_bytes_atomically(schema_path, schema_text().encode())
-            write_bytes_atomically(output, text.encode())
+            with atomic_target(output) as temporary:
+                temporary.write_bytes(text.encode("utf-8", "surrogateescape"))
+                _read_back(temporary, output, inspection)  # before it replaces anything
         except OSError as err:
             raise ConfigError(f"--output {output}: cannot write it ({err.strerror or err}); choose a writable path"
                               ) from err
@@ -78,20 +80,46 @@ def init(
 def _check_output(output: Path, inputs: list[Path], force: bool) -> None:
     if output.suffix.lower() not in (".yaml", ".yml"):
         raise ConfigError(f"--output {output}: expected a .yaml case file, got '{output.suffix or '(no suffix)'}'")
-    if output.is_dir():
-        raise ConfigError(f"--output {output}: is a folder, expected a case file name (e.g. case.yaml)")
-    if not output.parent.is_dir():
-        raise ConfigError(f"--output {output}: the folder {output.parent} does not exist; create it first")
-    for path in inputs:
-        if path.exists() and output.exists() and output.resolve() == path.resolve():
-            raise ConfigError(f"--output {output}: is one of the inputs; choose another name for the case file")
-    if output.exists() and not force:
-        raise ConfigError(f"--output {output}: already exists; give --force to replace it, or another name")
+    check_output_file("--output", output, force, inputs)
+    for path in (*inputs, output):
+        try:
+            str(path.resolve()).encode("utf-8")
+        except UnicodeEncodeError:
+            raise ConfigError(f"{path!r}: its name is not UTF-8 text, and a case file is UTF-8; rename the file "
+                              "(or its folder) with UTF-8 characters") from None
+
+
+#: The largest file read to tell whether it is a schema softdesign wrote (the schema is about 40 kB).
+MAX_SCHEMA_BYTES = 4 << 20
+
+
+def _read_back(written: Path, output: Path, inspection: Any) -> None:
+    """Read the case file just written (at ``written``, beside ``output``) as a build would; exit 1 if it differs.
+
+    The paths must read back as the files inspected, and the case must pass the schema: a case that ``init``
+    writes and ``build`` refuses is init's bug, reported before the file takes the name ``output``.
+    """
+    from softdesign.config import load_case
+    from softdesign.io.case_yaml import parse_case_yaml, read_case_text
+    from softdesign.pipeline.case_template import expected_paths, paths_read_back
+
+    expected = expected_paths(inspection, output)
+    try:
+        got = paths_read_back(parse_case_yaml(written, read_case_text(written))[0])
+        load_case(written)
+    except ConfigError as err:
+        got = {"error": str(err)}
+    if got != expected:
+        raise SoftdesignError(f"--output {output}: the case file init wrote does not read back as written "
+                              f"(expected final paths {expected}, read {got}); nothing was written. This is a bug "
+                              "in softdesign init: please report it with the files' names")
 
 
 def _is_our_schema(path: Path) -> bool:
     """True when ``path`` holds a schema ``softdesign schema`` wrote (so it may be brought up to date)."""
     try:
+        if not path.is_file() or path.stat().st_size > MAX_SCHEMA_BYTES:  # a FIFO would hang the read
+            return False
         return json.loads(path.read_text()).get("title") == "softdesign case file"
     except (OSError, ValueError, AttributeError):
         return False

@@ -21,9 +21,11 @@ from softdesign.cli.common import TEXT_ANGLES, JsonOpt, emit_json, note, refuse_
 from softdesign.cli.pcc_bounds import (
     MAX_LENGTH_MM,
     MAX_POINTS_PER_SECTION,
+    MAX_REJECTED_NOTES,
     MAX_SECTIONS,
     check_backbone_points,
     check_readings_file,
+    check_readings_rows,
     check_shapes_dir,
 )
 from softdesign.cli.pcc_design import design
@@ -197,6 +199,7 @@ def read_readings(path: Path, max_rate: float | None = None) -> Readings:
     import numpy as np
 
     check_readings_file(path)
+    check_readings_rows(path)
     try:
         rows = [(n, row) for n, row in enumerate(csv.reader(io.StringIO(path.read_text())), start=1) if row]
     except (OSError, UnicodeDecodeError, csv.Error) as err:
@@ -289,8 +292,9 @@ def _readings_and_arcs(path: Path, d: str | None, max_rate: float | None) -> tup
     from softdesign.kinematics.chamber_lengths import arcs_from_chamber_lengths
 
     check_readings_file(path)  # the size bound, before either reader
+    check_readings_rows(path)
     if is_actuation_header(first_row(path)):
-        table = read_actuation_table(path)
+        table = read_actuation_table(path, MAX_LENGTH_MM, MAX_SECTIONS)
         if d is not None:
             given = spacing_from_text(d, table.lengths.shape[1], where=str(path))
             if not np.allclose(given, table.distance_mm, rtol=0.0, atol=1e-9):
@@ -354,8 +358,11 @@ def reconstruct(
             )
         readings, arcs, first = _readings_and_arcs(readings_csv, d, max_rate)
         check_backbone_points(str(readings_csv), len(readings.times), readings.lengths.shape[1], points_per_section)
-        for line, time, reason in readings.rejected:
+        for line, time, reason in readings.rejected[:MAX_REJECTED_NOTES]:
             note(f"{readings_csv} line {line} (time {time}): rejected: {reason}")
+        if len(readings.rejected) > MAX_REJECTED_NOTES:
+            note(f"{readings_csv}: {len(readings.rejected) - MAX_REJECTED_NOTES:,} more row(s) rejected; "
+                 f"{out_dir / 'rejected.csv'} lists every one with its reason")
         for name in ("tips.csv", "backbones.vtp", "rejected.csv"):  # never over the readings themselves
             refuse_overwriting_inputs("--shapes-dir", out_dir / name, [readings_csv])
         check_shapes_dir(out_dir)

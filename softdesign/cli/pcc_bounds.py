@@ -5,7 +5,11 @@ Why these values (seed 003's sections are a few cm long, a few mm from the backb
 * a cable length of at most :data:`MAX_LENGTH_MM` (100 m): beyond it the arcs' trigonometry loses every digit
   and ``--lengths 1e308`` gave NaN poses;
 * at most :data:`MAX_SECTIONS` sections, as a design has at most :data:`~softdesign.limits.MAX_LINKS` links;
-* a readings file of at most :data:`MAX_READINGS_BYTES` (64 MB, about a million rows of three sections);
+* a readings file of at most :data:`MAX_READINGS_BYTES` (64 MB, about a million rows of three sections) and
+  :data:`MAX_READINGS_ROWS` rows, counted before a row is parsed (8 million short rows of a 64 MB file took
+  4.3 GB and 218 s, a million rows 3.1 GB and 194 s; 100,000 rows at 20 points per section, the backbone
+  bound below, peak at 1.0 GB and 31 s), an actuation table too; at most :data:`MAX_REJECTED_NOTES` rejected
+  rows are told on stderr (all of them are in rejected.csv);
 * at most :data:`MAX_BACKBONE_POINTS` backbone samples written in all (rows x sections x points per section):
   each holds a 4x4 pose, its frame and arc length, about 250 bytes while built, 500 MB at the bound (1000 rows
   of 1000 sections tried 2.5 GiB);
@@ -29,6 +33,11 @@ MAX_LENGTH_MM = 100_000.0
 MAX_SECTIONS = MAX_LINKS
 #: Largest readings CSV, bytes.
 MAX_READINGS_BYTES = 64_000_000
+#: Most rows (readings or actuation-table rows) a file may have, counted before parsing: 100 readings a second for
+#: over 16 minutes.
+MAX_READINGS_ROWS = 100_000
+#: Most rejected rows told one by one on stderr; the rest are counted (rejected.csv lists them all).
+MAX_REJECTED_NOTES = 20
 #: Most backbone samples ``pcc reconstruct`` writes in all (accepted rows x sections x points per section).
 MAX_BACKBONE_POINTS = 2_000_000
 #: Most backbone samples per arc (``pcc reconstruct --points-per-section``).
@@ -62,6 +71,20 @@ def check_readings_file(path: Path) -> None:
     if info.st_size > MAX_READINGS_BYTES:
         raise InputDataError(f"{path}: {info.st_size:,} bytes, above the bound of {MAX_READINGS_BYTES:,} for a "
                              "readings file; split the readings into several files")
+
+
+def check_readings_rows(path: Path) -> None:
+    """InputDataError when ``path`` (within MAX_READINGS_BYTES) has more than MAX_READINGS_ROWS rows and a header."""
+    lines = 0
+    try:
+        with path.open("rb") as handle:
+            for chunk in iter(lambda: handle.read(1 << 20), b""):
+                lines += chunk.count(b"\n")
+    except OSError as err:
+        raise InputDataError(f"{path}: cannot read the readings file ({err.strerror})") from None
+    if lines > MAX_READINGS_ROWS + 1:
+        raise InputDataError(f"{path}: {lines:,} lines, above the bound of {MAX_READINGS_ROWS:,} rows (and a header) "
+                             "for a readings file; split the readings into several files")
 
 
 def check_shapes_dir(path: Path) -> None:

@@ -16,15 +16,14 @@ import typer
 from softdesign.cli.common import (
     Q_FIX,
     CaseArg,
-    ForceOpt,
     JsonOpt,
     OutOpt,
     QOpt,
     case_inputs,
+    check_output_file,
     emit_json,
     note,
     q_values_from_text,
-    refuse_overwriting_inputs,
     run_guarded,
 )
 from softdesign.errors import ConfigError, errors_named_for
@@ -35,6 +34,10 @@ OutputOpt = Annotated[
     typer.Option("--output", help="Mesh file to write; its suffix picks the format ("
                  + " ".join(f".{f}" for f in MESH_FORMATS) + ").", show_default=False),
 ]
+
+
+PoseForceOpt = Annotated[bool, typer.Option(
+    "--force", help="Redo every stage, ignoring the cache, and replace the --output file if it exists.")]
 
 
 def mesh_format_of(path: Path) -> str:
@@ -142,7 +145,7 @@ def pose(
     q: QOpt,
     output: OutputOpt,
     out: OutOpt = None,
-    force: ForceOpt = False,
+    force: PoseForceOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
     """The body with one q per link (each link's surface at its own q, placed by the links before it).
@@ -157,7 +160,7 @@ def pose(
         _check_build_folder_option(out)
         q_values = q_values_from_text(q)
         mesh_format_of(output)  # refuse an unknown suffix or folder before the build, not after
-        refuse_overwriting_inputs("--output", output, case_inputs(case_file))
+        check_output_file("--output", output, force, case_inputs(case_file))
         body = _make_pose(case_file, q_values, out, force)
         try:
             write_mesh(output, body.vertices, body.faces, body.regions)

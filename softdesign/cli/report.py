@@ -32,7 +32,7 @@ def report_after_build(build_dir: Path, pcc_d: str | None = None, jobs: int | No
     from softdesign.pipeline.parallel import checked_jobs
     from softdesign.report.writer import ReportOptions, write_report
 
-    workers = checked_jobs(jobs)
+    workers = checked_jobs(jobs, note=note)
     options = ReportOptions(pcc_d=pcc_d_from_text(pcc_d))
     start = time.perf_counter()
     with part_progress("report") as tick:  # a bar on a terminal only; logs get the one summary line below

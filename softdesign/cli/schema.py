@@ -8,7 +8,7 @@ from typing import Annotated, Any
 
 import typer
 
-from softdesign.cli.common import run_guarded
+from softdesign.cli.common import ReplaceOpt, check_output_file, run_guarded
 from softdesign.errors import ConfigError
 
 SchemaOutputOpt = Annotated[
@@ -33,7 +33,7 @@ def schema_text() -> str:
     return json.dumps(case_schema(), indent=2, sort_keys=True) + "\n"
 
 
-def schema(output: SchemaOutputOpt = None) -> None:
+def schema(output: SchemaOutputOpt = None, force: ReplaceOpt = False) -> None:
     """Print (or write) the case file's JSON Schema, for editors that complete and check case files."""
 
     def action() -> None:
@@ -43,10 +43,7 @@ def schema(output: SchemaOutputOpt = None) -> None:
         if output is None:
             typer.echo(text, nl=False)
             return
-        if output.is_dir():
-            raise ConfigError(f"--output {output}: is a folder, expected a file name (e.g. case.schema.json)")
-        if not output.parent.is_dir():
-            raise ConfigError(f"--output {output}: the folder {output.parent} does not exist; create it first")
+        check_output_file("--output", output, force)
         try:
             write_bytes_atomically(output, text.encode())
         except OSError as err:

@@ -35,7 +35,7 @@ from softdesign.config.actuation import Actuation
 from softdesign.config.design import Design, pcc_blend_problems
 from softdesign.config.material import CustomMaterial
 from softdesign.config.simulate import Simulate
-from softdesign.config.types import FiniteFloat, Integer, q_in_range
+from softdesign.config.types import FiniteFloat, Flag, Integer, q_in_range
 from softdesign.errors import ConfigError
 from softdesign.io.case_yaml import parse_case_yaml, read_case_text
 from softdesign.io.format_names import MESH_FORMATS, q_label
@@ -59,7 +59,12 @@ from softdesign.limits.shape import (
 from softdesign.limits.volume import MAX_MESHER_SECONDS, MAX_VOLUME_MESHES, MIN_TET_SIZE_MM
 from softdesign.materials import MaterialLimits, PresetName, resolve_material
 from softdesign.meshing.mould_spec import MIN_MOULD_WALL_MM
-from softdesign.meshing.volume_tolerance import MIN_ANGULAR_COUNT, VOLUME_RTOL
+from softdesign.meshing.volume_tolerance import (
+    MAX_CAVITY_SHARE,
+    MIN_ANGULAR_COUNT,
+    MIN_ANGULAR_COUNT_WITH_CAVITIES,
+    VOLUME_RTOL,
+)
 
 
 class _Section(BaseModel):
@@ -83,7 +88,7 @@ class FinalShape(_Section):
     """
     inlet: tuple[FiniteFloat, FiniteFloat, FiniteFloat] | None = None
     """A point near the inlet: the path's end nearest it is l = 0, where the actuator is mounted."""
-    reverse: bool = False
+    reverse: Flag = False
     """Flip the path's orientation (when the inlet rule picks the wrong end)."""
     surface_units: Literal["mm", "cm", "m"] | None = None
     """The surface file's unit when it differs from the case's units."""
@@ -104,7 +109,7 @@ class IntermediateShape(_Section):
     """The keyframe's centerline file."""
     path: Integer = Field(0, ge=0)
     """Which path of the keyframe's centerline file."""
-    reverse: bool = False
+    reverse: Flag = False
     """Flip the keyframe path's orientation."""
 
 
@@ -127,7 +132,7 @@ class InitialShape(_Section):
     """The q = 0 centerline file (kind: file)."""
     path: Integer = Field(0, ge=0)
     """Which path of the q = 0 centerline file (kind: file)."""
-    align_base: bool = True
+    align_base: Flag = True
     """Place the q = 0 shape's base on the q = 1 shape's base frame."""
 
     # after FiniteFloat's own check, so that a nan is called not finite rather than out of range
@@ -332,7 +337,7 @@ class Export(_Section):
     angular_count: Integer = Field(64, ge=MIN_ANGULAR_COUNT, le=MAX_ANGULAR_COUNT)
     """Vertices around each ring of the meshes."""
     #: also write one STL per face region (wall, caps, chamber, port): meshes/q_0.500/wall.stl, ...
-    split_regions: bool = False
+    split_regions: Flag = False
     """Also write one STL per face region (wall, caps, chamber, port)."""
     frame: Literal["patient", "base"] = "patient"
     """The output meshes' coordinates: patient (the input files', over the vessel) or base (the q = 0 body's base
@@ -525,7 +530,16 @@ class Case(_Section):
     @classmethod
     def _one_kind_of_cavity(cls, actuation: Actuation | None, info: ValidationInfo) -> Actuation | None:
         export = info.data.get("export")
-        if actuation is not None and isinstance(export, Export) and export.wall_mm is not None:
+        if actuation is None:  # a default is not validated: only a key given as null (a bare `actuation:`) is
+            raise ValueError("is empty (a bare `actuation:` line), which would mean no chambers; write "
+                             "`actuation: {}` for the default chambers, or remove the line for a body without them")
+        if isinstance(export, Export) and export.angular_count < MIN_ANGULAR_COUNT_WITH_CAVITIES:
+            raise ValueError(f"needs export.angular_count of at least {MIN_ANGULAR_COUNT_WITH_CAVITIES}, got "
+                             f"{export.angular_count}: the chambers leave less solid to hold the body polygon's "
+                             "missing area, and the mesh volume check fails (up to "
+                             f"{MAX_CAVITY_SHARE:.0%} of a section in chambers and feeds); raise "
+                             f"export.angular_count to {MIN_ANGULAR_COUNT_WITH_CAVITIES}")
+        if isinstance(export, Export) and export.wall_mm is not None:
             raise ValueError("actuation's chambers and export.wall_mm's single hollow chamber are two designs of "
                              "the cavity; drop export.wall_mm (and port_mm) or drop actuation")
         return actuation

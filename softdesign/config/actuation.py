@@ -20,11 +20,11 @@ chamber 1 where seed 003's encoder 1 sits (90 degrees from N).
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from softdesign.config.types import FiniteFloat
+from softdesign.config.types import FiniteFloat, Integer
 
 if TYPE_CHECKING:  # numpy stays out of `softdesign validate`
     from softdesign.meshing.chamber_layout import ActuationSpec
@@ -38,7 +38,7 @@ class Actuation(BaseModel):
 
     model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
 
-    chambers_per_section: Literal[3] = 3
+    chambers_per_section: Integer = Field(3, ge=3, le=3)
     """Chambers in each section (seed 003's three)."""
     distance_mm: FiniteFloat = Field(2.0, gt=0.0, le=MAX_ACTUATION_MM)
     """Distance of the chambers' axes from the backbone, mm (absolute: seed 003's d is one number per section)."""

@@ -11,11 +11,25 @@ elongation at break) unless ``material.max_stretch`` says otherwise.
 
 from __future__ import annotations
 
+import unicodedata
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from softdesign.materials import DESIGN_FRACTION, MaterialLimits
+
+#: The smallest C1 a law may have, kPa: a tenth of the softest silicone gels' (C1 about 1 kPa). Below it the finite
+#: elements' shear stiffness vanishes beside their bulk term and the factorization is singular (c1_kpa: 1e-300
+#: ended the solve in "Factor is exactly singular").
+MIN_C1_KPA = 0.1
+
+
+def _printable(value: str) -> str:
+    """``value`` when it holds no control character (a name reaches the terminal, the report and the manifest)."""
+    bad = [c for c in value if unicodedata.category(c) in ("Cc", "Cf", "Zl", "Zp")]
+    if bad:
+        raise ValueError(f"holds the control character {bad[0]!r}; write it on one line with printable characters")
+    return value
 
 
 class CustomLaw(BaseModel):
@@ -25,8 +39,8 @@ class CustomLaw(BaseModel):
 
     kind: Literal["neo-hookean", "yeoh"]
     """neo-hookean or yeoh."""
-    c1_kpa: float = Field(gt=0.0, le=1.0e6)
-    """C1 (mu / 2 for neo-Hookean), kPa."""
+    c1_kpa: float = Field(ge=MIN_C1_KPA, le=1.0e6)
+    """C1 (mu / 2 for neo-Hookean), kPa; at least 0.1 (the softest silicone gels have about 1)."""
     c2_kpa: float = Field(ge=-1.0e6, le=1.0e6)
     """Yeoh's C2, kPa."""
     c3_kpa: float = Field(ge=-1.0e6, le=1.0e6)
@@ -57,6 +71,11 @@ class CustomMaterial(BaseModel):
     #: the document and table the numbers come from (a test report, a datasheet)
     source: str = Field(min_length=3, max_length=500)
     """Where the numbers come from (document and table)."""
+
+    @field_validator("name", "shore", "source")
+    @classmethod
+    def _no_control_characters(cls, value: str) -> str:
+        return _printable(value)
 
     def limits(self) -> MaterialLimits:
         """The presets' rule applied to this material's elongation at break."""

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
-from softdesign.config.types import FiniteFloat, Integer, q_in_range
+from softdesign.config.types import FiniteFloat, Flag, Integer, q_in_range
 from softdesign.limits import MAX_LINKS
 from softdesign.limits.simulate import (
     MAX_ANGULAR_COUNT,
@@ -38,7 +38,7 @@ class Simulate(BaseModel):
 
     model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
 
-    enabled: bool = False
+    enabled: Flag = False
     """Run the simulate stage in `build` (minutes per section): false by default."""
     q: list[FiniteFloat] = Field([1.0], min_length=1, max_length=MAX_SIMULATE_Q)
     """The q values whose pressures are estimated, each in [0, 1], at least 0.001 apart (default [1])."""

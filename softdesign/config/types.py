@@ -4,7 +4,8 @@ Every numeric key of the case file is one of these two, so ``softdesign
 validate`` refuses what would otherwise reach the numeric core: NaN, inf and
 ``"1e400"`` (which reads as inf) for a float; a bool (``count: true`` is not
 one link), a float (``count: 1e30``, ``count: 2.0``) or a string for an
-integer.  A float key takes an integer (``spacing_mm: 1``) and a number
+integer; anything but true or false for a yes/no key (``enabled: "yes"``).
+A float key takes an integer (``spacing_mm: 1``) and a number
 written without a dot (YAML 1.1 reads ``1e-5`` as the string "1e-5"), but
 never a bool.
 """
@@ -26,6 +27,8 @@ def _not_a_bool(value: Any) -> Any:
 FiniteFloat = Annotated[float, BeforeValidator(_not_a_bool), AllowInfNan(False)]
 #: An integer written as one: bools, floats and strings are refused.
 Integer = Annotated[int, Strict()]
+#: A yes/no key written as true or false: a string ("yes", "false", which would read as true) or a number is refused.
+Flag = Annotated[bool, Strict()]
 
 
 def q_in_range(values: list[float]) -> list[float]:

@@ -59,13 +59,15 @@ def _number(path: Path, line: int, name: str, text: str) -> float:
     return value
 
 
-def read_actuation_table(path: Path) -> ActuationReadings:
-    """The readings of an actuation table.
+def read_actuation_table(path: Path, max_length_mm: float, max_sections: int) -> ActuationReadings:
+    """The readings of an actuation table, lengths and distances at most ``max_length_mm``, sections at most
+    ``max_sections`` (the bounds of encoder readings, so that a table is held to what a readings file is).
 
     Raises
     ------
     InputDataError
-        A missing column, a bad number, chambers not 1..3 at 120 degrees, or sections that differ between q.
+        A missing column, a bad number, a length, distance or section beyond its bound, chambers not 1..3 at
+        120 degrees, or sections that differ between q.
     """
     rows = list(csv.reader(io.StringIO(path.read_text(encoding="utf-8"))))
     header = [h.strip() for h in rows[0]]
@@ -79,10 +81,11 @@ def read_actuation_table(path: Path) -> ActuationReadings:
         q, angle, distance, length = (_number(path, line, n, values[col[n]])
                                       for n in ("q", "angle_deg", "distance_mm", "length_mm"))
         section, chamber = (int(_number(path, line, n, values[col[n]])) for n in ("section", "chamber"))
-        if chamber not in (1, 2, 3) or section < 1 or length <= 0.0 or distance <= 0.0:
+        if (chamber not in (1, 2, 3) or not 1 <= section <= max_sections or not 0.0 < length <= max_length_mm
+                or not 0.0 < distance <= max_length_mm):
             raise InputDataError(f"{path} line {line}: section {section} chamber {chamber} length {length:g} mm "
-                                 f"distance {distance:g} mm; expected chambers 1-3, sections from 1, lengths and "
-                                 "distances > 0")
+                                 f"distance {distance:g} mm; expected chambers 1-3, sections 1 to {max_sections}, "
+                                 f"lengths and distances > 0 and at most {max_length_mm:g} mm")
         table.setdefault(q, {}).setdefault(section, {})[chamber] = (angle, distance, length)
     return _assemble(path, table)
 

@@ -7,7 +7,11 @@ the user wrote them; relative input paths are re-expressed from the new file's
 folder when it is written elsewhere.  The edit is checked by parsing it back:
 if the parsed result is not exactly the case with the new links (YAML the
 span edit cannot handle, e.g. anchors), the file is written whole by
-``yaml.safe_dump`` instead (comments lost, values the same).
+``yaml.safe_dump`` instead (comments lost, values the same).  Every parse is
+:func:`~softdesign.io.case_yaml.parse_case_yaml`'s, the one reader of case
+files, so what ``build`` and ``validate`` accept (a tab before a comment, CRLF
+line ends, a byte-order mark) is edited the same way; a byte-order mark is
+dropped first, as the reader's positions do not count it.
 """
 
 from __future__ import annotations
@@ -19,6 +23,9 @@ from pathlib import Path
 from typing import Any
 
 import yaml
+
+from softdesign.errors import ConfigError
+from softdesign.io.case_yaml import parse_case_yaml
 
 #: Case keys that hold input file paths, relative to the case file's folder (``intermediate`` is a list of these).
 PATH_KEYS = (("final", "centerline"), ("final", "surface"), ("initial", "centerline"), ("initial", "surface"))
@@ -34,7 +41,8 @@ def rounded_breaks(breaks: list[float]) -> list[float]:
     return [round(float(b), 6) for b in breaks]
 
 
-def case_text_with_breaks(text: str, breaks: list[float], source_dir: Path, target_dir: Path) -> tuple[str, bool]:
+def case_text_with_breaks(text: str, breaks: list[float], source_dir: Path, target_dir: Path,
+                          where: Path = Path("case.yaml")) -> tuple[str, bool]:
     """The case file ``text`` with ``links: {breaks: ...}``, paths rebased from ``source_dir`` to ``target_dir``.
 
     Returns
@@ -42,26 +50,28 @@ def case_text_with_breaks(text: str, breaks: list[float], source_dir: Path, targ
     (text, kept) : the new text, and whether the user's text was kept (False: written whole by safe_dump)
     """
     return case_text_with_keys(text, {"links": ({"breaks": rounded_breaks(breaks)}, breaks_text(breaks))},
-                               source_dir, target_dir)
+                               source_dir, target_dir, where)
 
 
 def case_text_with_keys(text: str, updates: dict[str, tuple[Any, str]], source_dir: Path,
-                        target_dir: Path) -> tuple[str, bool]:
+                        target_dir: Path, where: Path = Path("case.yaml")) -> tuple[str, bool]:
     """The case file ``text`` with top-level keys set (``{key: (value, its YAML flow text)}``), paths rebased.
+
+    ``where`` names the case file in the messages of a text the reader refuses (ConfigError with its line).
 
     Returns
     -------
     (text, kept) : the new text, and whether the user's text was kept (False: written whole by safe_dump)
     """
-    raw = yaml.safe_load(text)
-    root = yaml.compose(text)
+    text = text.removeprefix("\ufeff")
+    raw, root = parse_case_yaml(where, text)
     expected = _expected(raw, updates, source_dir, target_dir)
     if isinstance(root, yaml.MappingNode) and not root.flow_style:
-        edited = _edited(text, root, updates, source_dir, target_dir)
+        edited = _edited(text, raw, root, updates, source_dir, target_dir)
         try:
-            if yaml.safe_load(edited) == expected:
+            if parse_case_yaml(where, edited)[0] == expected:
                 return edited, True
-        except yaml.YAMLError:
+        except ConfigError:
             pass
     return yaml.safe_dump(expected, sort_keys=False, default_flow_style=None), False
 
@@ -115,10 +125,9 @@ def _content_end(node: yaml.Node) -> int:
     return node.end_mark.index
 
 
-def _edited(text: str, root: yaml.MappingNode, updates: dict[str, tuple[Any, str]], source_dir: Path,
-            target_dir: Path) -> str:
+def _edited(text: str, raw: dict[str, Any], root: yaml.MappingNode, updates: dict[str, tuple[Any, str]],
+            source_dir: Path, target_dir: Path) -> str:
     edits: list[tuple[int, int, str]] = []
-    raw = yaml.safe_load(text)
     for slot in _path_slots(raw):
         node: yaml.Node | None = root
         for key in slot:

@@ -33,6 +33,11 @@ from softdesign.io.vtk_polydata import polydata_arrays, read_polydata
 RADIUS_KEY = "MaximumInscribedSphereRadius"
 
 
+#: Most points a .csv or .npy centerline may hold (a VTK file's counts are bounded by its header: vtk_header_bounds).
+#: A VMTK centerline has a few thousand points and the build resamples it to at most 50,000; a million read rows
+#: cost about 200 MB as the CSV is parsed (12 million .npy points passed 6.2 GB before).
+MAX_CENTERLINE_POINTS = 1_000_000
+
 def read_centerline_network(path: str | Path, scale_to_mm: float = 1.0) -> CenterlineNetwork:
     """Read every polyline of a centerline file.
 
@@ -110,8 +115,26 @@ def _line_cells(poly) -> list[np.ndarray]:
     return [ids[a:b] for a, b in zip(offsets[:-1], offsets[1:], strict=True) if b - a >= 1]
 
 
+def _check_points(path: Path, count: int, what: str) -> None:
+    """InputDataError when a centerline file holds more than MAX_CENTERLINE_POINTS points."""
+    if count > MAX_CENTERLINE_POINTS:
+        raise InputDataError(f"{path}: {count:,} {what}, above the bound of {MAX_CENTERLINE_POINTS:,} centerline "
+                             "points (a VMTK centerline has a few thousand); resample it (e.g. "
+                             "vmtkcenterlineresampling)")
+
+
+def _line_count(path: Path) -> int:
+    """Lines of a text file, counted in 1 MB chunks without decoding or keeping them."""
+    count = 0
+    with path.open("rb") as handle:
+        for chunk in iter(lambda: handle.read(1 << 20), b""):
+            count += chunk.count(b"\n")
+    return count
+
+
 def _read_csv(path: Path) -> list[Polyline]:
     try:
+        _check_points(path, _line_count(path) - 1, "rows")  # before parsing: 9M rows took 143 s and 3.5 GB
         with path.open(newline="", encoding="utf-8") as handle:
             rows = list(csv.reader(handle))
     except (OSError, UnicodeDecodeError, csv.Error) as err:  # csv.Error: a field over 128 kB, a NUL byte
@@ -139,7 +162,8 @@ def _csv_row(path: Path, line: int, row: list[str], cols: list[int]) -> list[flo
 
 
 def _read_npy(path: Path) -> list[Polyline]:
-    check_npy_header(path)
+    shape = check_npy_header(path)
+    _check_points(path, shape[0] if shape else 1, f"rows in its {shape} array")
     try:
         values = np.load(path, allow_pickle=False)
     except (OSError, ValueError) as err:

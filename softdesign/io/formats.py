@@ -24,6 +24,7 @@ Slicer expect.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,8 +47,9 @@ class MeshFormat:
     ----------
     name : the suffix without its dot, as the case file names it (``stl``)
     description : what the file holds, for messages and help
-    read : path -> (vertices (V, 3) float64 mm, faces (F, 3) int64), shared vertices merged;
-        empty arrays when the file holds no triangles
+    read : (path, the file's mm per unit) -> (vertices (V, 3) float64 in the file's units, faces (F, 3) int64),
+        shared vertices merged within MERGE_TOLERANCE_MM whatever the unit; empty arrays when the file holds no
+        triangles
     encode : the writer's bytes, or None for a format that is only read
     carries_regions : whether the file keeps a region label per face
     unit : the length unit of the file's coordinates (the package converts from and to mm)
@@ -55,7 +57,7 @@ class MeshFormat:
 
     name: str
     description: str
-    read: Callable[[Path], Mesh]
+    read: Callable[[Path, float], Mesh]
     encode: Encoder | None
     carries_regions: bool = False
     unit: str = "mm"
@@ -66,7 +68,17 @@ class MeshFormat:
         return f".{self.name}"
 
 
-def _read_trimesh(path: Path) -> Mesh:
+#: Vertices of a file closer than this are one (trimesh's default, 1e-8, in mm rather than in the file's units: at
+#: 1e-8 m, a surface in metres merged vertices 0.01 micrometre apart into edges of three triangles).
+MERGE_TOLERANCE_MM = 1e-8
+
+
+def _merge_digits(scale_to_mm: float) -> int:
+    """Decimals to which trimesh rounds a coordinate in the file's units to merge within MERGE_TOLERANCE_MM."""
+    return max(0, round(-math.log10(MERGE_TOLERANCE_MM / scale_to_mm)))
+
+
+def _read_trimesh(path: Path, scale_to_mm: float = 1.0) -> Mesh:
     import trimesh
 
     from softdesign.io.input_checks import stl_problem
@@ -82,7 +94,9 @@ def _read_trimesh(path: Path) -> Mesh:
     if not isinstance(mesh, trimesh.Trimesh):
         return np.zeros((0, 3)), np.zeros((0, 3), np.int64)
     _refuse_non_finite(path, np.asarray(mesh.vertices))
-    mesh.process()  # after the check: trimesh's processing drops non-finite vertices, and their faces, silently
+    # after the check (trimesh's processing drops non-finite vertices, and their faces, silently); what process()
+    # does, with the merge's rounding in mm
+    mesh.merge_vertices(digits_vertex=_merge_digits(scale_to_mm))
     return np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces, np.int64)
 
 
@@ -115,7 +129,7 @@ def _refuse_non_finite(path: Path, vertices: np.ndarray) -> None:
                              "coordinates: re-export the surface, or repair it (e.g. vmtksurfacecleaner)")
 
 
-def _read_vtk(path: Path) -> Mesh:
+def _read_vtk(path: Path, scale_to_mm: float = 1.0) -> Mesh:  # merges exact duplicates only: any unit
     from softdesign.io.vtk_polydata import read_polydata, triangles_from_polydata
 
     vertices, faces = triangles_from_polydata(read_polydata(path))
@@ -154,8 +168,8 @@ def _trimesh_encoder(file_type: str) -> Encoder:
 MM_PER_M = 1000.0
 
 
-def _read_glb(path: Path) -> Mesh:
-    vertices, faces = _read_trimesh(path)
+def _read_glb(path: Path, scale_to_mm: float = 1.0) -> Mesh:
+    vertices, faces = _read_trimesh(path, MM_PER_M)
     return vertices * MM_PER_M, faces
 
 
@@ -235,7 +249,7 @@ def read_mesh(path: str | Path) -> Mesh:
     if found is None:
         choices = ", ".join(f.suffix for f in FORMATS.values())
         raise InputDataError(f"{path}: unknown mesh format '{path.suffix}'; expected one of {choices}")
-    vertices, faces = found.read(path)
+    vertices, faces = found.read(path, 1.0)
     if len(faces) == 0:
         raise InputDataError(f"{path}: the mesh has no triangles")
     return vertices, faces

@@ -18,9 +18,13 @@ from pathlib import Path
 
 from softdesign.errors import InputDataError
 from softdesign.io.case_yaml import file_kind
+from softdesign.limits import MEMORY_BUDGET_BYTES, MEMORY_BUDGET_TEXT
 
 #: Number kinds an array input may hold: float, signed and unsigned integer (numpy dtype.kind).
 NUMBER_KINDS = "fiu"
+#: Largest input file, bytes: every reader holds its whole file in memory, so a file over the build's memory budget
+#: cannot be read (a 300 GB sparse surface was hashed for 200 s before ingest refused it).
+MAX_INPUT_BYTES = MEMORY_BUDGET_BYTES
 #: Size of one binary STL triangle record, bytes (normal, 3 corners, attribute count).
 STL_RECORD_BYTES = 50
 #: Size of a binary STL's header and triangle count, bytes.
@@ -50,6 +54,12 @@ def check_input_file(path: Path, key: str) -> None:
         )
     if not os.access(path, os.R_OK):
         raise InputDataError(f"{key}: {path} cannot be read (permission denied); make it readable for this user")
+    if info.st_size > MAX_INPUT_BYTES:
+        raise InputDataError(
+            f"{key}: {path} is {info.st_size:,} bytes, above the bound of {MAX_INPUT_BYTES:,} bytes "
+            f"({MEMORY_BUDGET_TEXT}, the build's memory budget: a reader holds its whole file); a vessel's surface or "
+            "centerline takes a few MB: check the file, or decimate the surface (e.g. vmtksurfacedecimation)"
+        )
 
 
 @contextmanager
@@ -70,8 +80,8 @@ def input_os_errors(inputs: list[Path]) -> Iterator[None]:
         ) from err
 
 
-def check_npy_header(path: Path) -> None:
-    """Raise InputDataError unless the ``.npy`` header names a number array that the file's size holds.
+def check_npy_header(path: Path) -> tuple[int, ...]:
+    """The array's shape; InputDataError unless the ``.npy`` header names a number array the file's size holds.
 
     Reads the header only (numpy.lib.format), so nothing is allocated for what the header claims.
     """
@@ -98,6 +108,7 @@ def check_npy_header(path: Path) -> None:
             f"{path}: the header claims a {shape} array ({needed} bytes), but the file has {size} bytes; "
             "the file is truncated or corrupt: save it again with numpy.save"
         )
+    return tuple(int(n) for n in shape)
 
 
 def stl_problem(path: Path) -> str | None:

@@ -37,7 +37,7 @@ def read_surface(path: str | Path, scale_to_mm: float = 1.0) -> Mesh:
             + ", ".join(sorted(f".{f}" for f in SURFACE_FORMATS))
         )
     check_input_file(path, "surface")
-    vertices, faces = FORMATS[name].read(path)
+    vertices, faces = FORMATS[name].read(path, scale_to_mm)
     if len(faces) == 0 or len(vertices) == 0:
         raise InputDataError(
             f"{path}: the surface is empty (0 triangles); expected the vessel wall from VMTK "

@@ -7,15 +7,20 @@ opening it ends at), so the file is its own first documentation.  ``path``
 is the main vessel by :data:`~softdesign.geometry.path_survey.MAIN_PATH_RULE`
 (the path of largest lumen volume), and the comment names the alternatives.
 Paths are written relative to the case file's folder, as the case file
-reads them.  The first line names the case file's JSON Schema
+reads them, each as a double-quoted YAML string (:func:`yaml_string`): a
+folder named ``Patient #12`` or holding ``: ``, braces, a leading ``- `` or
+a newline reads back as written, never as a comment or another key.
+:func:`paths_read_back` checks that on the text before it is written.  The first line names the case file's JSON Schema
 (``softdesign schema``) for editors that complete and check YAML
 (``yaml-language-server``).
 """
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
+from typing import Any
 
 from softdesign.geometry.path_survey import MAIN_PATH_RULE
 from softdesign.pipeline.inspect_inputs import Inspection
@@ -46,19 +51,19 @@ def init_case_text(inspection: Inspection, case_path: Path, name: str) -> str:
     main = inspection.main_path
     links = min(MAX_INIT_LINKS, max(1, round(main.length * scale / LINK_LENGTH_MM)))
     folder = case_path.parent
-    centerline = "auto" if inspection.centerline is None else _relative(inspection.centerline, folder)
+    centerline = "auto" if inspection.centerline is None else yaml_string(_relative(inspection.centerline, folder))
     inlet = ", ".join(f"{v:.6g}" for v in inspection.inlet)
     lines = [
         f"# yaml-language-server: $schema={SCHEMA_FILE}",
-        f"# Written by softdesign init from {inspection.surface.name}"
-        + ("" if inspection.centerline is None else f" and {inspection.centerline.name}")
+        f"# Written by softdesign init from {yaml_string(inspection.surface.name)}"
+        + ("" if inspection.centerline is None else f" and {yaml_string(inspection.centerline.name)}")
         + ". Build it with: softdesign build " + case_path.name,
         *_units_comment(inspection),
         f"name: {name}",
         f"units: {unit}                 # the unit of the input files (and of final.inlet)",
         "final:                      # the patient's shape, q = 1",
         f"  centerline: {centerline}" + ("   # extracted from the surface at ingest" if centerline == "auto" else ""),
-        f"  surface: {_relative(inspection.surface, folder)}",
+        f"  surface: {yaml_string(_relative(inspection.surface, folder))}",
         f"  path: {inspection.main}                   # which path the actuator follows; proposed: the main vessel, "
         + MAIN_PATH_RULE,
         *_path_comments(inspection),
@@ -71,6 +76,25 @@ def init_case_text(inspection: Inspection, case_path: Path, name: str) -> str:
         f"material: {{name: {DEFAULT_MATERIAL}}}    # the stretch and wall limits the design is judged against",
     ]
     return "\n".join(lines) + "\n"
+
+
+def yaml_string(text: str) -> str:
+    """``text`` as one double-quoted YAML scalar on one line (JSON's escapes, which YAML reads the same)."""
+    return json.dumps(text, ensure_ascii=False)
+
+
+def expected_paths(inspection: Inspection, case_path: Path) -> dict[str, str]:
+    """``{"centerline": ..., "surface": ...}`` as :func:`init_case_text` means the case's ``final`` to hold."""
+    folder = case_path.parent
+    centerline = "auto" if inspection.centerline is None else _relative(inspection.centerline, folder)
+    return {"centerline": centerline, "surface": _relative(inspection.surface, folder)}
+
+
+def paths_read_back(data: Any) -> dict[str, Any]:
+    """The ``final`` paths of a parsed case (what a build would read), for comparison with :func:`expected_paths`."""
+    final = data.get("final") if isinstance(data, dict) else None
+    final = final if isinstance(final, dict) else {}
+    return {key: final.get(key) for key in ("centerline", "surface")}
 
 
 def _relative(path: Path, folder: Path) -> str:

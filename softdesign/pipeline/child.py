@@ -10,7 +10,11 @@ child becomes a :class:`~softdesign.errors.MeshError` that says which, with
 the child's exit signal or error, and what to change; a memory limit on the
 child turns a runaway allocation into one of these too (Linux ``RLIMIT_AS``).
 The child works in a scratch folder of its own, so files a library writes
-into the working folder (fTetWild's ``__tracked_surface.stl``) go with it.  The function and its
+into the working folder (fTetWild's ``__tracked_surface.stl``) go with it:
+the parent makes it (``softdesign-child-<pid>-*`` in the temporary folder,
+with a marker inside) and removes it once the child has ended, however it
+ended; one left by a parent that was itself killed is removed by the next
+call, once that parent's process is gone (:func:`remove_stale_scratch`).  The function and its
 arguments and result travel by pickle, so the function must be importable
 by name (a module-level function).
 """
@@ -19,22 +23,49 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import re
 import resource
+import shutil
 import signal
 import tempfile
 from collections.abc import Callable
 from multiprocessing.connection import Connection
+from pathlib import Path
 from typing import Any
 
 from softdesign.errors import MeshError
 from softdesign.pipeline.parallel import die_with_parent
+from softdesign.pipeline.store import process_alive
 
 #: How long a killed child may take to be reaped, s.
 _REAP_S = 10.0
+#: A child's scratch folder in the temporary folder: ``softdesign-child-<parent pid>-<random>``, holding the marker.
+SCRATCH_PREFIX = "softdesign-child-"
+SCRATCH_MARKER = ".softdesign-child"
+_SCRATCH = re.compile(re.escape(SCRATCH_PREFIX) + r"(\d+)-[A-Za-z0-9_]+")
+
+
+def remove_stale_scratch(folder: str | None = None) -> None:
+    """Remove the scratch folders (marker inside, this user's) whose parent process has ended."""
+    root = Path(folder or tempfile.gettempdir())
+    try:
+        entries = list(root.iterdir())
+    except OSError:
+        return
+    for entry in entries:
+        match = _SCRATCH.fullmatch(entry.name)
+        try:
+            ours = (match is not None and not entry.is_symlink() and entry.is_dir()
+                    and entry.stat().st_uid == os.geteuid() and (entry / SCRATCH_MARKER).is_file())
+        except OSError:
+            continue
+        if ours and match is not None and not process_alive(match.group(1)):
+            shutil.rmtree(entry, ignore_errors=True)
 
 
 def _child_main(
-    send: Connection, target: Callable[..., Any], args: tuple[Any, ...], memory_bytes: int | None, parent: int
+    send: Connection, target: Callable[..., Any], args: tuple[Any, ...], memory_bytes: int | None, parent: int,
+    scratch: str,
 ) -> None:
     die_with_parent(parent)  # a mesher left running after its build was killed would run on for nothing
     try:
@@ -42,10 +73,9 @@ def _child_main(
             # address space, not resident memory: what a native allocation (malloc, new) is refused beyond
             resource.setrlimit(resource.RLIMIT_AS, (memory_bytes, memory_bytes))
         # native code may write files of its own into the working folder (fTetWild writes
-        # __tracked_surface.stl): a scratch folder of the child's, removed with it, takes them
-        with tempfile.TemporaryDirectory(prefix="softdesign-child-") as scratch:
-            os.chdir(scratch)
-            result = target(*args)
+        # __tracked_surface.stl): a scratch folder the parent removes once this child has ended takes them
+        os.chdir(scratch)
+        result = target(*args)
     except MemoryError as err:
         limit = "" if memory_bytes is None else f" of {memory_bytes / 2**30:.2f} GiB"
         send.send(("error", f"it ran out of memory (the child's limit{limit}): {type(err).__name__} {err}".strip()))
@@ -93,9 +123,24 @@ def run_in_child(
     """
     if not timeout_s > 0:
         raise ValueError(f"timeout_s must be > 0, got {timeout_s}")
+    remove_stale_scratch()
+    scratch = tempfile.mkdtemp(prefix=f"{SCRATCH_PREFIX}{os.getpid()}-")
+    try:
+        (Path(scratch) / SCRATCH_MARKER).write_bytes(b"")
+        return _run_and_wait(target, args, timeout_s, what, fix, memory_bytes, scratch)
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)  # the child has ended (reaped or killed): nothing writes there
+
+
+def _run_and_wait(
+    target: Callable[..., Any], args: tuple[Any, ...], timeout_s: float, what: str, fix: str,
+    memory_bytes: int | None, scratch: str,
+) -> Any:
+    """:func:`run_in_child`'s work, the child working in ``scratch``."""
     context = multiprocessing.get_context("spawn")
     receive, send = context.Pipe(duplex=False)
-    process = context.Process(target=_child_main, args=(send, target, args, memory_bytes, os.getpid()), daemon=True)
+    process = context.Process(target=_child_main, args=(send, target, args, memory_bytes, os.getpid(), scratch),
+                              daemon=True)
     process.start()
     send.close()  # the child holds the only writer: its death ends the pipe, and poll() sees it at once
     try:

@@ -52,6 +52,10 @@ VOLUME_SUMMARY = "volume_mesh/summary.json"
 # takes its name (``trash-<pid>-<hex>``, only where the two cannot be exchanged in one step) and the lock.
 
 
+#: The file inside a run's staging folder, from its creation until it is swapped in: the folder is softdesign's.
+STAGING_MARKER = ".softdesign-staging"
+
+
 def staging_name(build_name: str, pid: int, token: str) -> str:
     """``.<name>.staging-<pid>-<token>`` (token: lowercase hex): a run's next folder, before it becomes ``<name>``."""
     return f".{build_name}.staging-{pid}-{token}"

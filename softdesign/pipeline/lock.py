@@ -16,7 +16,7 @@ later run that finds the file of a killed run (still naming its process) says
 so and proceeds.  The file is opened without
 following a symbolic link and must be a regular file of this user, so a link
 planted beside the build folder (in a shared /tmp) cannot make a run write
-outside it.
+outside it; nor can a hard link (a lock file with more than one name is refused).
 """
 
 from __future__ import annotations
@@ -91,11 +91,17 @@ class BuildLock:
                                   f"the build folder is written; {fix}") from None
             raise
         info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode) or info.st_uid != os.geteuid():
+        what = None
+        if not stat.S_ISREG(info.st_mode):
+            what = "not a regular file"
+        elif info.st_uid != os.geteuid():
+            what = f"owned by user id {info.st_uid}"
+        elif info.st_nlink > 1:  # a hard link to another file: the run would write its pid into that file
+            what = f"a file with {info.st_nlink} names (a hard link to a file elsewhere)"
+        if what is not None:
             os.close(fd)
-            what = "not a regular file" if not stat.S_ISREG(info.st_mode) else f"owned by user id {info.st_uid}"
             raise ConfigError(f"{self.build_dir}: its lock file {self.path} is {what}; expected a regular file of "
-                              f"this user (id {os.geteuid()}); {fix}")
+                              f"this user with no other name (id {os.geteuid()}); {fix}")
         return fd
 
     def _held_message(self, holder: str) -> str:

@@ -58,7 +58,7 @@ def check_out_folder(build_dir: Path, inputs: list[Path]) -> None:
     entries = sorted(p.name for p in real.iterdir())
     if not entries:
         return
-    if not _is_softdesign_build(real):
+    if not is_softdesign_build(real):
         raise ConfigError(
             f"build folder {build_dir}: is a folder of other files ({_listed(entries)}) with no softdesign "
             "manifest.json, and a build replaces its whole folder; expected an empty folder or a softdesign build "
@@ -77,15 +77,29 @@ def _listed(names: list[str]) -> str:
     return shown + (f" and {len(names) - 3} more" if len(names) > 3 else "")
 
 
+#: The largest manifest.json read to tell whether a folder is a build (the demo's is about 60 kB).
+MAX_MANIFEST_BYTES = 64 << 20
+
+
 def _manifest(folder: Path) -> dict | None:
+    file = folder / MANIFEST
     try:
+        if not file.is_file() or file.stat().st_size > MAX_MANIFEST_BYTES:  # never a FIFO: reading it would wait
+            return None
         payload = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
     except (OSError, ValueError, RecursionError):
         return None
     return payload if isinstance(payload, dict) else None
 
 
-def _is_softdesign_build(folder: Path) -> bool:
+def build_folder_holding(folder: Path) -> Path | None:
+    """The softdesign build folder that is ``folder`` or holds it (real paths), or None."""
+    real = Path(os.path.realpath(folder))
+    return next((p for p in (real, *real.parents) if is_softdesign_build(p)), None)
+
+
+def is_softdesign_build(folder: Path) -> bool:
+    """Whether ``folder`` holds a manifest.json that softdesign wrote (its ``software`` names softdesign)."""
     manifest = _manifest(folder)
     return manifest is not None and isinstance(manifest.get("software"), dict) and "softdesign" in manifest["software"]
 

@@ -35,11 +35,12 @@ import signal
 import sys
 from collections.abc import Callable, Iterator, MutableMapping, Sequence
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from contextvars import ContextVar
 from typing import Any, TypeVar
 
-from softdesign.errors import ConfigError
+from softdesign.errors import ConfigError, SoftdesignError
 
 T = TypeVar("T")
 
@@ -48,6 +49,8 @@ T = TypeVar("T")
 MAX_JOBS = 256
 
 _JOBS: ContextVar[int] = ContextVar("softdesign_jobs", default=1)
+#: What the current parallel work is (a stage's name, "report") and what a failure keeps, for a dead worker's message.
+_WORK: ContextVar[tuple[str, str]] = ContextVar("softdesign_work", default=("the build", "the previous build is kept"))
 #: The function the forked workers call: inherited by fork, never pickled (it may be a closure).
 _TASK: Callable[[Any], Any] | None = None
 
@@ -76,13 +79,24 @@ def available_cores() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-def checked_jobs(jobs: int | None, option: str = "--jobs") -> int:
-    """``jobs``, or the available cores when None; ConfigError outside 1 to MAX_JOBS."""
+def checked_jobs(jobs: int | None, option: str = "--jobs", note: Callable[[str], None] | None = None) -> int:
+    """``jobs`` at most the available cores (None: the cores); ConfigError outside 1 to MAX_JOBS.
+
+    Each worker is a forked copy of the build (about 30 MB, and its own meshes): more workers than cores run no
+    faster and multiply the memory (``--jobs 256`` reached 7.2 GB in 2.3 s), so a larger count is capped at the
+    cores, and ``note`` is told so.
+    """
+    cores = min(available_cores(), MAX_JOBS)
     if jobs is None:
-        return min(available_cores(), MAX_JOBS)
+        return cores
     if not 1 <= jobs <= MAX_JOBS:
         raise ConfigError(f"{option} must be 1 to {MAX_JOBS} worker processes, got {jobs}; "
                           f"leave it out for the {available_cores()} core(s) available, or give {option} 1")
+    if jobs > cores:
+        if note is not None:
+            note(f"{option} {jobs}: capped at the {cores} core(s) this process may run on (more workers than "
+                 "cores only add memory)")
+        return cores
     return jobs
 
 
@@ -94,6 +108,16 @@ def jobs_for_build(jobs: int) -> Iterator[None]:
         yield
     finally:
         _JOBS.reset(token)
+
+
+@contextmanager
+def working_on(what: str, kept: str = "the previous build is kept") -> Iterator[None]:
+    """Name the parallel work inside the block (``what``: a stage's name) and what a failure keeps, for messages."""
+    token = _WORK.set((what, kept))
+    try:
+        yield
+    finally:
+        _WORK.reset(token)
 
 
 def current_jobs() -> int:
@@ -163,14 +187,32 @@ def map_items(
                 on_result(item, results[-1])
         return results
     _TASK = task
+    processes: dict[int, Any] = {}
     try:
         with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
                                  initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
+            found = getattr(pool, "_processes", None)  # the workers (filled as they start), to say how one died
+            processes = found if isinstance(found, dict) else {}
             results = []
             for item, result in zip(items, pool.map(_call, items), strict=True):
                 results.append(result)
                 if on_result is not None:
                     on_result(item, result)
             return results
+    except BrokenProcessPool:  # the pool has stopped and reaped every worker by now
+        what, kept = _WORK.get()
+        raise SoftdesignError(f"a worker died ({_how_died(list(processes.values()))}) during {what}; {kept} "
+                              "(a worker killed by the system is often out of memory: give --jobs 1, or free "
+                              "memory)") from None
     finally:
         _TASK = None
+
+
+def _how_died(processes: list[Any]) -> str:
+    """``signal 9`` for the first worker that ended by a signal other than the pool's own SIGTERM, else a guess."""
+    codes = [p.exitcode for p in processes if getattr(p, "exitcode", None) is not None]
+    killed = [-c for c in codes if c < 0 and -c != signal.SIGTERM] or [-c for c in codes if c < 0]
+    if killed:
+        return f"signal {killed[0]}"
+    ended = [c for c in codes if c > 0]
+    return f"exit code {ended[0]}" if ended else "no exit status"

@@ -24,7 +24,7 @@ from softdesign.pipeline.lock import BuildLock
 from softdesign.pipeline.manifest import build_manifest, run_log
 from softdesign.pipeline.out_folder import check_out_folder, folder_errors
 from softdesign.pipeline.owned import safe_relative
-from softdesign.pipeline.parallel import jobs_for_build
+from softdesign.pipeline.parallel import jobs_for_build, working_on
 from softdesign.pipeline.report_keep import carry_report
 from softdesign.pipeline.stage import Results, Stage, StageRun, Status, stage_key
 from softdesign.pipeline.store import Staging, read_record, sha256_file
@@ -123,7 +123,8 @@ def _run_all(
         upstream = [keys[u] for u in stage.upstream]
         keys[stage.name] = stage_key(stage, case, upstream, input_hashes if not stage.upstream else [])
         step = RunOptions(options.force, _counted(options.progress, index, len(stages)))
-        runs.append(_run_one(stage, case, keys[stage.name], results, staging, step))
+        with working_on(stage.name):  # a dead worker's message names the stage
+            runs.append(_run_one(stage, case, keys[stage.name], results, staging, step))
         if stage.name == "ingest":  # the vessel is measured: refuse spacings it cannot afford before they run
             check_sizes(case, results["ingest"])
     for stage in options.later:

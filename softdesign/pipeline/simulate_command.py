@@ -19,6 +19,7 @@ from softdesign.pipeline.simulate_run import (
     SimulateOptions,
     check_node_count,
     check_options,
+    no_law_error,
     payload,
     section_mesh_of,
     solve_in_child,
@@ -37,7 +38,7 @@ def run_simulate(case_file: Path, out: Path | None, o: SimulateOptions, progress
     outcome = build_through(case_file, out, "actuation", progress=progress)
     material = material_of(outcome.case)
     if material.law is None:
-        raise ConfigError(f"{case_file}: simulate needs material.name (a preset with a law) or material.custom")
+        raise no_law_error(outcome.case, str(case_file))
     section = section_mesh_of(outcome.case, outcome.results["kinematics"], outcome.results["fit"], o.section,
                               o.size_mm, o.angular_count, o.layer_mm)
     check_node_count(section, o.section + 1, "raise --size-mm or --layer-mm")

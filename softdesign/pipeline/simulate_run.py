@@ -60,6 +60,22 @@ class SimulateOptions:
     timeout_s: float = 600.0
 
 
+def no_law_error(case: Any, where: str) -> ConfigError:
+    """The refusal of a simulate whose case has no hyperelastic law, naming the key to change and the presets to use.
+
+    ``where`` starts the message (the case file for the command, ``simulate.enabled`` for the build's stage).
+    """
+    from softdesign.materials.data import material_presets
+
+    with_law = ", ".join(name for name, preset in material_presets().items() if preset.law_params is not None)
+    fix = f"give material.name one of the presets with a law ({with_law}), or material.custom with its law"
+    name = getattr(case.material, "name", None)
+    if name is not None:
+        return ConfigError(f"{where}: material.name {name}: this preset has no hyperelastic law in "
+                           f"softdesign/data/materials.yaml, which simulate needs; {fix}")
+    return ConfigError(f"{where}: simulate needs a material with a hyperelastic law, and the case gives none; {fix}")
+
+
 def check_options(o: SimulateOptions) -> None:
     """Refuse options outside the bounds (ConfigError: the option, the value, the bound, the fix)."""
     def bound(name: str, value: float, low: float, high: float) -> None:

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from softdesign.pipeline.layout import staging_name, trash_name
+from softdesign.pipeline.layout import STAGING_MARKER, staging_name, trash_name
 from softdesign.pipeline.swap import remove_folder, swap_in
 
 
@@ -119,6 +119,7 @@ class Staging:
         root = self.target.parent / staging_name(self.target.name, os.getpid(), secrets.token_hex(6))
         root.mkdir()  # unlike mkdtemp, honours the umask: the build is as readable as before
         self.root = root
+        (root / STAGING_MARKER).write_bytes(b"")  # a killed run's folder is known as softdesign's by this
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
@@ -176,6 +177,7 @@ class Staging:
     def commit(self) -> None:
         """Swap the new folder in for the build folder in one step (:func:`~softdesign.pipeline.swap.swap_in`)."""
         root = self._root()
+        (root / STAGING_MARKER).unlink()
         on_disk = {p.relative_to(root).as_posix() for p in root.rglob("*") if not p.is_dir()}
         if on_disk != set(self.written):  # a stage wrote a file it did not record: a bug
             raise RuntimeError(f"staged files not recorded: {sorted(on_disk ^ set(self.written))}")

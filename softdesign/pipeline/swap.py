@@ -20,7 +20,8 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from softdesign.pipeline.layout import MANIFEST, sibling_role
+from softdesign.pipeline.layout import MANIFEST, STAGING_MARKER, sibling_role
+from softdesign.pipeline.out_folder import is_softdesign_build
 
 _AT_FDCWD = -100
 _RENAME_EXCHANGE = 1 << 1
@@ -93,13 +94,15 @@ def repair(target: Path) -> list[str]:
 
     When ``target`` is missing and a complete previous folder waits under a
     trash name (a two-rename swap cut between its renames), it is renamed
-    back.  Every other staging or trash folder is a dead run's and is removed.
+    back.  Every other staging or trash folder is a dead run's and is removed,
+    but only when softdesign made it (:func:`made_by_softdesign`): a folder of
+    the user's that happens to have such a name is left alone.
 
     Returns
     -------
     One line per repair made, for the progress output.
     """
-    found = leftovers(target)
+    found = {role: [f for f in folders if made_by_softdesign(f)] for role, folders in leftovers(target).items()}
     done = []
     complete = [t for t in found["trash"] if (t / MANIFEST).is_file()]
     if not os.path.lexists(target) and complete:
@@ -110,6 +113,13 @@ def repair(target: Path) -> list[str]:
         if folder.exists():
             remove_folder(folder)
     return done
+
+
+def made_by_softdesign(folder: Path) -> bool:
+    """Whether ``folder`` (a staging or trash name) is a run's: it holds the staging marker or a build's manifest."""
+    if folder.is_symlink() or not folder.is_dir():
+        return False
+    return (folder / STAGING_MARKER).is_file() or is_softdesign_build(folder)
 
 
 def remove_folder(folder: Path) -> None:

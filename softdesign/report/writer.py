@@ -23,7 +23,7 @@ from softdesign.errors import ConfigError
 from softdesign.pipeline.layout import MANIFEST, REPORT_DIR, RUN_LOG
 from softdesign.pipeline.lock import BuildLock
 from softdesign.pipeline.out_folder import folder_errors
-from softdesign.pipeline.parallel import jobs_for_build, map_items
+from softdesign.pipeline.parallel import jobs_for_build, map_items, working_on
 from softdesign.report import (
     actuation_figures,
     animation,
@@ -146,7 +146,7 @@ class _Timer:
             self._ready[name] = outcome[0]
             self._record(name, outcome[1])
 
-        with jobs_for_build(self.jobs):
+        with jobs_for_build(self.jobs), working_on("the report", "the previous report is kept"):
             map_items(timed, list(parts), on_result=arrived)
 
     def _record(self, name: str, seconds: float) -> None:

@@ -123,3 +123,120 @@ def test_generated_case_files_never_end_in_a_traceback(tmp_path):
         codes[result.exit_code] = codes.get(result.exit_code, 0) + 1
     assert codes.get(2, 0) > CASES // 2  # most generated files are wrong, and refused
     assert codes.get(0, 0) > 0  # and some valid ones reach the end of validation
+
+
+# Issue 45: the round-3 and round-4 blocks, and pcc reconstruct's tables.  The keys come from the schema itself
+# (softdesign.cli.reference.case_keys), so a key a branch adds to one of these blocks (actuation.supply,
+# .reinforcement, .backbone) is fuzzed as soon as the model has it; a new block is one more name in BLOCKS.
+
+#: The blocks fuzzed key by key (dotted: a nested block is fuzzed whole and key by key).
+BLOCKS = ("actuation", "design", "simulate", "export.volume_mesh", "export.mould", "material.custom")
+#: How many case files of these blocks, and how many pcc tables.
+BLOCK_CASES = 200
+TABLES = 150
+#: Values these blocks' keys name or users type for them, beside SCALARS.
+BLOCK_SCALARS = [
+    "'yes'", "3.0", "3", "0.1", "0.2", "5", "37", "512", "single", "per_chamber", "hoop", "none", "free",
+    "inextensible", "sweep", "ftetwild", "neo-hookean", "yeoh", "ecoflex-00-30", "tpu-85a", "\"a\\x1b[2Jb\"",
+    "{kind: yeoh, c1_kpa: 1e-300, c2_kpa: 0, c3_kpa: 0}", "[1, 1]", "[0, 1.5]", "[2, 1]",
+]
+
+
+def _block_keys() -> list[str]:
+    from softdesign.cli.reference import case_keys
+    from softdesign.config import Case
+
+    return [key for key, _, _ in case_keys(Case) if any(key == b or key.startswith(b + ".") for b in BLOCKS)]
+
+
+def _block_value(rng: random.Random) -> str:
+    return rng.choice(BLOCK_SCALARS) if rng.random() < 0.5 else _value(rng)
+
+
+def block_case_text(rng: random.Random, keys: list[str]) -> str:
+    """The demo case with one to three keys of the round-3/4 blocks set to generated YAML (often still valid)."""
+    import yaml
+
+    case = yaml.safe_load(DEMO.read_text())
+    for key in ("centerline", "surface"):
+        case["final"][key] = str((DEMO.parent / case["final"][key]).resolve())
+    if rng.random() < 0.5:
+        case["actuation"] = {}  # simulate and the chambers' keys are read with it
+    raw: dict[str, str] = {}
+    for n, key in enumerate(rng.sample(keys, rng.randint(1, 3))):
+        *parents, last = key.split(".")
+        holder = case
+        for part in parents:
+            child = holder.get(part)
+            holder = holder.setdefault(part, {}) if child is None else child
+            if not isinstance(holder, dict):
+                break
+        else:
+            holder[last] = f"__value_{n}__"
+            raw[f"__value_{n}__"] = _block_value(rng)
+    text = yaml.safe_dump(case, sort_keys=False, width=10_000)
+    for marker, value in raw.items():
+        text = text.replace(marker, value)
+    return text
+
+
+def test_generated_round_3_and_4_blocks_never_end_in_a_traceback(tmp_path):
+    rng = random.Random(SEED + 9)
+    keys = _block_keys()
+    assert {k.split(".")[0] for k in keys} >= {"actuation", "design", "simulate", "export", "material"}
+    path = tmp_path / "case.yaml"
+    codes: dict[int, int] = {}
+    for index in range(BLOCK_CASES):
+        text = block_case_text(rng, keys)
+        path.write_text(text, encoding="utf-8")
+        result = runner.invoke(app, ["validate", str(path)])
+        escaped = result.exception if not isinstance(result.exception, SystemExit) else None
+        assert escaped is None, f"case {index}:\n{text}\n{type(escaped).__name__}: {escaped}"
+        assert result.exit_code in (0, 2), f"case {index}: exit {result.exit_code}\n{text}\n{result.output}"
+        assert "\x1b" not in result.output, f"case {index}: a control character reached the terminal"
+        codes[result.exit_code] = codes.get(result.exit_code, 0) + 1
+    assert codes.get(2, 0) > BLOCK_CASES // 2 and codes.get(0, 0) > 0, codes  # most refused, some pass through
+
+
+#: Cells of a generated readings or actuation table.
+CELLS = ["1", "10", "10.5", "0", "-1", "nan", "inf", "-inf", "1e300", "1e-300", "", "abc", "1:30", "0x10", "3", "2",
+         "90", "210", "330", "120", "\"1,2\"", "9" * 400]
+
+
+def table_text(rng: random.Random) -> str:
+    """A readings CSV (time + 3 lengths per section) or an actuation table, rows from CELLS or plausible values."""
+    if rng.random() < 0.5:
+        sections = rng.choice([1, 1, 2, 3, 0])
+        header = ["t"] + [f"l{s}{c}" for s in range(1, sections + 1) for c in (1, 2, 3)]
+        rows = [[str(k) if rng.random() < 0.8 else rng.choice(CELLS)]
+                + [f"{10 + rng.random():.3f}" if rng.random() < 0.8 else rng.choice(CELLS) for _ in header[1:]]
+                for k in range(rng.randint(0, 12))]
+    else:
+        header = ["q", "section", "chamber", "angle_deg", "distance_mm", "length_mm"]
+        rows = []
+        for q in range(rng.randint(0, 3)):
+            for section in range(1, rng.randint(1, 3) + 1):
+                for chamber, angle in ((1, 90), (2, 210), (3, 330)):
+                    row = [str(q / 2), str(section), str(chamber), str(angle), "3", f"{10 + rng.random():.3f}"]
+                    if rng.random() < 0.15:
+                        row[rng.randrange(len(row))] = rng.choice(CELLS)
+                    rows.append(row)
+    if rng.random() < 0.1 and rows:
+        rows[rng.randrange(len(rows))].append("extra")
+    return "\n".join(",".join(r) for r in [header, *rows]) + "\n"
+
+
+def test_generated_pcc_tables_never_end_in_a_traceback(tmp_path):
+    rng = random.Random(SEED + 45)
+    path = tmp_path / "table.csv"
+    codes: dict[int, int] = {}
+    for index in range(TABLES):
+        text = table_text(rng)
+        path.write_text(text, encoding="utf-8")
+        args = ["pcc", "reconstruct", str(path), "--shapes-dir", str(tmp_path / "shapes")]
+        result = runner.invoke(app, args + (["--d", "3"] if text.startswith("t") else []))
+        escaped = result.exception if not isinstance(result.exception, SystemExit) else None
+        assert escaped is None, f"table {index}:\n{text}\n{type(escaped).__name__}: {escaped}"
+        assert result.exit_code in (0, 2), f"table {index}: exit {result.exit_code}\n{text}\n{result.output}"
+        codes[result.exit_code] = codes.get(result.exit_code, 0) + 1
+    assert codes.get(2, 0) > 0 and codes.get(0, 0) > 0, codes

@@ -113,14 +113,14 @@ def run_simulate_stage(case: Case, kinematics: KinematicsResult, fit: FitResult)
     """Every requested section's pressures at every requested q; None unless ``simulate.enabled``."""
     from dataclasses import replace
 
-    from softdesign.pipeline.simulate_run import LEAVES_OUT, payload
+    from softdesign.pipeline.simulate_run import LEAVES_OUT, no_law_error, payload
     from softdesign.pipeline.stages.volume_sweep import material_of
 
     if case.simulate is None or not case.simulate.enabled:
         return None
     material = material_of(case)
     if material.law is None:
-        raise ConfigError("simulate.enabled needs material.name (a preset with a law) or material.custom")
+        raise no_law_error(case, "simulate.enabled")
     solves = []
     for index, mesh in _meshes(case, kinematics, fit).items():
         for q, target, answer in _solve_section(case, kinematics, mesh, index, material.law):

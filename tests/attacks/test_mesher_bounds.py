@@ -1,0 +1,49 @@
+"""Issue 45, valid inputs that ended as "a bug in the mesher": a key the mesher cannot honour is refused by the
+schema (exit 2) with the value that works, derived from the mesh it needs.
+"""
+
+from __future__ import annotations
+
+import pytest
+from typer.testing import CliRunner
+
+from softdesign.cli import app
+from softdesign.meshing.volume_tolerance import MIN_ANGULAR_COUNT, MIN_ANGULAR_COUNT_WITH_CAVITIES
+from tests.helpers.attacks import BUILD_TIMEOUT_S, assert_refused, demo_case, run_limited
+
+runner = CliRunner()
+
+
+def test_chambers_need_more_vertices_around_than_a_plain_body(tmp_path):
+    assert MIN_ANGULAR_COUNT_WITH_CAVITIES > MIN_ANGULAR_COUNT
+    export = {"q": [0, 1], "angular_count": MIN_ANGULAR_COUNT, "spacing_mm": 1.0}
+    plain = demo_case(tmp_path, name="plain", export=export)
+    assert runner.invoke(app, ["validate", str(plain)]).exit_code == 0
+    chambered = demo_case(tmp_path, name="chambered", export=export, actuation={})
+    result = runner.invoke(app, ["validate", str(chambered)])
+    assert_refused(result, "actuation", f"export.angular_count to {MIN_ANGULAR_COUNT_WITH_CAVITIES}")
+
+
+@pytest.mark.slow
+def test_the_chambered_demo_builds_at_the_bound(tmp_path):
+    # the demo with chambers at 37 sides failed the volume check by 0.503 % (exit 1, "refine the tessellation")
+    export = {"q": [0, 1], "angular_count": MIN_ANGULAR_COUNT_WITH_CAVITIES, "spacing_mm": 1.0}
+    case = demo_case(tmp_path, export=export, actuation={})
+    result = run_limited("build", str(case), "--out", str(tmp_path / "b"), "--jobs", "1", timeout=BUILD_TIMEOUT_S)
+    assert result.returncode == 0, result.stderr
+
+
+def test_vertices_merge_within_a_tolerance_in_mm_whatever_the_files_unit(tmp_path):
+    from softdesign.io.formats import MERGE_TOLERANCE_MM
+    from softdesign.io.surface import read_surface
+
+    # two triangles whose corners at 0 and 5e-9 are 5e-9 file units apart: in metres that is 5e-6 mm, far above the
+    # tolerance (two vertices); in mm it is below it (one vertex)
+    gap = 5e-9
+    assert gap * 1000.0 > 100 * MERGE_TOLERANCE_MM > gap
+    path = tmp_path / "two.obj"
+    corners = [(0.0, 0.0, 0.0), (1e-3, 0.0, 0.0), (0.0, 1e-3, 0.0), (gap, 0.0, 0.0), (1e-3, 1e-3, 0.0)]
+    path.write_text("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in corners) + "f 1 2 3\nf 4 5 3\n")
+    metres, _ = read_surface(path, 1000.0)
+    millimetres, _ = read_surface(path, 1.0)
+    assert (len(metres), len(millimetres)) == (5, 4)
