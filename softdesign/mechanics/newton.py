@@ -67,6 +67,7 @@ from softdesign.mechanics.quadratic import (
     quadratic_state,
 )
 from softdesign.mechanics.quadratic_pressure import quadratic_pressure_load
+from softdesign.mechanics.reinforcement import FibreMembrane
 from softdesign.mechanics.tets import TetMesh
 from softdesign.types import FloatArray, IntArray
 
@@ -102,6 +103,7 @@ class PressureProblem:
     fixed : (3V,) bool, unknowns held at zero displacement
     faces : (F, 3) int, wall triangles (F, 6 for a quadratic mesh), normals out of the cavity
     face_cavity : (F,) int, which cavity (index into the pressures) each face bounds
+    fibres : the reinforcement's fibres on 6-node faces (:mod:`softdesign.mechanics.reinforcement`), or None
     """
 
     mesh: TetMesh | QuadraticMesh
@@ -109,6 +111,7 @@ class PressureProblem:
     fixed: np.ndarray
     faces: IntArray
     face_cavity: IntArray
+    fibres: FibreMembrane | None = None
 
 
 @dataclass
@@ -137,19 +140,23 @@ def _residual(problem: PressureProblem, u: FloatArray, face_pressure: FloatArray
     ``element_pressure`` (quadratic elements) is the mixed method's pressure unknown the matrix carries.
     """
     mesh, law, positions = problem.mesh, problem.law, problem.mesh.points + u
+    f_fibre, K_fibre = (np.zeros(mesh.dof_count), None) if problem.fibres is None else \
+        problem.fibres.force_and_tangent(positions, tangent)
     if isinstance(mesh, QuadraticMesh):
         state_q = quadratic_state(mesh, law, u)
         f_p, dfp = quadratic_pressure_load(positions, problem.faces, face_pressure, tangent)
         if not tangent or dfp is None:
-            return quadratic_force(mesh, law, state_q) - f_p, f_p, None, state_q
+            return quadratic_force(mesh, law, state_q) + f_fibre - f_p, f_p, None, state_q
         f_int, K_q = quadratic_force_and_tangent(mesh, law, state_q, element_pressure)
-        return f_int - f_p, f_p, Tangent(K_q - dfp, sp.csr_matrix((0, mesh.dof_count)), np.zeros(0)), state_q
+        K_q = K_q - dfp if K_fibre is None else K_q + K_fibre - dfp
+        return f_int + f_fibre - f_p, f_p, Tangent(K_q, sp.csr_matrix((0, mesh.dof_count)), np.zeros(0)), state_q
     state = volumetric_state(mesh, law, u)
     f_p, dfp = pressure_load(positions, problem.faces, face_pressure, tangent)
     if not tangent or dfp is None:
-        return internal_force(mesh, law, state) - f_p, f_p, None, None
+        return internal_force(mesh, law, state) + f_fibre - f_p, f_p, None, None
     f_int, K = force_and_tangent(mesh, law, state)
-    return f_int - f_p, f_p, Tangent(K.K - dfp, K.G, K.compliance), None
+    K_lin = K.K - dfp if K_fibre is None else K.K + K_fibre - dfp
+    return f_int + f_fibre - f_p, f_p, Tangent(K_lin, K.G, K.compliance), None
 
 
 def tangent_solver(tangent: Tangent, free: np.ndarray, solver: TangentSolver) -> Callable[[FloatArray], FloatArray]:
