@@ -23,11 +23,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from softdesign.errors import MeshError
+from softdesign.errors import MeshError, SolveError
 from softdesign.kinematics.pcc_fit import arc_points, fit_arc, trapezoid_weights
+from softdesign.mechanics.continuation import ContinuationSettings, follow_pressures
 from softdesign.mechanics.laws import HyperelasticLaw, cauchy_stress
 from softdesign.mechanics.linear_solve import TangentSolver
-from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord, solve_pressures
+from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord
 from softdesign.mechanics.quadratic import (
     QuadraticMesh,
     quadratic_faces,
@@ -261,11 +262,16 @@ def simulate_section(section: SectionMesh, law: HyperelasticLaw, pressures: Floa
     MeshError
         Bad named sets, or a centerline outside the material.
     SolveError
-        The solve did not converge.
+        The pressures lie beyond a limit point, or the solve stopped: the message gives the largest
+        pressures reached (:mod:`softdesign.mechanics.continuation`).
     """
     pressures = np.asarray(pressures, float)
     if pressures.shape != (section.chamber_count,):
         raise ValueError(f"expected {section.chamber_count} pressures, got shape {pressures.shape}")
     prepared = prepare_section(section, law, thread)
-    u, record = solve_pressures(prepared.problem, pressures, settings, solver=prepared.solver)
-    return measure_section(prepared, u, pressures, record)
+    path = follow_pressures(prepared.problem, pressures, ContinuationSettings(
+        first_step=1.0 / settings.load_steps, max_cutbacks=settings.max_cutbacks, newton=settings),
+        solver=prepared.solver)
+    if path.status != "reached":
+        raise SolveError(path.stopped_because(pressures))
+    return measure_section(prepared, path.end.u, pressures, path.record())
