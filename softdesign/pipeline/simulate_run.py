@@ -10,6 +10,7 @@ fails cleanly; :func:`payload` gives its figures as JSON.
 
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass, replace
 from typing import Any
@@ -58,6 +59,10 @@ class SimulateOptions:
     max_pressure_kpa: float = 100.0
     max_solves: int = 16
     timeout_s: float = 600.0
+    #: the inverse stops after the trial that passes this many seconds, keeping its best (None: no limit)
+    time_limit_s: float | None = None
+    #: a context manager yielding the inverse's trial listener (the command line's progress), or None
+    trial_progress: Any = None
 
 
 def check_options(o: SimulateOptions) -> None:
@@ -80,6 +85,11 @@ def check_options(o: SimulateOptions) -> None:
     bound("--max-pressure", o.max_pressure_kpa, 1.0, MAX_PRESSURE_KPA)
     bound("--max-solves", o.max_solves, 1, MAX_INVERSE_SOLVES)
     bound("--timeout", o.timeout_s, 1.0, MAX_SIMULATE_SECONDS)
+    if o.time_limit_s is not None:
+        bound("--time-limit", o.time_limit_s, 1.0, MAX_SIMULATE_SECONDS)
+        if o.time_limit_s >= o.timeout_s:
+            raise ConfigError(f"simulate --time-limit: got {o.time_limit_s:g} s, not below --timeout "
+                              f"{o.timeout_s:g} s (the solve is stopped at the timeout); raise --timeout above it")
 
 
 def solve_in_child(section: Any, law: Any, o: SimulateOptions, target: tuple[float, float, float] | None
@@ -94,8 +104,9 @@ def solve_in_child(section: Any, law: Any, o: SimulateOptions, target: tuple[flo
         result = simulate_section(section, law, np.array(o.pressures_kpa, float), newton)
         return {"result": result, "inverse": None}
     settings = InverseSettings(o.max_pressure_kpa, 0.1 * o.max_pressure_kpa, 0.25 * o.max_pressure_kpa,
-                               tolerance_mm=1e-3, max_iterations=o.max_solves)
-    found = find_pressures(section, law, target, settings, newton)
+                               tolerance_mm=1e-3, max_iterations=o.max_solves, time_limit_s=o.time_limit_s)
+    with o.trial_progress or contextlib.nullcontext() as on_trial:
+        found = find_pressures(section, law, target, settings, newton, on_trial)
     return {"result": found.section, "inverse": found}
 
 
