@@ -37,6 +37,7 @@ import numpy as np
 from softdesign.errors import SolveError
 from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.newton import NewtonSettings, pressure_sensitivity, solve_pressures
+from softdesign.mechanics.reinforcement import HoopThread
 from softdesign.mechanics.section import SectionMesh, SectionResult, arc_of, measure_section, prepare_section
 from softdesign.types import FloatArray
 
@@ -110,8 +111,8 @@ class _Evaluations:
     """Forward solves by pressures, each continued from the last equilibrium, kept for the Jacobian at that point."""
 
     def __init__(self, section: SectionMesh, law: HyperelasticLaw, target: FloatArray, newton: NewtonSettings,
-                 settings: InverseSettings, on_trial: TrialListener | None):
-        self.prepared = prepare_section(section, law)
+                 settings: InverseSettings, on_trial: TrialListener | None, thread: HoopThread | None):
+        self.prepared = prepare_section(section, law, thread)
         self.target, self.newton, self.tolerance_mm = target, newton, settings.tolerance_mm
         self.time_limit_s, self.on_trial, self.started = settings.time_limit_s, on_trial, time.perf_counter()
         self.trials = 0
@@ -184,11 +185,11 @@ def _reach(runs: _Evaluations, kappa: float, converged: bool) -> str:
 
 
 def find_pressures(section: SectionMesh, law: HyperelasticLaw, target: tuple[float, float, float],
-                   settings: InverseSettings, newton: NewtonSettings, on_trial: TrialListener | None = None
-                   ) -> InverseResult:
+                   settings: InverseSettings, newton: NewtonSettings, on_trial: TrialListener | None = None,
+                   thread: HoopThread | None = None) -> InverseResult:
     """The pressures (k,) kPa whose section best matches the arc ``target`` = (kappa 1/mm, phi rad, L mm).
 
-    ``on_trial`` is told of every trial (see the module's docstring).
+    ``on_trial`` is told of every trial (see the module's docstring); ``thread``: the chambers' hoop winding.
 
     Raises
     ------
@@ -197,7 +198,7 @@ def find_pressures(section: SectionMesh, law: HyperelasticLaw, target: tuple[flo
     """
     from scipy.optimize import least_squares
 
-    runs = _Evaluations(section, law, arc_vector(*target), newton, settings, on_trial)
+    runs = _Evaluations(section, law, arc_vector(*target), newton, settings, on_trial, thread)
     start = np.full(section.chamber_count, settings.start_kpa)
     try:
         found = least_squares(runs.error_or_stop, start, jac=runs.jacobian, bounds=(0.0, settings.max_pressure_kpa),
