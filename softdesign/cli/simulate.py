@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -26,6 +28,9 @@ FigureOpt = Annotated[Path | None, typer.Option(
 WriteOpt = Annotated[bool, typer.Option(
     "--write", help="With --target: build with simulate enabled for this section and q, so that the build's "
     "actuation.csv carries the pressures found (as `simulate: {enabled: true}` does in build).")]
+TimeLimitOpt = Annotated[float | None, typer.Option(
+    "--time-limit", help="With --target: stop the search after the trial that passes this many seconds, keeping "
+    "its best (exit 1: not converged). Below --timeout.")]
 MaxPressureOpt = Annotated[float, typer.Option("--max-pressure", help="Upper bound of the inverse search, kPa.")]
 
 PRESSURES_FIX = "give three numbers in kPa separated by commas, e.g. --pressures 40,0,0"
@@ -83,6 +88,7 @@ def simulate(
     layer_mm: LayerOpt = 8.0,
     max_pressure: MaxPressureOpt = 100.0,
     timeout: TimeoutOpt = 600.0,
+    time_limit: TimeLimitOpt = None,
     figure: FigureOpt = None,
     write: WriteOpt = False,
     as_json: JsonOpt = False,
@@ -92,7 +98,8 @@ def simulate(
     The section's base is clamped and each chamber's wall carries its pressure on the deformed surface. It
     reports the best arc through the deformed centerline, each chamber's length, the largest stretch and stress
     and the convergence; with --target, the pressures whose arc best matches the design at q, and with --write
-    also into the build folder's actuation.csv (labelled as model estimates).
+    also into the build folder's actuation.csv (labelled as model estimates). A search shows its trials on a
+    terminal (each one's residual and the time) and exits 1 when it does not converge.
     """
 
     def action() -> None:
@@ -104,8 +111,10 @@ def simulate(
             raise ConfigError(f"simulate --section: got {section}; sections are numbered from 1 at the base, as "
                               "actuation.csv numbers them")
         values = None if pressures is None else pressures_from_text(pressures)
+        shown = target is not None and not as_json and sys.stderr.isatty()
         options = SimulateOptions(section - 1, values, target, size_mm, layer_mm, max_pressure_kpa=max_pressure,
-                                  timeout_s=timeout)
+                                  timeout_s=timeout, time_limit_s=time_limit,
+                                  trial_progress=TrialProgress() if shown else None)
         result = (write_to_table if write else run_simulate)(case_file, out, options, note)
         if figure is not None:
             from softdesign.io.atomic import write_bytes_atomically
@@ -113,5 +122,30 @@ def simulate(
 
             write_bytes_atomically(figure, simulate_figure_png(result))
         emit_json(result) if as_json else _print(result)
+        if "target" in result and not result["target"]["converged"]:
+            raise typer.Exit(code=1)
 
     run_guarded(action)
+
+
+class TrialProgress:
+    """The inverse's trials on a progress bar on stderr (:func:`softdesign.cli.progress.part_progress`): a
+    context manager yielding the trial listener, entered in the process that solves (it is pickled there)."""
+
+    def __init__(self) -> None:
+        self._bar: Any = None
+
+    def __enter__(self) -> Callable[[int, Any, float, float], None]:
+        from softdesign.cli.progress import part_progress
+
+        self._bar = part_progress("simulate --target", enabled=True)
+        tick = self._bar.__enter__()
+
+        def told(trial: int, pressures: Any, error_mm: float, seconds: float) -> None:
+            kpa = ", ".join(f"{p:.2f}" for p in pressures)
+            tick(f"trial {trial}, residual {error_mm:.3g} mm at {kpa} kPa", seconds)
+
+        return told
+
+    def __exit__(self, *exc: object) -> None:
+        self._bar.__exit__(*exc)

@@ -28,6 +28,8 @@ Method
 
 from __future__ import annotations
 
+import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,6 +37,7 @@ import numpy as np
 from softdesign.errors import SolveError
 from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.newton import NewtonSettings, pressure_sensitivity, solve_pressures
+from softdesign.mechanics.reinforcement import HoopThread
 from softdesign.mechanics.section import SectionMesh, SectionResult, arc_of, measure_section, prepare_section
 from softdesign.types import FloatArray
 
@@ -53,6 +56,7 @@ class InverseSettings:
     max_step_kpa: float
     tolerance_mm: float = 1e-4
     max_iterations: int = 12
+    time_limit_s: float | None = None  #: stop after the trial that passes this many seconds (None: no limit)
 
 
 @dataclass(frozen=True)
@@ -95,13 +99,23 @@ class _Reached(Exception):  # noqa: N818 - a signal, not an error: the search ma
     """Raised inside the search when an evaluation's error is below the tolerance."""
 
 
+class _TimeUp(Exception):  # noqa: N818 - a signal, not an error: the search must stop
+    """Raised inside the search when a trial ends past the time limit."""
+
+
+#: Told of each trial: (its number from 1, pressures (k,) kPa, its error's norm mm (inf: no equilibrium), seconds).
+TrialListener = Callable[[int, FloatArray, float, float], None]
+
+
 class _Evaluations:
     """Forward solves by pressures, each continued from the last equilibrium, kept for the Jacobian at that point."""
 
     def __init__(self, section: SectionMesh, law: HyperelasticLaw, target: FloatArray, newton: NewtonSettings,
-                 tolerance_mm: float):
-        self.prepared = prepare_section(section, law)
-        self.target, self.newton, self.tolerance_mm = target, newton, tolerance_mm
+                 settings: InverseSettings, on_trial: TrialListener | None, thread: HoopThread | None):
+        self.prepared = prepare_section(section, law, thread)
+        self.target, self.newton, self.tolerance_mm = target, newton, settings.tolerance_mm
+        self.time_limit_s, self.on_trial, self.started = settings.time_limit_s, on_trial, time.perf_counter()
+        self.trials = 0
         self.states: dict[bytes, tuple[FloatArray, SectionResult]] = {}
         self.last: tuple[FloatArray, FloatArray] | None = None
         self.rates: dict[bytes, FloatArray] = {}  # du/dp (k, V, 3) where the Jacobian was taken
@@ -131,10 +145,23 @@ class _Evaluations:
                 raise
             # a trial beyond what the solve reaches: a large error makes the trust region shrink
             self.failed.append(str(err))
-            return np.full(len(self.target), FAILED_TRIAL_MM)
+            error = np.full(len(self.target), FAILED_TRIAL_MM)
+        self._told(p, float(np.linalg.norm(error)) if error[0] != FAILED_TRIAL_MM else float("inf"))
         if np.linalg.norm(error) <= self.tolerance_mm:
             raise _Reached(np.array(p, float))
+        if self.time_limit_s is not None and time.perf_counter() - self.started > self.time_limit_s:
+            raise _TimeUp()
         return error
+
+    def _told(self, p: FloatArray, norm: float) -> None:
+        self.trials += 1
+        if self.on_trial is not None:
+            self.on_trial(self.trials, np.array(p, float), norm, time.perf_counter() - self.started)
+
+    def best(self) -> FloatArray:
+        """The pressures of the converged trial with the smallest error."""
+        key = min(self.states, key=lambda k: float(np.linalg.norm(self.error(np.frombuffer(k)))))
+        return np.frombuffer(key).copy()
 
     def jacobian(self, p: FloatArray) -> FloatArray:
         u, result = self.state(p)
@@ -158,8 +185,11 @@ def _reach(runs: _Evaluations, kappa: float, converged: bool) -> str:
 
 
 def find_pressures(section: SectionMesh, law: HyperelasticLaw, target: tuple[float, float, float],
-                   settings: InverseSettings, newton: NewtonSettings) -> InverseResult:
+                   settings: InverseSettings, newton: NewtonSettings, on_trial: TrialListener | None = None,
+                   thread: HoopThread | None = None) -> InverseResult:
     """The pressures (k,) kPa whose section best matches the arc ``target`` = (kappa 1/mm, phi rad, L mm).
+
+    ``on_trial`` is told of every trial (see the module's docstring); ``thread``: the chambers' hoop winding.
 
     Raises
     ------
@@ -168,7 +198,7 @@ def find_pressures(section: SectionMesh, law: HyperelasticLaw, target: tuple[flo
     """
     from scipy.optimize import least_squares
 
-    runs = _Evaluations(section, law, arc_vector(*target), newton, settings.tolerance_mm)
+    runs = _Evaluations(section, law, arc_vector(*target), newton, settings, on_trial, thread)
     start = np.full(section.chamber_count, settings.start_kpa)
     try:
         found = least_squares(runs.error_or_stop, start, jac=runs.jacobian, bounds=(0.0, settings.max_pressure_kpa),
@@ -177,6 +207,10 @@ def find_pressures(section: SectionMesh, law: HyperelasticLaw, target: tuple[flo
         p, message = np.asarray(found.x, float), str(found.message)
     except _Reached as reached:
         p, message = reached.args[0], "the error is below the tolerance"
+    except _TimeUp:
+        p = runs.best()
+        message = (f"the time limit of {settings.time_limit_s:g} s was reached after {runs.trials} trials "
+                   f"({time.perf_counter() - runs.started:.0f} s); the best trial is kept")
     result = runs.state(p)[1]
     error = runs.error(p)
     converged = bool(np.linalg.norm(error) <= settings.tolerance_mm)

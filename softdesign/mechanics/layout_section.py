@@ -109,4 +109,5 @@ def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, lay
     s = curve0.curve.arc_length(mesh.l)
     return SectionMesh(local, mesh.tets, mesh.node_layer == 0, np.concatenate(walls),
                        np.concatenate([np.full(len(w), k, np.int64) for k, w in enumerate(walls)]),
-                       centerline, (s - s[0])[mesh.node_layer], np.array([c.angle for c in chambers]))
+                       centerline, (s - s[0])[mesh.node_layer], np.array([c.angle for c in chambers]),
+                       np.array([0.5 * c.diameter_mm for c in chambers]))

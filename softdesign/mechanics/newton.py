@@ -67,6 +67,7 @@ from softdesign.mechanics.quadratic import (
     quadratic_state,
 )
 from softdesign.mechanics.quadratic_pressure import quadratic_pressure_load
+from softdesign.mechanics.reinforcement import FibreMembrane
 from softdesign.mechanics.tets import TetMesh
 from softdesign.types import FloatArray, IntArray
 
@@ -102,6 +103,10 @@ class PressureProblem:
     fixed : (3V,) bool, unknowns held at zero displacement
     faces : (F, 3) int, wall triangles (F, 6 for a quadratic mesh), normals out of the cavity
     face_cavity : (F,) int, which cavity (index into the pressures) each face bounds
+    fibres : the reinforcement's fibres on 6-node faces (:mod:`softdesign.mechanics.reinforcement`), or None
+    lids : (L, 3) int, flat 3-node triangles that also carry a cavity's pressure (a cavity's flat end), or None
+    lid_cavity : (L,) int, the cavity of each lid triangle
+    springs : (3V, 3V) constant symmetric matrix, mN/mm: linear springs of energy ``u^T S u / 2`` (ties), or None
     """
 
     mesh: TetMesh | QuadraticMesh
@@ -109,6 +114,10 @@ class PressureProblem:
     fixed: np.ndarray
     faces: IntArray
     face_cavity: IntArray
+    fibres: FibreMembrane | None = None
+    lids: IntArray | None = None
+    lid_cavity: IntArray | None = None
+    springs: sp.csr_matrix | None = None
 
 
 @dataclass
@@ -129,7 +138,19 @@ def check_admissible(problem: PressureProblem, u: FloatArray) -> None:
         volumetric_state(problem.mesh, problem.law, u)
 
 
-def _residual(problem: PressureProblem, u: FloatArray, face_pressure: FloatArray, tangent: bool,
+def pressure_forces(problem: PressureProblem, positions: FloatArray, cavity_pressures: FloatArray,
+                    want_tangent: bool) -> tuple[FloatArray, sp.csr_matrix | None]:
+    """The cavities' pressure forces (3V,) mN on the deformed walls (and lids), and ``dF/dx`` if asked."""
+    load = quadratic_pressure_load if isinstance(problem.mesh, QuadraticMesh) else pressure_load
+    f, dF = load(positions, problem.faces, cavity_pressures[problem.face_cavity], want_tangent)
+    if problem.lids is not None and problem.lid_cavity is not None:
+        f_lid, dF_lid = pressure_load(positions, problem.lids, cavity_pressures[problem.lid_cavity], want_tangent)
+        f = f + f_lid
+        dF = None if dF is None or dF_lid is None else dF + dF_lid
+    return f, dF
+
+
+def _residual(problem: PressureProblem, u: FloatArray, cavity_pressures: FloatArray, tangent: bool,
               element_pressure: FloatArray | None = None
               ) -> tuple[FloatArray, FloatArray, Tangent | None, QuadraticState | None]:
     """Residual (3V,), the pressure load (3V,), if asked the Newton matrix, and the quadratic state, at ``u`` (V, 3).
@@ -137,19 +158,25 @@ def _residual(problem: PressureProblem, u: FloatArray, face_pressure: FloatArray
     ``element_pressure`` (quadratic elements) is the mixed method's pressure unknown the matrix carries.
     """
     mesh, law, positions = problem.mesh, problem.law, problem.mesh.points + u
+    f_extra, K_extra = np.zeros(mesh.dof_count), sp.csr_matrix((mesh.dof_count, mesh.dof_count))
+    if problem.fibres is not None:
+        f_fibre, K_fibre = problem.fibres.force_and_tangent(positions, tangent)
+        f_extra, K_extra = f_extra + f_fibre, K_extra if K_fibre is None else K_extra + K_fibre
+    if problem.springs is not None:
+        f_extra, K_extra = f_extra + problem.springs @ u.ravel(), K_extra + problem.springs
+    f_p, dfp = pressure_forces(problem, positions, cavity_pressures, tangent)
     if isinstance(mesh, QuadraticMesh):
         state_q = quadratic_state(mesh, law, u)
-        f_p, dfp = quadratic_pressure_load(positions, problem.faces, face_pressure, tangent)
         if not tangent or dfp is None:
-            return quadratic_force(mesh, law, state_q) - f_p, f_p, None, state_q
+            return quadratic_force(mesh, law, state_q) + f_extra - f_p, f_p, None, state_q
         f_int, K_q = quadratic_force_and_tangent(mesh, law, state_q, element_pressure)
-        return f_int - f_p, f_p, Tangent(K_q - dfp, sp.csr_matrix((0, mesh.dof_count)), np.zeros(0)), state_q
+        K_q = K_q + K_extra - dfp
+        return f_int + f_extra - f_p, f_p, Tangent(K_q, sp.csr_matrix((0, mesh.dof_count)), np.zeros(0)), state_q
     state = volumetric_state(mesh, law, u)
-    f_p, dfp = pressure_load(positions, problem.faces, face_pressure, tangent)
     if not tangent or dfp is None:
-        return internal_force(mesh, law, state) - f_p, f_p, None, None
+        return internal_force(mesh, law, state) + f_extra - f_p, f_p, None, None
     f_int, K = force_and_tangent(mesh, law, state)
-    return f_int - f_p, f_p, Tangent(K.K - dfp, K.G, K.compliance), None
+    return f_int + f_extra - f_p, f_p, Tangent(K.K + K_extra - dfp, K.G, K.compliance), None
 
 
 def tangent_solver(tangent: Tangent, free: np.ndarray, solver: TangentSolver) -> Callable[[FloatArray], FloatArray]:
@@ -191,16 +218,17 @@ def _admissible(problem: PressureProblem, u: FloatArray, du: FloatArray) -> Floa
     return u + du
 
 
-def _newton_step(problem: PressureProblem, u: FloatArray, face_pressure: FloatArray, settings: NewtonSettings,
+def _newton_step(problem: PressureProblem, u: FloatArray, cavity_pressures: FloatArray, settings: NewtonSettings,
                  solver: TangentSolver) -> tuple[FloatArray, list[float]] | tuple[None, list[float]]:
-    """Equilibrium at ``face_pressure`` from ``u``: the new displacement and residual history, or None if it failed."""
+    """Equilibrium at ``cavity_pressures`` (k,) kPa from ``u``: the new displacement and residual history, or None
+    if it failed."""
     free = ~problem.fixed
     history: list[float] = []
     u = u.copy()
     pressure: FloatArray | None = None  # the mixed method's element pressures (None: U'(theta) of u)
     for _ in range(settings.max_iterations):
         try:
-            R, f_p, K, state = _residual(problem, u, face_pressure, True, pressure)
+            R, f_p, K, state = _residual(problem, u, cavity_pressures, True, pressure)
         except InvertedElementError:
             return None, history
         norm = float(np.linalg.norm(R[free]))
@@ -262,9 +290,9 @@ def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: N
     first_rate = None if start_rate is None else np.einsum("c,cvi->vi", pressures - p0, start_rate)
     while t < 1.0 - 1e-12:
         target = min(1.0, t + dt)
-        face_pressure = ((1.0 - target) * p0 + target * pressures)[problem.face_cavity]
+        cavity_pressures = (1.0 - target) * p0 + target * pressures
         new_u, history = _newton_step(problem, _predicted(problem, u, t, target, previous, first_rate),
-                                       face_pressure, settings, solver)
+                                       cavity_pressures, settings, solver)
         if new_u is None:
             if record.cutbacks >= settings.max_cutbacks:
                 last = f"{history[-1]:.3g} mN" if history else "none (an element turned inside out)"
@@ -294,14 +322,13 @@ def pressure_sensitivity(problem: PressureProblem, u: FloatArray, pressures: Flo
     forces of a unit pressure in cavity c alone on the deformed walls: solves with the Newton matrix there.
     """
     pressures = np.asarray(pressures, float)
-    _, _, tangent, _ = _residual(problem, u, pressures[problem.face_cavity], tangent=True)
+    _, _, tangent, _ = _residual(problem, u, pressures, tangent=True)
     if tangent is None:
         raise SolveError("no tangent at the equilibrium for the pressure sensitivity")
     solve = tangent_solver(tangent, ~problem.fixed, TangentSolver() if solver is None else solver)
     positions = problem.mesh.points + u
     out = []
     for c in range(len(pressures)):
-        load = quadratic_pressure_load if isinstance(problem.mesh, QuadraticMesh) else pressure_load
-        unit, _ = load(positions, problem.faces, (problem.face_cavity == c).astype(float), False)
+        unit, _ = pressure_forces(problem, positions, (np.arange(len(pressures)) == c).astype(float), False)
         out.append(solve(unit).reshape(-1, 3))
     return np.stack(out)

@@ -23,11 +23,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from softdesign.errors import MeshError
+from softdesign.errors import MeshError, SolveError
 from softdesign.kinematics.pcc_fit import arc_points, fit_arc, trapezoid_weights
+from softdesign.mechanics.continuation import ContinuationSettings, follow_pressures
 from softdesign.mechanics.laws import HyperelasticLaw, cauchy_stress
 from softdesign.mechanics.linear_solve import TangentSolver
-from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord, solve_pressures
+from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord
 from softdesign.mechanics.quadratic import (
     QuadraticMesh,
     quadratic_faces,
@@ -36,6 +37,7 @@ from softdesign.mechanics.quadratic import (
     quadratic_state,
     shape_values,
 )
+from softdesign.mechanics.reinforcement import FibreMembrane, HoopThread, hoop_membrane
 from softdesign.mechanics.tets import TetMesh, make_tet_mesh
 from softdesign.types import FloatArray, IntArray
 
@@ -59,6 +61,7 @@ class SectionMesh:
     centerline : (n, 3) float, mm, the reference centerline from base to tip, inside the material
     node_l : (V,) float, mm, each node's arc length along the centerline (its level)
     chamber_angles : (k,) float, rad, each chamber's angle from x towards y
+    chamber_radii_mm : (k,) float, mm, each chamber's radius (the reinforcement's winding needs it), or None
     """
 
     points: FloatArray
@@ -69,6 +72,7 @@ class SectionMesh:
     centerline: FloatArray
     node_l: FloatArray
     chamber_angles: FloatArray
+    chamber_radii_mm: FloatArray | None = None
 
     @property
     def chamber_count(self) -> int:
@@ -93,6 +97,7 @@ class SectionResult:
     max_stress_kpa: float  #: largest principal Cauchy stress of any element, kPa
     max_stress_at: FloatArray  #: (3,) reference centroid of that element, mm
     record: SolveRecord  #: load steps, iterations and residuals
+    displacement: FloatArray | None = None  #: (N, 3) mm, every node's (corners first), when kept
 
 
 def check_section(section: SectionMesh) -> TetMesh:
@@ -112,17 +117,36 @@ def check_section(section: SectionMesh) -> TetMesh:
     return mesh
 
 
-def section_problem(section: SectionMesh, law: HyperelasticLaw) -> PressureProblem:
+def section_problem(section: SectionMesh, law: HyperelasticLaw, thread: HoopThread | None = None
+                    ) -> PressureProblem:
     """The pressure problem of a section in quadratic tetrahedra (:mod:`softdesign.mechanics.quadratic`).
 
     The section's linear tetrahedra get a node at each edge's middle; the base
     nodes (corners and the midpoints between them) are fixed in every
     direction and each chamber's wall carries its pressure on 6-node faces.
+    With a ``thread``, every chamber's side wall carries the hoop winding's fibres
+    (:mod:`softdesign.mechanics.reinforcement`), its axis the centerline's tangent at the face's level.
     """
     mesh = quadratic_mesh(check_section(section))
     fixed = quadratic_fixed(mesh, np.repeat(section.base[:, None], 3, axis=1)).ravel()
-    return PressureProblem(mesh, law, fixed, quadratic_faces(mesh, np.asarray(section.wall_faces, np.int64)),
-                           np.asarray(section.face_chamber, np.int64))
+    faces = quadratic_faces(mesh, np.asarray(section.wall_faces, np.int64))
+    chambers = np.asarray(section.face_chamber, np.int64)
+    fibres = None if thread is None else _wall_fibres(section, mesh, faces, chambers, thread, law)
+    return PressureProblem(mesh, law, fixed, faces, chambers, fibres)
+
+
+def _wall_fibres(section: SectionMesh, mesh: QuadraticMesh, faces: IntArray, chambers: IntArray,
+                 thread: HoopThread, law: HyperelasticLaw) -> FibreMembrane:
+    """The hoop thread on every chamber wall face, its axis the centerline's tangent at the face's mean level."""
+    if section.chamber_radii_mm is None:
+        raise MeshError("section mesh: a reinforced section needs each chamber's radius (chamber_radii_mm)")
+    line = section.centerline
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(line, axis=0), axis=1))])
+    tangents = np.gradient(line, s, axis=0)
+    level = section.node_l[faces[:, :3]].mean(axis=1)
+    axes = np.stack([np.interp(level, s, tangents[:, k]) for k in range(3)], axis=1)
+    radii = np.asarray(section.chamber_radii_mm, float)[chambers]
+    return hoop_membrane(mesh.points, faces, axes, radii, thread, 3.0 * law.mu_kpa)  # incompressible: E = 3 mu
 
 
 def locate(mesh: TetMesh, query: FloatArray) -> tuple[IntArray, FloatArray]:
@@ -205,9 +229,10 @@ class PreparedSection:
         return self.section.centerline + self.centerline_motion(u)
 
 
-def prepare_section(section: SectionMesh, law: HyperelasticLaw) -> PreparedSection:
-    """Check a section and locate its centerline (MeshError when either is wrong)."""
-    problem = section_problem(section, law)
+def prepare_section(section: SectionMesh, law: HyperelasticLaw, thread: HoopThread | None = None
+                    ) -> PreparedSection:
+    """Check a section and locate its centerline (MeshError when either is wrong); ``thread``: its reinforcement."""
+    problem = section_problem(section, law, thread)
     assert isinstance(problem.mesh, QuadraticMesh)
     elements, weights = locate(problem.mesh.linear, section.centerline)
     steps = np.linalg.norm(np.diff(section.centerline, axis=0), axis=1)
@@ -225,11 +250,11 @@ def measure_section(prepared: PreparedSection, u: FloatArray, pressures: FloatAr
     corners = section.points + u[:len(section.points)]
     return SectionResult(np.asarray(pressures, float), centerline, kappa, phi, length, arc_max, arc_rms,
                          chamber_lengths(section, corners), chamber_lengths(section, section.points),
-                         stretch, stress, at, record)
+                         stretch, stress, at, record, u)
 
 
 def simulate_section(section: SectionMesh, law: HyperelasticLaw, pressures: FloatArray,
-                     settings: NewtonSettings) -> SectionResult:
+                     settings: NewtonSettings, thread: HoopThread | None = None) -> SectionResult:
     """Solve the section at chamber ``pressures`` (k,) kPa and measure it (see the module's docstring).
 
     Raises
@@ -237,11 +262,16 @@ def simulate_section(section: SectionMesh, law: HyperelasticLaw, pressures: Floa
     MeshError
         Bad named sets, or a centerline outside the material.
     SolveError
-        The solve did not converge.
+        The pressures lie beyond a limit point, or the solve stopped: the message gives the largest
+        pressures reached (:mod:`softdesign.mechanics.continuation`).
     """
     pressures = np.asarray(pressures, float)
     if pressures.shape != (section.chamber_count,):
         raise ValueError(f"expected {section.chamber_count} pressures, got shape {pressures.shape}")
-    prepared = prepare_section(section, law)
-    u, record = solve_pressures(prepared.problem, pressures, settings, solver=prepared.solver)
-    return measure_section(prepared, u, pressures, record)
+    prepared = prepare_section(section, law, thread)
+    path = follow_pressures(prepared.problem, pressures, ContinuationSettings(
+        first_step=1.0 / settings.load_steps, max_cutbacks=settings.max_cutbacks, newton=settings),
+        solver=prepared.solver)
+    if path.status != "reached":
+        raise SolveError(path.stopped_because(pressures))
+    return measure_section(prepared, path.end.u, pressures, path.record())

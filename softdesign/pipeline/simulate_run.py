@@ -10,6 +10,7 @@ fails cleanly; :func:`payload` gives its figures as JSON.
 
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass, replace
 from typing import Any
@@ -58,6 +59,12 @@ class SimulateOptions:
     max_pressure_kpa: float = 100.0
     max_solves: int = 16
     timeout_s: float = 600.0
+    #: the inverse stops after the trial that passes this many seconds, keeping its best (None: no limit)
+    time_limit_s: float | None = None
+    #: a context manager yielding the inverse's trial listener (the command line's progress), or None
+    trial_progress: Any = None
+    #: the chambers' hoop thread (:class:`softdesign.mechanics.reinforcement.HoopThread`), or None: unreinforced
+    thread: Any = None
 
 
 def no_law_error(case: Any, where: str) -> ConfigError:
@@ -96,6 +103,11 @@ def check_options(o: SimulateOptions) -> None:
     bound("--max-pressure", o.max_pressure_kpa, 1.0, MAX_PRESSURE_KPA)
     bound("--max-solves", o.max_solves, 1, MAX_INVERSE_SOLVES)
     bound("--timeout", o.timeout_s, 1.0, MAX_SIMULATE_SECONDS)
+    if o.time_limit_s is not None:
+        bound("--time-limit", o.time_limit_s, 1.0, MAX_SIMULATE_SECONDS)
+        if o.time_limit_s >= o.timeout_s:
+            raise ConfigError(f"simulate --time-limit: got {o.time_limit_s:g} s, not below --timeout "
+                              f"{o.timeout_s:g} s (the solve is stopped at the timeout); raise --timeout above it")
 
 
 def solve_in_child(section: Any, law: Any, o: SimulateOptions, target: tuple[float, float, float] | None
@@ -107,11 +119,12 @@ def solve_in_child(section: Any, law: Any, o: SimulateOptions, target: tuple[flo
 
     newton = NewtonSettings(load_steps=o.load_steps, max_iterations=o.max_iterations)
     if target is None:
-        result = simulate_section(section, law, np.array(o.pressures_kpa, float), newton)
+        result = simulate_section(section, law, np.array(o.pressures_kpa, float), newton, o.thread)
         return {"result": result, "inverse": None}
     settings = InverseSettings(o.max_pressure_kpa, 0.1 * o.max_pressure_kpa, 0.25 * o.max_pressure_kpa,
-                               tolerance_mm=1e-3, max_iterations=o.max_solves)
-    found = find_pressures(section, law, target, settings, newton)
+                               tolerance_mm=1e-3, max_iterations=o.max_solves, time_limit_s=o.time_limit_s)
+    with o.trial_progress or contextlib.nullcontext() as on_trial:
+        found = find_pressures(section, law, target, settings, newton, on_trial, o.thread)
     return {"result": found.section, "inverse": found}
 
 
@@ -164,7 +177,10 @@ def payload(o: SimulateOptions, section: Any, material: Any, answer: dict[str, A
                      "c2_kpa": material.law.c2, "c3_kpa": material.law.c3, "bulk_kpa": material.law.bulk_kpa,
                      "source": material.law.source},
         "formulation": ("quadratic (10-node) tetrahedra, mean dilatation per element (near-incompressible), "
-                        "follower pressure on 6-node faces"),
+                        "follower pressure on 6-node faces, volume continuation"
+                        + ("" if o.thread is None else
+                           f", hoop thread on the chamber walls (pitch {o.thread.pitch_mm:g} mm, diameter "
+                           f"{o.thread.diameter_mm:g} mm, modulus {o.thread.modulus_kpa:g} kPa)")),
         "mesh": {"nodes": len(section.points), "tets": len(section.tets),
                  "quadratic_nodes": quadratic_node_count(section), "size_mm": o.size_mm,
                  "layer_mm": o.layer_mm, "angular_count": o.angular_count},
@@ -180,7 +196,7 @@ def payload(o: SimulateOptions, section: Any, material: Any, answer: dict[str, A
                         for t, n, h in zip(r.record.load_factors, r.record.iterations, r.record.residuals,
                                            strict=True)],
         "deformed_centerline_mm": np.round(r.centerline, 6).tolist(),
-        "leaves_out": list(LEAVES_OUT),
+        "leaves_out": list(LEAVES_OUT if o.thread is None else LEAVES_OUT[1:]),
         "seconds": round(seconds, 2),
     }
     if target is not None and inverse is not None:

@@ -15,7 +15,7 @@ runner = CliRunner()
 def test_help_names_the_options() -> None:
     result = runner.invoke(app, ["simulate", "--help"])
     assert result.exit_code == 0
-    for option in ("--section", "--pressures", "--target", "--json", "--timeout"):
+    for option in ("--section", "--pressures", "--target", "--json", "--timeout", "--time-limit"):
         assert option in result.output
 
 
@@ -32,6 +32,8 @@ def test_help_names_the_options() -> None:
     (["--pressures", "10,0,0", "--figure", "out.svg"], "expected a .png file"),
     (["--pressures", "10,0,0", "--figure", "no/such/folder/out.png"], "does not exist"),
     (["--pressures", "10,0,0", "--section", "0"], "numbered from 1 at the base"),
+    (["--target", "1", "--time-limit", "700"], "not below --timeout 600 s"),
+    (["--target", "1", "--time-limit", "0"], "--time-limit: got 0"),
 ])
 def test_bad_options_exit_2_before_any_work(args: list[str], message: str, tmp_path) -> None:
     result = runner.invoke(app, ["simulate", str(DEMO), "--out", str(tmp_path / "build"), *args])

@@ -180,7 +180,7 @@ def three_chamber_section(radius: float, distance: float, chamber_diameter: floa
     chamber = np.argmin(np.linalg.norm(centroid[:, None, :] - centres[None], axis=2), axis=1)
     centerline = np.column_stack([np.zeros(len(z)), np.zeros(len(z)), z])
     return SectionMesh(points, kept, np.isclose(points[:, 2], 0.0), walls, chamber.astype(np.int64),
-                       centerline, points[:, 2].copy(), angles)
+                       centerline, points[:, 2].copy(), angles, np.full(3, chamber_diameter / 2))
 
 
 def _outer_skin(points: FloatArray, faces: IntArray, radius: float, length: float) -> np.ndarray:

@@ -45,3 +45,55 @@ def lame_displacement(mu: float, bulk: float, inner: float, outer: float, pressu
     nu = (3 * bulk - 2 * mu) / (2 * (3 * bulk + mu))
     young = 2 * mu * (1 + nu)
     return (1 + nu) / young * pressure * inner**2 / (outer**2 - inner**2) * ((1 - 2 * nu) * r + outer**2 / r)
+
+
+def closed_end_pressure(mu: float, inner: float, outer: float, hoop: float, axial: float) -> tuple[float, float]:
+    """Inner pressure (kPa) and the axial balance (mN, zero for a closed end) of an incompressible neo-Hookean tube
+    at inner hoop stretch ``hoop`` and axial stretch ``axial`` (Rivlin's inflation and extension).
+
+    A material circle of radius R goes to r with ``axial (r^2 - a^2) = R^2 - A^2``; the stretches are
+    ``r / R`` (hoop), ``R / (r axial)`` (radial) and ``axial``, and with ``sigma_i - sigma_j = mu (l_i^2 - l_j^2)``:
+
+        P = integral_a^b mu (l_t^2 - l_r^2) dr / r,
+        N - pi a^2 P = pi integral_a^b mu (2 l_z^2 - l_t^2 - l_r^2) r dr,
+
+    the second from ``d(r^2 sigma_rr)/dr = r (sigma_rr + sigma_tt)``; a closed end has ``N = pi a^2 P``.
+    """
+    from scipy.integrate import quad
+
+    a = hoop * inner
+    b = math.sqrt(a**2 + (outer**2 - inner**2) / axial)
+
+    def stretches(r: float) -> tuple[float, float]:
+        big_r = math.sqrt(inner**2 + axial * (r**2 - a**2))
+        return r / big_r, big_r / (r * axial)
+
+    def hoop_minus_radial(r: float) -> float:
+        t, rr = stretches(r)
+        return mu * (t**2 - rr**2) / r
+
+    def axial_excess(r: float) -> float:
+        t, rr = stretches(r)
+        return mu * (2 * axial**2 - t**2 - rr**2) * r
+
+    return quad(hoop_minus_radial, a, b, epsabs=1e-13, epsrel=1e-12)[0], \
+        math.pi * quad(axial_excess, a, b, epsabs=1e-13, epsrel=1e-12)[0]
+
+
+def closed_end_axial(mu: float, inner: float, outer: float, hoop: float) -> float:
+    """The axial stretch at which a closed-end tube at inner hoop stretch ``hoop`` is in axial balance."""
+    from scipy.optimize import brentq
+
+    return float(brentq(lambda z: closed_end_pressure(mu, inner, outer, hoop, z)[1], 0.5, 3.0, xtol=1e-14))
+
+
+def closed_end_limit(mu: float, inner: float, outer: float) -> tuple[float, float, float]:
+    """The closed-end tube's largest pressure (kPa) and the inner hoop and axial stretches there."""
+    from scipy.optimize import minimize_scalar
+
+    def minus_pressure(hoop: float) -> float:
+        return -closed_end_pressure(mu, inner, outer, hoop, closed_end_axial(mu, inner, outer, hoop))[0]
+
+    best = minimize_scalar(minus_pressure, bounds=(1.5, 5.0), method="bounded", options={"xatol": 1e-9})
+    hoop = float(best.x)
+    return -float(best.fun), hoop, closed_end_axial(mu, inner, outer, hoop)

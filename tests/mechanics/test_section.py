@@ -159,3 +159,17 @@ def test_curvature_converges_at_the_expected_order_under_nested_refinement() -> 
     assert abs(kappas[2] - extrapolated) < abs(kappas[2] - kappas[1])
     assert phi_errors[0] > phi_errors[1] > phi_errors[2]  # the direction converges to the side opposite
     assert phi_errors[2] < np.deg2rad(0.5)
+
+
+@pytest.mark.slow
+def test_an_inverse_past_its_time_limit_keeps_its_best_and_says_so() -> None:
+    told: list[tuple[int, float, float]] = []
+    settings = InverseSettings(max_pressure_kpa=30.0, start_kpa=5.0, max_step_kpa=10.0, tolerance_mm=1e-9,
+                               time_limit_s=1e-3)
+    found = find_pressures(_section(), LAW, (0.01, -np.pi / 2, 20.0), settings, NewtonSettings(load_steps=1),
+                           on_trial=lambda k, p, error, seconds: told.append((k, error, seconds)))
+    assert not found.converged
+    assert "the time limit of 0.001 s was reached after 1 trials" in found.stopped_because
+    assert [k for k, _, _ in told] == [1]
+    assert told[0][1] == pytest.approx(float(np.linalg.norm(found.error_mm)), rel=1e-12)
+    assert told[0][2] > 1e-3

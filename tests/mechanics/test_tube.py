@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from softdesign.errors import SolveError
+from softdesign.mechanics.continuation import ContinuationSettings, follow_pressures
 from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.newton import NewtonSettings, PressureProblem, pressure_sensitivity, solve_pressures
 from softdesign.mechanics.quadratic import quadratic_faces, quadratic_fixed, quadratic_mesh
@@ -97,3 +98,24 @@ def test_a_continuation_started_on_the_tangent_reaches_the_same_equilibrium() ->
         misses.append(np.abs(u10 + step * rate[0] - plain).max())
         assert misses[-1] < 0.05 * np.abs(u10 - plain).max()
     assert 3.0 < misses[0] / misses[1] < 5.0  # half the step, a quarter of the miss
+
+
+def test_the_volume_continuation_reaches_the_load_steps_equilibrium() -> None:
+    """Below any limit the path ends at t = 1 on the same equilibrium as load steps (the plane-strain tube has none:
+    its pressure rises to mu/2 ln(B^2/A^2) without a maximum)."""
+    _, problem = _problem(DEFAULT_COUNTS)
+    stepped, _ = solve_pressures(problem, np.array([20.0]), NewtonSettings(load_steps=4))
+    path = follow_pressures(problem, np.array([20.0]), ContinuationSettings())
+    assert path.status == "reached" and path.load_factor == 1.0
+    assert np.abs(path.end.u - stepped).max() < 1e-6 * np.abs(stepped).max()
+    assert np.all(np.diff(path.path[:, 0]) > 0)  # rising all the way
+    assert path.record().load_factors[-1] == 1.0
+
+
+def test_a_path_that_cannot_step_says_the_largest_load_it_reached() -> None:
+    _, problem = _problem(DEFAULT_COUNTS)
+    settings = ContinuationSettings(max_cutbacks=2, newton=NewtonSettings(max_iterations=1))
+    path = follow_pressures(problem, np.array([20.0]), settings)
+    assert path.status == "stopped" and path.load_factor == 0.0
+    assert "stopped at 0 kPa (load factor 0, the largest it reached towards 20 kPa)" in path.stopped_because(
+        np.array([20.0]))

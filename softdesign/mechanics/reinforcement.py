@@ -1,0 +1,214 @@
+"""Hoop reinforcement: a thread wound round each chamber, as a fibre membrane on the chamber's wall that takes
+no more compression than it can before it buckles.
+
+Formulation
+    The thread is wound round the chamber's core before casting, so it lies
+    on the chamber's wall.  It is smeared into a membrane on the wall's
+    6-node faces: at each quadrature point of a face the fibre's reference
+    direction ``a0`` (a unit vector in the wall's tangent plane) is carried
+    by the wall's surface map, ``a = dx/dS`` along ``a0``, and the fibre
+    stretch is ``lambda = |a|``, ``I4 = |a|^2``.  With ``e = (I4 - 1) / 2``
+    (the Green strain along the thread, ``eps`` at small strain) the energy
+    per reference wall area is
+
+        W = k e^2 / 2                                   when e >= -e_b,
+        W = k e_b^2 / 2 - k e_b (e + e_b)               below (buckled: a constant force),
+
+    with ``k = E_t A_t / pitch`` (kPa mm = mN/mm): the thread's axial
+    stiffness ``E_t A_t`` (``A_t = pi d^2 / 4``) per unit of chamber length
+    that each turn covers.  The thread's tension is ``T = E_t A_t e`` (its
+    Biot form ``lambda dW/dI4 * 2 pitch`` is the same to first order).
+Why not tension-only
+    A thread cannot push, but a thread *bonded in silicone* is held sideways
+    by it and carries compression up to its buckling load on that elastic
+    foundation (Winkler's beam: ``P_b = 2 sqrt(k_f E_t I_t)``, foundation
+    modulus ``k_f ~ E_m`` the matrix's Young's modulus, ``I_t = pi d^4 / 64``),
+    a strain ``e_b = P_b / (E_t A_t)`` of 4.4e-3 for a 0.2 mm, 2 GPa
+    thread in a silicone of E_m = 120 kPa.  Beyond it the buckled thread's force stays at
+    ``P_b`` (``W' `` constant, ``W'' = 0``).  A strictly tension-only law
+    (``e_b = 0``) was tried first: Newton cycled, the threads of the
+    unpressurised chambers (hoop strains of +-1e-6) switching a stiffness
+    1000 times the wall's on and off at every iteration.
+Direction
+    The winding is a helix of pitch ``pitch`` round a chamber of radius r:
+    its angle from the chamber's axis is ``beta = atan(2 pi r / pitch)``
+    (near hoop, 90 degrees, for a fine pitch).  ``a0 = cos(beta) t + sin(beta)
+    (n x t)``, with n the wall's normal and t the chamber's axis projected
+    into the wall.  One helix, one hand: a right-handed winding (its twist
+    coupling goes as ``cos(beta)``, 1 % at a pitch of a tenth of the
+    circumference).  The caps of a chamber (faces whose normal is within 45
+    degrees of the axis) carry no thread.
+Assumptions
+    The thread is bonded to the silicone (no slip), thin against the wall
+    (its bending stiffness is left out but for its buckling), linear elastic,
+    and every wall face has the same pitch.
+Derivatives
+    With ``a = sum_b D_b x_b`` (``D_b = alpha dN_b/dxi + beta dN_b/deta``,
+    constant per point) and ``W`` as a function of I4 (``W' = k e / 2``,
+    ``W'' = k / 4``, or ``-k e_b / 2`` and 0 when buckled),
+    ``f_b = sum_q w 2 W' a D_b`` and ``K_bc = sum_q w D_b D_c [4 W'' a (x) a + 2 W' I]``:
+    the exact Hessian but at the buckling kink (the tests check it against finite differences).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from softdesign.mechanics.quadratic_pressure import _DETA, _DXI, TRI_WEIGHTS, quadratic_face_dofs
+from softdesign.mechanics.tets import summed
+from softdesign.types import FloatArray, IntArray
+
+#: A wall face whose normal is within this angle of the chamber's axis is a cap: no thread on it, rad.
+CAP_ANGLE_RAD = math.pi / 4
+
+
+@dataclass(frozen=True)
+class HoopThread:
+    """The thread wound round each chamber (mm, kPa).
+
+    Attributes
+    ----------
+    pitch_mm : axial distance between turns, mm (> 0)
+    diameter_mm : the thread's diameter, mm (> 0)
+    modulus_kpa : the thread's Young's modulus in tension, kPa (> 0)
+    """
+
+    pitch_mm: float
+    diameter_mm: float
+    modulus_kpa: float
+
+    def __post_init__(self) -> None:
+        values = (self.pitch_mm, self.diameter_mm, self.modulus_kpa)
+        if not all(math.isfinite(v) and v > 0 for v in values):
+            raise ValueError(f"a hoop thread needs pitch_mm, diameter_mm and modulus_kpa > 0 and finite; got "
+                             f"{self.pitch_mm}, {self.diameter_mm}, {self.modulus_kpa}")
+
+    @property
+    def axial_stiffness_mn(self) -> float:
+        """``E_t A_t``, mN (kPa mm^2): the thread's tension per unit strain."""
+        return self.modulus_kpa * math.pi * self.diameter_mm**2 / 4.0
+
+    @property
+    def stiffness_mn_per_mm(self) -> float:
+        """``k = E_t A_t / pitch``, mN/mm: the membrane's hoop stiffness."""
+        return self.axial_stiffness_mn / self.pitch_mm
+
+    def buckling_strain(self, matrix_modulus_kpa: float) -> float:
+        """The compressive strain at which the thread buckles in a matrix of Young's modulus ``matrix_modulus_kpa``:
+        ``2 sqrt(E_m E_t I_t) / (E_t A_t)`` (a beam on a Winkler foundation of modulus E_m)."""
+        bending = self.modulus_kpa * math.pi * self.diameter_mm**4 / 64.0
+        return 2.0 * math.sqrt(matrix_modulus_kpa * bending) / self.axial_stiffness_mn
+
+    def winding_angle_rad(self, radius_mm: float) -> float:
+        """The helix's angle from the chamber's axis round a chamber of ``radius_mm``: ``atan(2 pi r / pitch)``."""
+        return math.atan2(2.0 * math.pi * radius_mm, self.pitch_mm)
+
+
+@dataclass(frozen=True)
+class FibreMembrane:
+    """Fibres on 6-node faces: the reinforcement's energy term of a pressure problem.
+
+    Attributes
+    ----------
+    faces : (F, 6) int, the 6-node faces carrying fibres
+    directions : (F, Q, 6) float, ``D_b``: the fibre vector ``a = sum_b D_b x_b`` at each point
+    weights : (F, Q) float, mm^2: quadrature weight times the reference area's Jacobian
+    stiffness : (F,) float, mN/mm: ``k`` of each face
+    axial_stiffness_mn : (F,) float, mN: ``E_t A_t`` (for the thread's tension)
+    buckling_strain : (F,) float: ``e_b`` >= 0, the compression the thread takes before it buckles
+    """
+
+    faces: IntArray
+    directions: FloatArray
+    weights: FloatArray
+    stiffness: FloatArray
+    axial_stiffness_mn: FloatArray
+    buckling_strain: FloatArray
+
+    def fibre_invariants(self, positions: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """The fibre vectors ``a`` (F, Q, 3) and ``I4 = |a|^2`` (F, Q) at deformed ``positions`` (N, 3) mm."""
+        a = np.einsum("fqb,fbi->fqi", self.directions, positions[self.faces])
+        return a, np.einsum("fqi,fqi->fq", a, a)
+
+    def strains(self, positions: FloatArray) -> FloatArray:
+        """The thread's Green strain ``e = (I4 - 1) / 2`` (F, Q) at each point."""
+        return 0.5 * (self.fibre_invariants(positions)[1] - 1.0)
+
+    def energy(self, positions: FloatArray) -> float:
+        """The stored energy, mN mm."""
+        e, e_b = self.strains(positions), self.buckling_strain[:, None]
+        per_area = np.where(e >= -e_b, 0.5 * e**2, 0.5 * e_b**2 - e_b * (e + e_b)) * self.stiffness[:, None]
+        return float(np.sum(self.weights * per_area))
+
+    def force_and_tangent(self, positions: FloatArray, want_tangent: bool
+                          ) -> tuple[FloatArray, sp.csr_matrix | None]:
+        """Internal forces (3N,) mN of the fibres and, if asked, their derivative (3N, 3N) mN/mm."""
+        a, i4 = self.fibre_invariants(positions)
+        e, e_b = 0.5 * (i4 - 1.0), self.buckling_strain[:, None]
+        w = self.weights * self.stiffness[:, None]
+        elastic = e >= -e_b
+        first = 0.5 * np.maximum(e, -e_b) * w  # dW/dI4 times the weight
+        forces = np.einsum("fq,fqi,fqb->fbi", 2.0 * first, a, self.directions)
+        dofs = quadratic_face_dofs(self.faces)
+        n = positions.size
+        f = summed(dofs, forces.reshape(len(self.faces), 18), n)
+        if not want_tangent:
+            return f, None
+        second = np.where(elastic, 0.25, 0.0) * w
+        inner = (4.0 * second[..., None, None] * np.einsum("fqi,fqk->fqik", a, a)
+                 + 2.0 * first[..., None, None] * np.eye(3)[None, None])
+        blocks = np.einsum("fqb,fqc,fqik->fbick", self.directions, self.directions, inner).reshape(-1, 18, 18)
+        rows = np.broadcast_to(dofs[:, :, None], blocks.shape).ravel()
+        cols = np.broadcast_to(dofs[:, None, :], blocks.shape).ravel()
+        return f, sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(n, n))
+
+    def thread_tension_mn(self, positions: FloatArray) -> FloatArray:
+        """The thread's force (F, Q) mN at each point, ``E_t A_t e`` (tension > 0; at least ``-E_t A_t e_b``)."""
+        return self.axial_stiffness_mn[:, None] * np.maximum(self.strains(positions), -self.buckling_strain[:, None])
+
+
+def _surface_tangents(points: FloatArray, faces: IntArray) -> tuple[FloatArray, FloatArray]:
+    """``dX/dxi`` and ``dX/deta`` (F, Q, 3) of 6-node faces at the rule's points, reference mm."""
+    x = points[faces]
+    return np.einsum("qb,fbi->fqi", _DXI, x), np.einsum("qb,fbi->fqi", _DETA, x)
+
+
+def hoop_membrane(points: FloatArray, faces: IntArray, axes: FloatArray, radii_mm: FloatArray,
+                  thread: HoopThread, matrix_modulus_kpa: float) -> FibreMembrane:
+    """The hoop thread's membrane on chamber walls (see the module's docstring).
+
+    Parameters
+    ----------
+    points : (N, 3) float, mm -- reference nodes (corners and midpoints)
+    faces : (F, 6) int -- chamber wall faces (any winding)
+    axes : (F, 3) float -- the chamber's axis direction at each face (need not be unit)
+    radii_mm : (F,) float, mm -- the radius of each face's chamber (for the winding angle)
+    thread : the thread
+    matrix_modulus_kpa : the silicone's Young's modulus, kPa (holds the thread sideways: its buckling strain)
+
+    Faces whose normal lies within ``CAP_ANGLE_RAD`` of the axis (the chamber's caps) are left out.
+    """
+    x_xi, x_eta = _surface_tangents(points, faces)
+    normal = np.cross(x_xi, x_eta)
+    area = np.linalg.norm(normal, axis=2)
+    n = normal / area[..., None]
+    t = np.asarray(axes, float) / np.linalg.norm(axes, axis=1)[:, None]
+    side = np.abs(np.einsum("fqi,fi->fq", n, t)).max(axis=1) < math.cos(CAP_ANGLE_RAD)
+    along = t[:, None, :] - np.einsum("fqi,fi->fq", n, t)[..., None] * n
+    along /= np.maximum(np.linalg.norm(along, axis=2), 1e-300)[..., None]  # caps (zero here) are dropped below
+    beta = np.array([thread.winding_angle_rad(float(r)) for r in radii_mm])[:, None, None]
+    a0 = np.cos(beta) * along + np.sin(beta) * np.cross(n, along)
+    # a0 = alpha X_xi + beta X_eta: the metric's inverse on the tangents' projections
+    g = np.stack([np.stack([np.einsum("fqi,fqi->fq", u, v) for v in (x_xi, x_eta)], -1) for u in (x_xi, x_eta)], -2)
+    rhs = np.stack([np.einsum("fqi,fqi->fq", u, a0) for u in (x_xi, x_eta)], axis=-1)
+    coeff = np.linalg.solve(g, rhs[..., None])[..., 0]  # (F, Q, 2)
+    directions = coeff[..., :1] * _DXI[None] + coeff[..., 1:] * _DETA[None]
+    keep = side
+    count = int(keep.sum())
+    return FibreMembrane(np.asarray(faces, np.int64)[keep], directions[keep], (TRI_WEIGHTS[None] * area)[keep],
+                         np.full(count, thread.stiffness_mn_per_mm), np.full(count, thread.axial_stiffness_mn),
+                         np.full(count, thread.buckling_strain(matrix_modulus_kpa)))
