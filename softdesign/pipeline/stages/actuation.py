@@ -45,6 +45,7 @@ from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.simulate_estimates import ESTIMATE_COLUMNS, SimulateResult, estimate_cells
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.fit import FitResult
+from softdesign.pipeline.stages.judges import material_judgement
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 
@@ -369,7 +370,7 @@ def load_actuation(build_dir: Path) -> ActuationResult | None:
 
 
 def describe_actuation(result: ActuationResult | None) -> list[str]:
-    """The thinnest walls, the extension range and the verdict."""
+    """The thinnest walls and the extension range."""
     if result is None:
         return []
     s = result.summary
@@ -382,10 +383,7 @@ def describe_actuation(result: ActuationResult | None) -> list[str]:
     lines.append(f"chamber extension {lo['min']:.4f} (section {lo['section']} chamber {lo['chamber']}, "
                  f"q={lo['q_min']:.3f}) to {hi['max']:.4f} (section {hi['section']} chamber {hi['chamber']}, "
                  f"q={hi['q_max']:.3f})")
-    if s["material"] is not None:
-        lines.append(f"actuation for {s['material']['name']}: {'feasible' if s['feasible'] else 'NOT feasible'}")
-        lines += [f"WARN {reason}" for reason in s["reasons"]]
-    return lines
+    return lines  # its verdict is the build's one (the manifest's)
 
 
 STAGE = Stage(
@@ -400,4 +398,5 @@ STAGE = Stage(
     describe=describe_actuation,
     metrics=lambda result: {} if result is None else result.summary,
     figures=lambda result: {} if result is None else {TABLE: {"rows": len(result.summary["rows"])}},
+    judge=lambda result: None if result is None else material_judgement(result.summary, "chambers"),
 )

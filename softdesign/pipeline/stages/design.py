@@ -35,8 +35,10 @@ from softdesign.kinematics.chain_design import METHOD, ChainOptions, ChainTarget
 from softdesign.kinematics.pcc_chain import arcs_from_w, dense_chain_points, section_poses
 from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import curve_options
+from softdesign.pipeline.notices import Notice
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.ingest import IngestResult
+from softdesign.pipeline.stages.judges import design_judgement
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 from softdesign.types import FloatArray, Pose
 
@@ -250,8 +252,13 @@ def describe_design(result: DesignResult | None) -> list[str]:
     lines = [f"{len(d['links'])} section(s) composed from the base: chain within {d['chain_max_deviation_mm']:.3g} mm "
              f"of the q = 1 centerline (tolerance {d['tolerance_mm']:g} mm), tip off by {d['tip_error_mm']:.3g} mm "
              f"and {d['tip_error_deg']:.3g} deg"]
-    miss = miss_text(d)
-    return lines + ([] if miss is None else [f"  warning: {miss}"])
+    return lines  # a miss of its bounds: :func:`design_notices`
+
+
+def design_notices(result: DesignResult | None) -> list[Notice]:
+    """A warning when the design misses its bounds."""
+    miss = None if result is None else miss_text(result.document)
+    return [] if miss is None else [Notice("design", "design_miss", "", miss)]
 
 
 def design_metrics(result: DesignResult | None) -> dict[str, Any]:
@@ -274,4 +281,6 @@ STAGE = Stage(
     load=lambda build_dir, results: load_design(build_dir),
     describe=describe_design,
     metrics=design_metrics,
+    warnings=design_notices,
+    judge=lambda result: design_judgement(None if result is None else result.document),
 )

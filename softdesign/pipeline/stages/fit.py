@@ -19,7 +19,6 @@ import numpy as np
 
 from softdesign.errors import ConfigError, FitError, FoldError
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
-from softdesign.fitting.end_checks import thin_end_warnings
 from softdesign.fitting.metrics import HoldoutSettings
 from softdesign.fitting.morph_folds import fold_over_morph
 from softdesign.fitting.projection import project_points
@@ -28,7 +27,6 @@ from softdesign.fitting.selection import NetworkContext, SelectionSettings, insc
 from softdesign.fitting.wall_fit import WallFitOptions, fit_wall
 from softdesign.geometry.curves import SmoothCurve, measure_deviation
 from softdesign.geometry.end_cut import choose_end_cuts
-from softdesign.geometry.end_planes import rim_gap_warnings
 from softdesign.geometry.morph_fold import MORPH_Q_SAMPLES
 from softdesign.geometry.network import SelectedPath
 from softdesign.kinematics.links import LinkChain
@@ -37,6 +35,7 @@ from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import describe_backbone_fit, stretch_fit_errors
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.fit_notices import fit_notices
 from softdesign.pipeline.stages.ingest import IngestResult
 from softdesign.pipeline.stages.links import LinksResult
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
@@ -262,11 +261,12 @@ def describe_fit(result: FitResult) -> list[str]:
         f"max rho * kappa at q = 1: {m['max_rho_kappa']:.3f} (folds at 1; every export q is checked at export)",
         *_morph_lines(result.summary),
         f"radius at q = 0: {result.summary['initial_radius']}",
-    ] + end_lines(result.summary) + describe_backbone_fit(result.summary.get("backbone", [])) + _stray_lines(result)
+    ] + end_lines(result.summary) + describe_backbone_fit(result.summary.get("backbone", []))
 
 
 def coverage_lines(summary: dict[str, Any]) -> list[str]:
-    """The all-wall figures, the coverage, each unseen stretch and the warnings (none for older builds)."""
+    """The all-wall figures, the coverage and each unseen stretch (none for older builds); the warnings are
+    :func:`~softdesign.pipeline.stages.fit_notices.fit_notices`'s."""
     if "all_wall" not in summary:
         return []
     a, c = summary["all_wall"], summary["coverage"]
@@ -277,7 +277,7 @@ def coverage_lines(summary: dict[str, Any]) -> list[str]:
     ]
     lines += [f"  wall not seen all round at {s['from_mm']:.1f}-{s['to_mm']:.1f} mm ({s['length_mm']:.1f} mm, local "
               f"diameter {s['diameter_mm']:.1f} mm): {s['how']}" for s in c["unseen_stretches"]]
-    return lines + [f"  warning: {w}" for w in summary.get("warnings", [])]
+    return lines
 
 
 def _morph_lines(summary: dict[str, Any]) -> list[str]:
@@ -288,27 +288,18 @@ def _morph_lines(summary: dict[str, Any]) -> list[str]:
             f"{m['q']:.3f}, l = {m['l']:.4f}"]
 
 
-def _stray_lines(result: FitResult) -> list[str]:
-    stray = result.summary.get("centerline_stray")
-    return [] if stray is None else [f"  warning: {stray}"]
-
-
 def end_lines(summary: dict[str, Any]) -> list[str]:
-    """Where an end's wall was unseen and held at the inscribed radius, and thin end rings (warnings)."""
+    """Where an end's wall was unseen and held at the inscribed radius, and how each end was cut (its warnings are
+    :func:`~softdesign.pipeline.stages.fit_notices.fit_notices`'s)."""
     lines = [
         f"{end}: wall not seen all round over the last {e['unseen_mm']:.1f} mm; {e['empty_cells']:.0f} empty cells "
         f"held at the inscribed radius ({e['reference_min_mm']:.3f} to {e['reference_max_mm']:.3f} mm)"
         for end, e in summary.get("end_prior", {}).items()
     ]
-    lines += [f"  warning: the fitted radius went to {h['rho_min_mm']:.3f} mm at {h['at_mm']:.1f} mm from the "
-              f"{end.removesuffix('_held')} (its wall points lean inwards): that end is held at the inscribed radius "
-              f"over {h['from_mm']:.1f}-{h['to_mm']:.1f} mm and fitted again"
-              for end, h in summary.get("ends", {}).items() if end.endswith("_held")]
     cuts = summary.get("end_cut", {})
     lines += [f"{end}: cut at the detected plane (tilt {c['tilt_deg']:.1f} deg, rim gap {c['rim_gap_mm']:.3f} mm)"
               if c["applied"] else f"{end}: cut square to the end tangent ({c['reason']})" for end, c in cuts.items()]
-    square = {end: c for end, c in cuts.items() if not c["applied"] and "rim_gap_mm" in c}
-    return lines + [f"  warning: {w}" for w in thin_end_warnings(summary.get("ends", {})) + rim_gap_warnings(square)]
+    return lines
 
 
 def _sampled_note(distance: dict[str, Any]) -> str:
@@ -329,4 +320,5 @@ STAGE = Stage(
     load=lambda build_dir, results: load_fit(build_dir),
     describe=describe_fit,
     metrics=fit_metrics,
+    warnings=lambda result: fit_notices(result.summary),
 )

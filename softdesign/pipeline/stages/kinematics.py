@@ -21,9 +21,11 @@ import numpy as np
 from softdesign.geometry.frames import FramedSpline
 from softdesign.kinematics import pcc
 from softdesign.kinematics.arc_check import arc_check_metrics, arc_misses, link_arcs_at_final_shape
+from softdesign.kinematics.arc_tolerance import ARC_TOLERANCE_MM
 from softdesign.kinematics.links import LinkChain, LinkReport
 from softdesign.kinematics.poe import PoeSplit
 from softdesign.pipeline import layout
+from softdesign.pipeline.notices import Notice
 from softdesign.pipeline.parallel import map_per_q
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.design import DesignResult
@@ -176,8 +178,15 @@ def describe_kinematics(result: KinematicsResult) -> list[str]:
                 f"theta1 {p['theta1']:.3f} mm, theta2 {math.degrees(p['theta2']):.3f} deg, "
                 f"stretch {link['stretch'][0]:.3f}..{link['stretch'][1]:.3f}"
             )
-    lines += [f"  warning: {line}" for line in arc_misses(link_arcs_at_final_shape(result.chain))]
-    return lines
+    return lines  # the links one arc cannot make: :func:`kinematics_notices`
+
+
+def kinematics_notices(result: KinematicsResult) -> list[Notice]:
+    """One warning per link whose q = 1 centerline one constant-curvature arc misses by more than the tolerance."""
+    arcs = link_arcs_at_final_shape(result.chain)
+    misses = [j for j, arc in enumerate(arcs) if arc.max_deviation_mm > ARC_TOLERANCE_MM]
+    return [Notice("kinematics", "arc_misfit", f"link {j}", text)
+            for j, text in zip(misses, arc_misses(arcs), strict=True)]
 
 
 STAGE = Stage(
@@ -191,4 +200,5 @@ STAGE = Stage(
     describe=describe_kinematics,
     metrics=lambda result: {"links": len(result.document["links"]), "file": layout.KINEMATICS,
                             "arc_check": arc_check_metrics(result.chain)},
+    warnings=kinematics_notices,
 )

@@ -32,6 +32,7 @@ from softdesign.pipeline.output_frame import base_pose, moved_points, moved_vect
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.actuation import actuation_layout
 from softdesign.pipeline.stages.fit import FitResult
+from softdesign.pipeline.stages.judges import mould_judgement
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 
@@ -157,4 +158,5 @@ STAGE = Stage(
     describe=describe_mould,
     metrics=lambda result: {k: v for k, v in result.summary.items() if k != "files"},
     figures=output_figures,
+    judge=lambda result: mould_judgement(result.summary),
 )
