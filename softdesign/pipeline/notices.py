@@ -57,7 +57,8 @@ class Judgement:
     Attributes
     ----------
     judged : the stage judged the design against the case's material (else its limits are unknown)
-    reasons : why the design cannot be made or cannot reach the vessel, each with its place and figures
+    reasons : why the design cannot be made or cannot reach the vessel, each a whole sentence with its place and
+        figures, starting with what it is about in an engineer's words (``chambers: ...``), never a stage's name
     margins : by how much it can, each a sentence with its figures
     material : the material judged against ("" when none)
     """
@@ -94,8 +95,8 @@ def verdict_record(judgements: Iterable[tuple[str, Judgement]]) -> dict[str, Any
     margins: list[str] = []
     materials: list[str] = []
     judged = False
-    for stage, judgement in judgements:
-        reasons += [f"{stage}: {r}" for r in judgement.reasons if f"{stage}: {r}" not in reasons]
+    for _stage, judgement in judgements:
+        reasons += [r for r in judgement.reasons if r not in reasons]
         margins += [m for m in judgement.margins if m not in margins]
         judged = judged or judgement.judged
         if judgement.material and judgement.material not in materials:
