@@ -52,7 +52,8 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:
     from softdesign.config import Case
 
-VERSION = 3  # 2: one reason per cause (a kind of wall, a bound of extension); 3: the simulate stage's pressures
+VERSION = 4  # 2: one reason per cause (a kind of wall, a bound of extension); 3: the simulate stage's pressures;
+#            4: angles in (-180, 180] degrees
 SUMMARY = "actuation/summary.json"
 TABLE = "actuation.csv"
 #: The dense q grid's size (q = 0, 0.05, ..., 1).
@@ -166,7 +167,7 @@ def _rows_at(kinematics: KinematicsResult, layout: ChamberLayout, q: float, expo
                         for i, f in enumerate(fits)])
     base = lengths if reference is None else reference
     rows = [{"q": q, "export": int(export), "section": i + 1, "chamber": j + 1,
-             "angle_deg": float(np.rad2deg(first[i, j])), "distance_mm": d, "length_mm": float(lengths[i, j]),
+             "angle_deg": degrees_wrapped(first[i, j]), "distance_mm": d, "length_mm": float(lengths[i, j]),
              "extension": float(lengths[i, j] / base[i, j]), "arc_kappa": f.kappa, "arc_phi": f.phi,
              "arc_length_mm": f.length, "arc_misfit_mm": f.backbone_max_mm}
             for i, f in enumerate(fits) for j in range(layout.spec.chambers_per_section)]
@@ -282,15 +283,22 @@ def judge(walls: list[Wall], extensions: list[dict[str, Any]], limits: dict[str,
     return reasons
 
 
+def degrees_wrapped(angle_rad: float) -> float:
+    """An angle in degrees in (-180, 180] (the one convention of the CSV and JSON outputs), rounded to 1e-9 deg so
+    that 30 and 390 - 360 are written as the same number."""
+    degrees = float(np.rad2deg(angle_rad)) % 360.0
+    return round(degrees - 360.0 if degrees > 180.0 else degrees, 9) + 0.0
+
+
 def layout_document(layout: ChamberLayout) -> dict[str, Any]:
     """The layout as JSON: the spec, every chamber and feed (angles in degrees)."""
     return {
         "rule": "section i chamber j at first_angle + 120 j + i 120/n deg in the body's RMF (0 along N); feeds on "
                 "the chambers' ring at their chamber's angle, from the base face into the chamber",
-        "chambers": [{"section": c.section + 1, "chamber": c.index + 1, "angle_deg": float(np.rad2deg(c.angle)),
+        "chambers": [{"section": c.section + 1, "chamber": c.index + 1, "angle_deg": degrees_wrapped(c.angle),
                       "distance_mm": c.distance_mm, "diameter_mm": c.diameter_mm, "l_start": c.l_start,
                       "l_end": c.l_end} for c in layout.chambers],
-        "feeds": [{"section": f.section + 1, "chamber": f.chamber + 1, "angle_deg": float(np.rad2deg(f.angle)),
+        "feeds": [{"section": f.section + 1, "chamber": f.chamber + 1, "angle_deg": degrees_wrapped(f.angle),
                    "ring_mm": f.ring_mm, "diameter_mm": f.diameter_mm, "l_start": f.l_start, "l_end": f.l_end}
                   for f in layout.feeds],
     }

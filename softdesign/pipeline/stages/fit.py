@@ -254,8 +254,9 @@ def describe_fit(result: FitResult) -> list[str]:
         f"spline: knots every {st['knot_spacing_mm']:g} mm, {st['angular_intervals']} angular intervals, "
         f"smoothing {st['smoothing']:g}",
         f"true distance to the fitted surface, kept points (mm){_sampled_note(result.summary['distance'])}:",
-        f"  RMS {m['rms_mm']:.4f}  p95 {m['p95_mm']:.4f}  p99 {m['p99_mm']:.4f}  max {m['max_mm']:.4f}",
-        f"  hold-out RMS ({result.summary['holdout_points']} points, k-fold) {m['holdout_rms_mm']:.4f}",
+        f"  kept-point RMS {m['rms_mm']:.4f}  p95 {m['p95_mm']:.4f}  p99 {m['p99_mm']:.4f}  max {m['max_mm']:.4f}",
+        f"  hold-out RMS {m['holdout_rms_mm']:.4f} (k-fold on {result.summary['holdout_points']} kept points: each "
+        "fold measured against the fit made without it)",
         *coverage_lines(result.summary),
         f"joints: value jump {m['joint_value_jump_mm']:.2e} mm, slope jump {m['joint_slope_jump']:.2e}",
         f"max rho * kappa at q = 1: {m['max_rho_kappa']:.3f} (folds at 1; every export q is checked at export)",
@@ -273,7 +274,7 @@ def coverage_lines(summary: dict[str, Any]) -> list[str]:
     lines = [
         f"true distance, all of the path's own wall ({c['own_wall_points']} vertices, {c['fraction']:.1%} of them "
         f"fitted):",
-        f"  RMS {a['rms_mm']:.4f}  p95 {a['p95_mm']:.4f}  p99 {a['p99_mm']:.4f}  max {a['max_mm']:.4f}",
+        f"  all-wall RMS {a['rms_mm']:.4f}  p95 {a['p95_mm']:.4f}  p99 {a['p99_mm']:.4f}  max {a['max_mm']:.4f}",
     ]
     lines += [f"  wall not seen all round at {s['from_mm']:.1f}-{s['to_mm']:.1f} mm ({s['length_mm']:.1f} mm, local "
               f"diameter {s['diameter_mm']:.1f} mm): {s['how']}" for s in c["unseen_stretches"]]
