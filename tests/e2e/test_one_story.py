@@ -23,6 +23,7 @@ from softdesign.cli import app
 from softdesign.report.writer import PAGE, REPORT_DIR
 from tests.helpers.paths import AORTA_DIR, DEMO, REPO
 from tests.helpers.robust_vessels import write_tilted_cap_vessel
+from tests.test_user_strings import INTERNAL
 
 pytestmark = pytest.mark.slow
 runner = CliRunner()
@@ -134,3 +135,11 @@ def test_each_case_raises_the_warnings_it_is_chosen_for(story):
         assert story.manifest["verdict"]["status"] == "NOT feasible"
         assert any(r.startswith("chambers: ") for r in story.manifest["verdict"]["reasons"])
         assert any("mould checks pass" in m for m in story.manifest["verdict"]["margins"])
+
+
+def test_no_output_names_the_projects_bookkeeping(story):
+    verdict = story.manifest["verdict"]
+    page = re.sub(r"<script.*?</script>", " ", story.page, flags=re.S)  # the 3D view's library is not prose
+    texts = [*story.stdout, *story.stderr, *(w["text"] for w in story.manifest["warnings"]), verdict["headline"],
+             *verdict["reasons"], *verdict["margins"], html.unescape(re.sub(r"<[^>]+>", " ", page))]
+    assert [INTERNAL.search(t).group(0) for t in texts if INTERNAL.search(t)] == []

@@ -352,7 +352,7 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult,
         "material": limits,
         "feasible": None if limits is None else not reasons,
         "reasons": reasons if limits is not None else ["no material: in the case file: figures only, not judged"],
-        "method": "lengths: seed 003 on each section's best arc at q (backbone started on the section's base "
+        "method": "lengths: Zou et al. on each section's best arc at q (backbone started on the section's base "
                   "frame); extension: the chamber's axis on the body at q over q = 0; walls in the sections' "
                   "normal planes (chamber-skin, feed-skin at every q; between tubes constant over q), and at every "
                   "export q the skin over each tube measured on the mesh (end caps included)",

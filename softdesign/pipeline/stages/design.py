@@ -45,7 +45,7 @@ from softdesign.types import FloatArray, Pose
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 2  # 2: each section's D-H rows (dh) and the dh_convention in design/summary.json
+VERSION = 3  # 2: each section's D-H rows (dh) and the dh_convention in design/summary.json; 3: its papers cited
 #: Below this bending angle (rad) a section is reported straight: kappa and phi 0 (phi is rounding noise there).
 STRAIGHT_THETA_RAD = 1e-9
 #: Spacing of the chain's points kept for the report, mm.
@@ -54,7 +54,7 @@ PROFILE_STEP_MM = 0.25
 CONVENTION = (
     "mm, radians (phi, theta) and degrees only where a key says _deg. Section 1 starts on base_frame (4x4, world: "
     "columns N, B, T and the position of the q = 1 centerline at l = 0, rotation-minimizing frames); each next "
-    "section starts on the previous tip_frame (seed 003's improved D-H). phi is measured in the section's base frame "
+    "section starts on the previous tip_frame (Zou et al.'s improved D-H). phi is measured in the section's base frame "
     "from N towards B, and the section bends towards phi; kappa >= 0, theta = kappa * length; a straight section has "
     "kappa = phi = 0. l_start, l_end are normalized l of the q = 1 centerline, at the joints' arc-length fractions of "
     "the chain. max_deviation_mm: the largest true distance between the composed chain and the centerline, both "

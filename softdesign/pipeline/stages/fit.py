@@ -44,12 +44,13 @@ from softdesign.types import FloatArray
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 7  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
+VERSION = 8  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
 # 3: points fitted in path order; distances sampled above 200k points (max still over all)
 # 4: end prior and end radii (issue 20); true distances on the regularized backbone's stretches (``backbone``)
 # 5: each end's cut plane in the end frame (``end_cut``, issue 20)
 # 6: fit/points.npz keeps the true distance of every point the metrics measured (``distance``, NaN elsewhere)
 # 7: the fit against all of the path's own wall, its coverage and flags (``all_wall``, ``coverage``, issue 29)
+# 8: the coverage warnings in an engineer's words (issue 44)
 #: Seed of the hold-out folds: the same case always gets the same folds.
 HOLDOUT_SEED = 4
 #: A failed fit is blamed on the centerline when the smoothed one strays from the input by this fraction of the

@@ -35,7 +35,8 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 2  # 2: blend: pcc builds carry the design's sections at each pose (pcc_sections, pcc_convention)
+VERSION = 3  # 2: blend: pcc builds carry the design's sections at each pose (pcc_sections, pcc_convention)
+#            3: the conventions cite their paper
 CONVENTION = (
     "F(q, l) = [[N B T c], [0 0 0 1]]; transform = S_T_E = inv(F(q, l_start)) F(q, l_end), "
     "mapping end-frame coordinates into start-frame coordinates; "
@@ -47,7 +48,7 @@ CONVENTION = (
 PCC_CONVENTION = (
     "blend: pcc: each pose's pcc_sections are the design's sections (design/summary.json) at the pose's q of their "
     "link: an arc of curvature q * kappa, plane phi and length L; transform is the section's HTM (its tip frame in "
-    "its base frame, seed 003: Rz(phi) Ry(theta/2) Tz(chord) Ry(theta/2) Rz(-phi)) and dh its rows (dh: "
+    "its base frame, Zou et al.: Rz(phi) Ry(theta/2) Tz(chord) Ry(theta/2) Rz(-phi)) and dh its rows (dh: "
     + pcc.DH_CONVENTION + "); the links' transforms are measured on the built centerline's frames, which follow "
     "the chain as resampled"
 )
