@@ -52,6 +52,7 @@ from softdesign.report.html_page import (
     render_page,
     table_html,
 )
+from softdesign.report.make_it import make_it_section
 from softdesign.report.plotting import pixel_size
 from softdesign.report.summary import facts_table, summary_facts, summary_warnings
 from softdesign.report.tables import (
@@ -312,6 +313,9 @@ def report_sections(
     fabrication = _fabrication_section(data, run)
     if fabrication is not None:
         sections.insert(-2, fabrication)
+    make_it = make_it_section(data.manifest)  # fabrication.md's lines: how to make it, from the build's figures
+    if make_it is not None:
+        sections.insert(-2, make_it)
     return sections, checks, notes
 
 

@@ -39,6 +39,7 @@ class Story:
     """What each output says of one build (``case``: one of :data:`CASES`)."""
 
     case: str
+    build_dir: Path
     stdout: list[str]
     stderr: list[str]
     manifest: dict
@@ -50,7 +51,7 @@ def _build(name: str, case: Path, out: Path) -> Story:
     assert result.exit_code == 0, result.output
     manifest = json.loads((out / "manifest.json").read_text(encoding="utf-8"))
     page = (out / REPORT_DIR / PAGE).read_text(encoding="utf-8")
-    return Story(name, result.stdout.splitlines(), result.stderr.splitlines(), manifest, page)
+    return Story(name, out, result.stdout.splitlines(), result.stderr.splitlines(), manifest, page)
 
 
 def _case(name: str, folder: Path) -> Path:
@@ -143,3 +144,25 @@ def test_no_output_names_the_projects_bookkeeping(story):
     texts = [*story.stdout, *story.stderr, *(w["text"] for w in story.manifest["warnings"]), verdict["headline"],
              *verdict["reasons"], *verdict["margins"], html.unescape(re.sub(r"<[^>]+>", " ", page))]
     assert [INTERNAL.search(t).group(0) for t in texts if INTERNAL.search(t)] == []
+
+
+def test_the_actuators_fabrication_sheet_is_the_builds_figures_and_the_report_shows_it(story):
+    if story.case != "actuator":
+        pytest.skip("the sheet's whole-build check is on the actuator: chambers, feeds and a mould")
+    from softdesign.pipeline.stages.fabrication import sheet_text
+
+    figures = story.manifest["metrics"]["fabrication"]
+    assert (story.build_dir / "fabrication.md").read_text(encoding="utf-8") == sheet_text(figures)
+    mould, case = figures["mould"], story.manifest["case"]
+    assert (mould["pour_mm"], mould["vent_mm"], mould["up"]) == tuple(case["export"]["mould"][k]
+                                                                      for k in ("pour_mm", "vent_mm", "up"))
+    chambers = {c["section"]: c for c in story.manifest["metrics"]["actuation"]["layout"]["chambers"]}
+    for core in figures["cores"]:  # each core's chamber part: the layout's diameter over its length at q = 0
+        chamber = core["segments"][0]
+        section = chambers[int(core["name"].split("_")[1])]
+        assert chamber["diameter_mm"] == section["diameter_mm"]
+        expected = (section["l_end"] - section["l_start"]) * figures["body_length_mm"]
+        assert abs(chamber["length_mm"] - expected) <= 1e-9 * expected  # the same product, maybe in another order
+        assert chamber["make"] == ("wire" if chamber["length_mm"] > 20.0 * chamber["diameter_mm"] else "printed")
+    assert figures["supply"]["count"] == len(story.manifest["metrics"]["actuation"]["layout"]["feeds"])
+    assert 'id="make-it"' in story.page and "<h3>Demoulding (in this order)</h3>" in story.page
