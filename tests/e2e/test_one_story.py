@@ -81,10 +81,26 @@ def _write(path: Path, case: dict) -> Path:
     return path
 
 
+#: Each case's build, made once for every test that asks for it.
+_BUILT: dict[str, Story] = {}
+
+
+def _story(name: str, factory: pytest.TempPathFactory) -> Story:
+    if name not in _BUILT:
+        folder = factory.mktemp(name)
+        _BUILT[name] = _build(name, _case(name, folder), folder / "build")
+    return _BUILT[name]
+
+
 @pytest.fixture(scope="module", params=CASES)
 def story(request, tmp_path_factory) -> Story:
-    folder = tmp_path_factory.mktemp(request.param)
-    return _build(request.param, _case(request.param, folder), folder / "build")
+    return _story(request.param, tmp_path_factory)
+
+
+@pytest.fixture(scope="module")
+def actuator(tmp_path_factory) -> Story:
+    """The actuator's build (chambers, feeds, a mould): the same one as ``story``'s actuator case."""
+    return _story("actuator", tmp_path_factory)
 
 
 def _terminal_warnings(story: Story) -> list[str]:
@@ -146,11 +162,10 @@ def test_no_output_names_the_projects_bookkeeping(story):
     assert [INTERNAL.search(t).group(0) for t in texts if INTERNAL.search(t)] == []
 
 
-def test_the_actuators_fabrication_sheet_is_the_builds_figures_and_the_report_shows_it(story):
-    if story.case != "actuator":
-        pytest.skip("the sheet's whole-build check is on the actuator: chambers, feeds and a mould")
+def test_the_actuators_fabrication_sheet_is_the_builds_figures_and_the_report_shows_it(actuator):
     from softdesign.pipeline.stages.fabrication import sheet_text
 
+    story = actuator
     figures = story.manifest["metrics"]["fabrication"]
     assert (story.build_dir / "fabrication.md").read_text(encoding="utf-8") == sheet_text(figures)
     mould, case = figures["mould"], story.manifest["case"]

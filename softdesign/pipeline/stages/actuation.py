@@ -41,6 +41,7 @@ from softdesign.meshing.chambers import measured_skin_walls
 from softdesign.meshing.sweep_layout import check_resolvable, layout_holes
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import export_workers
+from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.simulate_estimates import ESTIMATE_COLUMNS, SimulateResult, estimate_cells
 from softdesign.pipeline.stage import Stage
@@ -248,7 +249,9 @@ def _meshed(case: Case, kinematics: KinematicsResult, fit: FitResult, layout: Ch
                 for kind in dict.fromkeys(w.kind for w in walls)]
 
     longest = max(key.length for key in kinematics.chain.shape.keys)
-    return [w for walls in map_items(at, e.q_values(), most=export_workers(case, longest)) for w in walls]
+    counted = item_counter("actuation", e.q_values(), lambda q: f"walls at q = {q:g}")  # a bar, when one listens
+    return [w for walls in map_items(at, e.q_values(), most=export_workers(case, longest), on_result=counted)
+            for w in walls]
 
 
 def judge(walls: list[Wall], extensions: list[dict[str, Any]], limits: dict[str, Any] | None) -> list[str]:

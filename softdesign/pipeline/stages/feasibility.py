@@ -47,6 +47,7 @@ from softdesign.meshing.wall import FD_STEP_MM, offset_metric, port_wall_mm, thi
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import meshes_at_once
 from softdesign.pipeline.feasibility_judge import judge
+from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.fit import FitResult
@@ -240,7 +241,8 @@ def run_feasibility(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
         kind, q = item
         return _at_q(body, q, case) if kind == "q" else _extremes(body, q, 0.0, (0.0, 1.0))
 
-    done = map_items(task, work, most=most)
+    counted = item_counter("feasibility", work, lambda item: f"skin at q = {item[1]:.3g}")  # a bar, when one listens
+    done = map_items(task, work, most=most, on_result=counted)
     rows, polished = done[:-2], (done[-2], done[-1])
     per_link = []
     for j in range(len(fit.field.final)):
