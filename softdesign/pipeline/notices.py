@@ -45,10 +45,6 @@ class Notice:
     text: str
     kind: str = WARNING
 
-    def line(self) -> str:
-        """The one line the terminal prints and the report lists."""
-        return f"{self.stage}: {self.text}"
-
 
 @dataclass(frozen=True)
 class Judgement:
