@@ -24,6 +24,7 @@ from PIL import Image
 from typer.testing import CliRunner
 
 from softdesign.pipeline.api import build_through
+from softdesign.pipeline.manifest import STALE_TEXT
 from softdesign.pipeline.owned import REPORT_MARKER
 from softdesign.pipeline.versions import software_versions
 from softdesign.report.interactive import DISPLAY_TOLERANCE_MM, DIV_ID, JS_NAME
@@ -326,7 +327,9 @@ def test_tampered_outputs_fail_their_checks(demo, tmp_path):
     checks = [r for r in parse_page(copy / REPORT_DIR).rows if r[-1:] in (["FAIL"], ["pass"])]
     assert [r[-1] for r in checks[:3]] == ["FAIL"] * 3 and "FAIL" not in [r[-1] for r in checks[3:]]  # failures first
     text = (copy / REPORT_DIR / PAGE).read_text(encoding="utf-8")
-    assert "3 of " in text[text.index('<div class="banner"'):text.index("<nav>")]  # and in the banner
+    # and in the checks' tally under the verdict, opened on its failures (the build's warnings are the banner's)
+    box = text[text.index('<details class="tally" id="checks" open>'):text.index("<nav>")]
+    assert f"Checks: {result.checks_passed} of {result.checks_total} passed" in box and f"{mesh}: watertight" in box
     failed = {(r[0], r[1]) for r in checks if r[-1] == "FAIL"}
     assert failed == {(mesh, "watertight"), (mesh, "volume vs integrated volume"),
                       ("export/summary.json", "file as recorded (sha256)")}
@@ -342,13 +345,15 @@ def test_a_stale_stage_is_noted_on_the_page(demo, tmp_path):
     for stage in manifest["stages"]:
         if stage["name"] == "export":
             stage["stale"] = True
+    # as the build records it (pipeline/manifest.py): the stale stage is one of the manifest's warnings
+    manifest["warnings"].append({"stage": "export", "code": "stale", "place": "", "text": STALE_TEXT,
+                                 "kind": "warning"})
     manifest_file.write_text(json.dumps(manifest))
     write_report(copy, ReportOptions(gif_frames=3))
     text = (copy / REPORT_DIR / PAGE).read_text(encoding="utf-8")
-    assert "export: out of date" in text
     banner = text[text.index('<div class="banner"'):text.index("<nav>")]  # the warnings sit above every section
-    assert "stale: stage export is out of date" in banner
-    assert "out of date" not in (demo[0] / REPORT_DIR / PAGE).read_text(encoding="utf-8")
+    assert html.escape(f"export: {STALE_TEXT}") in banner and text.count(html.escape(STALE_TEXT)) == 1
+    assert html.escape(STALE_TEXT) not in (demo[0] / REPORT_DIR / PAGE).read_text(encoding="utf-8")
 
 
 def test_a_failed_write_leaves_the_previous_report(tmp_path):
