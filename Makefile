@@ -21,19 +21,25 @@ install: $(STAMP) $(CLUSTER_STAMP)
 
 # A fresh venv each time (--clear), so a package dropped from the pins leaves it too.
 # The venv's own pip predates --build-constraint: it first installs the pinned pip.
+# Quiet: one line says what it does.  setuptools' "Editable installation" notice (a folder named softdesign in the
+# directory you run Python from would shadow the installed package) is the only thing pip --quiet lets through: it
+# is silenced by its message (PYTHONWARNINGS), and said here instead.
 $(STAMP): pyproject.toml $(CONSTRAINTS)
-	$(PYTHON) -m venv --clear $(VENV)
-	$(BIN)/python -m pip install --quiet -c $(CONSTRAINTS) pip setuptools
-	$(BIN)/python -m pip install --quiet -c $(CONSTRAINTS) --build-constraint $(CONSTRAINTS) -e '.[test,lint]'
-	touch $@
+	@echo "make: a fresh $(VENV) with the pinned packages ($(CONSTRAINTS)) and softdesign installed editable (a minute or two)"
+	@$(PYTHON) -m venv --clear $(VENV)
+	@$(BIN)/python -m pip install --quiet -c $(CONSTRAINTS) pip setuptools
+	@PYTHONWARNINGS="ignore:Editable installation" \
+		$(BIN)/python -m pip install --quiet -c $(CONSTRAINTS) --build-constraint $(CONSTRAINTS) -e '.[test,lint]'
+	@touch $@
 
 # The workflow engine only (the workflow runs softdesign from .venv); its pins: requirements/cluster.txt.
 $(CLUSTER_STAMP): pyproject.toml $(CLUSTER_CONSTRAINTS)
-	$(PYTHON) -m venv --clear $(CLUSTER_VENV)
-	$(CLUSTER_VENV)/bin/python -m pip install --quiet -c $(CLUSTER_CONSTRAINTS) pip setuptools
-	$(CLUSTER_VENV)/bin/python -m pip install --quiet -c $(CLUSTER_CONSTRAINTS) --build-constraint $(CLUSTER_CONSTRAINTS) \
+	@echo "make: a fresh $(CLUSTER_VENV) with snakemake and its SLURM executor ($(CLUSTER_CONSTRAINTS))"
+	@$(PYTHON) -m venv --clear $(CLUSTER_VENV)
+	@$(CLUSTER_VENV)/bin/python -m pip install --quiet -c $(CLUSTER_CONSTRAINTS) pip setuptools
+	@$(CLUSTER_VENV)/bin/python -m pip install --quiet -c $(CLUSTER_CONSTRAINTS) --build-constraint $(CLUSTER_CONSTRAINTS) \
 		$(CLUSTER_PACKAGES)
-	touch $@
+	@touch $@
 
 # `make lock`: on purpose only.  Resolves the newest releases pyproject.toml
 # allows in a throwaway venv and pins all of them; then `make install test`.
@@ -70,12 +76,13 @@ lock-cluster:
 # package's modules again (about 0.1 s of each command's start).  A stale file is only ignored: Python checks it
 # against the source's time stamp and size.
 bytecode: $(STAMP)
-	$(BIN)/python -m compileall -q softdesign
+	@$(BIN)/python -m compileall -q softdesign
 
+# What it makes is said first: the build's own last lines are its verdict and its folder.
 demo: bytecode
-	$(BIN)/softdesign build configs/demo.yaml --report
-	@echo "Results in build/demo/: meshes/q_*.stl (the actuator at each q), kinematics.json,"
-	@echo "manifest.json, and the report to open in a browser: build/demo/report/index.html"
+	@echo "make: softdesign build configs/demo.yaml --report: build/demo/ gets meshes/q_*.stl (the actuator at each q),"
+	@echo "      kinematics.json, manifest.json, fabrication.md and the report to open: build/demo/report/index.html"
+	@$(BIN)/softdesign build configs/demo.yaml --report
 
 test: $(STAMP) $(CLUSTER_STAMP)
 	$(BIN)/python -m pytest

@@ -246,7 +246,9 @@ def case_row(name: str, build_dir: Path, record: RunRecord | None) -> dict[str, 
 def manifest_figures(build_dir: Path) -> dict[str, Any]:
     """Fit, feasibility, design, stretch, rho*kappa, radius, wall and volume figures of a build folder's manifest.
 
-    ``feasible`` is the feasibility stage's verdict (``not judged`` without a material); the skin's stretches are
+    ``feasible`` is the build's one verdict (``manifest.verdict``: the skin, the chambers, the 3D figures and the
+    mould; the feasibility stage's for a build made before it was recorded; ``not judged`` without a material),
+    the same word the terminal and the report give; the skin's stretches are
     the extremes over the whole morph and the thinnest wall the least over the export q (feasibility), the axial
     stretches the centerline's.  ``meshes`` counts the exported q values (one mesh per q, whatever the number of
     formats), and ``volumes_mm3`` lists one volume per q.
@@ -264,7 +266,7 @@ def manifest_figures(build_dir: Path) -> dict[str, Any]:
         "fit_rms_mm": fit.get("rms_mm", ""),
         "fit_p99_mm": fit.get("p99_mm", ""),
         "fit_max_mm": fit.get("max_mm", ""),
-        **_feasibility_figures(metrics.get("feasibility") or {}),
+        **_feasibility_figures(metrics.get("feasibility") or {}, manifest.get("verdict")),
         "chain_deviation_mm": design.get("chain_max_deviation_mm", ""),
         "tip_error_mm": design.get("tip_error_mm", ""),
         "tip_error_deg": design.get("tip_error_deg", ""),
@@ -291,12 +293,13 @@ def _one_mesh_per_q(outputs: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return [by_q[q] for q in sorted(by_q)]
 
 
-def _feasibility_figures(block: dict[str, Any]) -> dict[str, Any]:
-    """The verdict, the skin's stretch extremes over the morph and the thinnest wall over the export q."""
+def _feasibility_figures(block: dict[str, Any], record: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The verdict (``record``, the manifest's, when it has one), the skin's stretch extremes over the morph and
+    the thinnest wall over the export q."""
     if not block or "morph" not in block:
         return {"feasible": "", "skin_stretch_min": "", "skin_stretch_max": "", "wall_min_mm": ""}
     walls = [row["wall_min_mm"] for row in block.get("per_q", []) if row.get("wall_min_mm") is not None]
-    verdict = block.get("feasible")
+    verdict = record.get("feasible") if isinstance(record, dict) and "feasible" in record else block.get("feasible")
     return {
         "feasible": "not judged" if verdict is None else str(bool(verdict)).lower(),
         "skin_stretch_min": block["morph"]["stretch_min"]["value"],

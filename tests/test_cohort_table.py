@@ -51,6 +51,16 @@ def test_the_row_gives_the_designs_deviation_and_a_not_judged_verdict(tmp_path):
     assert (figures["chain_deviation_mm"], figures["tip_error_mm"]) == (0.8, 0.33)
 
 
+def test_the_rows_verdict_is_the_builds_one_when_the_manifest_records_it(tmp_path):
+    """Issue 44: the chambers' walls can make a design infeasible whose skin passes: the row says what the
+    terminal and the report say."""
+    folder = _build_folder(tmp_path / "actuator", True)
+    manifest = json.loads((folder / "manifest.json").read_text())
+    manifest["verdict"] = {"feasible": False, "status": "NOT feasible", "reasons": ["chambers: wall 0.4 mm < 1"]}
+    (folder / "manifest.json").write_text(json.dumps(manifest))
+    assert cohort.manifest_figures(folder)["feasible"] == "false"
+
+
 def test_a_different_older_table_is_kept_and_the_same_one_is_not_duplicated(tmp_path):
     table = tmp_path / "cohort-summary.csv"
     row = {column: "" for column in cohort.SUMMARY_COLUMNS} | {"case": "a", "status": "ok"}

@@ -52,47 +52,41 @@ def _run(case_file: Path, out: Path | None, target: str | None, force: bool, job
     workers = checked_jobs(jobs, note=note)
     with build_progress() as (stage_line, per_mesh), items_told_to(per_mesh):  # the mesh bar: on a terminal only
         outcome = build_through(case_file, out, target, force, progress=stage_line, jobs=workers)
-    _warn_arc_misses(case_file, outcome.results)
-    _warn_design_miss(case_file, outcome.results)
     return outcome
 
 
-def _warn_design_miss(case_file: Path, results: dict[str, Any]) -> None:
-    """On stderr: the case's design (design: block) misses its tolerance (issue 30)."""
-    design = results.get("design")
-    if design is None:
-        return
-    from softdesign.cli.common import note
-    from softdesign.pipeline.stages.design import miss_text
-
-    miss = miss_text(design.document)
-    if miss is not None:
-        note(f"warning: {case_file}: {miss}")
-
-
-def _warn_arc_misses(case_file: Path, results: dict[str, Any]) -> None:
-    """On stderr: every link one constant-curvature arc misses at q = 1 by more than the stated tolerance."""
-    if "kinematics" not in results:
-        return
-    from softdesign.cli.common import note
-    from softdesign.kinematics.arc_check import arc_misses, link_arcs_at_final_shape
-
-    for line in arc_misses(link_arcs_at_final_shape(results["kinematics"].chain)):
-        note(f"warning: {case_file}: {line}")
-
-
-def _print_runs(build_dir: Path, runs) -> None:
+def _print_runs(runs) -> None:
     for run in runs:
         typer.echo(f"[{run.name}] {run.status} ({run.seconds:.2f} s)")
         for line in run.lines:
             typer.echo(f"  {line}")
+
+
+def _print_story(build_dir: Path, with_verdict: bool) -> bool | None:
+    """The build's warnings (stderr), then its verdict and the build folder (stdout), all read from the manifest just
+    written: the terminal says what the manifest and the report say.  Returns the verdict's ``feasible``."""
+    import json
+
+    from softdesign.cli.common import note
+    from softdesign.pipeline import layout
+    from softdesign.pipeline.notices import verdict_lines, warning_lines
+
+    manifest = json.loads((build_dir / layout.MANIFEST).read_text(encoding="utf-8"))
+    for line in warning_lines(manifest.get("warnings", [])):
+        note(line)
+    verdict = manifest.get("verdict", {})
+    if with_verdict:
+        for line in verdict_lines(verdict):
+            typer.echo(line)
     typer.echo(f"build folder: {build_dir}")
+    return verdict.get("feasible")
 
 
 def _stage_command(case_file: Path, out: Path | None, target: str, force: bool, jobs: int | None = 1) -> None:
     def action() -> None:
         outcome = _run(case_file, out, target, force, jobs)
-        _print_runs(outcome.build_dir, outcome.runs)
+        _print_runs(outcome.runs)
+        _print_story(outcome.build_dir, with_verdict=False)
 
     run_guarded(action)
 
@@ -127,16 +121,15 @@ def build(
         from softdesign.cli.report import report_after_build
 
         outcome = _run(case_file, out, None, force, jobs)
-        _print_runs(outcome.build_dir, outcome.runs)
-        if with_report:
+        _print_runs(outcome.runs)
+        if with_report:  # the report's line (with the checks' tally) comes before the verdict
             report_after_build(outcome.build_dir, jobs=jobs)
-        # the skin's stretch (feasibility), the chambers' walls and extension (actuation), the 3D figures (swept mesh)
-        judged = [outcome.results.get(name) for name in ("feasibility", "actuation", "volume_mesh")]
-        return any(r is not None and r.summary.get("feasible") is False for r in judged)
+        # the one verdict (the manifest's): the skin (feasibility), the chambers (actuation), the 3D figures, the mould
+        return _print_story(outcome.build_dir, with_verdict=True) is False
 
     infeasible = run_guarded(action)
     if strict and infeasible:
-        typer.echo(f"error: {case_file}: the design is not feasible for its material (WARN lines above); "
+        typer.echo(f"error: {case_file}: the design is not feasible (the verdict above); "
                    "--strict exits 1: change the design or the material", err=True)
         raise typer.Exit(code=1)
 
@@ -177,7 +170,8 @@ def mould(case_file: CaseArg, out: OutOpt = None, force: ForceOpt = False) -> No
             raise ConfigError(f"{case_file}: no export.mould in the case file, so there is no mould to build; add "
                               "e.g. `mould: {margin_mm: 10, clearance_mm: 0.2}` under export: (README: the case file)")
         outcome = _run(case_file, out, "mould", force)
-        _print_runs(outcome.build_dir, outcome.runs)
+        _print_runs(outcome.runs)
+        _print_story(outcome.build_dir, with_verdict=False)
 
     run_guarded(action)
 
@@ -196,7 +190,8 @@ def kinematics(
             if as_json:
                 emit_json(outcome.results["kinematics"].document)
             else:
-                _print_runs(outcome.build_dir, outcome.runs)
+                _print_runs(outcome.runs)
+                _print_story(outcome.build_dir, with_verdict=False)
             return
         document = pose_document(outcome.results["kinematics"].chain, q_values)
         payload = {

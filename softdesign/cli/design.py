@@ -128,7 +128,7 @@ def design(
     "tip_tolerance_mm", "tip_tolerance_deg", "min_link_mm", "max_links",
     "meets_tolerance", "chain_max_deviation_mm", "tip_error_mm",
     "tip_error_deg", "base_frame" (4x4), "links": [{"index", "l_start",
-    "l_end", "kappa", "phi", "length", "theta", "dh" (seed 003's five D-H
+    "l_end", "kappa", "phi", "length", "theta", "dh" (Zou et al.'s five D-H
     rows {"theta", "d", "a", "alpha"}), "tip_frame" (4x4),
     "max_deviation_mm", "chamber_lengths"}], "breaks", "searched", "method",
     "convention", "dh_convention"}; mm and radians, degrees only in keys
@@ -171,7 +171,7 @@ def design(
 
 
 def _chamber_lengths(links: list[dict[str, Any]], d: str) -> np.ndarray:
-    """(links, 3) mm, seed 003's inverse (``pcc.lengths_from_arcs``) per designed arc; a note for a chamber <= 0."""
+    """(links, 3) mm, Zou et al.'s inverse (``pcc.lengths_from_arcs``) per designed arc; a note for a chamber <= 0."""
     import numpy as np
 
     from softdesign.cli.pcc_options import spacing_from_text

@@ -1,4 +1,4 @@
-"""`softdesign pcc ...`: seed 003's piecewise-constant-curvature model from encoder lengths.
+"""`softdesign pcc ...`: Zou et al.'s piecewise-constant-curvature model from encoder lengths.
 
 The ``pcc`` command group, with ``forward`` (lengths given) and ``reconstruct``
 (a readings CSV); ``design`` (a case file) is :mod:`softdesign.pcc_design_cli`
@@ -43,7 +43,7 @@ CONVENTION = (
 )
 
 #: The group's line in ``softdesign --help`` (its own --help adds the convention).
-PCC_SHORT_HELP = "Piecewise constant curvature from three cable-encoder lengths per section (seed 003)."
+PCC_SHORT_HELP = "Piecewise constant curvature from three cable-encoder lengths per section (Zou et al.)."
 
 pcc_app = typer.Typer(no_args_is_help=True, help=f"{PCC_SHORT_HELP} {CONVENTION}", rich_markup_mode=None)
 
@@ -97,7 +97,7 @@ def forward(
     """Shape of a chain of sections from encoder lengths: kappa, phi, L, theta per section, and the tip pose.
 
     JSON: {"sections": [{"kappa" (1/mm), "phi" (rad), "length" (mm), "theta" (rad),
-    "transform" (4x4, section tip to previous tip), "dh" (seed 003's Table 1: five rows {"theta", "d", "a",
+    "transform" (4x4, section tip to previous tip), "dh" (Zou et al.'s Table 1: five rows {"theta", "d", "a",
     "alpha"}, rad and mm, whose D-H links Rz Tz Tx Rx multiply to "transform")}], "tip" [x, y, z] (mm),
     "transform" (4x4, tip to base), "dh_convention"}.
     """

@@ -1,6 +1,6 @@
 """The bounds of the `softdesign pcc` commands' numbers, each stated and refused (exit 2) before any work.
 
-Why these values (seed 003's sections are a few cm long, a few mm from the backbone, sampled at tens of points):
+Why these values (Zou et al.'s sections are a few cm long, a few mm from the backbone, sampled at tens of points):
 
 * a cable length of at most :data:`MAX_LENGTH_MM` (100 m): beyond it the arcs' trigonometry loses every digit
   and ``--lengths 1e308`` gave NaN poses;

@@ -83,7 +83,7 @@ def design(
     against q = 0 and how far the arc misses the design (backbone max and RMS,
     tip position, tangent and rotation errors).  JSON: {"d": [mm per link],
     "poses": [{"q", "links": [{"index", "l_start", "l_end", "kappa", "phi",
-    "length", "theta", "dh" (seed 003's five D-H rows), "chamber_lengths", "chamber_strain", "backbone_max_mm",
+    "length", "theta", "dh" (Zou et al.'s five D-H rows), "chamber_lengths", "chamber_strain", "backbone_max_mm",
     "backbone_rms_mm", "tip_error_mm", "tangent_error_rad",
     "rotation_error_rad"}], "worst": {"index", and those five errors}}],
     "convention", "warnings": [one sentence per q and link whose backbone_max_mm

@@ -43,7 +43,7 @@ def report_after_build(build_dir: Path, pcc_d: str | None = None, jobs: int | No
     slowest = sorted(result.seconds.items(), key=lambda item: -item[1])[:5]
     note("report: slowest parts: " + ", ".join(f"{name} {s:.1f} s" for name, s in slowest))
     for line in result.warnings:
-        note(f"report: WARNING: {line}")
+        note(f"report: {line}")
     size = sum(result.files.values())
     typer.echo(
         f"report: {result.page} ({len(result.files)} files, {size / 1e6:.2f} MB, "

@@ -61,7 +61,12 @@ def _print(payload: dict[str, Any]) -> None:
     typer.echo("pressures kPa: " + ", ".join(f"{p:.3f}" for p in payload["pressures_kpa"]))
     typer.echo(f"best arc: kappa {arc['kappa_per_mm']:.6g} 1/mm, phi {math.degrees(arc['phi_rad']):.2f} deg, "
                f"L {arc['length_mm']:.4f} mm (misfit max {arc['misfit_max_mm']:.4f} mm)")
-    typer.echo("chamber lengths mm: " + ", ".join(f"{v:.4f}" for v in payload["chamber_lengths_mm"]))
+    # the cavity between its end walls, not actuation.csv's length_mm (the line at the chambers' distance over the
+    # whole section): the extensions compare, the lengths do not
+    lengths, rest = payload["chamber_lengths_mm"], payload["rest_chamber_lengths_mm"]
+    typer.echo("chamber cavity lengths mm (each cavity between its end walls; actuation.csv's length_mm is the line "
+               "at the chambers' distance over the whole section): " + ", ".join(f"{v:.4f}" for v in lengths)
+               + " (extension " + ", ".join(f"{v / r:.4f}" for v, r in zip(lengths, rest, strict=True)) + ")")
     strength = payload["tensile_strength_kpa"]
     versus = f" (tensile strength {strength:.0f} kPa)" if strength else ""
     typer.echo(f"largest stretch {payload['max_stretch']:.4f}, largest principal stress "

@@ -434,12 +434,12 @@ class Case(_Section):
     resample: Resample = Resample()
     """Arc-length resampling and smoothing of every centerline."""
     frames: Literal["rmf", "frenet"] = "rmf"
-    """The frames along each centerline: rmf (rotation-minimizing, defined on straight runs) or frenet (the seed's;
-    undefined where the curvature vanishes).
+    """The frames along each centerline: rmf (rotation-minimizing, defined on straight runs) or frenet (Awasthi et
+    al.'s; undefined where the curvature vanishes).
     """
     blend: Literal["auto", "linear", "intrinsic", "pcc"] = "auto"
-    """How c(q, l) morphs from q = 0 to q = 1: auto (linear unless its intermediate shapes fold), linear (the seed's),
-    intrinsic (length-preserving) or pcc (each designed section bends at constant length; needs design:).
+    """How c(q, l) morphs from q = 0 to q = 1: auto (linear unless its intermediate shapes fold), linear (Awasthi et
+    al.'s), intrinsic (length-preserving) or pcc (each designed section bends at constant length; needs design:).
     """
     #: the composed-chain design stage (between ingest and blend); blend: pcc morphs its chain
     design: Design | None = None
@@ -457,7 +457,7 @@ class Case(_Section):
     """The material the design is judged against: a preset and/or explicit limits (the verdict of the report)."""
     #: seed 003's three chambers per section with their feed lines, built into the body (issue 31)
     actuation: Actuation | None = None
-    """Seed 003's three chambers per section, with their feed lines, cut into the body."""
+    """Zou et al.'s three chambers per section, with their feed lines, cut into the body."""
     #: chamber pressures per section and q by finite elements in the build (the simulate stage; issue 33)
     simulate: Simulate | None = None
     """Estimate each section's chamber pressures for given q in the build (finite elements; off unless enabled)."""

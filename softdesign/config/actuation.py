@@ -1,6 +1,6 @@
-"""The case file's ``actuation:`` block: seed 003's three chambers per section, with their feed lines.
+"""The case file's ``actuation:`` block: Zou et al.'s three chambers per section, with their feed lines.
 
-Sizes are absolute millimetres, not fractions of the local radius: seed 003's
+Sizes are absolute millimetres, not fractions of the local radius: Zou et al.'s
 inverse (three lengths -> kappa, phi, L) takes one chamber distance ``d`` per
 section, and the relation ``l_j = L - kappa L d cos(beta_j - phi)`` holds only
 when the chamber runs at a constant distance from the backbone.  A fraction of
@@ -14,7 +14,7 @@ The defaults fit the demo (radius 2.9-3.7 mm, four sections, nine feeds through
 the first): ring at 2.0 mm, chambers 0.8 mm, feeds 0.4 mm, leaving 0.5 mm of
 skin over a chamber, 0.44 mm between a chamber and a feed and 0.64 mm between
 two feeds (30 degrees apart on the ring).  ``first_angle_deg`` 90 puts section 1's
-chamber 1 where seed 003's encoder 1 sits (90 degrees from N).
+chamber 1 where Zou et al.'s encoder 1 sits (90 degrees from N).
 """
 
 from __future__ import annotations
@@ -39,9 +39,9 @@ class Actuation(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
 
     chambers_per_section: Integer = Field(3, ge=3, le=3)
-    """Chambers in each section (seed 003's three)."""
+    """Chambers in each section (Zou et al.'s three)."""
     distance_mm: FiniteFloat = Field(2.0, gt=0.0, le=MAX_ACTUATION_MM)
-    """Distance of the chambers' axes from the backbone, mm (absolute: seed 003's d is one number per section)."""
+    """Distance of the chambers' axes from the backbone, mm (absolute: Zou et al.'s d is one number per section)."""
     diameter_mm: FiniteFloat = Field(0.8, gt=0.0, le=MAX_ACTUATION_MM)
     """Diameter of each chamber, mm."""
     feed_diameter_mm: FiniteFloat = Field(0.4, gt=0.0, le=MAX_ACTUATION_MM)
@@ -49,7 +49,7 @@ class Actuation(BaseModel):
     end_wall_mm: FiniteFloat = Field(1.0, gt=0.0, le=MAX_ACTUATION_MM)
     """Wall at each end of a chamber, mm."""
     first_angle_deg: FiniteFloat = Field(90.0, ge=-360.0, le=360.0)
-    """Angle of the first chamber from the section's base N, degrees (seed 003's first encoder is at 90)."""
+    """Angle of the first chamber from the section's base N, degrees (Zou et al.'s first encoder is at 90)."""
 
     @model_validator(mode="after")
     def _chambers_fit_their_ring(self) -> Actuation:

@@ -121,7 +121,7 @@ def measure_coverage(
         warnings += [
             f"no wall seen all round over {s['length_mm']:.1f} mm at {s['from_mm']:.1f}-{s['to_mm']:.1f} mm from the "
             f"inlet, longer than the local diameter {s['diameter_mm']:.1f} mm: the body there is {s['how']}, not "
-            "matched to the wall (fit.summary coverage)" for s in long]
+            "matched to the wall (the report's fit section shows where)" for s in long]
     if measured.count and measured.p95_mm > ALL_WALL_P95_FRACTION * radius:
         flags.append(FLAG_P95)
         warnings.append(
@@ -156,7 +156,7 @@ def unseen_stretches(
             float(np.median(kept.rho)) if len(kept) else float("nan"))
         end = "inlet" if first == 0 else ("outlet" if stop == intervals else None)
         held = end is not None and end in held_ends
-        how = (f"held at the inscribed radius in its empty cells (the {end}'s end prior)" if held
+        how = (f"held at the inscribed radius where no wall was seen near the {end}" if held
                else "bridged by the fit's smoothing (a branch's mouth, or wall dropped there)")
         out.append({"from_mm": lo, "to_mm": hi, "length_mm": hi - lo, "diameter_mm": 2.0 * r, "held": held,
                     "how": how, "end": end})

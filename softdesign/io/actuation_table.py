@@ -106,8 +106,8 @@ def _assemble(path: Path, table: dict[float, dict[int, dict[int, tuple[float, fl
         steps = np.mod(np.diff(a), 360.0)
         if np.any(np.abs(steps - 120.0) > ANGLE_TOL_DEG) or len({chambers[j][1] for j in (1, 2, 3)}) != 1:
             raise InputDataError(f"{path}: section {s}: chambers at {a.tolist()} deg, distances "
-                                 f"{[chambers[j][1] for j in (1, 2, 3)]} mm; seed 003 needs three chambers 120 deg "
-                                 "apart at one distance")
+                                 f"{[chambers[j][1] for j in (1, 2, 3)]} mm; Zou et al.'s model needs three "
+                                 "chambers 120 deg apart at one distance")
         angles.append(np.deg2rad(a[0]))
         distances.append(chambers[1][1])
     lengths = np.empty((len(table), len(sections), 3))

@@ -237,7 +237,7 @@ def dh_table_from_arc(kappa: npt.ArrayLike, phi: npt.ArrayLike, length: npt.Arra
 #: The columns of :func:`dh_table_from_arc`, as seed 003's Table 1 orders them.
 DH_COLUMNS = ("theta", "d", "a", "alpha")
 #: How the rows compose, for JSON documents that carry them.
-DH_CONVENTION = ("improved D-H rows of seed 003 (Table 1), standard D-H links Rz(theta) Tz(d) Tx(a) Rx(alpha), "
+DH_CONVENTION = ("improved D-H rows of Zou et al. (Table 1), standard D-H links Rz(theta) Tz(d) Tx(a) Rx(alpha), "
                  "multiplied in row order: the product is the section's transform (rad, mm)")
 
 

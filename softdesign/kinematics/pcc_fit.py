@@ -50,7 +50,7 @@ from softdesign.types import FloatArray, Points, Pose
 DESIGN_CONVENTION = (
     "Per q and link, one constant-curvature arc starting at the link's start frame {S} = F(q, l_start) = [N B T c], "
     "tangent to T; phi (rad) is measured from N towards B, the arc bends towards phi; chambers at 90, 210, 330 degrees "
-    "from N, d mm from the backbone (seed 003); chamber_strain = l_j(q) / l_j(0) - 1 "
+    "from N, d mm from the backbone (Zou et al.); chamber_strain = l_j(q) / l_j(0) - 1 "
     "against the same link's arc at q = 0. "
     "The arc is the least-squares fit of the backbone samples matched at equal arc-length fractions "
     "(trapezoid weights); "

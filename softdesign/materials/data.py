@@ -39,6 +39,7 @@ class MaterialPreset:
     law_params : (kind, C1, C2, C3) kPa of the hyperelastic law, or None (:meth:`law` builds it)
     source, law_source, rule : the document and table of the values, of the law, and the stretch rule applied
     checked : whether the values were read in the manufacturer's document itself
+    mixing : the ratio of the parts and how they are measured, with its document (the fabrication sheet's)
     """
 
     name: str
@@ -54,6 +55,7 @@ class MaterialPreset:
     law_source: str
     rule: str
     checked: bool
+    mixing: str = ""
 
     def law(self) -> HyperelasticLaw | None:
         """The law (numpy is imported here, not when the presets are read), or None."""
@@ -123,7 +125,7 @@ def _preset(name: str, raw: dict[str, Any], fraction: float, min_stretch: float)
     law, law_source = _law(raw.get("law"), modulus, name)
     return MaterialPreset(name, str(raw["shore"]), _stress_kpa(raw.get("tensile_strength"), name, "tensile_strength"),
                           modulus, elongation, max_stretch, min_stretch, float(raw["min_wall_mm"]), law,
-                          str(raw["source"]), law_source, rule, bool(raw["checked"]))
+                          str(raw["source"]), law_source, rule, bool(raw["checked"]), str(raw.get("mixing", "")))
 
 
 @cache

@@ -23,6 +23,7 @@ from softdesign.geometry.curves import SmoothCurve, l_from_points
 from softdesign.geometry.frames import FrameMode
 from softdesign.geometry.morph_fold import MORPH_REACH_LIMIT, MorphReach, morph_reach, radius_profile_on
 from softdesign.geometry.network import SelectedPath
+from softdesign.pipeline.notices import Notice
 
 #: A q = 1 shape whose reach r * kappa (r the inscribed radius) is at least this is warned about: a tube of
 #: that radius would fold, but a real lumen is flatter on a bend's inner side (the fit decides).
@@ -109,8 +110,13 @@ def describe_choice(summary: dict[str, Any]) -> list[str]:
     """The blend stage's line on the chosen blend (summaries of builds before ``choice`` existed have none)."""
     if "choice" not in summary:
         return []
+    return [f"blend chosen: {summary['choice']}"]  # its warning: :func:`blend_notices`
+
+
+def blend_notices(summary: dict[str, Any]) -> list[Notice]:
+    """The chosen blend's warning (a fold over the morph), if any."""
     warning = summary.get("warning")
-    return [f"blend chosen: {summary['choice']}"] + ([] if warning is None else [f"  warning: {warning}"])
+    return [] if warning is None else [Notice("blend", "fold_mid_morph", "", warning)]
 
 def _figure(reach: MorphReach) -> str:
     return f"largest r * kappa {reach.reach:.3f} at q = {reach.q:.3f}"

@@ -44,6 +44,9 @@ MESHES_PVD = "meshes.pvd"
 #: One glTF binary with a morph target per export q and an animation over q (when .glb is exported).
 MORPH_GLB = "morph.glb"
 MOULD_SUMMARY = "mould/summary.json"
+#: How to make the body (material, mould, cores, supply, winding, casting, demoulding), and the figures it says.
+FABRICATION = "fabrication.md"
+FABRICATION_FIGURES = "fabrication/figures.json"
 VOLUME_SUMMARY = "volume_mesh/summary.json"
 
 

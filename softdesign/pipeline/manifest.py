@@ -6,6 +6,9 @@ its stage gives (volume, area, ...); outputs of a stale stage are flagged
 ``"stale": true``.  With ``records`` (each ``<stage>/stage.json``), the
 manifest lists every file of the folder but itself and the run log.
 
+``warnings`` and ``verdict`` are :mod:`softdesign.pipeline.notices`'s: every stage's notices once, and
+one verdict from every stage's judgement; the terminal and the report print these, nothing else.
+
 The manifest is a function of the build's inputs: the same bytes after a fresh build and after any sequence
 of incremental ones (issue 35).  How the run went, each stage's status and seconds, goes to
 :data:`~softdesign.pipeline.layout.RUN_LOG` (:func:`run_log`), which no check or report compares.
@@ -18,6 +21,7 @@ from typing import Any
 
 from softdesign.config import Case
 from softdesign.pipeline import layout
+from softdesign.pipeline.notices import Notice, notices_record, verdict_record
 from softdesign.pipeline.stage import Results, Stage, StageRun, Status
 from softdesign.pipeline.store import read_record, sha256_file
 from softdesign.pipeline.versions import software_versions
@@ -60,12 +64,30 @@ def build_manifest(
                    for r in runs],
         "metrics": {s.name: s.metrics(results[s.name]) for s in stages if s.name in results},
         "outputs": outputs,
+        "warnings": notices_record(build_notices(stages, runs, results)),
+        "verdict": verdict_record(_judgements(stages, results)),
         "records": [
             {"path": layout.stage_record(s.name), "sha256": sha256_file(folder / layout.stage_record(s.name))}
             for s in stages
             if (folder / layout.stage_record(s.name)).is_file()
         ],
     }
+
+
+STALE_TEXT = ("its outputs here were built from other inputs or settings than this run's: run `softdesign build` "
+              "to redo them")
+
+
+def build_notices(stages: list[Stage], runs: list[StageRun], results: Results) -> list[Notice]:
+    """Every stage's warnings and notes in stage order, then one per stage whose outputs are out of date."""
+    notices = [n for s in stages if s.name in results for n in s.warnings(results[s.name])]
+    return notices + [Notice(r.name, "stale", "", STALE_TEXT) for r in runs if r.status == Status.STALE]
+
+
+def _judgements(stages: list[Stage], results: Results) -> list[tuple[str, Any]]:
+    """``(stage, judgement)`` of every stage with a result that judges the design."""
+    found = ((s.name, s.judge(results[s.name])) for s in stages if s.name in results)
+    return [(name, j) for name, j in found if j is not None]
 
 
 def _all_outputs(folder: Path, stages: list[Stage]) -> list[dict[str, Any]]:

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from softdesign.pipeline.notices import Judgement, Notice
 from softdesign.pipeline.store import Staging, canonical_json, sha256_bytes
 
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
@@ -52,6 +53,9 @@ class Stage:
     metrics : result -> JSON-ready figures for the manifest
     figures : result -> {output path: figures} merged into the manifest's outputs
     log : result -> lines for the run log (``run.log.json``): how the computation went, e.g. each part's time
+    warnings : result -> the stage's warnings and notes (:mod:`softdesign.pipeline.notices`); ``describe``
+        leaves them out: the command line prints the manifest's list once
+    judge : result -> what the stage says of the design (reasons it cannot be made, margins), or None
     """
 
     name: str
@@ -66,6 +70,8 @@ class Stage:
     figures: Callable[[Any], dict[str, dict[str, Any]]] = lambda result: {}
     #: result -> lines of how its computation went (each part's time) for the run log, never an output
     log: Callable[[Any], list[str]] = lambda result: []
+    warnings: Callable[[Any], list[Notice]] = lambda result: []
+    judge: Callable[[Any], Judgement | None] = lambda result: None
 
 
 @dataclass

@@ -16,6 +16,7 @@ from softdesign.pipeline.stages import (
     blend,
     design,
     export,
+    fabrication,
     feasibility,
     fit,
     ingest,
@@ -29,7 +30,7 @@ from softdesign.pipeline.stages import (
 #: Every stage, in build order.
 STAGES: list[Stage] = [
     ingest.STAGE, design.STAGE, blend.STAGE, links.STAGE, kinematics.STAGE, fit.STAGE, simulate.STAGE,
-    actuation.STAGE, export.STAGE, mould.STAGE, volume_mesh.STAGE, feasibility.STAGE,
+    actuation.STAGE, export.STAGE, mould.STAGE, volume_mesh.STAGE, feasibility.STAGE, fabrication.STAGE,
 ]
 
 

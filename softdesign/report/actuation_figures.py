@@ -79,7 +79,7 @@ def actuation_picture(data: BuildData) -> Picture | None:
             ax.plot([r["q"] for r in rows], [r["length_mm"] for r in rows], color=colours[i], lw=1.0,
                     ls=("-", "--", ":")[j - 1], label=f"section {i + 1}" if j == 1 else None)
     ax.set_xlabel("q")
-    ax.set_ylabel("chamber length, mm (seed 003)")
+    ax.set_ylabel("chamber length, mm (Zou et al.)")
     ax.legend(fontsize=7, ncols=min(sections, 6))
     thin = "; ".join(f"{k} {w['thickness_mm']:.3f} mm" for k, w in block["thinnest"].items())
     ext = block["extensions"]

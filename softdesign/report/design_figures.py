@@ -102,9 +102,9 @@ def design_picture(chain: LinkChain) -> Picture:
                   title="per-link error", ylim=(0.0, None))
         _legend_below(right)
     caption = (
-        "Each link's best constant-curvature arc (seed 003's section) at q = 1, started on the link's start frame "
+        "Each link's best constant-curvature arc (Zou et al.'s section) at q = 1, started on the link's start frame "
         "(least squares, as softdesign design fits it), over the centerline; the dotted line chains those arcs from "
-        "the base frame by seed 003's improved D-H, so its drift from the centerline is what an actuator of one PCC "
+        "the base frame by Zou et al.'s improved D-H, so its drift from the centerline is what an actuator of one PCC "
         "section per link would miss. Right: each centerline sample's true distance to its link's arc. "
         "`softdesign design CASE --tolerance-mm T` chooses the fewest links within T."
     )
@@ -159,7 +159,7 @@ def chain_picture(document: dict[str, Any], profile: dict[str, np.ndarray]) -> P
         _legend_below(right)
     verdict = "within" if document["meets_tolerance"] else "NOT within"
     caption = (
-        f"{len(document['links'])} constant-curvature sections (seed 003), section 1 on the centerline's base frame "
+        f"{len(document['links'])} constant-curvature sections (Zou et al.), section 1 on the centerline's base frame "
         "and each next one on the previous tip, over the q = 1 centerline. Right: each centerline sample's true "
         f"distance to the chain (shaded: the sections' l ranges); both ways the chain is at most "
         f"{document['chain_max_deviation_mm']:.3g} mm from the centerline, {verdict} the tolerance; the tip is "

@@ -170,13 +170,19 @@ def _section_html(number: int, section: Section) -> str:
     return "\n".join(parts + ["</section>"])
 
 
-def banner_html(warnings: list[str]) -> str:
-    """Every warning in one box at the top that cannot be missed, or a plain all-clear line."""
+def banner_html(warnings: Sequence[str], notes: Sequence[str] = ()) -> str:
+    """Every warning in one box at the top that cannot be missed, or a plain line that there are none; then the
+    notes (what was done on the way), folded."""
     if not warnings:
-        return '<p class="allclear">No other warnings: no stale outputs, every check passed, no fold.</p>'
-    items = "".join(f"<li>{escape(w)}</li>" for w in warnings)
-    return (f'<div class="banner" id="warnings" role="alert"><h2>{len(warnings)} warning(s)</h2>'
-            f"<ul>{items}</ul></div>")
+        html = '<p class="allclear" id="warnings">No warnings.</p>'
+    else:
+        items = "".join(f"<li>{escape(w)}</li>" for w in warnings)
+        html = (f'<div class="banner" id="warnings" role="alert"><h2>{len(warnings)} warning(s)</h2>'
+                f"<ul>{items}</ul></div>")
+    if notes:
+        items = "".join(f"<li>{escape(n)}</li>" for n in notes)
+        html += f'<details class="notes" id="notes"><summary>{len(notes)} note(s)</summary><ul>{items}</ul></details>'
+    return html
 
 
 def render_page(title: str, summary: list[str], sections: list[Section], top: str = "") -> str:

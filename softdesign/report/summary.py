@@ -4,10 +4,8 @@ Each figure is read from ``manifest.json`` (with its JSON pointer, so the page
 can be traced like the key-figure table) except the diameter range, which is
 computed here from the kept radius field: the mean caliper diameter
 rho(l, a) + rho(l, a + pi) averaged over a, at q = 1, its smallest and largest
-over l.  Warnings are whatever a device engineer must not miss: stale stage
-outputs, failed checks, a design judged infeasible for its material (thin
-walls among its reasons), a fold (rho * kappa >= 1) and one-arc-per-link
-misfits above the build's tolerance.
+over l.  The warnings are the manifest's (every stage's, each once: the
+terminal printed the same list).
 """
 
 from __future__ import annotations
@@ -18,9 +16,10 @@ from typing import Any
 
 import numpy as np
 
+from softdesign.pipeline.notices import NOTE, WARNING
 from softdesign.report.build_folder import BuildData
 from softdesign.report.html_page import Cell, Table
-from softdesign.report.tables import FOLD_LIMIT, Check, format_value, resolve_or, resolve_pointer
+from softdesign.report.tables import format_value, resolve_or, resolve_pointer
 
 #: Samples along l and around a for the diameter range (the fit's knots are about 1.5 mm apart).
 DIAMETER_L_SAMPLES, DIAMETER_ANGLES = 801, 96
@@ -117,24 +116,16 @@ def _actuation_facts(m: dict[str, Any]) -> list[Fact]:
     return facts
 
 
-def summary_warnings(data: BuildData, checks: list[Check]) -> list[str]:
-    """Every warning of the build, most serious first: stale, failed checks, fold, fit (dropped wall).
+def summary_warnings(manifest: dict[str, Any]) -> tuple[list[str], list[str]]:
+    """The build's warnings and notes as the manifest records them (each once, the terminal's same lines).
 
-    The feasibility verdict's causes are the verdict box's (:mod:`softdesign.report.verdict`), not repeated here;
-    one-arc-per-link misfits are information about a PCC reading of the body, shown in the tables' notes.
+    The verdict's reasons are the verdict box's (:mod:`softdesign.report.verdict`), not repeated here; failed
+    checks are the checks' (:func:`softdesign.report.verdict.checks_html`).
     """
-    m = data.manifest
-    warnings = [f"stale: stage {s['name']} is out of date (its outputs here were built from other inputs or settings); "
-                "run softdesign build" for s in m.get("stages", []) if s.get("stale") is True]
-    failed = [c for c in checks if not c.passed]
-    if failed:
-        names = "; ".join(f"{c.subject}: {c.name}" for c in failed[:5]) + ("; ..." if len(failed) > 5 else "")
-        warnings.append(f"{len(failed)} of {len(checks)} checks FAILED ({names}): see the checks table")
-    rho_kappa = resolve_or(m, "/metrics/fit/max_rho_kappa", None)
-    if rho_kappa is not None and rho_kappa >= FOLD_LIMIT:
-        warnings.append(f"the surface folds through itself at q = 1: largest rho * kappa {rho_kappa:.3g} >= 1")
-    warnings += [f"fit: {w}" for w in resolve_or(m, "/metrics/fit/warnings", [])]  # dropped wall, unseen stretches
-    return warnings
+    record = [w for w in manifest.get("warnings", []) if isinstance(w, dict)]
+    warnings = [f"{w['stage']}: {w['text']}" for w in record if w.get("kind", WARNING) == WARNING]
+    notes = [f"{w['stage']}: {w['text']}" for w in record if w.get("kind") == NOTE]
+    return warnings, notes
 
 
 def _num(value: Any) -> str:

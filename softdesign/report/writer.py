@@ -52,6 +52,7 @@ from softdesign.report.html_page import (
     render_page,
     table_html,
 )
+from softdesign.report.make_it import make_it_section
 from softdesign.report.plotting import pixel_size
 from softdesign.report.summary import facts_table, summary_facts, summary_warnings
 from softdesign.report.tables import (
@@ -63,7 +64,7 @@ from softdesign.report.tables import (
     output_checks,
     software_rows,
 )
-from softdesign.report.verdict import build_verdict, verdict_html
+from softdesign.report.verdict import build_verdict, checks_html, verdict_html
 from softdesign.report.volume_mesh_tables import volume_mesh_checks, volume_mesh_table
 
 T = TypeVar("T")
@@ -77,8 +78,6 @@ NO_FIT = (
     "run softdesign build"
 )
 NO_EXPORT = "no export in this build folder: no mesh checks; run softdesign build"
-STALE_NOTE = ("out of date: its outputs here were built from other inputs or settings than the stages before it; "
-              "run softdesign build")
 #: Pixel (width, height) of every image the report can hold.
 EXPECTED_SIZES = {
     "morph.png": pixel_size(morph_figures.SIZE_IN),
@@ -202,7 +201,7 @@ class ReportResult:
     checks_total: int
     notes: list[str] = field(default_factory=list)
     seconds: dict[str, float] = field(default_factory=dict)  #: time of each part, s (not written to the page)
-    warnings: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)  #: the failed checks (the build's warnings: its manifest)
 
 
 def write_report(
@@ -241,10 +240,10 @@ def _write_report(build_dir: Path, options: ReportOptions, progress: Progress | 
         sections, checks, notes = report_sections(data, options, timer)
     passed = sum(c.passed for c in checks)
     summary = _summary(data)
-    warnings = summary_warnings(data, checks)
-    verdict = verdict_html(build_verdict(data.manifest), f"Checks: {passed} of {len(checks)} passed.")
-    top = timer("summary", lambda: verdict + banner_html(warnings)
-                + table_html(facts_table(summary_facts(data), data.manifest)))
+    warnings, build_notes = summary_warnings(data.manifest)
+    # the verdict, the warnings (the manifest's: the terminal's same lines), then the checks folded, then the figures
+    top = timer("summary", lambda: verdict_html(build_verdict(data.manifest)) + banner_html(warnings, build_notes)
+                + checks_html(checks) + table_html(facts_table(summary_facts(data), data.manifest)))
     page = render_page(f"softdesign report: {data.name}", summary, sections, top)
     files = {p.name: p.data for s in sections for p in s.pictures}
     files[PAGE] = page.encode("utf-8")
@@ -256,8 +255,9 @@ def _write_report(build_dir: Path, options: ReportOptions, progress: Progress | 
         raise RuntimeError(f"report page links to files it does not write: {missing}")  # a bug, not a user error
     target = build_dir / REPORT_DIR
     timer("write the files", lambda: commit_folder(target, files))
+    failed = [f"check failed: {c.subject}: {c.name}" for c in checks if not c.passed]
     return ReportResult(target / PAGE, {k: len(v) for k, v in sorted(files.items())}, passed, len(checks), notes,
-                        timer.seconds, warnings)
+                        timer.seconds, failed)
 
 
 def report_sections(
@@ -313,6 +313,9 @@ def report_sections(
     fabrication = _fabrication_section(data, run)
     if fabrication is not None:
         sections.insert(-2, fabrication)
+    make_it = make_it_section(data.manifest)  # fabrication.md's lines: how to make it, from the build's figures
+    if make_it is not None:
+        sections.insert(-2, make_it)
     return sections, checks, notes
 
 
@@ -425,10 +428,7 @@ def _tables_section(data: BuildData) -> tuple[Section, list[Check]]:
         plain_table("Stages", ("stage", "cache key", "outputs"), stages, ("", "hash", "")),
         *compact_check_tables(checks),
     ]
-    notes = [f"ingest: {n}" for n in data.ingest.notes]
-    notes += [f"kinematics: warning: {n}" for n in data.manifest.get("metrics", {}).get("kinematics", {})
-              .get("arc_check", {}).get("warnings", [])]
-    notes += [f"{s['name']}: {STALE_NOTE}" for s in data.manifest.get("stages", []) if s.get("stale") is True]
+    notes: list[str] = []  # the build's warnings and notes are the banner's (the manifest's), not repeated here
     return Section("tables", "Figures, inputs, software and checks", notes=notes, tables=tables), checks
 
 

@@ -38,8 +38,13 @@ def test_the_demo_build_names_every_link_one_arc_misses_and_its_figure(tmp_path)
     warned = [(int(j), float(v)) for j, v in FIGURE.findall(result.stderr)]
     assert [j for j, _ in warned] == missed and len(check["warnings"]) == len(missed)
     np.testing.assert_allclose([v for _, v in warned], [deviations[j] for j in missed], rtol=5e-3)  # 3 digits
-    assert all(line.startswith(f"warning: {DEMO}: link") for line in result.stderr.splitlines() if "q = 1" in line)
-    assert "warning: link 2" in result.stdout  # and in the stage's summary
+    # issue 44: each once, on stderr, with its stage; the same as the manifest's record, and not in the summary
+    lines = [line for line in result.stderr.splitlines() if "q = 1" in line]
+    assert all(line.startswith("  warning: kinematics: link") for line in lines) and len(lines) == len(missed)
+    recorded = [w for w in manifest["warnings"] if w["code"] == "arc_misfit"]
+    assert [w["place"] for w in recorded] == [f"link {j}" for j in missed]
+    assert [f"  warning: kinematics: {w['text']}" for w in recorded] == lines
+    assert "q = 1 its centerline" not in result.stdout
 
 
 def test_the_designed_demo_builds_without_a_warning_and_with_the_designs_figures(tmp_path):

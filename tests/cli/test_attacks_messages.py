@@ -72,7 +72,7 @@ def test_a_centerline_that_strays_is_warned_about_naming_the_resample_keys(prior
     result = runner.invoke(app, ["build", str(case), "--out", str(out)])
     assert result.exit_code == 0, result.output
     assert "Traceback" not in result.output
-    assert "warning: the centerline, resampled every" in result.output
+    assert "warning: fit: the centerline, resampled every" in result.output
     assert "smoothed by 2 mm (resample.smoothing_mm)" in result.output
     assert "lower resample.smoothing_mm" in result.output
     assert "raise fit.smoothing" not in result.output

@@ -55,4 +55,5 @@ def test_dropped_wall_is_measured_flagged_and_warned_about_by_the_build(tmp_path
     assert held["from_mm"] == 0.0 and held["length_mm"] > 2 * R
     assert fit["flags"] == [FLAG_LONG_STRETCH, FLAG_P95]
     assert "true distance, all of the path's own wall" in result.output
-    assert "warning: no wall seen all round over" in result.output and "the kept-point figures do not" in result.output
+    assert "warning: fit: no wall seen all round over" in result.output
+    assert "the kept-point figures do not" in result.output

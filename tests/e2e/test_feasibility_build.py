@@ -1,4 +1,4 @@
-"""The feasibility stage on the demo: the table and WARN lines, --strict, the linear blend's mid-q shortening,
+"""The feasibility stage on the demo: the table and the verdict, --strict, the linear blend's mid-q shortening,
 the grid's convergence and the morph search's accuracy."""
 
 from __future__ import annotations
@@ -72,7 +72,9 @@ def test_strict_exits_1_only_when_infeasible(hollow):
     block = json.loads((out / "manifest.json").read_text())["metrics"]["feasibility"]
     assert block["feasible"] is False  # dragon-skin-30's rule-of-thumb min_stretch 0.7 is passed on the demo
     assert result.exit_code == 1, result.output
-    assert "WARN" in result.output and "link" in result.output and "angle" in result.output
+    verdict = result.stdout.splitlines()[-3:]  # the verdict, its reason, the build folder: the last lines
+    assert verdict[0].startswith("verdict: NOT feasible for dragon-skin-30") and verdict[2].startswith("build folder:")
+    assert "link" in verdict[1] and "angle" in verdict[1]
     assert runner.invoke(app, ["build", str(case), "--out", str(out)]).exit_code == 0
 
 

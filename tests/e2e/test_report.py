@@ -24,6 +24,7 @@ from PIL import Image
 from typer.testing import CliRunner
 
 from softdesign.pipeline.api import build_through
+from softdesign.pipeline.manifest import STALE_TEXT
 from softdesign.pipeline.owned import REPORT_MARKER
 from softdesign.pipeline.versions import software_versions
 from softdesign.report.interactive import DISPLAY_TOLERANCE_MM, DIV_ID, JS_NAME
@@ -326,7 +327,9 @@ def test_tampered_outputs_fail_their_checks(demo, tmp_path):
     checks = [r for r in parse_page(copy / REPORT_DIR).rows if r[-1:] in (["FAIL"], ["pass"])]
     assert [r[-1] for r in checks[:3]] == ["FAIL"] * 3 and "FAIL" not in [r[-1] for r in checks[3:]]  # failures first
     text = (copy / REPORT_DIR / PAGE).read_text(encoding="utf-8")
-    assert "3 of " in text[text.index('<div class="banner"'):text.index("<nav>")]  # and in the banner
+    # and in the checks' tally under the verdict, opened on its failures (the build's warnings are the banner's)
+    box = text[text.index('<details class="tally" id="checks" open>'):text.index("<nav>")]
+    assert f"Checks: {result.checks_passed} of {result.checks_total} passed" in box and f"{mesh}: watertight" in box
     failed = {(r[0], r[1]) for r in checks if r[-1] == "FAIL"}
     assert failed == {(mesh, "watertight"), (mesh, "volume vs integrated volume"),
                       ("export/summary.json", "file as recorded (sha256)")}
@@ -342,13 +345,15 @@ def test_a_stale_stage_is_noted_on_the_page(demo, tmp_path):
     for stage in manifest["stages"]:
         if stage["name"] == "export":
             stage["stale"] = True
+    # as the build records it (pipeline/manifest.py): the stale stage is one of the manifest's warnings
+    manifest["warnings"].append({"stage": "export", "code": "stale", "place": "", "text": STALE_TEXT,
+                                 "kind": "warning"})
     manifest_file.write_text(json.dumps(manifest))
     write_report(copy, ReportOptions(gif_frames=3))
     text = (copy / REPORT_DIR / PAGE).read_text(encoding="utf-8")
-    assert "export: out of date" in text
     banner = text[text.index('<div class="banner"'):text.index("<nav>")]  # the warnings sit above every section
-    assert "stale: stage export is out of date" in banner
-    assert "out of date" not in (demo[0] / REPORT_DIR / PAGE).read_text(encoding="utf-8")
+    assert html.escape(f"export: {STALE_TEXT}") in banner and text.count(html.escape(STALE_TEXT)) == 1
+    assert html.escape(STALE_TEXT) not in (demo[0] / REPORT_DIR / PAGE).read_text(encoding="utf-8")
 
 
 def test_a_failed_write_leaves_the_previous_report(tmp_path):
@@ -478,24 +483,20 @@ def test_a_killed_runs_temporary_folder_is_removed_a_running_ones_kept(tmp_path)
     assert not dead.exists() and alive.exists()
 
 
-def test_the_verdict_comes_first_then_the_tally_and_arc_misfits_are_notes_not_alarms(built):
+def test_the_verdict_comes_first_then_the_warnings_then_the_folded_tally(built):
     build_dir, result = built
     manifest = json.loads((build_dir / "manifest.json").read_text())
     text = (build_dir / REPORT_DIR / PAGE).read_text(encoding="utf-8")
     top = text[:text.index("<nav>")]
-    feasibility = manifest["metrics"]["feasibility"]
-    # the first box is the verdict, and the checks' tally follows it (issue 34)
-    assert top.index('id="verdict"') < top.index("Checks: ") and top.index('id="verdict"') < top.index("<table>")
-    expected = {True: "feasible", False: "infeasible", None: "not judged"}[feasibility["feasible"]]
-    assert f'data-status="{expected}"' in top
-    if feasibility["feasible"] is False:
-        first = html.escape(feasibility["reasons"][0])
-        assert f"NOT feasible: {first}" in top
-        assert top.count(first) == 1  # said once, not again in the banner
-    # one-arc-per-link misfits are information about a PCC reading of the body: a note, not a red warning
-    misfits = manifest["metrics"]["kinematics"]["arc_check"]["warnings"]
-    assert not any(html.escape(w) in top for w in misfits)
-    assert all(html.escape(w) in text for w in misfits)
+    verdict = manifest["verdict"]
+    # the first box is the manifest's verdict; the warnings and then the checks' tally, folded, follow it (issue 44)
+    assert top.index('id="verdict"') < top.index('id="warnings"') < top.index('id="checks"') < top.index("<table>")
+    assert f'data-status="{verdict["status"]}"' in top and html.escape(verdict["headline"]) in top
+    for reason in verdict["reasons"]:
+        assert top.count(html.escape(reason)) == 1  # said once, not again in the banner
+    # every warning of the manifest (the demo's one-arc-per-link misfits) once in the banner, and nowhere else
+    for w in (w for w in manifest["warnings"] if w["kind"] == "warning"):
+        assert text.count(html.escape(w["text"])) == 1, w["text"]
     for i, entry in enumerate(manifest["outputs"]):  # every exported q's volume is in the summary, traced
         if entry["path"].startswith("meshes/q_") and entry["path"].endswith(".stl"):
             assert f'data-pointer="/outputs/{i}/volume_mm3"' in top, entry["path"]
@@ -506,7 +507,7 @@ def test_the_verdict_comes_first_then_the_tally_and_arc_misfits_are_notes_not_al
 def test_passed_checks_are_folded_away_under_a_tally(built):
     build_dir, result = built
     text = (build_dir / REPORT_DIR / PAGE).read_text(encoding="utf-8")
-    folded = text[text.index("<details>"):text.index("</details>")]
+    folded = text[text.index("<details>"):text.index("</details>", text.index("<details>"))]
     assert folded.count("<tr><td>") == result.checks_passed  # each passed check once, folded
     outputs = json.loads((build_dir / "manifest.json").read_text())["outputs"]
     assert f"<td>file as recorded (sha256)</td><td class=\"num\">{len(outputs)}</td>" in text  # the tally row

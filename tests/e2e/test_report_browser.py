@@ -284,6 +284,7 @@ def test_the_aortas_page_opens_on_its_verdict_not_on_its_check_tally(tmp_path, a
         tally = page.evaluate("document.querySelector('.tally').getBoundingClientRect().top")
         browser.close()
     top, status, text = verdict
-    assert 0 <= top < tally < VIEWPORT["height"]  # the verdict first, the tally after it, both on the first screen
-    assert status == "infeasible" and text.startswith("NOT feasible: skin stretch")
-    assert "mm from the base" in text
+    # the verdict first, on the first screen; the tally after it and the warnings, folded (issue 44)
+    assert 0 <= top < VIEWPORT["height"] and top < tally
+    assert status == "NOT feasible" and text.startswith("Verdict: NOT feasible for ecoflex-00-30")
+    assert "skin stretch" in text and "mm from the base" in text

@@ -21,7 +21,7 @@ from tests.helpers.paths import REPO
 
 runner = CliRunner()
 STAGES = ["ingest", "design", "blend", "links", "kinematics", "fit", "simulate", "actuation", "export", "mould",
-          "volume_mesh", "feasibility"]
+          "volume_mesh", "feasibility", "fabrication"]
 
 
 def snapshot(folder: Path) -> dict[str, str]:
@@ -72,12 +72,14 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
         "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
         "fit": "ran", "simulate": "ran",
         "actuation": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
+        "fabrication": "ran",
     }
     edit(demo_case, "export", q=[0, 0.5, 1])
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "ran",
         "fit": "skipped", "simulate": "ran",
         "actuation": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
+        "fabrication": "ran",
     }
     # The mesh formats are read by export (and the mould's formats): kinematics, the fit and the feasibility
     # figures stay cached.
@@ -86,6 +88,7 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
         "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
         "fit": "skipped", "simulate": "skipped",
         "actuation": "skipped", "export": "ran", "mould": "ran", "volume_mesh": "skipped", "feasibility": "skipped",
+        "fabrication": "ran",
     }
     # A mould is read by the mould stage and by the fit (which turns the end cuts into the mould's parting
     # plane): the fit and what follows it are redone; ingest, blend, links and kinematics stay.
@@ -94,6 +97,7 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
         "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
         "fit": "ran", "simulate": "ran",
         "actuation": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
+        "fabrication": "ran",
     }
     assert (out / "meshes" / "mould" / "half_a.ply").is_file()
     # New link breaks: the blend (explicit breaks may be sharp joints of the path, geometry/curve_joints.py), the
@@ -103,6 +107,7 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
         "ingest": "skipped", "design": "skipped", "blend": "ran", "links": "ran", "kinematics": "ran",
         "fit": "ran", "simulate": "ran", "actuation": "ran",
         "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
+        "fabrication": "ran",
     }
     # A material is read by the verdicts alone (feasibility, the chambers' actuation, the volume mesh's 3D stress
     # and stretch) and by the simulate stage's law (off here: it runs and does nothing): every surface mesh stays
@@ -110,7 +115,7 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     edit(demo_case, "material", name="dragon-skin-10")
     assert statuses(build(demo_case, out)) == {**dict.fromkeys(STAGES, "skipped"), "simulate": "ran",
                                                "actuation": "ran", "volume_mesh": "ran",
-                                               "feasibility": "ran"}
+                                               "feasibility": "ran", "fabrication": "ran"}
     assert statuses(build(demo_case, out, "--force")) == dict.fromkeys(STAGES, "ran")
 
 
@@ -131,6 +136,7 @@ def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tm
         "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
         "fit": "skipped", "simulate": "kept",
         "actuation": "kept", "export": "kept", "mould": "kept", "volume_mesh": "kept", "feasibility": "kept",
+        "fabrication": "kept",
     }
     outputs = {o["path"]: o for o in manifest["outputs"]}
     assert all(outputs[m]["watertight"] and outputs[m]["volume_mm3"] > 0 and "stale" not in outputs[m] for m in meshes)

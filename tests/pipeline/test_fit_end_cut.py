@@ -12,6 +12,7 @@ import pytest
 from softdesign.geometry.end_planes import RIM_GAP_TOLERANCE_MM
 from softdesign.pipeline.api import build_through
 from softdesign.pipeline.stages.fit import describe_fit, fit_metrics
+from softdesign.pipeline.stages.fit_notices import fit_notices
 from tests.helpers.cases import write_case
 from tests.helpers.robust_vessels import write_tilted_cap_vessel
 
@@ -33,7 +34,8 @@ def test_the_fit_records_the_cut_per_end_and_warns_only_about_a_large_gap_left_s
     np.testing.assert_allclose(cuts["inlet"]["tilt_deg"], 8.0, atol=1e-3)
     assert cuts["inlet"]["rim_gap_mm"] > RIM_GAP_TOLERANCE_MM
     lines = describe_fit(result)
-    warned = [line for line in lines if "warning: the vessel's flat cap at the inlet is tilted 8.0 deg" in line]
+    warned = [n.text for n in fit_notices(result.summary)
+              if n.text.startswith("the vessel's flat cap at the inlet is tilted 8.0 deg") and n.place == "inlet"]
     if mode == "auto":
         said = f"inlet: cut at the detected plane (tilt 8.0 deg, rim gap {cuts['inlet']['rim_gap_mm']:.3f} mm)"
         assert said in lines and warned == []

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from softdesign.config import load_case
-from softdesign.pipeline.stages.ingest import describe_ingest, run_ingest
+from softdesign.pipeline.stages.ingest import ingest_notices, run_ingest
 from tests.geometry.test_end_planes import COORD_TOL_MM, SAGITTA, TILT_TOL_DEG
 from tests.helpers.cases import straight_tube, write_case
 from tests.helpers.robust_vessels import write_tilted_cap_vessel
@@ -32,7 +32,7 @@ def test_ingest_reports_the_tilt_and_rim_gap_of_a_tilted_inlet_cap(tmp_path, til
     assert expected * (1.0 - SAGITTA) - COORD_TOL_MM <= inlet["rim_gap_mm"] <= expected + COORD_TOL_MM
     assert outlet["kind"] == "flat_cap" and outlet["tilt_deg"] < TILT_TOL_DEG and outlet["rim_gap_mm"] < COORD_TOL_MM
     # ingest measures; the fit, which decides whether the body is cut there, warns (test_fit_end_cut.py)
-    assert not any(line.startswith("warning: the vessel's flat cap") for line in describe_ingest(result))
+    assert not any(n.text.startswith("the vessel's flat cap") for n in ingest_notices(result))
 
 
 def test_a_vessel_cut_square_at_both_ends_has_no_tilt_and_no_warning(tmp_path):
@@ -43,7 +43,7 @@ def test_a_vessel_cut_square_at_both_ends_has_no_tilt_and_no_warning(tmp_path):
         assert plane["kind"] == "flat_cap" and plane["tilt_deg"] < TILT_TOL_DEG and plane["rim_gap_mm"] < COORD_TOL_MM
         # the cylinder runs 1 mm past each end of the centerline
         assert abs(plane["axis_offset_mm"] - 1.0) < COORD_TOL_MM
-    assert not any(line.startswith("warning") for line in describe_ingest(result))
+    assert not any(n.kind == "warning" for n in ingest_notices(result))
 
 
 def test_without_a_surface_nothing_is_measured(tmp_path):

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from types import SimpleNamespace
-
 import numpy as np
 import pytest
 import trimesh
@@ -15,46 +13,22 @@ from softdesign.report.summary import summary_warnings
 from softdesign.report.tables import Check
 
 
-def _data(manifest):
-    return SimpleNamespace(manifest=manifest)  # summary_warnings reads only the manifest
+def test_the_banner_lists_the_manifests_warnings_each_once_and_its_notes_apart():
+    manifest = {"warnings": [
+        {"stage": "ingest", "code": "note", "place": "", "text": "3 duplicate points removed", "kind": "note"},
+        {"stage": "kinematics", "code": "arc_misfit", "place": "link 0", "text": "link 0: 1.9 mm from its arc",
+         "kind": "warning"},
+        {"stage": "export", "code": "stale", "place": "", "text": "out of date", "kind": "warning"}]}
+    warnings, notes = summary_warnings(manifest)
+    assert warnings == ["kinematics: link 0: 1.9 mm from its arc", "export: out of date"]
+    assert notes == ["ingest: 3 duplicate points removed"]
+    page = banner_html(warnings, notes)
+    assert page.count("<li>") == 3 and 'role="alert"' in page and "No warnings" not in page
 
 
-def test_every_kind_of_warning_is_listed_stale_first_and_the_verdicts_causes_are_not_repeated():
-    manifest = {
-        "stages": [{"name": "fit"}, {"name": "export", "stale": True}],
-        "metrics": {
-            "feasibility": {"feasible": False, "reasons": ["q=1.000: wall 0.400 mm < min_wall_mm 1 (x) at link 2",
-                                                           "q=1.000: skin stretch 3.1 > max_stretch 2.8 (x)"]},
-            "fit": {"max_rho_kappa": 1.2},
-            "kinematics": {"arc_check": {"warnings": ["link 0: 1.9 mm from its arc"]}},
-        },
-    }
-    checks = [Check("a.stl", "watertight", "no", "yes", False), Check("a.stl", "one body", "1", "1", True)]
-    warnings = summary_warnings(_data(manifest), checks)  # type: ignore[arg-type]
-    assert warnings[0].startswith("stale: stage export")
-    assert warnings[1].startswith("1 of 2 checks FAILED (a.stl: watertight)")
-    assert "rho * kappa 1.2 >= 1" in warnings[2]
-    # infeasibility is the verdict's (report/verdict.py), the arc misfit a note of the tables: neither repeated
-    assert len(warnings) == 3
-    assert banner_html(warnings).count("<li>") == 3 and 'role="alert"' in banner_html(warnings)
-
-
-def test_the_fit_s_coverage_warnings_are_named_in_the_banner():
-    # issue 29: a held stretch longer than a diameter, an all-wall p95 above its stated fraction of the radius
-    held = "no wall seen all round over 30.0 mm at 0.0-30.0 mm from the inlet, longer than the local diameter 6.0 mm"
-    manifest = {"stages": [{"name": "fit"}],
-                "metrics": {"fit": {"max_rho_kappa": 0.3, "flags": ["unseen_stretch_longer_than_diameter"],
-                                    "warnings": [held]},
-                            "kinematics": {"arc_check": {"warnings": []}}}}
-    assert summary_warnings(_data(manifest), []) == [f"fit: {held}"]  # type: ignore[arg-type]
-
-
-def test_a_clean_build_has_no_warning_and_says_so():
-    manifest = {"stages": [{"name": "fit"}],
-                "metrics": {"feasibility": {"feasible": None, "reasons": ["no material"]},
-                            "fit": {"max_rho_kappa": 0.3}, "kinematics": {"arc_check": {"warnings": []}}}}
-    assert summary_warnings(_data(manifest), [Check("a", "b", "c", "d", True)]) == []  # type: ignore[arg-type]
-    assert 'class="allclear"' in banner_html([])
+def test_a_build_without_warnings_says_so_and_only_then():
+    assert summary_warnings({"warnings": []}) == ([], [])
+    assert 'class="allclear"' in banner_html([]) and "No warnings." in banner_html([])
 
 
 def test_failures_first_then_a_tally_per_kind_and_every_passed_check_folded():

@@ -1,58 +1,54 @@
-"""The report's first screen: the verdict, then its reasons, from hand-made manifests (no build)."""
+"""The report's first screen: the manifest's one verdict, then its reasons and margins (hand-made manifests)."""
 
 from __future__ import annotations
 
-from softdesign.report.verdict import build_verdict, verdict_html
+from html import escape
+
+from softdesign.pipeline.notices import Judgement, verdict_record
+from softdesign.report.tables import Check
+from softdesign.report.verdict import OLDER_BUILD, build_verdict, checks_html, verdict_html
+
+SKIN = "skin stretch 0.5 < min_stretch 0.7 (ecoflex-00-30) at link 0, 2.5 mm from the base"
+WALL = "wall 0.4 mm < min_wall_mm 1 mm (ecoflex-00-30) at link 2, 40.1 mm from the base"
 
 
-def _manifest(**metrics):
-    return {"metrics": metrics}
+def test_an_infeasible_design_opens_with_not_feasible_then_every_reason_with_its_stage():
+    record = verdict_record([("feasibility", Judgement(True, (SKIN,), material="ecoflex-00-30")),
+                             ("actuation", Judgement(True, (f"chambers: {WALL}",), material="ecoflex-00-30"))])
+    verdict = build_verdict({"verdict": record})
+    assert verdict.status == "NOT feasible"
+    assert verdict.headline == "NOT feasible for ecoflex-00-30: 2 reason(s)"
+    assert verdict.reasons == (SKIN, f"chambers: {WALL}")
+    page = verdict_html(verdict)
+    assert 'data-status="NOT feasible"' in page and page.index("NOT feasible for") < page.index(escape(SKIN))
 
 
-def test_an_infeasible_design_opens_with_not_feasible_and_its_first_cause():
-    feasibility = {"feasible": False, "material": {"name": "ecoflex-00-30"},
-                   "reasons": ["skin stretch 0.5 < min_stretch 0.7 (ecoflex-00-30) at link 0, 2.5 mm from the base",
-                               "wall 0.4 mm < min_wall_mm 1 mm (ecoflex-00-30) at link 2, 40.1 mm from the base"]}
-    verdict = build_verdict(_manifest(feasibility=feasibility))
-    assert verdict.status == "infeasible"
-    assert verdict.headline == f"NOT feasible: {feasibility['reasons'][0]}"
-    assert verdict.reasons == (feasibility["reasons"][1],)
-    page = verdict_html(verdict, "Checks: 93 of 93 passed.")
-    # the verdict comes first, the tally after it
-    assert page.index("NOT feasible") < page.index("Checks: 93 of 93 passed.")
-    assert 'data-status="infeasible"' in page
+def test_a_feasible_design_names_its_material_and_its_margins():
+    record = verdict_record([("design", Judgement(False, margins=("within 0.81 mm of the vessel",))),
+                             ("feasibility", Judgement(True, material="dragon-skin-10")),
+                             ("mould", Judgement(False, margins=("the mould checks pass",)))])
+    verdict = build_verdict({"verdict": record})
+    assert (verdict.status, verdict.headline) == ("feasible", "feasible for dragon-skin-10")
+    assert verdict.margins == ("within 0.81 mm of the vessel", "the mould checks pass")
+    assert verdict_html(verdict).count('class="margin"') == 2
 
 
-def test_a_feasible_design_names_its_material_its_design_and_its_mould():
-    manifest = _manifest(
-        feasibility={"feasible": True, "material": {"name": "dragon-skin-10"}, "reasons": []},
-        design={"chain_max_deviation_mm": 0.81, "tip_error_mm": 0.4},
-        mould={"requested": True, "cavity": {"ok": True}, "disjoint": {"ok": True},
-               "pull": {"half_a": {"ok": True}, "half_b": {"ok": True}}},
-    )
-    verdict = build_verdict(manifest)
-    assert verdict.status == "feasible"
-    assert verdict.headline.startswith("Feasible for dragon-skin-10; the composed design is within 0.81 mm")
-    assert "the mould checks pass" in verdict.headline
-
-
-def test_a_failed_mould_check_is_said():
-    manifest = _manifest(feasibility={"feasible": True, "material": {"name": "x"}, "reasons": []},
-                         mould={"requested": True, "cavity": {"ok": True}, "disjoint": {"ok": True},
-                                "pull": {"half_a": {"ok": False}}})
-    assert "the mould checks FAIL" in build_verdict(manifest).headline
+def test_a_reason_without_a_material_still_makes_the_design_infeasible():
+    record = verdict_record([("mould", Judgement(False, ("the mould cannot be used as drawn",)))])
+    assert record["feasible"] is False and record["status"] == "NOT feasible"
 
 
 def test_without_a_material_the_design_is_not_judged_and_the_line_says_how_to_judge_it():
-    verdict = build_verdict(_manifest(feasibility={"feasible": None, "material": None, "reasons": ["no material"]}))
-    assert verdict.status == "not judged" and "material:" in verdict.headline
+    verdict = build_verdict({"verdict": verdict_record([("feasibility", Judgement(False))])})
+    assert verdict.status == "not judged" and "material: {name:" in verdict.headline
 
 
-def test_the_fits_warnings_are_named_in_the_verdict():
-    held = "no wall seen all round over 30.0 mm at 0.0-30.0 mm from the inlet, longer than the local diameter 6.0 mm"
-    manifest = _manifest(feasibility={"feasible": True, "material": {"name": "x"}, "reasons": []},
-                         fit={"warnings": [held]})
-    verdict = build_verdict(manifest)
-    assert verdict.headline.endswith("but the fit does not match the vessel everywhere (below)")
-    assert verdict.notes == (f"fit: {held}",)
-    assert f"fit: {held}" in verdict_html(verdict, "Checks: 1 of 1 passed.")
+def test_a_manifest_without_a_verdict_asks_for_a_new_build():
+    assert build_verdict({"metrics": {}}).headline == OLDER_BUILD
+
+
+def test_the_checks_tally_is_folded_and_opens_on_a_failure():
+    ok = checks_html([Check("a.stl", "watertight", "yes", "yes", True)])
+    assert ok.startswith('<details class="tally" id="checks">') and "Checks: 1 of 1 passed" in ok
+    bad = checks_html([Check("a.stl", "watertight", "no", "yes", False)])
+    assert 'id="checks" open>' in bad and "a.stl: watertight" in bad

@@ -41,17 +41,20 @@ from softdesign.meshing.chambers import measured_skin_walls
 from softdesign.meshing.sweep_layout import check_resolvable, layout_holes
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import export_workers
+from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.simulate_estimates import ESTIMATE_COLUMNS, SimulateResult, estimate_cells
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.fit import FitResult
+from softdesign.pipeline.stages.judges import material_judgement
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 
 if TYPE_CHECKING:
     from softdesign.config import Case
 
-VERSION = 3  # 2: one reason per cause (a kind of wall, a bound of extension); 3: the simulate stage's pressures
+VERSION = 4  # 2: one reason per cause (a kind of wall, a bound of extension); 3: the simulate stage's pressures;
+#            4: angles in (-180, 180] degrees
 SUMMARY = "actuation/summary.json"
 TABLE = "actuation.csv"
 #: The dense q grid's size (q = 0, 0.05, ..., 1).
@@ -165,7 +168,7 @@ def _rows_at(kinematics: KinematicsResult, layout: ChamberLayout, q: float, expo
                         for i, f in enumerate(fits)])
     base = lengths if reference is None else reference
     rows = [{"q": q, "export": int(export), "section": i + 1, "chamber": j + 1,
-             "angle_deg": float(np.rad2deg(first[i, j])), "distance_mm": d, "length_mm": float(lengths[i, j]),
+             "angle_deg": degrees_wrapped(first[i, j]), "distance_mm": d, "length_mm": float(lengths[i, j]),
              "extension": float(lengths[i, j] / base[i, j]), "arc_kappa": f.kappa, "arc_phi": f.phi,
              "arc_length_mm": f.length, "arc_misfit_mm": f.backbone_max_mm}
             for i, f in enumerate(fits) for j in range(layout.spec.chambers_per_section)]
@@ -246,7 +249,9 @@ def _meshed(case: Case, kinematics: KinematicsResult, fit: FitResult, layout: Ch
                 for kind in dict.fromkeys(w.kind for w in walls)]
 
     longest = max(key.length for key in kinematics.chain.shape.keys)
-    return [w for walls in map_items(at, e.q_values(), most=export_workers(case, longest)) for w in walls]
+    counted = item_counter("actuation", e.q_values(), lambda q: f"walls at q = {q:g}")  # a bar, when one listens
+    return [w for walls in map_items(at, e.q_values(), most=export_workers(case, longest), on_result=counted)
+            for w in walls]
 
 
 def judge(walls: list[Wall], extensions: list[dict[str, Any]], limits: dict[str, Any] | None) -> list[str]:
@@ -281,15 +286,22 @@ def judge(walls: list[Wall], extensions: list[dict[str, Any]], limits: dict[str,
     return reasons
 
 
+def degrees_wrapped(angle_rad: float) -> float:
+    """An angle in degrees in (-180, 180] (the one convention of the CSV and JSON outputs), rounded to 1e-9 deg so
+    that 30 and 390 - 360 are written as the same number."""
+    degrees = float(np.rad2deg(angle_rad)) % 360.0
+    return round(degrees - 360.0 if degrees > 180.0 else degrees, 9) + 0.0
+
+
 def layout_document(layout: ChamberLayout) -> dict[str, Any]:
     """The layout as JSON: the spec, every chamber and feed (angles in degrees)."""
     return {
         "rule": "section i chamber j at first_angle + 120 j + i 120/n deg in the body's RMF (0 along N); feeds on "
                 "the chambers' ring at their chamber's angle, from the base face into the chamber",
-        "chambers": [{"section": c.section + 1, "chamber": c.index + 1, "angle_deg": float(np.rad2deg(c.angle)),
+        "chambers": [{"section": c.section + 1, "chamber": c.index + 1, "angle_deg": degrees_wrapped(c.angle),
                       "distance_mm": c.distance_mm, "diameter_mm": c.diameter_mm, "l_start": c.l_start,
                       "l_end": c.l_end} for c in layout.chambers],
-        "feeds": [{"section": f.section + 1, "chamber": f.chamber + 1, "angle_deg": float(np.rad2deg(f.angle)),
+        "feeds": [{"section": f.section + 1, "chamber": f.chamber + 1, "angle_deg": degrees_wrapped(f.angle),
                    "ring_mm": f.ring_mm, "diameter_mm": f.diameter_mm, "l_start": f.l_start, "l_end": f.l_end}
                   for f in layout.feeds],
     }
@@ -343,7 +355,7 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult,
         "material": limits,
         "feasible": None if limits is None else not reasons,
         "reasons": reasons if limits is not None else ["no material: in the case file: figures only, not judged"],
-        "method": "lengths: seed 003 on each section's best arc at q (backbone started on the section's base "
+        "method": "lengths: Zou et al. on each section's best arc at q (backbone started on the section's base "
                   "frame); extension: the chamber's axis on the body at q over q = 0; walls in the sections' "
                   "normal planes (chamber-skin, feed-skin at every q; between tubes constant over q), and at every "
                   "export q the skin over each tube measured on the mesh (end caps included)",
@@ -369,7 +381,7 @@ def load_actuation(build_dir: Path) -> ActuationResult | None:
 
 
 def describe_actuation(result: ActuationResult | None) -> list[str]:
-    """The thinnest walls, the extension range and the verdict."""
+    """The thinnest walls and the extension range."""
     if result is None:
         return []
     s = result.summary
@@ -382,10 +394,7 @@ def describe_actuation(result: ActuationResult | None) -> list[str]:
     lines.append(f"chamber extension {lo['min']:.4f} (section {lo['section']} chamber {lo['chamber']}, "
                  f"q={lo['q_min']:.3f}) to {hi['max']:.4f} (section {hi['section']} chamber {hi['chamber']}, "
                  f"q={hi['q_max']:.3f})")
-    if s["material"] is not None:
-        lines.append(f"actuation for {s['material']['name']}: {'feasible' if s['feasible'] else 'NOT feasible'}")
-        lines += [f"WARN {reason}" for reason in s["reasons"]]
-    return lines
+    return lines  # its verdict is the build's one (the manifest's)
 
 
 STAGE = Stage(
@@ -400,4 +409,5 @@ STAGE = Stage(
     describe=describe_actuation,
     metrics=lambda result: {} if result is None else result.summary,
     figures=lambda result: {} if result is None else {TABLE: {"rows": len(result.summary["rows"])}},
+    judge=lambda result: None if result is None else material_judgement(result.summary, "chambers"),
 )

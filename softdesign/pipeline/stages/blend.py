@@ -28,7 +28,7 @@ from softdesign.geometry.frames import FrameMode
 from softdesign.geometry.initial import InitialSpec, build_initial_shape, initial_shape_from_polyline
 from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import curve_options
-from softdesign.pipeline.blend_choice import choose_blend, describe_choice, pcc_choice
+from softdesign.pipeline.blend_choice import blend_notices, choose_blend, describe_choice, pcc_choice
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.design import DesignResult, load_design
 from softdesign.pipeline.stages.ingest import IngestResult
@@ -222,4 +222,5 @@ STAGE = Stage(
     load=lambda build_dir, results: load_blend(build_dir),
     describe=describe_blend,
     metrics=lambda result: result.summary,
+    warnings=lambda result: blend_notices(result.summary),
 )

@@ -35,15 +35,17 @@ from softdesign.kinematics.chain_design import METHOD, ChainOptions, ChainTarget
 from softdesign.kinematics.pcc_chain import arcs_from_w, dense_chain_points, section_poses
 from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import curve_options
+from softdesign.pipeline.notices import Notice
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.ingest import IngestResult
+from softdesign.pipeline.stages.judges import design_judgement
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 from softdesign.types import FloatArray, Pose
 
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 2  # 2: each section's D-H rows (dh) and the dh_convention in design/summary.json
+VERSION = 3  # 2: each section's D-H rows (dh) and the dh_convention in design/summary.json; 3: its papers cited
 #: Below this bending angle (rad) a section is reported straight: kappa and phi 0 (phi is rounding noise there).
 STRAIGHT_THETA_RAD = 1e-9
 #: Spacing of the chain's points kept for the report, mm.
@@ -52,7 +54,7 @@ PROFILE_STEP_MM = 0.25
 CONVENTION = (
     "mm, radians (phi, theta) and degrees only where a key says _deg. Section 1 starts on base_frame (4x4, world: "
     "columns N, B, T and the position of the q = 1 centerline at l = 0, rotation-minimizing frames); each next "
-    "section starts on the previous tip_frame (seed 003's improved D-H). phi is measured in the section's base frame "
+    "section starts on the previous tip_frame (Zou et al.'s improved D-H). phi is measured in the section's base frame "
     "from N towards B, and the section bends towards phi; kappa >= 0, theta = kappa * length; a straight section has "
     "kappa = phi = 0. l_start, l_end are normalized l of the q = 1 centerline, at the joints' arc-length fractions of "
     "the chain. max_deviation_mm: the largest true distance between the composed chain and the centerline, both "
@@ -250,8 +252,13 @@ def describe_design(result: DesignResult | None) -> list[str]:
     lines = [f"{len(d['links'])} section(s) composed from the base: chain within {d['chain_max_deviation_mm']:.3g} mm "
              f"of the q = 1 centerline (tolerance {d['tolerance_mm']:g} mm), tip off by {d['tip_error_mm']:.3g} mm "
              f"and {d['tip_error_deg']:.3g} deg"]
-    miss = miss_text(d)
-    return lines + ([] if miss is None else [f"  warning: {miss}"])
+    return lines  # a miss of its bounds: :func:`design_notices`
+
+
+def design_notices(result: DesignResult | None) -> list[Notice]:
+    """A warning when the design misses its bounds."""
+    miss = None if result is None else miss_text(result.document)
+    return [] if miss is None else [Notice("design", "design_miss", "", miss)]
 
 
 def design_metrics(result: DesignResult | None) -> dict[str, Any]:
@@ -274,4 +281,6 @@ STAGE = Stage(
     load=lambda build_dir, results: load_design(build_dir),
     describe=describe_design,
     metrics=design_metrics,
+    warnings=design_notices,
+    judge=lambda result: design_judgement(None if result is None else result.document),
 )

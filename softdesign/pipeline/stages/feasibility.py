@@ -47,9 +47,11 @@ from softdesign.meshing.wall import FD_STEP_MM, offset_metric, port_wall_mm, thi
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import meshes_at_once
 from softdesign.pipeline.feasibility_judge import judge
+from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.fit import FitResult
+from softdesign.pipeline.stages.judges import material_judgement
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 from softdesign.types import FramedCurve
@@ -239,7 +241,8 @@ def run_feasibility(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
         kind, q = item
         return _at_q(body, q, case) if kind == "q" else _extremes(body, q, 0.0, (0.0, 1.0))
 
-    done = map_items(task, work, most=most)
+    counted = item_counter("feasibility", work, lambda item: f"skin at q = {item[1]:.3g}")  # a bar, when one listens
+    done = map_items(task, work, most=most, on_result=counted)
     rows, polished = done[:-2], (done[-2], done[-1])
     per_link = []
     for j in range(len(fit.field.final)):
@@ -290,7 +293,7 @@ def load_feasibility(build_dir: Path) -> FeasibilityResult:
 
 
 def describe_feasibility(result: FeasibilityResult) -> list[str]:
-    """The feasibility table, then a WARN line per violation."""
+    """The feasibility table and the material's limits; the verdict is the build's one (the manifest's)."""
     s = result.summary
     lines = ["     q  stretch_max  stretch_min  rho*kappa  wall_min_mm  port_wall_mm"]
     for r in s["per_q"]:
@@ -305,11 +308,9 @@ def describe_feasibility(result: FeasibilityResult) -> list[str]:
     if material is None:
         lines.append("material: none given, not judged (add material: to the case file)")
         return lines
-    verdict = "feasible" if s["feasible"] else "NOT feasible"
     limits = ", ".join(f"{k} {material[k]:g}" for k in ("max_stretch", "min_stretch", "min_wall_mm")
                        if material[k] is not None)
-    lines.append(f"material {material['name']} ({limits}): {verdict}")
-    lines += [f"WARN {reason}" for reason in s["reasons"]]
+    lines.append(f"material {material['name']} ({limits}): {len(s['reasons'])} limit(s) crossed (the verdict below)")
     return lines
 
 
@@ -329,4 +330,5 @@ STAGE = Stage(
     load=lambda build_dir, results: load_feasibility(build_dir),
     describe=describe_feasibility,
     metrics=feasibility_metrics,
+    judge=lambda result: material_judgement(result.summary),
 )

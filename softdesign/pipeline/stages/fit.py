@@ -19,7 +19,6 @@ import numpy as np
 
 from softdesign.errors import ConfigError, FitError, FoldError
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
-from softdesign.fitting.end_checks import thin_end_warnings
 from softdesign.fitting.metrics import HoldoutSettings
 from softdesign.fitting.morph_folds import fold_over_morph
 from softdesign.fitting.projection import project_points
@@ -28,7 +27,6 @@ from softdesign.fitting.selection import NetworkContext, SelectionSettings, insc
 from softdesign.fitting.wall_fit import WallFitOptions, fit_wall
 from softdesign.geometry.curves import SmoothCurve, measure_deviation
 from softdesign.geometry.end_cut import choose_end_cuts
-from softdesign.geometry.end_planes import rim_gap_warnings
 from softdesign.geometry.morph_fold import MORPH_Q_SAMPLES
 from softdesign.geometry.network import SelectedPath
 from softdesign.kinematics.links import LinkChain
@@ -37,6 +35,7 @@ from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import describe_backbone_fit, stretch_fit_errors
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.fit_notices import fit_notices
 from softdesign.pipeline.stages.ingest import IngestResult
 from softdesign.pipeline.stages.links import LinksResult
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
@@ -45,12 +44,13 @@ from softdesign.types import FloatArray
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 7  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
+VERSION = 8  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
 # 3: points fitted in path order; distances sampled above 200k points (max still over all)
 # 4: end prior and end radii (issue 20); true distances on the regularized backbone's stretches (``backbone``)
 # 5: each end's cut plane in the end frame (``end_cut``, issue 20)
 # 6: fit/points.npz keeps the true distance of every point the metrics measured (``distance``, NaN elsewhere)
 # 7: the fit against all of the path's own wall, its coverage and flags (``all_wall``, ``coverage``, issue 29)
+# 8: the coverage warnings in an engineer's words (issue 44)
 #: Seed of the hold-out folds: the same case always gets the same folds.
 HOLDOUT_SEED = 4
 #: A failed fit is blamed on the centerline when the smoothed one strays from the input by this fraction of the
@@ -255,29 +255,31 @@ def describe_fit(result: FitResult) -> list[str]:
         f"spline: knots every {st['knot_spacing_mm']:g} mm, {st['angular_intervals']} angular intervals, "
         f"smoothing {st['smoothing']:g}",
         f"true distance to the fitted surface, kept points (mm){_sampled_note(result.summary['distance'])}:",
-        f"  RMS {m['rms_mm']:.4f}  p95 {m['p95_mm']:.4f}  p99 {m['p99_mm']:.4f}  max {m['max_mm']:.4f}",
-        f"  hold-out RMS ({result.summary['holdout_points']} points, k-fold) {m['holdout_rms_mm']:.4f}",
+        f"  kept-point RMS {m['rms_mm']:.4f}  p95 {m['p95_mm']:.4f}  p99 {m['p99_mm']:.4f}  max {m['max_mm']:.4f}",
+        f"  hold-out RMS {m['holdout_rms_mm']:.4f} (k-fold on {result.summary['holdout_points']} kept points: each "
+        "fold measured against the fit made without it)",
         *coverage_lines(result.summary),
         f"joints: value jump {m['joint_value_jump_mm']:.2e} mm, slope jump {m['joint_slope_jump']:.2e}",
         f"max rho * kappa at q = 1: {m['max_rho_kappa']:.3f} (folds at 1; every export q is checked at export)",
         *_morph_lines(result.summary),
         f"radius at q = 0: {result.summary['initial_radius']}",
-    ] + end_lines(result.summary) + describe_backbone_fit(result.summary.get("backbone", [])) + _stray_lines(result)
+    ] + end_lines(result.summary) + describe_backbone_fit(result.summary.get("backbone", []))
 
 
 def coverage_lines(summary: dict[str, Any]) -> list[str]:
-    """The all-wall figures, the coverage, each unseen stretch and the warnings (none for older builds)."""
+    """The all-wall figures, the coverage and each unseen stretch (none for older builds); the warnings are
+    :func:`~softdesign.pipeline.stages.fit_notices.fit_notices`'s."""
     if "all_wall" not in summary:
         return []
     a, c = summary["all_wall"], summary["coverage"]
     lines = [
         f"true distance, all of the path's own wall ({c['own_wall_points']} vertices, {c['fraction']:.1%} of them "
         f"fitted):",
-        f"  RMS {a['rms_mm']:.4f}  p95 {a['p95_mm']:.4f}  p99 {a['p99_mm']:.4f}  max {a['max_mm']:.4f}",
+        f"  all-wall RMS {a['rms_mm']:.4f}  p95 {a['p95_mm']:.4f}  p99 {a['p99_mm']:.4f}  max {a['max_mm']:.4f}",
     ]
     lines += [f"  wall not seen all round at {s['from_mm']:.1f}-{s['to_mm']:.1f} mm ({s['length_mm']:.1f} mm, local "
               f"diameter {s['diameter_mm']:.1f} mm): {s['how']}" for s in c["unseen_stretches"]]
-    return lines + [f"  warning: {w}" for w in summary.get("warnings", [])]
+    return lines
 
 
 def _morph_lines(summary: dict[str, Any]) -> list[str]:
@@ -288,27 +290,18 @@ def _morph_lines(summary: dict[str, Any]) -> list[str]:
             f"{m['q']:.3f}, l = {m['l']:.4f}"]
 
 
-def _stray_lines(result: FitResult) -> list[str]:
-    stray = result.summary.get("centerline_stray")
-    return [] if stray is None else [f"  warning: {stray}"]
-
-
 def end_lines(summary: dict[str, Any]) -> list[str]:
-    """Where an end's wall was unseen and held at the inscribed radius, and thin end rings (warnings)."""
+    """Where an end's wall was unseen and held at the inscribed radius, and how each end was cut (its warnings are
+    :func:`~softdesign.pipeline.stages.fit_notices.fit_notices`'s)."""
     lines = [
         f"{end}: wall not seen all round over the last {e['unseen_mm']:.1f} mm; {e['empty_cells']:.0f} empty cells "
         f"held at the inscribed radius ({e['reference_min_mm']:.3f} to {e['reference_max_mm']:.3f} mm)"
         for end, e in summary.get("end_prior", {}).items()
     ]
-    lines += [f"  warning: the fitted radius went to {h['rho_min_mm']:.3f} mm at {h['at_mm']:.1f} mm from the "
-              f"{end.removesuffix('_held')} (its wall points lean inwards): that end is held at the inscribed radius "
-              f"over {h['from_mm']:.1f}-{h['to_mm']:.1f} mm and fitted again"
-              for end, h in summary.get("ends", {}).items() if end.endswith("_held")]
     cuts = summary.get("end_cut", {})
     lines += [f"{end}: cut at the detected plane (tilt {c['tilt_deg']:.1f} deg, rim gap {c['rim_gap_mm']:.3f} mm)"
               if c["applied"] else f"{end}: cut square to the end tangent ({c['reason']})" for end, c in cuts.items()]
-    square = {end: c for end, c in cuts.items() if not c["applied"] and "rim_gap_mm" in c}
-    return lines + [f"  warning: {w}" for w in thin_end_warnings(summary.get("ends", {})) + rim_gap_warnings(square)]
+    return lines
 
 
 def _sampled_note(distance: dict[str, Any]) -> str:
@@ -329,4 +322,5 @@ STAGE = Stage(
     load=lambda build_dir, results: load_fit(build_dir),
     describe=describe_fit,
     metrics=fit_metrics,
+    warnings=lambda result: fit_notices(result.summary),
 )

@@ -27,6 +27,7 @@ from softdesign.pipeline.auto_centerline import (
 )
 from softdesign.pipeline.backbone_step import regularized_path
 from softdesign.pipeline.end_plane_step import end_plane_summary
+from softdesign.pipeline.notices import NOTE, Notice
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 from softdesign.pipeline.surface_radius import with_surface_radius
@@ -248,7 +249,21 @@ def describe_ingest(result: IngestResult) -> list[str]:
         kind = "capped (watertight)" if s["capped"] else f"open, {s['boundary_loops']} boundary loop(s)"
         lines.append(f"surface {s['file']}: {s['vertices']} vertices, {s['faces']} triangles, {kind}")
     lines.append(f"units: {result.summary['units']} (converted to mm)")
-    return lines + list(result.notes)
+    return lines  # the notes are :func:`ingest_notices`': printed once from the manifest
+
+
+def ingest_notices(result: IngestResult) -> list[Notice]:
+    """The notes of what was done on the way (duplicates, orientation), and its warnings (``warning: ...`` notes:
+    a centerline that turns tighter than the vessel is wide, an end the extraction could not place)."""
+    notices = []
+    for text in result.notes:
+        if text.startswith("warning: "):
+            body = text.removeprefix("warning: ")
+            code = "tight_turn" if "turns" in body and "than the vessel is wide" in body else "centerline"
+            notices.append(Notice("ingest", code, "", body))
+        else:
+            notices.append(Notice("ingest", "note", "", text, NOTE))
+    return notices
 
 
 STAGE = Stage(
@@ -264,4 +279,5 @@ STAGE = Stage(
     load=lambda build_dir, results: load_ingest(build_dir),
     describe=describe_ingest,
     metrics=lambda result: result.summary,
+    warnings=ingest_notices,
 )

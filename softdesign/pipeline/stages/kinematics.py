@@ -21,9 +21,11 @@ import numpy as np
 from softdesign.geometry.frames import FramedSpline
 from softdesign.kinematics import pcc
 from softdesign.kinematics.arc_check import arc_check_metrics, arc_misses, link_arcs_at_final_shape
+from softdesign.kinematics.arc_tolerance import ARC_TOLERANCE_MM
 from softdesign.kinematics.links import LinkChain, LinkReport
 from softdesign.kinematics.poe import PoeSplit
 from softdesign.pipeline import layout
+from softdesign.pipeline.notices import Notice
 from softdesign.pipeline.parallel import map_per_q
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.design import DesignResult
@@ -33,7 +35,8 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 2  # 2: blend: pcc builds carry the design's sections at each pose (pcc_sections, pcc_convention)
+VERSION = 3  # 2: blend: pcc builds carry the design's sections at each pose (pcc_sections, pcc_convention)
+#            3: the conventions cite their paper
 CONVENTION = (
     "F(q, l) = [[N B T c], [0 0 0 1]]; transform = S_T_E = inv(F(q, l_start)) F(q, l_end), "
     "mapping end-frame coordinates into start-frame coordinates; "
@@ -45,7 +48,7 @@ CONVENTION = (
 PCC_CONVENTION = (
     "blend: pcc: each pose's pcc_sections are the design's sections (design/summary.json) at the pose's q of their "
     "link: an arc of curvature q * kappa, plane phi and length L; transform is the section's HTM (its tip frame in "
-    "its base frame, seed 003: Rz(phi) Ry(theta/2) Tz(chord) Ry(theta/2) Rz(-phi)) and dh its rows (dh: "
+    "its base frame, Zou et al.: Rz(phi) Ry(theta/2) Tz(chord) Ry(theta/2) Rz(-phi)) and dh its rows (dh: "
     + pcc.DH_CONVENTION + "); the links' transforms are measured on the built centerline's frames, which follow "
     "the chain as resampled"
 )
@@ -176,8 +179,15 @@ def describe_kinematics(result: KinematicsResult) -> list[str]:
                 f"theta1 {p['theta1']:.3f} mm, theta2 {math.degrees(p['theta2']):.3f} deg, "
                 f"stretch {link['stretch'][0]:.3f}..{link['stretch'][1]:.3f}"
             )
-    lines += [f"  warning: {line}" for line in arc_misses(link_arcs_at_final_shape(result.chain))]
-    return lines
+    return lines  # the links one arc cannot make: :func:`kinematics_notices`
+
+
+def kinematics_notices(result: KinematicsResult) -> list[Notice]:
+    """One warning per link whose q = 1 centerline one constant-curvature arc misses by more than the tolerance."""
+    arcs = link_arcs_at_final_shape(result.chain)
+    misses = [j for j, arc in enumerate(arcs) if arc.max_deviation_mm > ARC_TOLERANCE_MM]
+    return [Notice("kinematics", "arc_misfit", f"link {j}", text)
+            for j, text in zip(misses, arc_misses(arcs), strict=True)]
 
 
 STAGE = Stage(
@@ -191,4 +201,5 @@ STAGE = Stage(
     describe=describe_kinematics,
     metrics=lambda result: {"links": len(result.document["links"]), "file": layout.KINEMATICS,
                             "arc_check": arc_check_metrics(result.chain)},
+    warnings=kinematics_notices,
 )

@@ -28,10 +28,12 @@ from softdesign.meshing.mould_cores import make_actuated_mould
 from softdesign.meshing.mould_make import MouldMesh, make_mould
 from softdesign.pipeline import layout
 from softdesign.pipeline.body_spec import body_spec
+from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.output_frame import base_pose, moved_points, moved_vectors, output_pose
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.actuation import actuation_layout
 from softdesign.pipeline.stages.fit import FitResult
+from softdesign.pipeline.stages.judges import mould_judgement
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 
@@ -67,11 +69,15 @@ def run_mould(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Mould
     e = case.export
     sections = body_sections(kinematics.chain.shape.curve_at(0.0), fit.field, 0.0, e.spacing_mm, e.angular_count)
     actuated = actuation_layout(case, kinematics)
+    steps = ("the parts", "their checks")
+    tick = item_counter("mould", steps)  # two steps of a bar (the parts take most of the time), when one listens
     if actuated is None:
         mould = make_mould(sections, body_spec(case, fit), spec, fit.field.link_of)
     else:
         mould = make_actuated_mould(sections, body_spec(case, fit), spec, kinematics.chain.shape.curve_at(0.0),
                                     actuated, fit.field.link_of)
+    if tick is not None:
+        tick(steps[0], None)
     files: dict[str, Any] = {}
     for part in mould.parts:
         euler = 2 - 2 * mould.figures["parts"][part.name]["genus"]  # the core plate has a hole per core print
@@ -81,6 +87,8 @@ def run_mould(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Mould
                 "part": part.name, "vertices": report.vertices, "faces": report.faces, "volume_mm3": report.volume,
                 "area_mm2": report.area, "watertight": report.watertight, "bodies": report.bodies,
                 "euler": report.euler}
+    if tick is not None:
+        tick(steps[1], None)
     pose = output_pose(case.export.frame, base_pose(kinematics.chain.shape))  # checked first, then moved rigidly
     parts = tuple(replace(p, vertices=moved_points(p.vertices, pose)) for p in mould.parts)
     figures = dict(mould.figures)
@@ -157,4 +165,5 @@ STAGE = Stage(
     describe=describe_mould,
     metrics=lambda result: {k: v for k, v in result.summary.items() if k != "files"},
     figures=output_figures,
+    judge=lambda result: mould_judgement(result.summary),
 )

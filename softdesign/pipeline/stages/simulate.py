@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, Any
 from softdesign.errors import ConfigError, MeshError, SolveError
 from softdesign.pipeline.simulate_estimates import SimulateResult, arc_error_mm
 from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.judges import simulate_notices
 from softdesign.pipeline.store import Staging
 
 if TYPE_CHECKING:
@@ -179,4 +180,5 @@ STAGE = Stage(
     load=lambda build_dir, results: load_simulate(build_dir),
     describe=describe_simulate,
     metrics=lambda result: {} if result is None else result.summary,
+    warnings=lambda result: simulate_notices(None if result is None else result.summary),
 )

@@ -57,6 +57,7 @@ from softdesign.pipeline.output_frame import base_pose, moved_points, output_pos
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.export import solid_at
 from softdesign.pipeline.stages.fit import FitResult
+from softdesign.pipeline.stages.judges import material_judgement
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 from softdesign.types import FloatArray, IntArray
@@ -276,4 +277,5 @@ STAGE = Stage(
     metrics=lambda result: {k: v for k, v in result.summary.items() if k != "files"},
     figures=lambda result: result.summary["files"] if result.summary["requested"] else {},
     log=lambda result: list(result.log),
+    judge=lambda result: material_judgement(result.summary if result.summary["requested"] else None, "3D"),
 )

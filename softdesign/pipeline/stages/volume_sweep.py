@@ -375,7 +375,7 @@ def part_lines(parts: list[dict[str, Any]]) -> list[str]:
 
 
 def describe_sweep(summary: dict[str, Any]) -> list[str]:
-    """A line per mesh with its figures and strain, the morph's extremes, the verdict."""
+    """A line per mesh with its figures and strain, the morph's extremes, the material's limits crossed."""
     lines: list[str] = []
     for f in summary["per_q"]:
         w = f["worst"]["min_dihedral"]
@@ -395,11 +395,8 @@ def describe_sweep(summary: dict[str, Any]) -> list[str]:
         lines.append(f"over {len(m['q_samples'])} q: 3D stretch max {m['stretch_max']['value']:.4f} at "
                      f"q={m['stretch_max']['q']:.3f}{stress}")
     material = summary["material"]
-    if summary["feasible"] is None:
-        lines.append("material: none judged (add material: to the case file)")
-    else:
-        verdict = "feasible" if summary["feasible"] else "NOT feasible"
+    if material is not None:
         lines.append(f"material {material['name']} (max_stretch {material['max_stretch']}, tensile strength "
-                     f"{material['tensile_strength_kpa']} kPa): {verdict} in 3D")
-        lines += [f"WARN {r}" for r in summary["reasons"]]
+                     f"{material['tensile_strength_kpa']} kPa): {len(summary['reasons'])} limit(s) crossed in 3D "
+                     "(the verdict below)")
     return lines
