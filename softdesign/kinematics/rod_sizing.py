@@ -1,0 +1,314 @@
+"""Chambers sized by the rod model (:mod:`softdesign.kinematics.rod`): one supply pressure, or one per chamber.
+
+``supply: single``
+    One chamber per section, on the outside of the section's bend: a
+    pressurised chamber bends its section away from itself, so one chamber
+    placed opposite the designed bending plane phi_i reaches any (kappa_i,
+    phi_i); two or three chambers per section would only add cavities (walls,
+    feeds, cores) for the same two numbers.  At every station of the chamber
+    its angle and diameter are solved (2 x 2 Newton on the rod model, every
+    other cavity held) so that the rod model's bending at the design pressure
+    P is the section's designed ``w_i = kappa_i (cos phi_i, sin phi_i)``: the
+    chamber tapers with the body, ``P A(l) d(l) / (E I(l))`` constant.  It
+    sits as far out as the skin wall allows (``d = R_min - wall - D / 2``,
+    R_min the station's smallest outer radius): the largest arm, the smallest
+    chamber.  Its feed runs from the base face on the chamber's ring at the
+    chamber's angle, pressurised with it (the proximal sections it crosses are
+    sized with its moment included), so the sections are sized distal first.
+    The design pressure P* is the lowest at which every wall (chamber-skin,
+    chamber-feed, feed-feed, feed-skin, and against the backbone thread) is at
+    least the material's; a higher pressure needs smaller chambers, but loads
+    the threads more (their check follows P*).
+``supply: per_chamber``
+    Seed 003's three chambers per section, one feed each.  The rod model is
+    linear in the 3n pressures; section i bends under its own chambers and the
+    feeds of the distal ones, so the sections are solved distal first: the
+    section's rotation ``int w ds`` (and with ``backbone: free`` its length)
+    equals the target's.  With an inextensible backbone two equations leave
+    one free combination (equal moments cancelling): the lowest pressures,
+    one chamber at zero, are chosen.
+
+Pure numpy; no I/O.  Every pressure is kPa, every length mm.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from softdesign.kinematics.rod import Backbone, Cavities, RodBody, rod_body, strains
+from softdesign.types import FloatArray, IntArray
+
+#: Newton steps of a station's chamber solve, and its convergence (relative to the target's bending).
+NEWTON_STEPS = 30
+NEWTON_RTOL = 1e-13
+#: Finite-difference steps of the 2 x 2 Jacobian: rad and mm.
+STEP_ANGLE, STEP_DIAMETER = 1e-7, 1e-7
+#: P*: the first of TRIALS log-spaced pressures that fits (the fit is not monotone: at high pressures a chamber
+#: shrinks below its feed), then bisection in log P below it to BISECT_RTOL.
+TRIALS = 25
+BISECT_RTOL = 1e-9
+#: Lowest pressure tried, kPa.
+LOWEST_PRESSURE_KPA = 1.0
+
+
+@dataclass(frozen=True)
+class Stations:
+    """Stations along a body of sections, proximal first.
+
+    Attributes
+    ----------
+    ds : (k,) mm rest length;  s : (k,) mm rest arc length of the middle from the base;  section : (k,) int
+    chamber : (k,) bool, the section's chamber crosses the station (outside its end walls)
+    """
+
+    ds: FloatArray
+    s: FloatArray
+    section: IntArray
+    chamber: np.ndarray
+
+
+def stations_along(lengths: npt.ArrayLike, per_section: int, end_wall_mm: float) -> Stations:
+    """``per_section`` equal stations in every section's chamber and one in each end wall (none when 0 mm).
+
+    Raises ValueError for a section no longer than its two end walls.
+    """
+    lengths = np.asarray(lengths, float)
+    ds, section, chamber = [], [], []
+    for i, length in enumerate(lengths):
+        inner = length - 2.0 * end_wall_mm
+        if inner <= 0.0:
+            raise ValueError(f"section {i + 1} is {length:.3f} mm long, not longer than its two end walls of "
+                             f"{end_wall_mm:g} mm")
+        walls = [end_wall_mm] if end_wall_mm > 0.0 else []
+        pieces = walls + [inner / per_section] * per_section + walls
+        ds += pieces
+        section += [i] * len(pieces)
+        chamber += [False] * len(walls) + [True] * per_section + [False] * len(walls)
+    ds_array = np.asarray(ds)
+    return Stations(ds_array, np.cumsum(ds_array) - 0.5 * ds_array, np.asarray(section, np.int64),
+                    np.asarray(chamber))
+
+
+@dataclass(frozen=True)
+class Limits:
+    """What a single-supply design must respect: walls and thread (mm, N, kPa)."""
+
+    wall_mm: float
+    feed_diameter_mm: float
+    thread_diameter_mm: float
+    max_pressure_kpa: float
+
+
+@dataclass(frozen=True)
+class SingleSupply:
+    """A single-supply device at its design pressure.
+
+    Attributes
+    ----------
+    pressure_kpa : P*
+    angle, distance_mm, diameter_mm : (k,) each station's chamber (rad from N towards B; 0 mm where none)
+    feed_angle, feed_ring_mm : (n,) each section's feed;  feed_until : (n,) mm, rest arc length where it ends
+    body : the rod (every chamber and feed on channel 0)
+    walls : (k,) mm, each station's thinnest wall;  wall_kind : (k,) its kind
+    """
+
+    pressure_kpa: float
+    angle: FloatArray
+    distance_mm: FloatArray
+    diameter_mm: FloatArray
+    feed_angle: FloatArray
+    feed_ring_mm: FloatArray
+    feed_until: FloatArray
+    body: RodBody
+    walls: FloatArray
+    wall_kind: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Problem:
+    """A body to size: stations, outlines (k, m) mm, designed bending per section (n, 2) 1/mm, material."""
+
+    stations: Stations
+    outlines: FloatArray
+    w: FloatArray
+    modulus_kpa: float
+    backbone: Backbone
+    limits: Limits
+
+
+def _polar(radius: npt.ArrayLike, angle: npt.ArrayLike) -> FloatArray:
+    r, a = np.asarray(radius, float), np.asarray(angle, float)
+    return np.stack([r * np.cos(a), r * np.sin(a)], axis=-1)
+
+
+def _bending(problem: Problem, at: IntArray, fixed: tuple[FloatArray, FloatArray], angle: FloatArray,
+             diameter: FloatArray, pressure: float) -> FloatArray:
+    """The rod model's ``w`` (len(at), 2) at stations ``at`` with a chamber (angle, diameter) and fixed cavities."""
+    r_min = problem.outlines[at].min(axis=1)
+    distance = r_min - problem.limits.wall_mm - 0.5 * diameter
+    centers = np.concatenate([fixed[0], _polar(distance, angle)[:, None, :]], axis=1)
+    radii = np.concatenate([fixed[1], 0.5 * diameter[:, None]], axis=1)
+    body = rod_body(problem.stations.ds[at], problem.stations.section[at], problem.outlines[at],
+                    Cavities(centers, radii, np.zeros(radii.shape[1], np.int64)), problem.modulus_kpa,
+                    problem.backbone)
+    return strains(body, [pressure])[1]
+
+
+def _solve_stations(problem: Problem, at: IntArray, fixed: tuple[FloatArray, FloatArray], target: FloatArray,
+                    pressure: float) -> tuple[FloatArray, FloatArray]:
+    """Each station's chamber (angle rad, diameter mm) whose bending at ``pressure`` is ``target`` (len(at), 2)."""
+    scale = max(float(np.max(np.hypot(target[:, 0], target[:, 1]))), 1e-300)
+    r_min = problem.outlines[at].min(axis=1)
+    i_round = np.pi * r_min**4 / 4.0
+    arm = r_min - 2.0 * problem.limits.wall_mm
+    moment = problem.modulus_kpa * i_round * np.hypot(target[:, 0], target[:, 1])
+    diameter = np.sqrt(np.maximum(4.0 * moment / (np.pi * pressure * np.maximum(arm, 1e-3)), 1e-12))
+    angle = np.arctan2(target[:, 1], target[:, 0]) + np.pi
+    for _ in range(NEWTON_STEPS):
+        f = _bending(problem, at, fixed, angle, diameter, pressure) - target
+        if np.max(np.abs(f)) <= NEWTON_RTOL * scale:
+            break
+        da = (_bending(problem, at, fixed, angle + STEP_ANGLE, diameter, pressure) - target - f) / STEP_ANGLE
+        dd = (_bending(problem, at, fixed, angle, diameter + STEP_DIAMETER, pressure) - target - f) / STEP_DIAMETER
+        jac = np.stack([da, dd], axis=2)
+        det = jac[:, 0, 0] * jac[:, 1, 1] - jac[:, 0, 1] * jac[:, 1, 0]
+        ok = np.abs(det) > 0.0
+        step_a = np.where(ok, (jac[:, 1, 1] * f[:, 0] - jac[:, 0, 1] * f[:, 1]) / np.where(ok, det, 1.0), 0.0)
+        step_d = np.where(ok, (-jac[:, 1, 0] * f[:, 0] + jac[:, 0, 0] * f[:, 1]) / np.where(ok, det, 1.0), 0.0)
+        angle = angle - step_a
+        diameter = np.clip(diameter - step_d, 0.5 * diameter, 2.0 * diameter)
+    return angle, diameter
+
+
+def _walls(problem: Problem, centers: FloatArray, radii: FloatArray, kinds: list[str]) -> tuple[FloatArray,
+                                                                                                list[str]]:
+    """Each station's thinnest wall (mm) and its kind: between cavities, to the skin, to the axis thread."""
+    r_min = problem.outlines.min(axis=1)
+    present = radii > 0.0
+    reach = np.hypot(centers[..., 0], centers[..., 1])
+    skin = np.where(present, r_min[:, None] - reach - radii, np.inf)
+    thread = np.where(present, reach - radii - 0.5 * problem.limits.thread_diameter_mm, np.inf)
+    gap = np.linalg.norm(centers[:, :, None, :] - centers[:, None, :, :], axis=3) - radii[:, :, None] - radii[:, None]
+    both = present[:, :, None] & present[:, None, :] & ~np.eye(radii.shape[1], dtype=bool)[None]
+    between = np.where(both, gap, np.inf)
+    h = radii.shape[1]
+    every = np.concatenate([skin, thread, between.reshape(len(r_min), h * h)], axis=1)
+    best = np.argmin(every, axis=1)
+    names = ([f"{kinds[j]}-skin" for j in range(h)] + [f"{kinds[j]}-thread" for j in range(h)]
+             + [f"{kinds[a]}-{kinds[b]}" for a in range(h) for b in range(h)])
+    return every[np.arange(len(r_min)), best], [names[j] for j in best]
+
+
+def size_single(problem: Problem, pressure: float) -> SingleSupply:
+    """The chambers and feeds that bend every section into its designed arc at ``pressure`` kPa (distal first)."""
+    st, n = problem.stations, int(problem.stations.section.max()) + 1
+    k = len(st.ds)
+    angle, diameter = np.zeros(k), np.zeros(k)
+    feed_angle, feed_ring, feed_until = np.zeros(n), np.zeros(n), np.zeros(n)
+    f = 0.5 * problem.limits.feed_diameter_mm
+    r_min = problem.outlines.min(axis=1)
+    for i in reversed(range(n)):
+        at = np.flatnonzero((st.section == i) & st.chamber)
+        distal = np.arange(i + 1, n)
+        crossing = st.s[at][:, None] < feed_until[distal][None, :]
+        fixed = (np.broadcast_to(_polar(feed_ring[distal], feed_angle[distal]), (len(at), len(distal), 2)).copy(),
+                 np.where(crossing, f, 0.0))
+        target = np.broadcast_to(problem.w[i], (len(at), 2))
+        angle[at], diameter[at] = _solve_stations(problem, at, fixed, target, pressure)
+        feed_angle[i] = angle[at[0]]
+        feed_ring[i] = r_min[at[0]] - problem.limits.wall_mm - 0.5 * diameter[at[0]]
+        feed_until[i] = st.s[at[0]]
+    distance = np.where(st.chamber, r_min - problem.limits.wall_mm - 0.5 * diameter, 0.0)
+    chamber_at = st.section[:, None] == np.arange(n)[None, :]
+    centers = np.concatenate([np.broadcast_to(_polar(distance, angle)[:, None, :], (k, n, 2)),
+                              np.broadcast_to(_polar(feed_ring, feed_angle)[None], (k, n, 2))], axis=1)
+    radii = np.concatenate([np.where(chamber_at & st.chamber[:, None], 0.5 * diameter[:, None], 0.0),
+                            np.where(st.s[:, None] < feed_until[None, :], f, 0.0)], axis=1)
+    body = rod_body(st.ds, st.section, problem.outlines, Cavities(centers, radii, np.zeros(2 * n, np.int64)),
+                    problem.modulus_kpa, problem.backbone)
+    walls, kinds = _walls(problem, centers, radii, ["chamber"] * n + ["feed"] * n)
+    return SingleSupply(pressure, angle, np.where(st.chamber, distance, 0.0), diameter, feed_angle, feed_ring,
+                        feed_until, body, walls, tuple(kinds))
+
+
+def _fits(device: SingleSupply, wall_mm: float) -> bool:
+    return bool(np.all(device.walls >= wall_mm * (1.0 - 1e-12)))
+
+
+def design_pressure(problem: Problem) -> SingleSupply | None:
+    """The device at P*, the lowest pressure (to ``BISECT_RTOL``) whose walls all fit; None when none of the trial
+    pressures up to the limits' ``max_pressure_kpa`` does."""
+    wall = problem.limits.wall_mm
+    low: float | None = None
+    high: SingleSupply | None = None
+    for p in np.geomspace(LOWEST_PRESSURE_KPA, problem.limits.max_pressure_kpa, TRIALS):
+        device = size_single(problem, float(p))
+        if _fits(device, wall):
+            high = device
+            break
+        low = float(p)
+    if high is None:
+        return None
+    if low is None:
+        return high
+    while high.pressure_kpa - low > BISECT_RTOL * high.pressure_kpa:
+        middle = float(np.sqrt(low * high.pressure_kpa))  # bisection in log P: the range spans decades
+        device = size_single(problem, middle)
+        if _fits(device, wall):
+            high = device
+        else:
+            low = middle
+    return high
+
+
+def largest_fitting_kappa(problem: Problem, section: int, pressure: float) -> float:
+    """The largest curvature (1/mm) section ``section``'s stations all reach at ``pressure`` with the biggest
+    chamber its walls allow (skin and axis thread; feeds ignored), bending as designed."""
+    st = problem.stations
+    at = np.flatnonzero((st.section == section) & st.chamber)
+    lim = problem.limits
+    biggest = np.maximum(problem.outlines[at].min(axis=1) - 2.0 * lim.wall_mm - 0.5 * lim.thread_diameter_mm, 0.0)
+    target = problem.w[section]
+    angle = np.full(len(at), float(np.arctan2(target[1], target[0]) + np.pi))
+    empty = (np.zeros((len(at), 0, 2)), np.zeros((len(at), 0)))
+    w = _bending(problem, at, empty, angle, biggest, pressure)
+    return float(np.min(np.hypot(w[:, 0], w[:, 1])))
+
+
+def per_chamber_pressures(body: RodBody, rotation: FloatArray, stretch: FloatArray | None) -> FloatArray:
+    """Every channel's pressure (c,) kPa, distal sections first, for each section's rotation and length.
+
+    Parameters
+    ----------
+    body : three channels per section (section i's are 3 i, 3 i + 1, 3 i + 2)
+    rotation : (n, 2) rad, each section's ``int w ds`` (its theta (cos phi, sin phi))
+    stretch : (n,) mm, each section's ``int eps0 ds`` (``backbone: free``), None when inextensible
+
+    Returns the pressures; a negative one is returned as is (the caller refuses it, naming the section).
+    """
+    n = int(body.section.max()) + 1
+    unit = np.eye(body.channels)
+    response = [strains(body, unit[c]) for c in range(body.channels)]
+    eps = np.stack([r[0] for r in response], axis=1)  # (k, c)
+    w = np.stack([r[1] for r in response], axis=2)  # (k, 2, c)
+    pressures = np.zeros(body.channels)
+    for i in reversed(range(n)):
+        at = body.section == i
+        own = np.arange(3 * i, 3 * i + 3)
+        rows = [np.einsum("k,kic->ic", body.ds[at], w[at])]
+        goal = [rotation[i]]
+        if stretch is not None:
+            rows.append(np.einsum("k,kc->c", body.ds[at], eps[at])[None])
+            goal.append(np.asarray([stretch[i]]))
+        matrix, rhs = np.concatenate(rows), np.concatenate(goal)
+        rhs = rhs - matrix @ pressures
+        solution, *_ = np.linalg.lstsq(matrix[:, own], rhs, rcond=None)
+        if stretch is None:
+            null = np.linalg.svd(matrix[:, own])[2][-1]
+            null = null if null.sum() > 0 else -null
+            solution = solution - np.min(solution / null) * null  # the lowest: one chamber at zero
+        pressures[own] = solution
+    return pressures
