@@ -31,7 +31,7 @@ from pydantic import (
     model_validator,
 )
 
-from softdesign.config.actuation import Actuation
+from softdesign.config.actuation import Actuation, single_supply_problems
 from softdesign.config.design import Design, pcc_blend_problems
 from softdesign.config.material import CustomMaterial
 from softdesign.config.simulate import Simulate
@@ -462,6 +462,7 @@ class Case(_Section):
     @model_validator(mode="after")
     def _pcc_needs_a_design(self) -> Case:
         problems = pcc_blend_problems(self.blend, self.design, self.initial.kind, len(self.intermediate))
+        problems += single_supply_problems(self.actuation, self.blend, self.design is not None)
         if problems:
             raise ValueError("; ".join(problems))
         return self

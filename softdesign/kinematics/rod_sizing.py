@@ -12,9 +12,19 @@
     chamber tapers with the body, ``P A(l) d(l) / (E I(l))`` constant.  It
     sits as far out as the skin wall allows (``d = R_min - wall - D / 2``,
     R_min the station's smallest outer radius): the largest arm, the smallest
-    chamber.  Its feed runs from the base face on the chamber's ring at the
-    chamber's angle, pressurised with it (the proximal sections it crosses are
-    sized with its moment included), so the sections are sized distal first.
+    chamber.  The chambers are fed in series: one supply line, a feed on the
+    first chamber's ring and angle, runs from the base face into section 1's
+    chamber (it crosses that section's proximal end wall, and is in the model
+    there), and each next chamber is fed from the one before by a short
+    channel through the joint's two end walls, in the joint's plane: it
+    crosses no station and adds no load (an assumption: its length along the
+    body is its diameter).  No feed runs through a section, which is what
+    leaves room for a chamber in a 3 mm vessel.  Sections are sized distal
+    first (the code takes feeds through proximal sections into account; in
+    series there are none).  The end walls hold no chamber: the chamber's
+    stations bend by ``w_i L_i / L_chamber``, so that the section turns
+    through its designed angle (the end walls stay straight; the section is
+    an arc to within that).
     The design pressure P* is the lowest at which every wall (chamber-skin,
     chamber-feed, feed-feed, feed-skin, and against the backbone thread) is at
     least the material's; a higher pressure needs smaller chambers, but loads
@@ -33,7 +43,7 @@ Pure numpy; no I/O.  Every pressure is kPa, every length mm.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import numpy.typing as npt
@@ -110,7 +120,8 @@ class SingleSupply:
     ----------
     pressure_kpa : P*
     angle, distance_mm, diameter_mm : (k,) each station's chamber (rad from N towards B; 0 mm where none)
-    feed_angle, feed_ring_mm : (n,) each section's feed;  feed_until : (n,) mm, rest arc length where it ends
+    feed_angle, feed_ring_mm : (n,) where each chamber's inlet is (section 1's: the supply line's ring and angle)
+    feed_until : (n,) mm, rest arc length where each feed ends (0: none crosses a station but the supply line)
     body : the rod (every chamber and feed on channel 0)
     walls : (k,) mm, each station's thinnest wall;  wall_kind : (k,) its kind
     """
@@ -129,7 +140,11 @@ class SingleSupply:
 
 @dataclass(frozen=True)
 class Problem:
-    """A body to size: stations, outlines (k, m) mm, designed bending per section (n, 2) 1/mm, material."""
+    """A body to size: stations, outlines (k, m) mm, designed bending per section (n, 2) 1/mm, material.
+
+    ``skin_mm`` (k,) mm: the outer radius every cavity keeps its wall from at each station (default: the
+    outline's smallest; a caller may take the smallest over the station's length and over the morph).
+    """
 
     stations: Stations
     outlines: FloatArray
@@ -137,6 +152,11 @@ class Problem:
     modulus_kpa: float
     backbone: Backbone
     limits: Limits
+    skin_mm: FloatArray | None = None
+
+    def skin(self) -> FloatArray:
+        """(k,) mm, the radius walls are measured from."""
+        return self.outlines.min(axis=1) if self.skin_mm is None else np.asarray(self.skin_mm, float)
 
 
 def _polar(radius: npt.ArrayLike, angle: npt.ArrayLike) -> FloatArray:
@@ -147,7 +167,7 @@ def _polar(radius: npt.ArrayLike, angle: npt.ArrayLike) -> FloatArray:
 def _bending(problem: Problem, at: IntArray, fixed: tuple[FloatArray, FloatArray], angle: FloatArray,
              diameter: FloatArray, pressure: float) -> FloatArray:
     """The rod model's ``w`` (len(at), 2) at stations ``at`` with a chamber (angle, diameter) and fixed cavities."""
-    r_min = problem.outlines[at].min(axis=1)
+    r_min = problem.skin()[at]
     distance = r_min - problem.limits.wall_mm - 0.5 * diameter
     centers = np.concatenate([fixed[0], _polar(distance, angle)[:, None, :]], axis=1)
     radii = np.concatenate([fixed[1], 0.5 * diameter[:, None]], axis=1)
@@ -161,7 +181,7 @@ def _solve_stations(problem: Problem, at: IntArray, fixed: tuple[FloatArray, Flo
                     pressure: float) -> tuple[FloatArray, FloatArray]:
     """Each station's chamber (angle rad, diameter mm) whose bending at ``pressure`` is ``target`` (len(at), 2)."""
     scale = max(float(np.max(np.hypot(target[:, 0], target[:, 1]))), 1e-300)
-    r_min = problem.outlines[at].min(axis=1)
+    r_min = problem.skin()[at]
     i_round = np.pi * r_min**4 / 4.0
     arm = r_min - 2.0 * problem.limits.wall_mm
     moment = problem.modulus_kpa * i_round * np.hypot(target[:, 0], target[:, 1])
@@ -186,7 +206,7 @@ def _solve_stations(problem: Problem, at: IntArray, fixed: tuple[FloatArray, Flo
 def _walls(problem: Problem, centers: FloatArray, radii: FloatArray, kinds: list[str]) -> tuple[FloatArray,
                                                                                                 list[str]]:
     """Each station's thinnest wall (mm) and its kind: between cavities, to the skin, to the axis thread."""
-    r_min = problem.outlines.min(axis=1)
+    r_min = problem.skin()
     present = radii > 0.0
     reach = np.hypot(centers[..., 0], centers[..., 1])
     skin = np.where(present, r_min[:, None] - reach - radii, np.inf)
@@ -209,18 +229,20 @@ def size_single(problem: Problem, pressure: float) -> SingleSupply:
     angle, diameter = np.zeros(k), np.zeros(k)
     feed_angle, feed_ring, feed_until = np.zeros(n), np.zeros(n), np.zeros(n)
     f = 0.5 * problem.limits.feed_diameter_mm
-    r_min = problem.outlines.min(axis=1)
+    r_min = problem.skin()
     for i in reversed(range(n)):
         at = np.flatnonzero((st.section == i) & st.chamber)
         distal = np.arange(i + 1, n)
         crossing = st.s[at][:, None] < feed_until[distal][None, :]
         fixed = (np.broadcast_to(_polar(feed_ring[distal], feed_angle[distal]), (len(at), len(distal), 2)).copy(),
                  np.where(crossing, f, 0.0))
-        target = np.broadcast_to(problem.w[i], (len(at), 2))
+        # the end walls hold no chamber: the chamber's stations bend the more, so the section turns by its theta
+        spread = float(st.ds[st.section == i].sum() / st.ds[at].sum())
+        target = np.broadcast_to(spread * problem.w[i], (len(at), 2))
         angle[at], diameter[at] = _solve_stations(problem, at, fixed, target, pressure)
         feed_angle[i] = angle[at[0]]
         feed_ring[i] = r_min[at[0]] - problem.limits.wall_mm - 0.5 * diameter[at[0]]
-        feed_until[i] = st.s[at[0]]
+        feed_until[i] = st.s[at[0]] if i == 0 else 0.0  # in series: only the supply line crosses a station
     distance = np.where(st.chamber, r_min - problem.limits.wall_mm - 0.5 * diameter, 0.0)
     chamber_at = st.section[:, None] == np.arange(n)[None, :]
     centers = np.concatenate([np.broadcast_to(_polar(distance, angle)[:, None, :], (k, n, 2)),
@@ -270,7 +292,7 @@ def largest_fitting_kappa(problem: Problem, section: int, pressure: float) -> fl
     st = problem.stations
     at = np.flatnonzero((st.section == section) & st.chamber)
     lim = problem.limits
-    biggest = np.maximum(problem.outlines[at].min(axis=1) - 2.0 * lim.wall_mm - 0.5 * lim.thread_diameter_mm, 0.0)
+    biggest = np.maximum(problem.skin()[at] - 2.0 * lim.wall_mm - 0.5 * lim.thread_diameter_mm, 0.0)
     target = problem.w[section]
     angle = np.full(len(at), float(np.arctan2(target[1], target[0]) + np.pi))
     empty = (np.zeros((len(at), 0, 2)), np.zeros((len(at), 0)))
@@ -312,3 +334,30 @@ def per_chamber_pressures(body: RodBody, rotation: FloatArray, stretch: FloatArr
             solution = solution - np.min(solution / null) * null  # the lowest: one chamber at zero
         pressures[own] = solution
     return pressures
+
+
+def uniform_chamber(problem: Problem, section: int, angle: float, pressure: float) -> tuple[float, float]:
+    """One chamber the whole section long at one size (distance, diameter mm) whose section turns through its
+    designed angle at ``pressure`` (its curvature then goes as 1 / I(l)); the largest that fits when none does.
+
+    It sits at ``min R_skin - wall - D / 2`` (every station's skin wall at least the wall).
+    """
+    from scipy.optimize import brentq
+
+    st, lim = problem.stations, problem.limits
+    at = np.flatnonzero((st.section == section) & st.chamber)
+    skin = float(problem.skin()[at].min())
+    goal = float(np.hypot(*problem.w[section]) * st.ds[st.section == section].sum())
+    bend = problem.w[section] / max(float(np.hypot(*problem.w[section])), 1e-300)
+    empty = (np.zeros((len(at), 0, 2)), np.zeros((len(at), 0)))
+    local = replace(problem, skin_mm=np.full(len(st.ds), skin))
+
+    def turn(diameter: float) -> float:
+        w = _bending(local, at, empty, np.full(len(at), angle), np.full(len(at), diameter), pressure)
+        return float(np.sum(st.ds[at] * (w @ bend))) - goal
+
+    top = skin - 2.0 * lim.wall_mm - 0.5 * lim.thread_diameter_mm
+    if top <= 0.0 or goal <= 0.0:
+        return skin - lim.wall_mm, 0.0
+    diameter = top if turn(top) < 0.0 else float(brentq(turn, 1e-9, top, xtol=1e-12))
+    return skin - lim.wall_mm - 0.5 * diameter, diameter

@@ -24,7 +24,7 @@ from __future__ import annotations
 import csv
 import io
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -42,8 +42,10 @@ from softdesign.meshing.sweep_layout import check_resolvable, layout_holes
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import export_workers
 from softdesign.pipeline.parallel import map_items
+from softdesign.pipeline.rod_actuation import describe_rod, rod_figures
 from softdesign.pipeline.simulate_estimates import ESTIMATE_COLUMNS, SimulateResult, estimate_cells
 from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.design import DesignResult
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
@@ -51,7 +53,7 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:
     from softdesign.config import Case
 
-VERSION = 3  # 2: one reason per cause (a kind of wall, a bound of extension); 3: the simulate stage's pressures
+VERSION = 4  # 2: one reason per cause; 3: the simulate stage's pressures; 4: the rod model (supply, pressure_kpa)
 SUMMARY = "actuation/summary.json"
 TABLE = "actuation.csv"
 #: The dense q grid's size (q = 0, 0.05, ..., 1).
@@ -63,7 +65,7 @@ ARC_SAMPLES = 201
 MIN_LAYOUT_WALL_MM = 0.2
 #: Columns of actuation.csv.
 COLUMNS = ("q", "export", "section", "chamber", "angle_deg", "distance_mm", "length_mm", "extension", "arc_kappa",
-           "arc_phi", "arc_length_mm", "arc_misfit_mm")
+           "arc_phi", "arc_length_mm", "arc_misfit_mm", "pressure_kpa")
 
 
 @dataclass(frozen=True)
@@ -80,8 +82,11 @@ def actuation_layout(case: Case, kinematics: KinematicsResult) -> ChamberLayout 
         return None
     curve0 = kinematics.chain.shape.curve_at(0.0)
     l = curve0.curve.dense_l()
+    spec = case.actuation.spec()
+    if case.actuation.supply == "single":  # one chamber per section, placed and sized by the rod model
+        spec = replace(spec, chambers_per_section=1)
     try:
-        return plan_layout(case.actuation.spec(), kinematics.chain.breaks, l, curve0.curve.arc_length(l))
+        return plan_layout(spec, kinematics.chain.breaks, l, curve0.curve.arc_length(l))
     except ValueError as err:
         raise ConfigError(f"actuation.end_wall_mm: {err}; use a thinner end wall or fewer links") from err
 
@@ -199,9 +204,9 @@ def _add_estimates(rows: list[dict[str, Any]], simulated: SimulateResult | None)
         return
     for r in rows:
         cells = estimate_cells(simulated, r["q"], r["section"])
-        r["pressure_kpa"] = None if cells is None else float(cells["pressure_kpa"][r["chamber"] - 1])
-        r["pressure_arc_error_mm"] = None if cells is None else cells["pressure_arc_error_mm"]
-        r["pressure_source"] = None if cells is None else cells["pressure_source"]
+        r["fe_pressure_kpa"] = None if cells is None else float(cells["pressure_kpa"][r["chamber"] - 1])
+        r["fe_pressure_arc_error_mm"] = None if cells is None else cells["pressure_arc_error_mm"]
+        r["fe_pressure_source"] = None if cells is None else cells["pressure_source"]
 
 
 def _extensions(kinematics: KinematicsResult, layout: ChamberLayout, grid: list[float]) -> list[dict[str, Any]]:
@@ -249,13 +254,15 @@ def _meshed(case: Case, kinematics: KinematicsResult, fit: FitResult, layout: Ch
     return [w for walls in map_items(at, e.q_values(), most=export_workers(case, longest)) for w in walls]
 
 
-def judge(walls: list[Wall], extensions: list[dict[str, Any]], limits: dict[str, Any] | None) -> list[str]:
-    """One reason per cause beyond the material's limits (empty when none, or no material): per kind of wall the
-    thinnest, with the q values where that kind is too thin; per bound the worst chamber extension, with how many
-    chambers cross it."""
+def judge(walls: list[Wall], extensions: list[dict[str, Any]],
+          limits: dict[str, Any] | None) -> tuple[list[str], list[str]]:
+    """One reason per cause beyond the material's limits, and one warning per rule of thumb crossed (both empty
+    when none, or no material): per kind of wall the thinnest, with the q values where that kind is too thin; per
+    bound the worst chamber extension, with how many chambers cross it.  ``min_stretch`` has no published source
+    (materials.yaml): crossing it is a warning, not a verdict (issue 41)."""
     if limits is None:
-        return []
-    reasons, name = [], limits["name"]
+        return [], []
+    reasons, warnings, name = [], [], limits["name"]
     if limits["min_wall_mm"] is not None:
         thin: dict[str, list[Wall]] = {}
         for w in walls:
@@ -275,10 +282,14 @@ def judge(walls: list[Wall], extensions: list[dict[str, Any]], limits: dict[str,
         if crossed:
             e = worse(crossed, key=lambda e: e[key])
             sign = ">" if key == "max" else "<"
-            reasons.append(f"chamber extension {e[key]:.4f} {sign} {bound} {limit:g} ({name}) at section "
-                           f"{e['section']} chamber {e['chamber']}, q={e['q_' + key]:.3f}; {len(crossed)} of "
-                           f"{len(extensions)} chambers cross it")
-    return reasons
+            text = (f"chamber extension {e[key]:.4f} {sign} {bound} {limit:g} ({name}) at section "
+                    f"{e['section']} chamber {e['chamber']}, q={e['q_' + key]:.3f}; {len(crossed)} of "
+                    f"{len(extensions)} chambers cross it")
+            if bound == "min_stretch":
+                warnings.append(text + " (a rule of thumb without a source: a warning, not a verdict)")
+            else:
+                reasons.append(text)
+    return reasons, warnings
 
 
 def layout_document(layout: ChamberLayout) -> dict[str, Any]:
@@ -306,31 +317,35 @@ def _check_sweep(case: Case, fit: FitResult, layout: ChamberLayout) -> None:
     check_resolvable(layout, layout_holes(layout, scale, volume.size_mm), scale)
 
 
-def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult,
-                  simulated: SimulateResult | None = None) -> ActuationResult | None:
-    """Layout (or refusal), the lengths table (with the simulate stage's pressures), the walls and extensions and
-    their verdict; None without actuation."""
+def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult, simulated: SimulateResult | None = None,
+                  design: DesignResult | None = None) -> ActuationResult | None:
+    """Layout (or refusal), the lengths table with the rod model's pressures (and the simulate stage's), the walls
+    and extensions and their verdict; None without actuation."""
     layout = actuation_layout(case, kinematics)
     if layout is None:
         return None
-    sections = check_layout(layout, section_radii(fit, layout))
-    _check_sweep(case, fit, layout)
     grid = q_grid(case)
-    rows, reference = _rows_at(kinematics, layout, 0.0, 0.0 in case.export.q_values(), None)
-    for q, export in grid:
-        if q != 0.0:
-            rows += _rows_at(kinematics, layout, q, export, reference)[0]
+    rod = rod_figures(case, kinematics, fit, design, layout, grid)
+    layout = rod.layout
+    sections = rod.sections if rod.sections is not None else check_layout(layout, section_radii(fit, layout))
+    _check_sweep(case, fit, layout)
+    rows = rod.rows if rod.rows is not None else _per_chamber_rows(kinematics, layout, grid)
+    filled = rod.fill(rows)
     _add_estimates(rows, simulated)
     qs = [q for q, _ in grid]
-    walls = ring_walls(layout) + _skin(kinematics, fit, layout, qs, case.export.offset_mm)
+    walls = (rod.walls if rod.walls is not None else ring_walls(layout)) + _skin(kinematics, fit, layout, qs,
+                                                                                 case.export.offset_mm)
     walls += _meshed(case, kinematics, fit, layout)
     extensions = _extensions(kinematics, layout, qs)
     limits = case.material.limits().as_dict() if case.material is not None else None
-    reasons = judge(walls, extensions, limits)
+    reasons, warnings = judge(walls, extensions, limits)
+    reasons += rod.reasons
     thinnest = {kind: min((w for w in walls if w.kind == kind), key=lambda w: w.thickness_mm).as_dict()
                 for kind in dict.fromkeys(w.kind for w in walls)}
     summary = {
         "spec": case.actuation.model_dump() if case.actuation is not None else None,
+        **rod.summary,
+        **filled,
         "layout": layout_document(layout),
         "sections": sections,
         "thinnest": thinnest,
@@ -343,12 +358,24 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult,
         "material": limits,
         "feasible": None if limits is None else not reasons,
         "reasons": reasons if limits is not None else ["no material: in the case file: figures only, not judged"],
+        "warnings": warnings + rod.warnings,
         "method": "lengths: seed 003 on each section's best arc at q (backbone started on the section's base "
-                  "frame); extension: the chamber's axis on the body at q over q = 0; walls in the sections' "
-                  "normal planes (chamber-skin, feed-skin at every q; between tubes constant over q), and at every "
-                  "export q the skin over each tube measured on the mesh (end caps included)",
+                  "frame), or with supply: single the rod model's chamber axis at q P*; pressure_kpa: the rod model "
+                  "(softdesign/kinematics/rod.py); extension: the chamber's axis on the body at q over q = 0; walls "
+                  "in the sections' normal planes (chamber-skin, feed-skin at every q; between tubes constant over "
+                  "q), and at every export q the skin over each tube measured on the mesh (end caps included)",
     }
     return ActuationResult(summary, table_text(rows, estimates=simulated is not None))
+
+
+def _per_chamber_rows(kinematics: KinematicsResult, layout: ChamberLayout,
+                      grid: list[tuple[float, bool]]) -> list[dict[str, Any]]:
+    """Seed 003's lengths on each section's best arc at every q of the grid (q = 0 first: the reference)."""
+    rows, reference = _rows_at(kinematics, layout, 0.0, any(q == 0.0 and e for q, e in grid), None)
+    for q, export in grid:
+        if q != 0.0:
+            rows += _rows_at(kinematics, layout, q, export, reference)[0]
+    return rows
 
 
 def write_actuation(result: ActuationResult | None, staging: Staging) -> None:
@@ -382,9 +409,11 @@ def describe_actuation(result: ActuationResult | None) -> list[str]:
     lines.append(f"chamber extension {lo['min']:.4f} (section {lo['section']} chamber {lo['chamber']}, "
                  f"q={lo['q_min']:.3f}) to {hi['max']:.4f} (section {hi['section']} chamber {hi['chamber']}, "
                  f"q={hi['q_max']:.3f})")
+    lines += describe_rod(s)
     if s["material"] is not None:
         lines.append(f"actuation for {s['material']['name']}: {'feasible' if s['feasible'] else 'NOT feasible'}")
         lines += [f"WARN {reason}" for reason in s["reasons"]]
+    lines += [f"note: {w}" for w in s.get("warnings", [])]
     return lines
 
 
@@ -392,9 +421,10 @@ STAGE = Stage(
     name="actuation",
     version=VERSION,
     reads=("actuation", "export.q", "export.frames", "export.offset_mm", "export.spacing_mm", "export.angular_count",
-           "material"),
-    upstream=("kinematics", "fit", "simulate"),
-    compute=lambda case, results: run_actuation(case, results["kinematics"], results["fit"], results["simulate"]),
+           "material", "blend"),
+    upstream=("design", "kinematics", "fit", "simulate"),
+    compute=lambda case, results: run_actuation(case, results["kinematics"], results["fit"], results["simulate"],
+                                                results["design"]),
     write=write_actuation,
     load=lambda build_dir, results: load_actuation(build_dir),
     describe=describe_actuation,

@@ -1,0 +1,134 @@
+"""What the rod model adds to the actuation stage: the single-supply layout and rows, or the per-chamber pressures.
+
+``supply: single``: the chambers sized for P* (:mod:`softdesign.pipeline.rod_single`) replace the layout's
+three-chamber rule, its ring walls and its table rows; ``per_chamber``: the layout stays seed 003's and every row
+gets the chamber's pressure from the rod model's inverse (:func:`~softdesign.pipeline.rod_device.per_chamber_rows`).
+Without a hoop reinforcement or a material law the rows' ``pressure_kpa`` is empty and a note says why.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from softdesign.errors import ConfigError
+from softdesign.io.format_names import q_label
+from softdesign.kinematics.pcc_fit import fit_links
+from softdesign.meshing.chamber_walls import Wall
+from softdesign.pipeline.rod_device import (
+    RodSetup,
+    layout_body,
+    layout_stations,
+    outlines_at,
+    per_chamber_rows,
+    rod_setup,
+    section_rest_lengths,
+)
+from softdesign.pipeline.rod_single import single_layout, single_rows, single_summary, size_case, verdict_line
+
+if TYPE_CHECKING:
+    from softdesign.config import Case
+    from softdesign.meshing.chamber_layout import ChamberLayout
+    from softdesign.pipeline.stages.design import DesignResult
+    from softdesign.pipeline.stages.fit import FitResult
+    from softdesign.pipeline.stages.kinematics import KinematicsResult
+
+#: Backbone samples per section for its best arc (as the stage's).
+ARC_SAMPLES = 201
+
+
+@dataclass(frozen=True)
+class RodFigures:
+    """The rod model's part of the actuation stage.
+
+    ``sections``, ``rows``, ``walls``: None where the stage's own (seed 003) figures stand; ``fill`` puts the
+    pressures into the rows and returns the summary's per-q pressures.
+    """
+
+    layout: ChamberLayout
+    sections: list[dict[str, Any]] | None
+    rows: list[dict[str, Any]] | None
+    walls: list[Wall] | None
+    summary: dict[str, Any]
+    reasons: list[str]
+    warnings: list[str]
+    fill: Callable[[list[dict[str, Any]]], dict[str, Any]] = field(default=lambda rows: {})
+
+
+def rod_figures(case: Case, kinematics: KinematicsResult, fit: FitResult, design: DesignResult | None,
+                layout: ChamberLayout, grid: list[tuple[float, bool]]) -> RodFigures:
+    """The single-supply device, or the per-chamber pressures, of the case (see the module notes)."""
+    setup = rod_setup(case)
+    if case.actuation is not None and case.actuation.supply == "single":
+        if isinstance(setup, str):
+            raise ConfigError(f"actuation.supply: single: {setup}")
+        if design is None:
+            raise ConfigError("actuation.supply: single sizes each designed section: add design: {tolerance_mm: 1} "
+                              "and blend: pcc")
+        return _single(case, kinematics, fit, design, layout, grid, setup)
+    head = {"supply": "per_chamber", "backbone": case.actuation.backbone if case.actuation else None,
+            "design_pressure_kpa": None}
+    if isinstance(setup, str):
+        def empty(rows: list[dict[str, Any]]) -> dict[str, Any]:
+            for r in rows:
+                r["pressure_kpa"] = None
+            return {}
+        return RodFigures(layout, None, None, None, {**head, "body_modulus_kpa": None, "rod_model": setup}, [],
+                          [f"no pressures: {setup}"], empty)
+    stations = layout_stations(layout, section_rest_lengths(kinematics))
+    body = layout_body(layout, stations, outlines_at(kinematics, fit, stations.s), setup)
+    rest = section_rest_lengths(kinematics)
+    export = [q for q, e in grid if e]
+
+    def fill(rows: list[dict[str, Any]]) -> dict[str, Any]:
+        per_chamber_rows(rows, body, rest)
+        return {"pressures_kpa": {q_label(q): [[r["pressure_kpa"] for r in rows if r["q"] == q and r["section"] == i]
+                                               for i in range(1, layout.sections + 1)] for q in export}}
+
+    return RodFigures(layout, None, None, None, {**head, "body_modulus_kpa": setup.modulus_kpa,
+                                                 "reinforcement": setup.reinforcement()}, [], [], fill)
+
+
+def _single(case: Case, kinematics: KinematicsResult, fit: FitResult, design: DesignResult, layout: ChamberLayout,
+            grid: list[tuple[float, bool]], setup: RodSetup) -> RodFigures:
+    single = size_case(case, kinematics, fit, design, setup)
+    summary = single_summary(case, single, setup)
+    arcs = {q: fit_links(kinematics.chain, q, ARC_SAMPLES) for q, _ in grid}
+    rows = single_rows(single, grid, arcs)
+    st, dev = single.problem.stations, single.device
+    walls = []
+    for i in range(int(st.section.max()) + 1):  # between cavities and against the thread (the skin is measured)
+        inner = [(float(dev.walls[k]), dev.wall_kind[k]) for k in np.flatnonzero(st.section == i)
+                 if not dev.wall_kind[k].endswith("-skin")]
+        if inner:
+            value, kind = min(inner)
+            walls.append(Wall(kind, value, i + 1, 0, None, None, None))
+    warnings = [f"the meshes and the mould carry each chamber at one size (the size that turns its section "
+                f"through its designed angle, as far out as its thinnest station allows), not tapered: the rod "
+                f"model of that body is {summary['meshed_model_deviation_mm']:.3g} mm from the designed "
+                f"chain at P* (the tapered one {summary['model_deviation_mm']:.3g} mm)"]
+    if summary["rest_lengths_mm"] is not None:
+        warnings.append("backbone: free: cast each section shorter, at " + ", ".join(
+            f"{v:.2f}" for v in summary["rest_lengths_mm"]) + " mm, to reach its designed length at P* (the meshes "
+            "are at the designed lengths)")
+    sections = summary.pop("sections")
+    return RodFigures(single_layout(layout, single), sections, rows, walls, summary, list(summary["model_reasons"]),
+                      warnings)
+
+
+def describe_rod(summary: dict[str, Any]) -> list[str]:
+    """The rod model's lines: the single-supply device's verdict line, or the per-chamber pressures' range."""
+    if summary.get("supply") == "single":
+        lines = [f"section {s['section']}: chamber at {s['chambers'][0]['angle_rad']['middle']:.3f} rad, "
+                 f"{s['chambers'][0]['distance_mm']['middle']:.3f} mm out, diameter "
+                 f"{s['chambers'][0]['diameter_mm']['start']:.3f}-{s['chambers'][0]['diameter_mm']['end']:.3f} mm, "
+                 f"{s['chambers'][0]['turns']} turns" for s in summary.get("sections", [])]
+        return lines + [verdict_line(summary)]
+    pressures = summary.get("pressures_kpa")
+    if not pressures:
+        return [f"pressures: none ({summary.get('rod_model', 'no rod model')})"]
+    top = max((p for per_q in pressures.values() for sec in per_q for p in sec if p is not None), default=0.0)
+    return [f"pressures (rod model, per chamber): up to {top:.1f} kPa at q = 1"]
