@@ -46,7 +46,7 @@ from softdesign.meshing.volume import BodySpec
 from softdesign.meshing.wall import FD_STEP_MM, offset_metric, port_wall_mm, thinnest, wall_map
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import meshes_at_once
-from softdesign.pipeline.feasibility_judge import judge
+from softdesign.pipeline.feasibility_judge import judge, warnings_of
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.fit import FitResult
@@ -54,7 +54,7 @@ from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 from softdesign.types import FramedCurve
 
-VERSION = 2  # 2: places in mm from the base (arc_mm), one reason per cause (causes)
+VERSION = 3  # 2: places in mm from the base (arc_mm), one reason per cause (causes); 3: min_stretch a warning
 SUMMARY = "feasibility/summary.json"
 #: Memory for the rest state's metrics a body keeps (:meth:`_Body.rest`), bytes: the finest grid's
 #: (E, F, G) of the 1M-triangle benchmark case is 18 MB (729,600 points), and every q asks for the same grids.
@@ -261,6 +261,7 @@ def run_feasibility(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
     summary["feasible"] = feasible
     summary["reasons"] = reasons if limits is not None else ["no material: in the case file: figures only, not judged"]
     summary["causes"] = causes
+    summary["warnings"] = warnings_of(causes)
     return FeasibilityResult(summary)
 
 
@@ -310,6 +311,7 @@ def describe_feasibility(result: FeasibilityResult) -> list[str]:
                        if material[k] is not None)
     lines.append(f"material {material['name']} ({limits}): {verdict}")
     lines += [f"WARN {reason}" for reason in s["reasons"]]
+    lines += [f"note: {w}" for w in s.get("warnings", [])]
     return lines
 
 
