@@ -85,6 +85,9 @@ def _print_runs(build_dir: Path, runs) -> None:
         typer.echo(f"[{run.name}] {run.status} ({run.seconds:.2f} s)")
         for line in run.lines:
             typer.echo(f"  {line}")
+    # the single-supply device's verdict (the actuation stage's "device: " line) is the build's last word
+    for line in [line for run in runs if run.name == "actuation" for line in run.lines if line.startswith("device: ")]:
+        typer.echo(line)
     typer.echo(f"build folder: {build_dir}")
 
 

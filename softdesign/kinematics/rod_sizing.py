@@ -19,9 +19,8 @@
     channel through the joint's two end walls, in the joint's plane: it
     crosses no station and adds no load (an assumption: its length along the
     body is its diameter).  No feed runs through a section, which is what
-    leaves room for a chamber in a 3 mm vessel.  Sections are sized distal
-    first (the code takes feeds through proximal sections into account; in
-    series there are none).  The end walls hold no chamber: the chamber's
+    leaves room for a chamber in a 3 mm vessel.  Every station is solved at
+    once (nothing but its own chamber is pressurised there).  The end walls hold no chamber: the chamber's
     stations bend by ``w_i L_i / L_chamber``, so that the section turns
     through its designed angle (the end walls stay straight; the section is
     an arc to within that).
@@ -48,7 +47,15 @@ from dataclasses import dataclass, replace
 import numpy as np
 import numpy.typing as npt
 
-from softdesign.kinematics.rod import Backbone, Cavities, RodBody, rod_body, strains
+from softdesign.kinematics.rod import (
+    Backbone,
+    Cavities,
+    RodBody,
+    cavity_properties,
+    outline_properties,
+    rod_body,
+    strains,
+)
 from softdesign.types import FloatArray, IntArray
 
 #: Newton steps of a station's chamber solve, and its convergence (relative to the target's bending).
@@ -56,12 +63,10 @@ NEWTON_STEPS = 30
 NEWTON_RTOL = 1e-13
 #: Finite-difference steps of the 2 x 2 Jacobian: rad and mm.
 STEP_ANGLE, STEP_DIAMETER = 1e-7, 1e-7
-#: P*: the first of TRIALS log-spaced pressures that fits (the fit is not monotone: at high pressures a chamber
-#: shrinks below its feed), then bisection in log P below it to BISECT_RTOL.
+#: P*: from the thread's bound, the first of TRIALS log-spaced pressures that fits, then bisection in log P
+#: below it to BISECT_RTOL (1e-7: P* to 0.1 Pa in 1000 kPa).
 TRIALS = 25
-BISECT_RTOL = 1e-9
-#: Lowest pressure tried, kPa.
-LOWEST_PRESSURE_KPA = 1.0
+BISECT_RTOL = 1e-7
 
 
 @dataclass(frozen=True)
@@ -158,6 +163,21 @@ class Problem:
         """(k,) mm, the radius walls are measured from."""
         return self.outlines.min(axis=1) if self.skin_mm is None else np.asarray(self.skin_mm, float)
 
+    def outline(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The outlines' area, first and second moments (:func:`~softdesign.kinematics.rod.outline_properties`),
+        made once per problem (the sizing evaluates the model thousands of times)."""
+        key = id(self.outlines)
+        cached = _OUTLINES.get(key)
+        if cached is None or cached[0] is not self.outlines:
+            cached = (self.outlines, outline_properties(self.outlines))
+            _OUTLINES.clear()
+            _OUTLINES[key] = cached
+        return cached[1]
+
+
+#: The last problem's outline properties, keyed by the outlines array's identity (checked, not trusted).
+_OUTLINES: dict[int, tuple[FloatArray, tuple[FloatArray, FloatArray, FloatArray]]] = {}
+
 
 def _polar(radius: npt.ArrayLike, angle: npt.ArrayLike) -> FloatArray:
     r, a = np.asarray(radius, float), np.asarray(angle, float)
@@ -166,14 +186,17 @@ def _polar(radius: npt.ArrayLike, angle: npt.ArrayLike) -> FloatArray:
 
 def _bending(problem: Problem, at: IntArray, fixed: tuple[FloatArray, FloatArray], angle: FloatArray,
              diameter: FloatArray, pressure: float) -> FloatArray:
-    """The rod model's ``w`` (len(at), 2) at stations ``at`` with a chamber (angle, diameter) and fixed cavities."""
+    """The rod model's ``w`` (len(at), 2) at stations ``at`` with a chamber (angle, diameter) and fixed cavities,
+    every cavity at ``pressure`` (the outlines' properties are the problem's, made once)."""
     r_min = problem.skin()[at]
     distance = r_min - problem.limits.wall_mm - 0.5 * diameter
     centers = np.concatenate([fixed[0], _polar(distance, angle)[:, None, :]], axis=1)
     radii = np.concatenate([fixed[1], 0.5 * diameter[:, None]], axis=1)
-    body = rod_body(problem.stations.ds[at], problem.stations.section[at], problem.outlines[at],
-                    Cavities(centers, radii, np.zeros(radii.shape[1], np.int64)), problem.modulus_kpa,
-                    problem.backbone)
+    area, first, second = problem.outline()
+    a, f, i = cavity_properties(centers, radii)
+    body = RodBody(problem.stations.ds[at], problem.stations.section[at], area[at] - a.sum(axis=1),
+                   first[at] - f.sum(axis=1), second[at] - i.sum(axis=1), a.sum(axis=1)[:, None],
+                   f.sum(axis=1)[:, None, :], problem.modulus_kpa, problem.backbone, np.zeros(2))
     return strains(body, [pressure])[1]
 
 
@@ -223,26 +246,26 @@ def _walls(problem: Problem, centers: FloatArray, radii: FloatArray, kinds: list
 
 
 def size_single(problem: Problem, pressure: float) -> SingleSupply:
-    """The chambers and feeds that bend every section into its designed arc at ``pressure`` kPa (distal first)."""
+    """The chambers (and the supply line) that bend every section into its designed arc at ``pressure`` kPa.
+
+    In series no feed crosses a chamber's station, so every station is solved at once; the supply line runs from
+    the base face into section 1's chamber on its ring and angle.
+    """
     st, n = problem.stations, int(problem.stations.section.max()) + 1
     k = len(st.ds)
-    angle, diameter = np.zeros(k), np.zeros(k)
-    feed_angle, feed_ring, feed_until = np.zeros(n), np.zeros(n), np.zeros(n)
     f = 0.5 * problem.limits.feed_diameter_mm
     r_min = problem.skin()
-    for i in reversed(range(n)):
-        at = np.flatnonzero((st.section == i) & st.chamber)
-        distal = np.arange(i + 1, n)
-        crossing = st.s[at][:, None] < feed_until[distal][None, :]
-        fixed = (np.broadcast_to(_polar(feed_ring[distal], feed_angle[distal]), (len(at), len(distal), 2)).copy(),
-                 np.where(crossing, f, 0.0))
-        # the end walls hold no chamber: the chamber's stations bend the more, so the section turns by its theta
-        spread = float(st.ds[st.section == i].sum() / st.ds[at].sum())
-        target = np.broadcast_to(spread * problem.w[i], (len(at), 2))
-        angle[at], diameter[at] = _solve_stations(problem, at, fixed, target, pressure)
-        feed_angle[i] = angle[at[0]]
-        feed_ring[i] = r_min[at[0]] - problem.limits.wall_mm - 0.5 * diameter[at[0]]
-        feed_until[i] = st.s[at[0]] if i == 0 else 0.0  # in series: only the supply line crosses a station
+    at = np.flatnonzero(st.chamber)
+    # the end walls hold no chamber: the chamber's stations bend the more, so the section turns by its theta
+    spread = np.array([st.ds[st.section == i].sum() / st.ds[(st.section == i) & st.chamber].sum() for i in range(n)])
+    target = (spread[:, None] * problem.w)[st.section[at]]
+    angle, diameter = np.zeros(k), np.zeros(k)
+    empty = (np.zeros((len(at), 0, 2)), np.zeros((len(at), 0)))
+    angle[at], diameter[at] = _solve_stations(problem, at, empty, target, pressure)
+    first = np.array([np.flatnonzero((st.section == i) & st.chamber)[0] for i in range(n)])
+    feed_angle = angle[first]
+    feed_ring = r_min[first] - problem.limits.wall_mm - 0.5 * diameter[first]
+    feed_until = np.where(np.arange(n) == 0, st.s[first], 0.0)  # only the supply line crosses a station
     distance = np.where(st.chamber, r_min - problem.limits.wall_mm - 0.5 * diameter, 0.0)
     chamber_at = st.section[:, None] == np.arange(n)[None, :]
     centers = np.concatenate([np.broadcast_to(_polar(distance, angle)[:, None, :], (k, n, 2)),
@@ -260,13 +283,41 @@ def _fits(device: SingleSupply, wall_mm: float) -> bool:
     return bool(np.all(device.walls >= wall_mm * (1.0 - 1e-12)))
 
 
+def thread_bound_kpa(problem: Problem) -> float:
+    """The pressure below which some station's chamber would reach past its wall to the axis thread, kPa.
+
+    At a fixed chamber the bending is linear in the pressure: with the largest chamber the skin and thread walls
+    allow (``D = R_skin - 2 wall - t / 2``), placed opposite its target, a station needs ``|target| / |w(1 kPa)|``.
+    """
+    st, lim = problem.stations, problem.limits
+    at = np.flatnonzero(st.chamber)
+    n = int(st.section.max()) + 1
+    spread = np.array([st.ds[st.section == i].sum() / st.ds[(st.section == i) & st.chamber].sum() for i in range(n)])
+    target = (spread[:, None] * problem.w)[st.section[at]]
+    biggest = problem.skin()[at] - 2.0 * lim.wall_mm - 0.5 * lim.thread_diameter_mm
+    if np.any(biggest <= 0.0):
+        return float("inf")
+    angle = np.arctan2(target[:, 1], target[:, 0]) + np.pi
+    empty = (np.zeros((len(at), 0, 2)), np.zeros((len(at), 0)))
+    unit = np.hypot(*_bending(problem, at, empty, angle, biggest, 1.0).T)
+    return float(np.max(np.hypot(target[:, 0], target[:, 1]) / unit))
+
+
 def design_pressure(problem: Problem) -> SingleSupply | None:
     """The device at P*, the lowest pressure (to ``BISECT_RTOL``) whose walls all fit; None when none of the trial
-    pressures up to the limits' ``max_pressure_kpa`` does."""
-    wall = problem.limits.wall_mm
-    low: float | None = None
+    pressures up to the limits' ``max_pressure_kpa`` does.
+
+    The search starts at :func:`thread_bound_kpa` (no lower pressure fits), then tries ``TRIALS`` log-spaced
+    pressures up to the limit (the fit is not monotone: at high pressures a chamber shrinks below its supply line)
+    and bisects below the first that fits.
+    """
+    wall, top = problem.limits.wall_mm, problem.limits.max_pressure_kpa
+    start = thread_bound_kpa(problem)
+    if not start <= top:
+        return None
+    low = start * (1.0 - 1e-3)  # the bound's chamber angle is the target's: within this of the solved one
     high: SingleSupply | None = None
-    for p in np.geomspace(LOWEST_PRESSURE_KPA, problem.limits.max_pressure_kpa, TRIALS):
+    for p in np.concatenate([[start], np.geomspace(start, top, TRIALS)[1:]]):
         device = size_single(problem, float(p))
         if _fits(device, wall):
             high = device
@@ -274,10 +325,8 @@ def design_pressure(problem: Problem) -> SingleSupply | None:
         low = float(p)
     if high is None:
         return None
-    if low is None:
-        return high
     while high.pressure_kpa - low > BISECT_RTOL * high.pressure_kpa:
-        middle = float(np.sqrt(low * high.pressure_kpa))  # bisection in log P: the range spans decades
+        middle = float(np.sqrt(low * high.pressure_kpa))
         device = size_single(problem, middle)
         if _fits(device, wall):
             high = device

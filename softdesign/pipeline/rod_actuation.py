@@ -119,14 +119,24 @@ def _single(case: Case, kinematics: KinematicsResult, fit: FitResult, design: De
                       warnings)
 
 
+def device_line(summary: dict[str, Any]) -> str | None:
+    """The single-supply device's verdict (None for other supplies): the rod model's line when every judged figure
+    is within its limits, else ``device: NOT feasible:`` and every reason (each names the key to change)."""
+    if summary.get("supply") != "single":
+        return None
+    if summary.get("material") is not None and summary.get("reasons"):
+        return "device: NOT feasible: " + "; ".join(summary["reasons"])
+    return verdict_line(summary)
+
+
 def describe_rod(summary: dict[str, Any]) -> list[str]:
-    """The rod model's lines: the single-supply device's verdict line, or the per-chamber pressures' range."""
+    """The rod model's lines: the single-supply device's chambers and verdict line, or the per-chamber pressures."""
     if summary.get("supply") == "single":
         lines = [f"section {s['section']}: chamber at {s['chambers'][0]['angle_rad']['middle']:.3f} rad, "
                  f"{s['chambers'][0]['distance_mm']['middle']:.3f} mm out, diameter "
                  f"{s['chambers'][0]['diameter_mm']['start']:.3f}-{s['chambers'][0]['diameter_mm']['end']:.3f} mm, "
                  f"{s['chambers'][0]['turns']} turns" for s in summary.get("sections", [])]
-        return lines + [verdict_line(summary)]
+        return lines + [summary.get("verdict_line") or verdict_line(summary)]
     pressures = summary.get("pressures_kpa")
     if not pressures:
         return [f"pressures: none ({summary.get('rod_model', 'no rod model')})"]

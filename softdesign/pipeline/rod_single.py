@@ -39,6 +39,9 @@ if TYPE_CHECKING:
     from softdesign.pipeline.stages.fit import FitResult
     from softdesign.pipeline.stages.kinematics import KinematicsResult
 
+#: Sized walls are this much over the material's: the meshes' polygons (equal-area chambers, a faceted skin) reach
+#: up to about 0.005 mm further than the circles the rod model sizes, and the build measures walls on the meshes.
+MESH_MARGIN_MM = 0.01
 ANGLE_CONVENTION = ("angle_rad: a chamber's axis in its section's base frame, from N towards B (0 along N); the "
                     "section bends away from its chamber, towards phi = angle - pi")
 
@@ -61,7 +64,7 @@ def size_case(case: Case, kinematics: KinematicsResult, fit: FitResult, design: 
         stations = stations_along(design.lengths, STATIONS_PER_SECTION, case.actuation.end_wall_mm)
     except ValueError as err:
         raise ConfigError(f"actuation.end_wall_mm: {err}; use a thinner end wall or longer sections") from err
-    limits = Limits(setup.wall_mm, case.actuation.feed_diameter_mm, setup.thread.diameter_mm,
+    limits = Limits(setup.wall_mm + MESH_MARGIN_MM, case.actuation.feed_diameter_mm, setup.thread.diameter_mm,
                     setup.max_pressure_kpa)
     problem = Problem(stations, outlines_at(kinematics, fit, stations.s, 0.0), design.w, setup.modulus_kpa,
                       setup.backbone, limits, skin_radii(kinematics, fit, stations))
@@ -252,8 +255,7 @@ def single_summary(case: Case, single: SingleDesign, setup: RodSetup) -> dict[st
         "reinforcement": setup.reinforcement(),
         "angle_convention": ANGLE_CONVENTION,
         "sections": sections,
-        "model_deviation_mm": deviation[f"{1.0:g}"] if f"{1.0:g}" in deviation else
-        chain_deviation_mm(dev.body, p, design, 1.0),
+        "model_deviation_mm": deviation.get("1", chain_deviation_mm(dev.body, p, design, 1.0)),
         "model_deviation_by_q_mm": deviation,
         "meshed_model_deviation_mm": meshed,
         "wall_min_mm": wall,
@@ -261,6 +263,9 @@ def single_summary(case: Case, single: SingleDesign, setup: RodSetup) -> dict[st
         "tension_max_n": tension,
         "tension_limit_n": setup.tension_limit_n,
         "model_reasons": reasons,
+        "margins": {"wall_mm": wall - setup.wall_mm, "thread_fraction": tension / setup.tension_limit_n,
+                    "stress_fraction": None if setup.tensile_kpa is None else stress / setup.tensile_kpa,
+                    "model_deviation_mm": deviation.get("1", chain_deviation_mm(dev.body, p, design, 1.0))},
         "rest_lengths_mm": _rest_lengths(single) if setup.backbone == "free" else None,
     }
 
@@ -278,7 +283,7 @@ def _rest_lengths(single: SingleDesign) -> list[float]:
 def verdict_line(summary: dict[str, Any]) -> str:
     """The build's last word on the device: one pressure bends it into the vessel, or why not."""
     if summary["model_reasons"]:
-        return "the single-supply device is NOT feasible: " + "; ".join(summary["model_reasons"])
-    return (f"one pressure of {summary['design_pressure_kpa']:.1f} kPa bends it into the vessel within "
+        return "device: NOT feasible: " + "; ".join(summary["model_reasons"])
+    return (f"device: one pressure of {summary['design_pressure_kpa']:.1f} kPa bends it into the vessel within "
             f"{summary['model_deviation_mm']:.3g} mm (rod model), walls >= {summary['wall_min_mm']:.2f} mm, thread "
             f"at {100.0 * summary['tension_max_n'] / summary['tension_limit_n']:.1f} % of its limit")

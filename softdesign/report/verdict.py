@@ -65,6 +65,9 @@ def _extras(manifest: dict[str, Any]) -> list[str]:
         tip = resolve_or(manifest, "/metrics/design/tip_error_mm", None)
         tip_text = f", tip {tip:.2g} mm" if isinstance(tip, (int, float)) else ""
         extras.append(f"the composed design is within {chain:.2g} mm of the vessel{tip_text}")
+    device = resolve_or(manifest, "/metrics/actuation/verdict_line", None)
+    if isinstance(device, str):  # the single-supply device: one pressure bends it into the vessel, or why not
+        extras.append(device.removeprefix("device: "))
     mould = resolve_or(manifest, "/metrics/mould", None)
     if isinstance(mould, dict) and mould.get("requested"):
         parts = [mould.get("cavity", {}), mould.get("disjoint", {}), *mould.get("pull", {}).values()]

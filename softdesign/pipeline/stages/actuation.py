@@ -42,7 +42,7 @@ from softdesign.meshing.sweep_layout import check_resolvable, layout_holes
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import export_workers
 from softdesign.pipeline.parallel import map_items
-from softdesign.pipeline.rod_actuation import describe_rod, rod_figures
+from softdesign.pipeline.rod_actuation import describe_rod, device_line, rod_figures
 from softdesign.pipeline.simulate_estimates import ESTIMATE_COLUMNS, SimulateResult, estimate_cells
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.design import DesignResult
@@ -365,6 +365,7 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult, simu
                   "in the sections' normal planes (chamber-skin, feed-skin at every q; between tubes constant over "
                   "q), and at every export q the skin over each tube measured on the mesh (end caps included)",
     }
+    summary["verdict_line"] = device_line(summary)
     return ActuationResult(summary, table_text(rows, estimates=simulated is not None))
 
 
