@@ -452,7 +452,7 @@ class Case(_Section):
     """The material the design is judged against: a preset and/or explicit limits (the verdict of the report)."""
     #: seed 003's three chambers per section with their feed lines, built into the body (issue 31)
     actuation: Actuation | None = None
-    """Seed 003's three chambers per section, with their feed lines, cut into the body."""
+    """Chambers cut into the body: seed 003's three per section with a feed each, or one per section on one supply."""
     #: chamber pressures per section and q by finite elements in the build (the simulate stage; issue 33)
     simulate: Simulate | None = None
     """Estimate each section's chamber pressures for given q in the build (finite elements; off unless enabled)."""

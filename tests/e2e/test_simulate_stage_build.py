@@ -35,7 +35,7 @@ ERROR_TOL_MM = 1e-4
 
 
 def case_file(folder: Path, simulate: dict | None) -> Path:
-    case = yaml.safe_load((REPO / "configs" / "actuator.yaml").read_text())
+    case = yaml.safe_load((REPO / "configs" / "actuator-per-chamber.yaml").read_text())
     for key in ("centerline", "surface"):
         case["final"][key] = str((REPO / "configs" / case["final"][key]).resolve())
     case["export"] = {"q": [0, 1], "formats": ["stl"]}
