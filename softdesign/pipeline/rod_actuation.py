@@ -38,6 +38,21 @@ if TYPE_CHECKING:
 
 #: Backbone samples per section for its best arc (as the stage's).
 ARC_SAMPLES = 201
+#: Longest core, in diameters, the mould prints as a pin: a printed pin more slender than this bends under the
+#: pour and breaks on release (a rule of thumb, stated as such); a longer core is a steel wire or rod.
+MAX_PIN_ASPECT = 20.0
+
+
+def core_figures(lengths_mm: list[float], diameters_mm: list[float]) -> list[dict[str, Any]]:
+    """Per chamber its core: length, diameter, aspect ratio and what to make it of (a printed pin or steel)."""
+    out = []
+    for length, diameter in zip(lengths_mm, diameters_mm, strict=True):
+        aspect = length / diameter if diameter > 0 else float("inf")
+        make = ("printed pin (the mould's core)" if aspect <= MAX_PIN_ASPECT else
+                f"steel wire or rod of {diameter:.2f} mm, {length:.1f} mm long (aspect ratio {aspect:.0f} > "
+                f"{MAX_PIN_ASPECT:g}: a printed pin this slender bends or breaks)")
+        out.append({"length_mm": length, "diameter_mm": diameter, "aspect_ratio": aspect, "make": make})
+    return out
 
 
 @dataclass(frozen=True)
@@ -88,8 +103,11 @@ def rod_figures(case: Case, kinematics: KinematicsResult, fit: FitResult, design
         return {"pressures_kpa": {q_label(q): [[r["pressure_kpa"] for r in rows if r["q"] == q and r["section"] == i]
                                                for i in range(1, layout.sections + 1)] for q in export}}
 
+    inner = [float(stations.ds[(stations.section == c.section) & stations.chamber].sum()) for c in layout.chambers]
+    cores = core_figures(inner, [c.diameter_mm for c in layout.chambers])
     return RodFigures(layout, None, None, None, {**head, "body_modulus_kpa": setup.modulus_kpa,
-                                                 "reinforcement": setup.reinforcement()}, [], [], fill)
+                                                 "reinforcement": setup.reinforcement(), "cores": cores}, [],
+                      _core_notes(cores), fill)
 
 
 def _single(case: Case, kinematics: KinematicsResult, fit: FitResult, design: DesignResult, layout: ChamberLayout,
@@ -115,8 +133,22 @@ def _single(case: Case, kinematics: KinematicsResult, fit: FitResult, design: De
             f"{v:.2f}" for v in summary["rest_lengths_mm"]) + " mm, to reach its designed length at P* (the meshes "
             "are at the designed lengths)")
     sections = summary.pop("sections")
-    return RodFigures(single_layout(layout, single), sections, rows, walls, summary, list(summary["model_reasons"]),
-                      warnings)
+    meshed = single_layout(layout, single)
+    summary["cores"] = core_figures([s["chambers"][0]["length_mm"] for s in sections],
+                                    [c.diameter_mm for c in meshed.chambers])
+    warnings += _core_notes(summary["cores"])
+    return RodFigures(meshed, sections, rows, walls, summary, list(summary["model_reasons"]), warnings)
+
+
+def _core_notes(cores: list[dict[str, Any]]) -> list[str]:
+    """One note when some cores are too slender to print: how many, and what to use."""
+    steel = [c for c in cores if c["aspect_ratio"] > MAX_PIN_ASPECT]
+    if not steel:
+        return []
+    worst = max(steel, key=lambda c: c["aspect_ratio"])
+    return [f"{len(steel)} of {len(cores)} chamber cores are longer than {MAX_PIN_ASPECT:g} diameters (up to "
+            f"{worst['aspect_ratio']:.0f}): cast them on steel wire or rod of the chamber's diameter, not printed "
+            "pins (actuation/summary.json: cores)"]
 
 
 def device_line(summary: dict[str, Any]) -> str | None:

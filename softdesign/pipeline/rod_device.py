@@ -69,23 +69,37 @@ class RodSetup:
                 "safety_factor": self.safety_factor}
 
 
+def _material(case: Case) -> tuple[float | None, float | None, str]:
+    """The case material's initial shear modulus mu (kPa, 2 C1 of its law), tensile strength (kPa) and name."""
+    from softdesign.materials.data import material_presets
+
+    m = case.material
+    if m is None:
+        return None, None, "none"
+    if m.custom is not None:
+        return 2.0 * m.custom.law.c1_kpa, 1000.0 * m.custom.tensile_strength_mpa, m.limits().name
+    if m.name is None:
+        return None, None, m.limits().name
+    preset = material_presets()[m.name]
+    mu = None if preset.law_params is None else 2.0 * preset.law_params[1]
+    return mu, preset.tensile_strength_kpa, m.limits().name
+
+
 def rod_setup(case: Case) -> RodSetup | str:
     """The rod model's numbers, or why there are none (no reinforcement; no material law or wall)."""
-    from softdesign.pipeline.stages.volume_sweep import material_of
-
     actuation = case.actuation
     if actuation is None:
         return "no actuation: block"
     if actuation.reinforcement.kind == "none":
         return NO_REINFORCEMENT
-    material = material_of(case)
+    mu, tensile, name = _material(case)
     limits = case.material.limits() if case.material is not None else None
-    if material.law is None or limits is None or limits.min_wall_mm is None:
+    if mu is None or limits is None or limits.min_wall_mm is None:
         return ("the rod model takes E = 3 mu from the material's law and the wall from its min_wall_mm: give "
                 "material: {name: <preset>} (softdesign materials lists them) or material.custom")
     r = actuation.reinforcement
-    return RodSetup(3.0 * material.law.mu_kpa, float(limits.min_wall_mm), material.tensile_strength_kpa,
-                    material.name, thread_presets()[r.thread.name], r.pitch_mm, r.safety_factor, actuation.backbone)
+    return RodSetup(3.0 * mu, float(limits.min_wall_mm), tensile, name, thread_presets()[r.thread.name],
+                    r.pitch_mm, r.safety_factor, actuation.backbone)
 
 
 def outlines_at(kinematics: KinematicsResult, fit: FitResult, s: FloatArray, q: float = 0.0) -> FloatArray:
