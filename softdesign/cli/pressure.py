@@ -46,11 +46,15 @@ def pressure(
     """
 
     def action() -> None:
+        from softdesign.config import load_case
         from softdesign.pipeline.api import build_through
-        from softdesign.pipeline.rod_pressure import pressure_document
+        from softdesign.pipeline.rod_pressure import check_pressure_case, pressure_document
 
         _check(q, pressure_kpa)
-        outcome = build_through(case_file, out, target="fit", progress=note)
+        case = load_case(case_file)
+        with errors_named_for(case_file):
+            check_pressure_case(case, pressure_kpa)
+        outcome = build_through(case_file, out, target="fit", progress=note, case=case)
         with errors_named_for(case_file):
             document = pressure_document(outcome, q, pressure_kpa)
         if json_out:

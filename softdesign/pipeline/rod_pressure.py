@@ -16,32 +16,40 @@ from softdesign.errors import ConfigError
 from softdesign.kinematics.rod import section_arcs, station_poses, strains
 
 if TYPE_CHECKING:
+    from softdesign.config import Case
     from softdesign.pipeline.api import BuildOutcome
+    from softdesign.pipeline.rod_device import RodSetup
 
 
-def pressure_document(outcome: BuildOutcome, q: float | None, pressure_kpa: float | None) -> dict[str, Any]:
-    """The rod model at ``q`` (or one supply pressure): JSON-ready (see ``softdesign pressure --help``)."""
+def check_pressure_case(case: Case, pressure_kpa: float | None) -> RodSetup:
+    """The rod model's numbers for ``softdesign pressure``, or ConfigError (before any stage runs) saying why not."""
     from softdesign.pipeline.rod_device import rod_setup
 
-    case = outcome.case
     if case.actuation is None:
         raise ConfigError("pressure: the case has no actuation: block (the chambers the rod model pressurises)")
     setup = rod_setup(case)
     if isinstance(setup, str):
         raise ConfigError(f"pressure: {setup}")
+    if pressure_kpa is not None and case.actuation.supply != "single":
+        raise ConfigError("pressure: --pressure is one supply pressure (actuation.supply: single); this case has a "
+                          "pressure per chamber: give --q")
+    return setup
+
+
+def pressure_document(outcome: BuildOutcome, q: float | None, pressure_kpa: float | None) -> dict[str, Any]:
+    """The rod model at ``q`` (or one supply pressure): JSON-ready (see ``softdesign pressure --help``)."""
+    case = outcome.case
+    setup = check_pressure_case(case, pressure_kpa)
     start = time.perf_counter()
-    if case.actuation.supply == "single":
+    if case.actuation is not None and case.actuation.supply == "single":
         document = _single(outcome, setup, q, pressure_kpa)
     else:
-        if pressure_kpa is not None:
-            raise ConfigError("pressure: --pressure is one supply pressure (actuation.supply: single); this case has "
-                              "a pressure per chamber: give --q")
         document = _per_chamber(outcome, setup, 1.0 if q is None else q)
     document["seconds"] = time.perf_counter() - start
     return document
 
 
-def _single(outcome: BuildOutcome, setup: Any, q: float | None, pressure_kpa: float | None) -> dict[str, Any]:
+def _single(outcome: BuildOutcome, setup: RodSetup, q: float | None, pressure_kpa: float | None) -> dict[str, Any]:
     from softdesign.pipeline.rod_single import chain_deviation_mm, chamber_lengths_mm, size_case
 
     results = outcome.results
@@ -67,7 +75,7 @@ def _single(outcome: BuildOutcome, setup: Any, q: float | None, pressure_kpa: fl
     }
 
 
-def _per_chamber(outcome: BuildOutcome, setup: Any, q: float) -> dict[str, Any]:
+def _per_chamber(outcome: BuildOutcome, setup: RodSetup, q: float) -> dict[str, Any]:
     from softdesign.pipeline.rod_device import (
         layout_body,
         layout_stations,

@@ -159,6 +159,7 @@ def section_figures(single: SingleDesign, setup: RodSetup) -> list[dict[str, Any
             "chambers": [{"angle_rad": _at_ends(np.unwrap(dev.angle[at]), s),
                           "distance_mm": _at_ends(dev.distance_mm[at], s),
                           "diameter_mm": _at_ends(dev.diameter_mm[at], s),
+                          "diameter_max_mm": 2.0 * radius,
                           "length_mm": chamber_length,
                           "turns": int(np.ceil(chamber_length / setup.pitch_mm)),
                           "tension_per_turn_n": tension,
