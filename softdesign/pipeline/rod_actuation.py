@@ -173,4 +173,4 @@ def describe_rod(summary: dict[str, Any]) -> list[str]:
     if not pressures:
         return [f"pressures: none ({summary.get('rod_model', 'no rod model')})"]
     top = max((p for per_q in pressures.values() for sec in per_q for p in sec if p is not None), default=0.0)
-    return [f"pressures (rod model, per chamber): up to {top:.1f} kPa at q = 1"]
+    return [f"pressures (rod model, per chamber): up to {top:.1f} kPa over the export q"]
