@@ -111,3 +111,15 @@ def test_per_chamber_inverse_then_forward_recovers_every_arc(backbone):
     if backbone == "inextensible":
         assert np.all(pressures >= -1e-9)
         np.testing.assert_allclose(pressures.reshape(-1, 3).min(axis=1), 0.0, rtol=0, atol=1e-9)  # the lowest
+
+
+def test_a_free_backbone_turns_each_section_through_its_angle_and_lengthens_it():
+    lengths, w = _designed()
+    problem = _problem(lengths, 3.2, w, backbone="free")
+    device = size_single(problem, 400.0)
+    eps0, bend, _ = strains(device.body, [400.0])
+    kappa, phi, length = section_arcs(device.body, station_poses(eps0, bend, device.body.ds, np.eye(4)), eps0)
+    np.testing.assert_allclose(kappa * length, np.hypot(w[:, 0], w[:, 1]) * lengths, rtol=0, atol=ROUND_TRIP_ATOL)
+    np.testing.assert_allclose(np.angle(np.exp(1j * (phi - np.arctan2(w[:, 1], w[:, 0])))), 0.0, rtol=0,
+                               atol=ROUND_TRIP_ATOL)
+    assert np.all(length > lengths)  # the pressure pushes every chamber's ends apart: the rest body is shorter
