@@ -462,7 +462,8 @@ class Case(_Section):
     @model_validator(mode="after")
     def _pcc_needs_a_design(self) -> Case:
         problems = pcc_blend_problems(self.blend, self.design, self.initial.kind, len(self.intermediate))
-        problems += single_supply_problems(self.actuation, self.blend, self.design is not None)
+        problems += single_supply_problems(self.actuation, self.blend, self.design is not None,
+                                           self.export.mould is not None, self.export.volume_mesh is not None)
         if problems:
             raise ValueError("; ".join(problems))
         return self

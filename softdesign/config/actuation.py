@@ -162,8 +162,11 @@ class Actuation(BaseModel):
                              self.first_angle_deg, self.chambers_per_section)
 
 
-def single_supply_problems(actuation: Actuation | None, blend: str, designed: bool) -> list[str]:
-    """Why ``supply: single`` cannot build this case (empty when it can): it sizes each designed arc."""
+def single_supply_problems(actuation: Actuation | None, blend: str, designed: bool, mould: bool,
+                           volume_mesh: bool) -> list[str]:
+    """Why ``supply: single`` cannot build this case (empty when it can): it sizes each designed arc, and its
+    tapered chambers, joined in series, are not yet in the mould (its pins cannot be drawn from a chamber wider
+    inside than at its mouth, and only the first chamber reaches the base face) nor in the volume mesh."""
     if actuation is None or actuation.supply != "single":
         return []
     problems = []
@@ -171,4 +174,9 @@ def single_supply_problems(actuation: Actuation | None, blend: str, designed: bo
         problems.append("actuation.supply: single sizes one chamber per designed constant-curvature section and "
                         "morphs as blend: pcc; add design: {tolerance_mm: 1} and blend: pcc (or use supply: "
                         "per_chamber)")
+    for wanted, key in ((mould, "export.mould"), (volume_mesh, "export.volume_mesh")):
+        if wanted:
+            problems.append(f"{key} does not take actuation.supply: single's tapered chambers joined in series yet "
+                            f"(cast them on lost wax cores as actuation/summary.json gives them); drop {key} or use "
+                            "supply: per_chamber")
     return problems

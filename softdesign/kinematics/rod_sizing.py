@@ -42,7 +42,7 @@ Pure numpy; no I/O.  Every pressure is kPa, every length mm.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
@@ -384,29 +384,3 @@ def per_chamber_pressures(body: RodBody, rotation: FloatArray, stretch: FloatArr
         pressures[own] = solution
     return pressures
 
-
-def uniform_chamber(problem: Problem, section: int, angle: float, pressure: float) -> tuple[float, float]:
-    """One chamber the whole section long at one size (distance, diameter mm) whose section turns through its
-    designed angle at ``pressure`` (its curvature then goes as 1 / I(l)); the largest that fits when none does.
-
-    It sits at ``min R_skin - wall - D / 2`` (every station's skin wall at least the wall).
-    """
-    from scipy.optimize import brentq
-
-    st, lim = problem.stations, problem.limits
-    at = np.flatnonzero((st.section == section) & st.chamber)
-    skin = float(problem.skin()[at].min())
-    goal = float(np.hypot(*problem.w[section]) * st.ds[st.section == section].sum())
-    bend = problem.w[section] / max(float(np.hypot(*problem.w[section])), 1e-300)
-    empty = (np.zeros((len(at), 0, 2)), np.zeros((len(at), 0)))
-    local = replace(problem, skin_mm=np.full(len(st.ds), skin))
-
-    def turn(diameter: float) -> float:
-        w = _bending(local, at, empty, np.full(len(at), angle), np.full(len(at), diameter), pressure)
-        return float(np.sum(st.ds[at] * (w @ bend))) - goal
-
-    top = skin - 2.0 * lim.wall_mm - 0.5 * lim.thread_diameter_mm
-    if top <= 0.0 or goal <= 0.0:
-        return skin - lim.wall_mm, 0.0
-    diameter = top if turn(top) < 0.0 else float(brentq(turn, 1e-9, top, xtol=1e-12))
-    return skin - lim.wall_mm - 0.5 * diameter, diameter

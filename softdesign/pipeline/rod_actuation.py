@@ -26,6 +26,7 @@ from softdesign.pipeline.rod_device import (
     per_chamber_rows,
     rod_setup,
     section_rest_lengths,
+    station_l,
 )
 from softdesign.pipeline.rod_single import single_layout, single_rows, single_summary, size_case, verdict_line
 
@@ -43,14 +44,25 @@ ARC_SAMPLES = 201
 MAX_PIN_ASPECT = 20.0
 
 
-def core_figures(lengths_mm: list[float], diameters_mm: list[float]) -> list[dict[str, Any]]:
-    """Per chamber its core: length, diameter, aspect ratio and what to make it of (a printed pin or steel)."""
+def core_figures(lengths_mm: list[float], diameters_mm: list[float], lost: bool = False) -> list[dict[str, Any]]:
+    """Per chamber its core: length, (smallest) diameter, aspect ratio and what to make it of.
+
+    ``lost``: tapered chambers joined in series (``supply: single``) are cast on lost cores (wax or dissolvable),
+    a slender one over a steel wire of half its smallest diameter; else a straight pin, printed or, past
+    ``MAX_PIN_ASPECT``, a steel wire or rod of the chamber's diameter.
+    """
     out = []
     for length, diameter in zip(lengths_mm, diameters_mm, strict=True):
         aspect = length / diameter if diameter > 0 else float("inf")
-        make = ("printed pin (the mould's core)" if aspect <= MAX_PIN_ASPECT else
-                f"steel wire or rod of {diameter:.2f} mm, {length:.1f} mm long (aspect ratio {aspect:.0f} > "
-                f"{MAX_PIN_ASPECT:g}: a printed pin this slender bends or breaks)")
+        slender = aspect > MAX_PIN_ASPECT
+        if lost:
+            make = "lost core (wax or dissolvable), tapered as the chamber's profile" + (
+                f", cast over a steel wire of {0.5 * diameter:.2f} mm (aspect ratio {aspect:.0f} > "
+                f"{MAX_PIN_ASPECT:g})" if slender else "")
+        else:
+            make = ("printed pin (the mould's core)" if not slender else
+                    f"steel wire or rod of {diameter:.2f} mm, {length:.1f} mm long (aspect ratio {aspect:.0f} > "
+                    f"{MAX_PIN_ASPECT:g}: a printed pin this slender bends or breaks)")
         out.append({"length_mm": length, "diameter_mm": diameter, "aspect_ratio": aspect, "make": make})
     return out
 
@@ -124,18 +136,15 @@ def _single(case: Case, kinematics: KinematicsResult, fit: FitResult, design: De
         if inner:
             value, kind = min(inner)
             walls.append(Wall(kind, value, i + 1, 0, None, None, None))
-    warnings = [f"the meshes and the mould carry each chamber at one size (the size that turns its section "
-                f"through its designed angle, as far out as its thinnest station allows), not tapered: the rod "
-                f"model of that body is {summary['meshed_model_deviation_mm']:.3g} mm from the designed "
-                f"chain at P* (the tapered one {summary['model_deviation_mm']:.3g} mm)"]
+    warnings: list[str] = []
     if summary["rest_lengths_mm"] is not None:
         warnings.append("backbone: free: cast each section shorter, at " + ", ".join(
             f"{v:.2f}" for v in summary["rest_lengths_mm"]) + " mm, to reach its designed length at P* (the meshes "
             "are at the designed lengths)")
     sections = summary.pop("sections")
-    meshed = single_layout(layout, single)
+    meshed = single_layout(layout, single, station_l(kinematics, single.problem.stations.s))
     summary["cores"] = core_figures([s["chambers"][0]["length_mm"] for s in sections],
-                                    [c.diameter_mm for c in meshed.chambers])
+                                    [min(s["chambers"][0]["diameter_mm"].values()) for s in sections], lost=True)
     warnings += _core_notes(summary["cores"])
     return RodFigures(meshed, sections, rows, walls, summary, list(summary["model_reasons"]), warnings)
 
@@ -147,8 +156,7 @@ def _core_notes(cores: list[dict[str, Any]]) -> list[str]:
         return []
     worst = max(steel, key=lambda c: c["aspect_ratio"])
     return [f"{len(steel)} of {len(cores)} chamber cores are longer than {MAX_PIN_ASPECT:g} diameters (up to "
-            f"{worst['aspect_ratio']:.0f}): cast them on steel wire or rod of the chamber's diameter, not printed "
-            "pins (actuation/summary.json: cores)"]
+            f"{worst['aspect_ratio']:.0f}): {worst['make']} (actuation/summary.json: cores)"]
 
 
 def device_line(summary: dict[str, Any]) -> str | None:

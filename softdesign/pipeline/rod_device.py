@@ -102,13 +102,17 @@ def rod_setup(case: Case) -> RodSetup | str:
                     r.pitch_mm, r.safety_factor, actuation.backbone)
 
 
-def outlines_at(kinematics: KinematicsResult, fit: FitResult, s: FloatArray, q: float = 0.0) -> FloatArray:
-    """The body's radii (k, OUTLINE_ANGLES) mm at q (0: as cast) at rest arc lengths ``s`` (k,) mm from the base."""
+def station_l(kinematics: KinematicsResult, s: FloatArray) -> FloatArray:
+    """Normalized l (k,) of rest arc lengths ``s`` (k,) mm from the base on the cast (q = 0) body."""
     curve0 = kinematics.chain.shape.curve_at(0.0).curve
     l_table = curve0.dense_l()
-    l = np.clip(np.interp(s, curve0.arc_length(l_table), l_table), 0.0, 1.0)
+    return np.clip(np.interp(s, curve0.arc_length(l_table), l_table), 0.0, 1.0)
+
+
+def outlines_at(kinematics: KinematicsResult, fit: FitResult, s: FloatArray, q: float = 0.0) -> FloatArray:
+    """The body's radii (k, OUTLINE_ANGLES) mm at q (0: as cast) at rest arc lengths ``s`` (k,) mm from the base."""
     a = 2.0 * np.pi * np.arange(OUTLINE_ANGLES) / OUTLINE_ANGLES
-    return np.asarray(fit.field.evaluate_grid(q, l, a), float)
+    return np.asarray(fit.field.evaluate_grid(q, station_l(kinematics, s), a), float)
 
 
 def skin_radii(kinematics: KinematicsResult, fit: FitResult, stations: Stations) -> FloatArray:

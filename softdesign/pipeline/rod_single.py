@@ -5,8 +5,7 @@ the section (:mod:`softdesign.kinematics.rod_sizing`); P* is the lowest pressure
 material's ``min_wall_mm`` or more.  The figures: the chambers (angle, distance, diameter at the start, middle
 and end of each section), the section's second moment, the rod model's arc at P*, its distance from the
 designed chain at every export q, each chamber's winding (turns, tension per turn against the thread's limit),
-the stress at P*.  The meshes and the mould carry each chamber at one size (:func:`meshed_chambers`: its
-smallest diameter, as far out as its thinnest station allows), so the rod model of that body is given too.
+the stress at P*.  The meshes and the mould carry the tapered chambers (:func:`single_layout`).
 """
 
 from __future__ import annotations
@@ -18,7 +17,7 @@ import numpy as np
 
 from softdesign.errors import ConfigError
 from softdesign.kinematics.pcc_chain import feet_on_chain, section_poses
-from softdesign.kinematics.rod import Cavities, RodBody, rod_body, section_arcs, station_poses, strains
+from softdesign.kinematics.rod import RodBody, section_arcs, station_poses, strains
 from softdesign.kinematics.rod_sizing import (
     Limits,
     Problem,
@@ -27,7 +26,6 @@ from softdesign.kinematics.rod_sizing import (
     largest_fitting_kappa,
     size_single,
     stations_along,
-    uniform_chamber,
 )
 from softdesign.pipeline.rod_device import STATIONS_PER_SECTION, RodSetup, outlines_at, skin_radii
 from softdesign.types import FloatArray
@@ -90,36 +88,16 @@ def _refusal(problem: Problem, setup: RodSetup) -> str:
             "design.tolerance_mm, more links)")
 
 
-def meshed_chambers(single: SingleDesign) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Per section the one-size chamber the meshes carry: angle (rad), distance and diameter (mm).
-
-    At the tapered chamber's middle angle, as far out as the section's thinnest station allows, the size that
-    turns the section through its designed angle at P* (:func:`~softdesign.kinematics.rod_sizing.uniform_chamber`):
-    the section's tip frame is the designed one, its curvature goes as 1 / I(l) along it.
-    """
+def middle_chambers(single: SingleDesign) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Per section the chamber's angle (rad), distance and diameter (mm) at the chamber's middle arc length."""
     st, dev = single.problem.stations, single.device
     n = int(st.section.max()) + 1
-    angle, distance, diameter = np.zeros(n), np.zeros(n), np.zeros(n)
+    out = np.zeros((3, n))
     for i in range(n):
         at = np.flatnonzero((st.section == i) & st.chamber)
-        angle[i] = float(np.interp(0.5, np.linspace(0.0, 1.0, len(at)), np.unwrap(dev.angle[at])))
-        distance[i], diameter[i] = uniform_chamber(single.problem, i, angle[i], dev.pressure_kpa)
-    return angle, distance, diameter
-
-
-def meshed_body(single: SingleDesign, feed_diameter_mm: float) -> RodBody:
-    """The rod of the body as meshed: each section's one-size chamber, its feed coaxial from the base."""
-    st, problem = single.problem.stations, single.problem
-    angle, distance, diameter = meshed_chambers(single)
-    n, k = len(angle), len(st.ds)
-    xy = np.stack([distance * np.cos(angle), distance * np.sin(angle)], axis=1)
-    centers = np.concatenate([np.broadcast_to(xy[None], (k, n, 2)), np.broadcast_to(xy[None], (k, n, 2))], axis=1)
-    own = (st.section[:, None] == np.arange(n)[None]) & st.chamber[:, None]
-    feed = st.s[:, None] < single.device.feed_until[None, :]
-    radii = np.concatenate([np.where(own, 0.5 * diameter[None], 0.0), np.where(feed, 0.5 * feed_diameter_mm, 0.0)],
-                           axis=1)
-    return rod_body(st.ds, st.section, problem.outlines, Cavities(centers, radii, np.zeros(2 * n, np.int64)),
-                    problem.modulus_kpa, problem.backbone)
+        for row, values in enumerate((np.unwrap(dev.angle[at]), dev.distance_mm[at], dev.diameter_mm[at])):
+            out[row, i] = _at_ends(values, st.s[at])["middle"]
+    return out[0], out[1], out[2]
 
 
 def chain_deviation_mm(body: RodBody, pressure_kpa: float, design: DesignResult, q: float) -> float:
@@ -185,16 +163,24 @@ def stress_kpa(body: RodBody, pressure_kpa: float, outlines: FloatArray) -> floa
     return float(max(body.modulus_kpa * np.max(np.abs(eps)), pressure_kpa))
 
 
-def single_layout(layout: ChamberLayout, single: SingleDesign) -> ChamberLayout:
-    """The meshes' layout: one chamber per section at its one size (:func:`meshed_chambers`), and the supply line
-    into section 1's chamber, coaxial (the channels joining consecutive chambers are not meshed)."""
-    angle, distance, diameter = meshed_chambers(single)
-    chambers = tuple(replace(c, angle=float(angle[c.section]), distance_mm=float(distance[c.section]),
-                             diameter_mm=float(diameter[c.section])) for c in layout.chambers)
-    feeds = tuple(replace(f, angle=float(angle[0]), ring_mm=float(distance[0])) for f in layout.feeds
-                  if f.section == 0)
-    spec = replace(layout.spec, distance_mm=float(distance.max()), diameter_mm=float(diameter.min()))
-    return replace(layout, spec=spec, chambers=chambers, feeds=feeds)
+def single_layout(layout: ChamberLayout, single: SingleDesign, station_l: FloatArray) -> ChamberLayout:
+    """The meshes' and mould's layout: each section's chamber tapered as sized (its profile at the stations'
+    normalized l ``station_l`` (k,), held over the end half-stations), at its middle angle; the supply line into
+    section 1's chamber, coaxial (the channels joining consecutive chambers are not meshed)."""
+    st, dev = single.problem.stations, single.device
+    angle, distance, diameter = middle_chambers(single)
+    chambers = []
+    for c in layout.chambers:
+        at = np.flatnonzero((st.section == c.section) & st.chamber)
+        profile = tuple((float(station_l[k]), float(dev.distance_mm[k]), float(dev.diameter_mm[k])) for k in at)
+        chambers.append(replace(c, angle=float(angle[c.section]), distance_mm=float(distance[c.section]),
+                                diameter_mm=float(diameter[c.section]), profile=profile))
+    first = chambers[0]
+    feeds = tuple(replace(f, angle=first.angle, ring_mm=float(first.distance_at(first.l_start)))
+                  for f in layout.feeds if f.section == 0)
+    spec = replace(layout.spec, distance_mm=float(dev.distance_mm[st.chamber].max()),
+                   diameter_mm=float(dev.diameter_mm[st.chamber].min()))
+    return replace(layout, spec=spec, chambers=tuple(chambers), feeds=feeds)
 
 
 def chamber_lengths_mm(single: SingleDesign, pressure_kpa: float) -> FloatArray:
@@ -214,7 +200,7 @@ def single_rows(single: SingleDesign, grid: list[tuple[float, bool]], arcs: dict
     ``arcs``: each q's best arcs of the body's links (:func:`~softdesign.kinematics.pcc_fit.fit_links`).
     """
     dev = single.device
-    angle, distance, _ = meshed_chambers(single)
+    angle, distance, _ = middle_chambers(single)
     rest = chamber_lengths_mm(single, 0.0)
     rows = []
     for q, export in grid:
@@ -233,9 +219,7 @@ def single_summary(case: Case, single: SingleDesign, setup: RodSetup) -> dict[st
     dev, design = single.device, single.design
     p = dev.pressure_kpa
     sections = section_figures(single, setup)
-    feed = case.actuation.feed_diameter_mm if case.actuation is not None else 0.0
     deviation = {f"{q:g}": chain_deviation_mm(dev.body, q * p, design, q) for q in case.export.q_values()}
-    meshed = chain_deviation_mm(meshed_body(single, feed), p, design, 1.0)
     tension = max(c["tension_per_turn_n"] for s in sections for c in s["chambers"])
     stress = stress_kpa(dev.body, p, single.problem.outlines)
     wall = float(dev.walls.min())
@@ -258,7 +242,6 @@ def single_summary(case: Case, single: SingleDesign, setup: RodSetup) -> dict[st
         "sections": sections,
         "model_deviation_mm": deviation.get("1", chain_deviation_mm(dev.body, p, design, 1.0)),
         "model_deviation_by_q_mm": deviation,
-        "meshed_model_deviation_mm": meshed,
         "wall_min_mm": wall,
         "stress_max_kpa": stress,
         "tension_max_n": tension,

@@ -60,6 +60,8 @@ def test_supply_reinforcement_and_backbone_defaults(tmp_path: Path) -> None:
     ({"supply": "single"}, {}, "add design: {tolerance_mm: 1} and blend: pcc"),
     ({"supply": "single", "diameter_mm": 1.0}, {"design": {"tolerance_mm": 1.0}, "blend": "pcc"},
      "supply: single sizes diameter_mm itself"),
+    ({"supply": "single"}, {"design": {"tolerance_mm": 1.0}, "blend": "pcc", "export": {"mould": {}}},
+     "export.mould does not take actuation.supply: single's tapered chambers"),
     ({"supply": "both"}, {}, "supply"),
     ({"backbone": "stiff"}, {}, "backbone"),
     ({"reinforcement": {"kind": "braid"}}, {}, "reinforcement.kind"),

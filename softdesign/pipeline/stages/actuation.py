@@ -77,8 +77,13 @@ class ActuationResult:
     table: str
 
 
-def actuation_layout(case: Case, kinematics: KinematicsResult) -> ChamberLayout | None:
-    """The case's chambers and feeds on its links (None without ``actuation:``); end walls on the q = 0 body."""
+def actuation_layout(case: Case, kinematics: KinematicsResult,
+                     sized: ActuationResult | None = None) -> ChamberLayout | None:
+    """The case's chambers and feeds on its links (None without ``actuation:``); end walls on the q = 0 body.
+
+    ``supply: single``: the chambers this stage sized (``sized``, its result: the summary's layout with each
+    chamber's taper); a step that does not take them (the volume mesh, the finite elements) is refused.
+    """
     if case.actuation is None:
         return None
     curve0 = kinematics.chain.shape.curve_at(0.0)
@@ -87,9 +92,32 @@ def actuation_layout(case: Case, kinematics: KinematicsResult) -> ChamberLayout 
     if case.actuation.supply == "single":  # one chamber per section, placed and sized by the rod model
         spec = replace(spec, chambers_per_section=1)
     try:
-        return plan_layout(spec, kinematics.chain.breaks, l, curve0.curve.arc_length(l))
+        planned = plan_layout(spec, kinematics.chain.breaks, l, curve0.curve.arc_length(l))
     except ValueError as err:
         raise ConfigError(f"actuation.end_wall_mm: {err}; use a thinner end wall or fewer links") from err
+    if case.actuation.supply != "single" or sized is None:
+        return planned
+    return sized_layout(planned, sized.summary["layout"])
+
+
+def unsized_single(case: Case, what: str) -> None:
+    """Refuse a step that would lay out ``supply: single``'s chambers without the actuation stage's sizing."""
+    if case.actuation is not None and case.actuation.supply == "single":
+        raise ConfigError(f"{what}: actuation.supply: single's chambers are sized and tapered by the rod model in the "
+                          f"actuation stage, and {what} does not take them yet; use actuation.supply: per_chamber "
+                          "for it")
+
+
+def sized_layout(planned: ChamberLayout, document: dict[str, Any]) -> ChamberLayout:
+    """The layout kept in the summary (:func:`layout_document`) over the planned one: angles, sizes, tapers."""
+    chambers = tuple(replace(c, angle=float(np.deg2rad(d["angle_deg"])), distance_mm=d["distance_mm"],
+                             diameter_mm=d["diameter_mm"], profile=tuple(tuple(p) for p in d.get("profile", ())))
+                     for c, d in zip(planned.chambers, document["chambers"], strict=True))
+    feeds = tuple(replace(f, angle=float(np.deg2rad(d["angle_deg"])), ring_mm=d["ring_mm"])
+                  for f, d in zip((f for f in planned.feeds if f.section == 0), document["feeds"], strict=True))
+    spec = replace(planned.spec, distance_mm=max(c.distance_mm for c in chambers),
+                   diameter_mm=min(c.diameter_mm for c in chambers))
+    return replace(planned, spec=spec, chambers=chambers, feeds=feeds)
 
 
 def q_grid(case: Case) -> list[tuple[float, bool]]:
@@ -262,7 +290,8 @@ def layout_document(layout: ChamberLayout) -> dict[str, Any]:
                 "the chambers' ring at their chamber's angle, from the base face into the chamber",
         "chambers": [{"section": c.section + 1, "chamber": c.index + 1, "angle_deg": float(np.rad2deg(c.angle)),
                       "distance_mm": c.distance_mm, "diameter_mm": c.diameter_mm, "l_start": c.l_start,
-                      "l_end": c.l_end} for c in layout.chambers],
+                      "l_end": c.l_end, **({"profile": [list(p) for p in c.profile]} if c.profile else {})}
+                     for c in layout.chambers],
         "feeds": [{"section": f.section + 1, "chamber": f.chamber + 1, "angle_deg": float(np.rad2deg(f.angle)),
                    "ring_mm": f.ring_mm, "diameter_mm": f.diameter_mm, "l_start": f.l_start, "l_end": f.l_end}
                   for f in layout.feeds],
@@ -275,6 +304,10 @@ def _check_sweep(case: Case, fit: FitResult, layout: ChamberLayout) -> None:
     volume = case.export.volume_mesh
     if volume is None or volume.mesher != "sweep":
         return
+    if any(c.profile for c in layout.chambers):
+        raise ConfigError("export.volume_mesh (mesher sweep): the swept mesher meshes one cross-section for the "
+                          "whole body, and actuation.supply: single tapers its chambers and sets each section's "
+                          "own angle; use export.volume_mesh.mesher: ftetwild, or drop export.volume_mesh")
     a = np.linspace(0.0, 2.0 * np.pi, case.export.angular_count, endpoint=False)
     scale = float(np.median(fit.field.evaluate_grid(0.0, np.linspace(0.0, 1.0, 65), a)))
     check_resolvable(layout, layout_holes(layout, scale, volume.size_mm), scale)
