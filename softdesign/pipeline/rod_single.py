@@ -176,7 +176,7 @@ def single_layout(layout: ChamberLayout, single: SingleDesign, station_l: FloatA
         chambers.append(replace(c, angle=float(angle[c.section]), distance_mm=float(distance[c.section]),
                                 diameter_mm=float(diameter[c.section]), profile=profile))
     first = chambers[0]
-    feeds = tuple(replace(f, angle=first.angle, ring_mm=float(first.distance_at(first.l_start)))
+    feeds = tuple(replace(f, angle=first.angle, ring_mm=float(dev.feed_ring_mm[0]))
                   for f in layout.feeds if f.section == 0)
     spec = replace(layout.spec, distance_mm=float(dev.distance_mm[st.chamber].max()),
                    diameter_mm=float(dev.diameter_mm[st.chamber].min()))
