@@ -56,3 +56,13 @@ def test_the_fits_warnings_are_named_in_the_verdict():
     assert verdict.headline.endswith("but the fit does not match the vessel everywhere (below)")
     assert verdict.notes == (f"fit: {held}",)
     assert f"fit: {held}" in verdict_html(verdict, "Checks: 1 of 1 passed.")
+
+
+def test_a_single_supply_device_says_what_one_pressure_does():
+    line = ("device: one pressure of 852.5 kPa bends it into the vessel within 1.17 mm (rod model), walls >= 1.01 "
+            "mm, thread at 0.9 % of its limit")
+    manifest = _manifest(feasibility={"feasible": True, "material": {"name": "ecoflex-00-30"}, "reasons": []},
+                         actuation={"feasible": True, "reasons": [], "verdict_line": line})
+    verdict = build_verdict(manifest)
+    assert verdict.status == "feasible"
+    assert line.removeprefix("device: ") in verdict.headline and "device:" not in verdict.headline
