@@ -16,7 +16,8 @@ import numpy as np
 
 from softdesign.errors import ConfigError
 from softdesign.kinematics.rod import Backbone, Cavities, RodBody, rod_body
-from softdesign.kinematics.rod_sizing import Stations, per_chamber_pressures
+from softdesign.kinematics.rod_inverse import per_chamber_pressures
+from softdesign.kinematics.rod_sizing import Stations
 from softdesign.materials.threads import Thread, thread_presets
 from softdesign.types import FloatArray
 

@@ -7,11 +7,11 @@ import pytest
 
 from softdesign.kinematics.pcc_chain import chain_points_at
 from softdesign.kinematics.rod import Cavities, rod_body, section_arcs, station_poses, strains
+from softdesign.kinematics.rod_inverse import per_chamber_pressures
 from softdesign.kinematics.rod_sizing import (
     Limits,
     Problem,
     design_pressure,
-    per_chamber_pressures,
     size_single,
     stations_along,
 )
