@@ -1,6 +1,6 @@
 """Benchmark of `softdesign simulate` (issue 33): one section of the sample case and of the aorta, against 60 s.
 
-Cases: configs/actuator.yaml (the sample vessel with seed 003's chambers) and
+Cases: configs/actuator-per-chamber.yaml (the sample vessel with seed 003's chambers) and
 the VMTK aorta (path 0 of ../shared/data/vmtk-aorta, when present) with
 ``actuation: {}``, each at section 0 (the base, the thickest and the one every
 feed line runs through).  Each case is first built through actuation (untimed:
@@ -46,7 +46,7 @@ def case_files(folder: Path) -> list[tuple[str, Path]]:
     """(label, case file) of the sample case with chambers and, when present, the aorta with chambers."""
     import yaml
 
-    cases = [("demo (configs/actuator.yaml)", REPO / "configs" / "actuator.yaml")]
+    cases = [("demo (configs/actuator-per-chamber.yaml)", REPO / "configs" / "actuator-per-chamber.yaml")]
     if AORTA_DIR.is_dir():
         aorta = {"name": "aorta", "final": {"centerline": str(AORTA_DIR / "aorta-centerline.vtp"),
                                             "surface": str(AORTA_DIR / "aorta-surface.stl"), "path": 0},

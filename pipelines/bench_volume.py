@@ -2,10 +2,10 @@
 
 Cases (the swept mesher, ``export.volume_mesh.q`` 0, 0.5 and 1 unless said):
 the sample case solid (configs/demo.yaml); hollow (``wall_mm: 1``, ``port_mm:
-1.2``); chambered (configs/actuator.yaml: three chambers per section with their
+1.2``); chambered (configs/actuator-per-chamber.yaml: three chambers per section with their
 feeds, q = 0 as the case asks); and the VMTK aorta (path 0, when
 ../shared/data is there) solid, hollow as the demo, and chambered as
-configs/actuator.yaml (four sections of three chambers).  Each case's stages before volume_mesh are built
+configs/actuator-per-chamber.yaml (four sections of three chambers).  Each case's stages before volume_mesh are built
 once, untimed, into a temporary folder; then the volume_mesh stage alone
 (compute: the mesh, its checks, the 3D strain at each q and over the morph's
 q samples; write: the .vtu, .msh and cavity files) runs in this process,
@@ -56,10 +56,10 @@ def case_data(name: str) -> dict[str, Any] | None:
             "export": {"q": [0.0, 0.5, 1.0], **VOLUME_Q}, "material": {"name": "ecoflex-00-30"}}
         if name == "aorta-hollow":
             data["export"].update({"wall_mm": 1.0, "port_mm": 1.2})
-        if name == "aorta-chambered":  # configs/actuator.yaml's layout: four sections, three chambers each
+        if name == "aorta-chambered":  # configs/actuator-per-chamber.yaml's layout: four sections, three chambers each
             data.update({"links": {"count": 4}, "actuation": {}})
         return data
-    source = REPO / "configs" / ("actuator.yaml" if name == "chambered" else "demo.yaml")
+    source = REPO / "configs" / ("actuator-per-chamber.yaml" if name == "chambered" else "demo.yaml")
     data = yaml.safe_load(source.read_text(encoding="utf-8"))
     for key in ("centerline", "surface"):
         data["final"][key] = str((source.parent / data["final"][key]).resolve())

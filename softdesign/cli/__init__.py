@@ -27,6 +27,7 @@ from softdesign.cli.init import init
 from softdesign.cli.materials import materials
 from softdesign.cli.pcc import PCC_SHORT_HELP, pcc_app
 from softdesign.cli.pose import pose
+from softdesign.cli.pressure import pressure
 from softdesign.cli.report import report
 from softdesign.cli.sample import sample
 from softdesign.cli.schema import schema
@@ -65,7 +66,7 @@ def _options(
 app.add_typer(pcc_app, name="pcc", short_help=PCC_SHORT_HELP)
 for command in (
     validate, build, ingest, blend, links, kinematics, fit, export, mould, pose, check, report, sample, centerline,
-    design, init, schema, materials, simulate,
+    design, init, schema, materials, simulate, pressure,
 ):
     app.command()(command)
 for group in (app, pcc_app):

@@ -31,7 +31,7 @@ from pydantic import (
     model_validator,
 )
 
-from softdesign.config.actuation import Actuation
+from softdesign.config.actuation import Actuation, single_supply_problems
 from softdesign.config.design import Design, pcc_blend_problems
 from softdesign.config.material import CustomMaterial
 from softdesign.config.simulate import Simulate
@@ -457,7 +457,7 @@ class Case(_Section):
     """The material the design is judged against: a preset and/or explicit limits (the verdict of the report)."""
     #: seed 003's three chambers per section with their feed lines, built into the body (issue 31)
     actuation: Actuation | None = None
-    """Zou et al.'s three chambers per section, with their feed lines, cut into the body."""
+    """Chambers cut into the body: Zou et al.'s three per section with a feed each, or one per section on one supply."""
     #: chamber pressures per section and q by finite elements in the build (the simulate stage; issue 33)
     simulate: Simulate | None = None
     """Estimate each section's chamber pressures for given q in the build (finite elements; off unless enabled)."""
@@ -467,6 +467,8 @@ class Case(_Section):
     @model_validator(mode="after")
     def _pcc_needs_a_design(self) -> Case:
         problems = pcc_blend_problems(self.blend, self.design, self.initial.kind, len(self.intermediate))
+        problems += single_supply_problems(self.actuation, self.blend, self.design is not None,
+                                           self.export.mould is not None, self.export.volume_mesh is not None)
         if problems:
             raise ValueError("; ".join(problems))
         return self

@@ -1,4 +1,32 @@
-"""The case file's ``actuation:`` block: Zou et al.'s three chambers per section, with their feed lines.
+"""The case file's ``actuation:`` block: the chambers, their supply, reinforcement and backbone.
+
+``supply: per_chamber`` (the default, Zou et al.'s device: three chambers per
+section, one feed each, the sizes below) or ``single`` (one chamber per
+section, sized and tapered by the rod model so that one design pressure bends
+every section into its designed arc: :mod:`softdesign.kinematics.rod_sizing`;
+it needs ``design:`` and ``blend: pcc``).  ``per_chamber`` stays the default
+so that a case written before round 4 builds the device it describes.
+
+``reinforcement`` defaults to ``hoop``: without it a chamber balloons and, in
+an incompressible body, its side-wall pressure cancels the end caps' moment
+(kappa = (1 - 2 nu) P A d / (E I) = 0, issue 41); cast three-chamber arms wind
+a thread round each core (Pagliarani et al., Actuators 2023, cotton thread in
+Ecoflex 00-50) or sheathe them in a braid (STIFF-FLOP).  The default thread is
+``kevlar-69`` (softdesign/data/threads.yaml, its sources there), at a pitch of
+0.5 mm: below a chamber's radius (0.3-1 mm here), so the silicone between two
+turns cannot bulge (the rod model's assumption), and a safety factor of 4 on
+the thread's straight breaking load (a wound, knotted thread keeps about half
+of it, and half again for the cycling: a stated rule of thumb, not a datum).
+
+``backbone`` defaults to ``inextensible`` (a thread cast along the axis): the
+length then stays the designed one at every pressure, so the morph is exactly
+``blend: pcc``'s, each tapered section an exact arc, and the body is cast at
+the length the build meshes.  ``free`` lets the pressure stretch each section
+too; along a tapered section the stretch varies with the area, so a section
+is an arc only approximately, and its cast length must be shorter than the
+vessel's path (the build reports both).
+
+Per-chamber sizes:
 
 Sizes are absolute millimetres, not fractions of the local radius: Zou et al.'s
 inverse (three lengths -> kappa, phi, L) takes one chamber distance ``d`` per
@@ -20,9 +48,9 @@ chamber 1 where Zou et al.'s encoder 1 sits (90 degrees from N).
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from softdesign.config.types import FiniteFloat, Integer
 
@@ -33,10 +61,58 @@ if TYPE_CHECKING:  # numpy stays out of `softdesign validate`
 MAX_ACTUATION_MM = 50.0
 
 
-class Actuation(BaseModel):
-    """Three chambers per section (link) at ``distance_mm`` from the backbone, one feed line each."""
+#: The largest pitch of a hoop winding, mm (a turn per 10 mm no longer holds a sub-millimetre chamber).
+MAX_PITCH_MM = 10.0
+#: The largest safety factor on the thread's breaking load.
+MAX_SAFETY_FACTOR = 100.0
+#: Keys that ``supply: single`` sizes itself (a value given for them would be ignored).
+SIZED_BY_SINGLE = ("chambers_per_section", "distance_mm", "diameter_mm", "first_angle_deg")
+
+
+class ThreadChoice(BaseModel):
+    """A thread of softdesign/data/threads.yaml, by name."""
 
     model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+
+    name: str = "kevlar-69"
+    """The thread's name in softdesign/data/threads.yaml (``softdesign materials`` lists them)."""
+
+    @field_validator("name")
+    @classmethod
+    def _known(cls, name: str) -> str:
+        from softdesign.materials.threads import thread_presets
+
+        if name not in thread_presets():
+            raise ValueError(f"unknown thread {name!r}; choose one of {', '.join(sorted(thread_presets()))}")
+        return name
+
+
+class Reinforcement(BaseModel):
+    """What stops a chamber's radial growth: a thread wound round it (``hoop``), or nothing (``none``)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+
+    kind: Literal["hoop", "none"] = "hoop"
+    """hoop: a thread wound round each chamber core before casting; none: bare chambers (no rod-model bend)."""
+    pitch_mm: FiniteFloat = Field(0.5, gt=0.0, le=MAX_PITCH_MM)
+    """Distance between two turns of the winding, mm."""
+    thread: ThreadChoice = ThreadChoice()
+    """The thread (hoops and the inextensible backbone)."""
+    safety_factor: FiniteFloat = Field(4.0, ge=1.0, le=MAX_SAFETY_FACTOR)
+    """A turn's tension may reach the thread's breaking load over this factor."""
+
+
+class Actuation(BaseModel):
+    """The chambers in the body: their supply, reinforcement and backbone, and Zou et al.'s per-chamber sizes."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+
+    supply: Literal["single", "per_chamber"] = "per_chamber"
+    """single: one pressure, one sized chamber per section; per_chamber: Zou et al.'s three chambers, a feed each."""
+    reinforcement: Reinforcement = Reinforcement()
+    """The hoop winding round each chamber (or none)."""
+    backbone: Literal["free", "inextensible"] = "inextensible"
+    """inextensible: a thread along the axis keeps the length; free: pressure also stretches each section."""
 
     chambers_per_section: Integer = Field(3, ge=3, le=3)
     """Chambers in each section (Zou et al.'s three)."""
@@ -53,6 +129,12 @@ class Actuation(BaseModel):
 
     @model_validator(mode="after")
     def _chambers_fit_their_ring(self) -> Actuation:
+        if self.supply == "single":
+            given = [k for k in SIZED_BY_SINGLE if k in self.model_fields_set]
+            if given:
+                raise ValueError(f"supply: single sizes {', '.join(given)} itself (the rod model); remove "
+                                 f"{'it' if len(given) == 1 else 'them'}, or use supply: per_chamber")
+            return self
         d, big = self.distance_mm, self.diameter_mm
         if self.feed_diameter_mm > big:
             raise ValueError(
@@ -78,3 +160,23 @@ class Actuation(BaseModel):
 
         return ActuationSpec(self.distance_mm, self.diameter_mm, self.feed_diameter_mm, self.end_wall_mm,
                              self.first_angle_deg, self.chambers_per_section)
+
+
+def single_supply_problems(actuation: Actuation | None, blend: str, designed: bool, mould: bool,
+                           volume_mesh: bool) -> list[str]:
+    """Why ``supply: single`` cannot build this case (empty when it can): it sizes each designed arc, and its
+    tapered chambers, joined in series, are not yet in the mould (its pins cannot be drawn from a chamber wider
+    inside than at its mouth, and only the first chamber reaches the base face) nor in the volume mesh."""
+    if actuation is None or actuation.supply != "single":
+        return []
+    problems = []
+    if not designed or blend != "pcc":
+        problems.append("actuation.supply: single sizes one chamber per designed constant-curvature section and "
+                        "morphs as blend: pcc; add design: {tolerance_mm: 1} and blend: pcc (or use supply: "
+                        "per_chamber)")
+    for wanted, key in ((mould, "export.mould"), (volume_mesh, "export.volume_mesh")):
+        if wanted:
+            problems.append(f"{key} does not take actuation.supply: single's tapered chambers joined in series yet "
+                            f"(cast them on lost wax cores as actuation/summary.json gives them); drop {key} or use "
+                            "supply: per_chamber")
+    return problems

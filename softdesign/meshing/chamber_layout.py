@@ -68,6 +68,8 @@ class Chamber:
     distance_mm : mm, from the centerline to the chamber's axis
     diameter_mm : mm
     l_start, l_end : normalized l of its two flat ends (the section's, less the end walls)
+    profile : a tapered chamber's (l, distance mm, diameter mm) samples, l increasing (interpolated, held at
+        its ends); empty: ``distance_mm`` and ``diameter_mm`` all along (then its middle values)
     """
 
     section: int
@@ -77,6 +79,21 @@ class Chamber:
     diameter_mm: float
     l_start: float
     l_end: float
+    profile: tuple[tuple[float, float, float], ...] = ()
+
+    def distance_at(self, l: npt.ArrayLike) -> FloatArray:
+        """Distance of the axis from the centerline at normalized ``l`` (array), mm."""
+        if not self.profile:
+            return np.full(np.shape(l), self.distance_mm)
+        p = np.asarray(self.profile, float)
+        return np.interp(np.asarray(l, float), p[:, 0], p[:, 1])
+
+    def diameter_at(self, l: npt.ArrayLike) -> FloatArray:
+        """Diameter at normalized ``l`` (array), mm."""
+        if not self.profile:
+            return np.full(np.shape(l), self.diameter_mm)
+        p = np.asarray(self.profile, float)
+        return np.interp(np.asarray(l, float), p[:, 0], p[:, 2])
 
 
 @dataclass(frozen=True)

@@ -113,10 +113,14 @@ def skin_walls(curve: FramedSpline, field: RadiusField, q: float, layout: Chambe
     rho = field.evaluate_grid(q, l, a) + offset_mm
     rho2 = rho * rho
     out = []
+    tapered = {(c.section, c.index): c for c in layout.chambers if c.profile}
     for kind, section, chamber, distance, angle, radius, l_start, l_end in members:
         rows = np.flatnonzero((l >= l_start) & (l <= l_end))
-        along = distance * np.cos(a - angle)  # u . c
-        gap = np.sqrt(np.maximum(rho2[rows] - 2.0 * rho[rows] * along + distance * distance, 0.0)) - radius
+        member = tapered.get((section, chamber)) if kind == "chamber-skin" else None
+        d = np.full(len(rows), distance) if member is None else member.distance_at(l[rows])
+        r = np.full(len(rows), radius) if member is None else 0.5 * member.diameter_at(l[rows])
+        along = d[:, None] * np.cos(a - angle)[None, :]  # u . c
+        gap = np.sqrt(np.maximum(rho2[rows] - 2.0 * rho[rows] * along + (d * d)[:, None], 0.0)) - r[:, None]
         i, k = np.unravel_index(int(np.argmin(gap)), gap.shape)
         out.append(Wall(kind, float(gap[i, k]), section + 1, chamber + 1, float(q), float(l[rows[i]]),
                         float(np.rad2deg(a[k]))))

@@ -28,6 +28,7 @@ from dataclasses import dataclass, replace
 
 import manifold3d as m3
 import numpy as np
+import numpy.typing as npt
 
 from softdesign.geometry.frames import FramedSpline
 from softdesign.meshing.body import curvature_components
@@ -73,35 +74,39 @@ def _grid(l_body: FloatArray, l_start: float, l_end: float) -> FloatArray:
     return np.concatenate([[l_start], inside, [l_end]])
 
 
-def _tube(curve: FramedSpline, q: float, l: FloatArray, distance: float, angle: float, diameter: float,
-          segments: int, before_mm: float = 0.0, phase: float = 0.0) -> Sweep:
+def _tube(curve: FramedSpline, q: float, l: FloatArray, distance: npt.ArrayLike, angle: float,
+          diameter: npt.ArrayLike, segments: int, before_mm: float = 0.0, phase: float = 0.0) -> Sweep:
     """A tube of ``diameter`` about the offset curve over ``l``; ``before_mm`` > 0 starts it ``before_mm`` before
     ``l[0]`` along -T, in place of the ring at ``l[0]``.
 
-    The ring at ``l[0]`` (the base, l = 0) is dropped then: it would lie in the base cap's plane, and the boolean
-    cuts the tube there into faces of a few 1e-7 mm that single precision (STL) folds to zero area, leaving
-    non-manifold edges once coincident vertices are merged (issue 43).  The tube runs straight from outside
-    the base to the first ring inside.  ``phase`` turns the polygon's vertices by that angle, rad.
+    ``distance`` and ``diameter`` (mm) are one number, or one per ring of ``l`` (a tapered chamber).
+    The ring at ``l[0]`` (the base, l = 0) is dropped when ``before_mm`` > 0: it would lie in the base cap's plane,
+    and the boolean cuts the tube there into faces of a few 1e-7 mm that single precision (STL) folds to zero
+    area, leaving non-manifold edges once coincident vertices are merged (issue 43).  The tube runs straight from
+    outside the base to the first ring inside.  ``phase`` turns the polygon's vertices by that angle, rad.
     """
     centers, frames = curve.points(l), curve.frames(l)
     s = curve.curve.arc_length(l)
+    distance = np.broadcast_to(np.asarray(distance, float), l.shape)
+    diameter = np.broadcast_to(np.asarray(diameter, float), l.shape)
     if before_mm > 0.0:
         centers = np.concatenate([[centers[0] - before_mm * frames[0][:, 2]], centers[1:]])
         s = np.concatenate([[s[0] - before_mm], s[1:]])
     t = 2.0 * np.pi * np.arange(segments) / segments + phase
-    r = area_radius(0.5 * diameter, segments)
-    ring = np.column_stack([distance * np.cos(angle) + r * np.cos(t), distance * np.sin(angle) + r * np.sin(t)])
-    xy = np.broadcast_to(ring, (len(l), segments, 2)).copy()
+    r = np.array([area_radius(0.5 * d, segments) for d in diameter])[:, None]
+    xy = np.stack([distance[:, None] * np.cos(angle) + r * np.cos(t),
+                   distance[:, None] * np.sin(angle) + r * np.sin(t)], axis=2)
     return Sweep(float(q), l, s, centers, frames, xy)
 
 
 def cavity_sweeps(curve: FramedSpline, q: float, layout: ChamberLayout, l_body: FloatArray,
                   feed_extension_mm: float = FEED_EXTENSION_MM) -> tuple[Cavity, ...]:
     """Every chamber and feed of ``layout`` on the body's ring grid ``l_body`` at q, chambers first."""
-    out = [Cavity("chamber", c.section, c.index,
-                  _tube(curve, q, _grid(l_body, c.l_start, c.l_end), c.distance_mm, c.angle, c.diameter_mm,
-                        CHAMBER_SEGMENTS))
-           for c in layout.chambers]
+    out = []
+    for c in layout.chambers:
+        l = _grid(l_body, c.l_start, c.l_end)
+        out.append(Cavity("chamber", c.section, c.index,
+                          _tube(curve, q, l, c.distance_at(l), c.angle, c.diameter_at(l), CHAMBER_SEGMENTS)))
     starts = {(c.section, c.index): c.l_start for c in layout.chambers}
     out += [Cavity("feed", f.section, f.chamber,
                    _tube(curve, q, _clear_of(_grid(l_body, f.l_start, f.l_end), starts[f.section, f.chamber], l_body),
@@ -122,7 +127,8 @@ def _clear_of(l: FloatArray, plane_l: float, l_body: FloatArray) -> FloatArray:
 
 
 def carve_cavities(body: TubeMesh, cavities: Sequence[Cavity], max_rho_kappa: float, label: str) -> Solid:
-    """``body`` minus the union of ``cavities``: one shell, Euler 2 (each cavity opens at the base face).
+    """``body`` minus the union of ``cavities``: one shell, Euler 2 (each cavity opens at the base face through its
+    feed; a chamber without a feed is a closed void, Euler 2 more each).
 
     Regions: a chamber's wall CHAMBER, its flat ends CHAMBER_CAP; a feed's faces PORT.
     """
@@ -142,7 +148,11 @@ def carve_cavities(body: TubeMesh, cavities: Sequence[Cavity], max_rho_kappa: fl
     union = checked(m3.Manifold.batch_boolean(tubes, m3.OpType.Add), f"{label}: chambers and feeds")
     result = checked(body_manifold - union, f"{label}: actuated body")
     vertices, faces, regions = welded_as_written(*_regions_after(result, sources))
-    return Solid(vertices, faces, regions, 2, "actuated", max_rho_kappa)
+    # a chamber with no feed of its own (supply: single feeds them in series through channels not meshed) is a
+    # closed void: one more sphere-like shell, Euler 2 more
+    fed = {(c.section, c.chamber) for c in cavities if c.kind == "feed"}
+    closed = sum(1 for c in cavities if c.kind == "chamber" and (c.section, c.chamber) not in fed)
+    return Solid(vertices, faces, regions, 2 + 2 * closed, "actuated", max_rho_kappa)
 
 
 @functools.lru_cache(maxsize=4)
@@ -183,8 +193,12 @@ def cavity_volume_mm3(curve: FramedSpline, layout: ChamberLayout) -> float:
     total = 0.0
     starts = {(c.section, c.index): c.l_start for c in layout.chambers}
     for c in layout.chambers:
-        axis = piecewise_axis_length(curve, layout.breaks, c.l_start, c.l_end, c.distance_mm, c.angle)
-        total += np.pi * (0.5 * c.diameter_mm) ** 2 * axis
+        # a tapered chamber piece by piece between its profile's samples (trapezoid rule on the area)
+        cuts = np.unique(np.clip([c.l_start, *(p[0] for p in c.profile), c.l_end], c.l_start, c.l_end))
+        for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+            middle = 0.5 * (a + b)
+            axis = piecewise_axis_length(curve, layout.breaks, a, b, float(c.distance_at(middle)), c.angle)
+            total += np.pi * 0.125 * float(c.diameter_at(a) ** 2 + c.diameter_at(b) ** 2) * axis
     for f in layout.feeds:
         reach = piecewise_axis_length(curve, layout.breaks, 0.0, starts[f.section, f.chamber], f.ring_mm, f.angle)
         total += np.pi * (0.5 * f.diameter_mm) ** 2 * reach

@@ -110,12 +110,27 @@ def cause_text(cause: dict[str, Any]) -> str:
     return text + ("; crossed at " + " and ".join(crossed) if crossed else "")
 
 
+#: Limits with no published source (materials.yaml: ``min_stretch`` is a rule of thumb): crossing one is a
+#: warning, not a verdict (issue 41).
+WARNING_ONLY = ("min_stretch",)
+
+
 def judge(summary: dict[str, Any], limits: dict[str, Any] | None) -> tuple[bool | None, list[str], list[dict]]:
-    """The verdict, one reason per cause, and the causes themselves (JSON-ready); (None, [], []) without limits."""
+    """The verdict, one reason per cause, and the causes themselves (JSON-ready); (None, [], []) without limits.
+
+    A cause of a :data:`WARNING_ONLY` limit is kept in the causes but neither decides the verdict nor is a reason
+    (:func:`warnings_of` words it)."""
     if limits is None:
         return None, [], []
     found = causes(violations(summary, limits), limits["name"])
-    return not found, [cause_text(c) for c in found], found
+    binding = [c for c in found if c["limit_name"] not in WARNING_ONLY]
+    return not binding, [cause_text(c) for c in binding], found
+
+
+def warnings_of(found: list[dict[str, Any]]) -> list[str]:
+    """The causes of limits without a source, as warnings."""
+    return [cause_text(c) + " (a rule of thumb without a source: a warning, not a verdict)" for c in found
+            if c["limit_name"] in WARNING_ONLY]
 
 
 def _beyond(value: float, relation: str, limit: float) -> bool:

@@ -12,8 +12,9 @@ from typing import Any
 
 from softdesign.io.format_names import q_label
 
-#: actuation.csv's columns for the estimates (only when the build has them).
-ESTIMATE_COLUMNS = ("pressure_kpa", "pressure_arc_error_mm", "pressure_source")
+#: actuation.csv's columns for the estimates (only when the build has them); ``fe_``: the rod model's
+#: ``pressure_kpa`` is in every row (issue 41), the finite elements' estimates keep their own columns.
+ESTIMATE_COLUMNS = ("fe_pressure_kpa", "fe_pressure_arc_error_mm", "fe_pressure_source")
 
 
 @dataclass(frozen=True)

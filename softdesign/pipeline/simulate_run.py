@@ -139,8 +139,9 @@ def section_mesh_of(case: Any, kinematics: Any, fit: Any, section: int, size_mm:
     """Section ``section``'s (0 at the base) mesh at q = 0 (ConfigError without chambers or for a bad index)."""
     from softdesign.mechanics.layout_section import layout_section_mesh
     from softdesign.pipeline.body_spec import body_spec
-    from softdesign.pipeline.stages.actuation import actuation_layout
+    from softdesign.pipeline.stages.actuation import actuation_layout, unsized_single
 
+    unsized_single(case, "simulate")
     layout = actuation_layout(case, kinematics)
     if layout is None:
         raise ConfigError("simulate: the case has no actuation chambers; add an `actuation:` block")

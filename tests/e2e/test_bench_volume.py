@@ -27,7 +27,8 @@ def test_cases_ask_for_the_swept_volume_mesh():
     solid, hollow, chambered = (bench.case_data(name) for name in ("solid", "hollow", "chambered"))
     assert solid["export"]["volume_mesh"] == {"q": [0.0, 0.5, 1.0]} and "wall_mm" not in solid["export"]
     assert hollow["export"]["wall_mm"] == 1.0 and hollow["export"]["port_mm"] == 1.2
-    assert chambered["actuation"] == {} and chambered["export"]["volume_mesh"] == {}  # as configs/actuator.yaml
+    assert chambered["actuation"] == {"supply": "per_chamber"} and chambered["export"]["volume_mesh"] == {}
+    # as configs/actuator-per-chamber.yaml
     assert "mould" not in chambered["export"]
 
 

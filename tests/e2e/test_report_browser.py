@@ -267,7 +267,8 @@ def test_the_aortas_page_opens_on_its_verdict_not_on_its_check_tally(tmp_path, a
 
     case = write_case(tmp_path, "aorta", final={"centerline": str(aorta_dir / "aorta-centerline.vtp"),
                                                  "surface": str(aorta_dir / "aorta-surface.stl"), "path": 0},
-                      material={"name": "ecoflex-00-30"})
+                      # a sourced limit the aorta's skin passes (its min_stretch crossing is a note since issue 41)
+                      material={"name": "ecoflex-00-30", "max_stretch": 1.05})
     build_through(case, tmp_path / "build")
     write_report(tmp_path / "build", ReportOptions(gif_frames=3))
     ARTIFACTS.mkdir(parents=True, exist_ok=True)

@@ -35,7 +35,7 @@ ERROR_TOL_MM = 1e-4
 
 
 def case_file(folder: Path, simulate: dict | None) -> Path:
-    case = yaml.safe_load((REPO / "configs" / "actuator.yaml").read_text())
+    case = yaml.safe_load((REPO / "configs" / "actuator-per-chamber.yaml").read_text())
     for key in ("centerline", "surface"):
         case["final"][key] = str((REPO / "configs" / case["final"][key]).resolve())
     case["export"] = {"q": [0, 1], "formats": ["stl"]}
@@ -70,9 +70,9 @@ def test_the_pressures_are_in_actuation_csv_labelled_as_model_estimates(built: t
     mesh = json.loads((build_dir / "simulate" / "summary.json").read_text())["solves"][0]["mesh"]
     assert mesh["size_mm"] == 4 and mesh["nodes"] > 0
     for r in solved:
-        assert float(r["pressure_kpa"]) == pytest.approx(10.0)  # one evaluation: the start, 10 % of 100 kPa
-        assert "model estimate" in r["pressure_source"] and "ecoflex-00-30" in r["pressure_source"]
-        assert f"section mesh {mesh['nodes']} nodes {mesh['tets']} tets, size 4 mm" in r["pressure_source"]
+        assert float(r["fe_pressure_kpa"]) == pytest.approx(10.0)  # one evaluation: the start, 10 % of 100 kPa
+        assert "model estimate" in r["fe_pressure_source"] and "ecoflex-00-30" in r["fe_pressure_source"]
+        assert f"section mesh {mesh['nodes']} nodes {mesh['tets']} tets, size 4 mm" in r["fe_pressure_source"]
     others = [r for r in table if r not in solved]
     assert others and all(r[c] == "" for r in others for c in ESTIMATE_COLUMNS)
 
@@ -91,11 +91,11 @@ def test_a_forward_solve_at_the_tabled_pressures_gives_the_tabled_arc_error(buil
     case = load_case(case_path)
     mesh = section_mesh_of(case, outcome.results["kinematics"], outcome.results["fit"], 0, 4.0, 8, 10.0)
     defaults = SimulateOptions(0, (0.0, 0.0, 0.0), None)
-    result = simulate_section(mesh, material_of(case).law, np.array([float(r["pressure_kpa"]) for r in solved]),
+    result = simulate_section(mesh, material_of(case).law, np.array([float(r["fe_pressure_kpa"]) for r in solved]),
                               NewtonSettings(load_steps=defaults.load_steps, max_iterations=defaults.max_iterations))
     target = arc_vector(*(float(solved[0][k]) for k in ("arc_kappa", "arc_phi", "arc_length_mm")))
     error = weighted_error(arc_vector(result.kappa, result.phi, result.length), target)
-    assert math.hypot(*error) == pytest.approx(float(solved[0]["pressure_arc_error_mm"]), abs=ERROR_TOL_MM)
+    assert math.hypot(*error) == pytest.approx(float(solved[0]["fe_pressure_arc_error_mm"]), abs=ERROR_TOL_MM)
 
 
 def test_the_stage_is_cached_and_the_report_draws_it(built: tuple[Path, Path]) -> None:
@@ -131,6 +131,6 @@ def test_simulate_write_puts_one_sections_pressures_in_the_table(tmp_path: Path)
     solve = write_to_table(case, tmp_path / "build", options, lambda line: None)
     assert solve["section"] == 2 and solve["q"] == 0.5 and solve["written"].endswith("actuation.csv")
     _, table = rows(tmp_path / "build" / "actuation.csv")
-    solved = [r for r in table if r["pressure_kpa"]]
+    solved = [r for r in table if r["fe_pressure_kpa"]]
     assert [(float(r["q"]), r["section"]) for r in solved] == [(0.5, "2")] * 3  # 0-based in the options
-    assert [float(r["pressure_kpa"]) for r in solved] == pytest.approx(solve["pressures_kpa"], abs=0)
+    assert [float(r["fe_pressure_kpa"]) for r in solved] == pytest.approx(solve["pressures_kpa"], abs=0)

@@ -196,3 +196,37 @@ def test_measured_skin_over_a_straight_body_is_the_analytic_wall() -> None:
         reach = (SPEC.diameter_mm if segments == 32 else SPEC.feed_diameter_mm) / 2 * (
             np.sqrt(2 * np.pi / segments / np.sin(2 * np.pi / segments)) - 1)
         assert design - sagitta - reach - 1e-9 <= value <= design + 1e-9, (value, design)
+
+
+def test_a_tapered_chamber_holds_the_frustum_volume_and_its_walls_follow_the_taper() -> None:
+    from dataclasses import replace
+
+    from softdesign.meshing.chambers import cavity_volume_mm3
+
+    curve = straight()
+    planned = layout_on(curve)
+    c = planned.chambers[0]
+    # diameter 0.6 -> 1.0 mm and distance 1.8 -> 2.1 mm, linear in l over the chamber: skin 0.9 -> 0.4 mm
+    profile = ((c.l_start, 1.8, 0.6), (c.l_end, 2.1, 1.0))
+    tapered = replace(planned, chambers=(replace(c, profile=profile),), feeds=())
+    length = (c.l_end - c.l_start) * LENGTH
+    frustum = np.pi / 12.0 * length * (0.6**2 + 0.6 * 1.0 + 1.0**2)
+    # the trapezoid rule on the area over one piece overestimates a cone's by (D1 - D0)^2 pi L / 24
+    trapezoid = frustum + np.pi * length * (1.0 - 0.6) ** 2 / 24.0
+    np.testing.assert_allclose(cavity_volume_mm3(curve, tapered), trapezoid, rtol=1e-9, atol=0)
+    walls = skin_walls(curve, _flat_field(), 0.0, tapered)
+    (chamber,) = [w for w in walls if w.kind == "chamber-skin"]
+    l_end = chamber.l
+    assert l_end is not None and abs(l_end - c.l_end) < 1e-9  # the widest, outermost end is the thinnest wall
+    np.testing.assert_allclose(chamber.thickness_mm, RADIUS - 2.1 - 0.5, rtol=0, atol=SKIN_TOL_MM)
+    sweep = cavity_sweeps(curve, 0.0, tapered, np.linspace(0.0, 1.0, 81))[0].sweep
+    spread = np.linalg.norm(sweep.xy - sweep.xy.mean(axis=1, keepdims=True), axis=2).max(axis=1)
+    assert spread[0] < spread[-1]  # the rings widen along the chamber
+
+
+def _flat_field():
+    class Field:  # a round body of RADIUS everywhere (the one method skin_walls reads)
+        def evaluate_grid(self, q, l, a):
+            return np.full((len(l), len(a)), RADIUS)
+
+    return Field()

@@ -52,3 +52,18 @@ def test_the_checks_tally_is_folded_and_opens_on_a_failure():
     assert ok.startswith('<details class="tally" id="checks">') and "Checks: 1 of 1 passed" in ok
     bad = checks_html([Check("a.stl", "watertight", "no", "yes", False)])
     assert 'id="checks" open>' in bad and "a.stl: watertight" in bad
+
+
+def test_a_single_supply_device_says_what_one_pressure_does():
+    from softdesign.pipeline.stages.judges import actuation_judgement
+
+    line = ("device: one pressure of 852.5 kPa bends it into the vessel within 1.17 mm (rod model), walls >= 1.01 "
+            "mm, thread at 0.9 % of its limit")
+    summary = {"material": {"name": "ecoflex-00-30"}, "feasible": True, "reasons": [], "verdict_line": line}
+    verdict = build_verdict({"verdict": verdict_record([("actuation", actuation_judgement(summary))])})
+    assert verdict.status == "feasible" and verdict.margins == (line.removeprefix("device: "),)
+    refused = {**summary, "feasible": False, "reasons": ["section 2: no chamber fits"],
+               "verdict_line": "device: NOT feasible: section 2: no chamber fits"}
+    verdict = build_verdict({"verdict": verdict_record([("actuation", actuation_judgement(refused))])})
+    assert verdict.status == "NOT feasible"
+    assert verdict.reasons == ("chambers: section 2: no chamber fits",) and verdict.margins == ()

@@ -24,7 +24,7 @@ from __future__ import annotations
 import csv
 import io
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -39,22 +39,25 @@ from softdesign.meshing.chamber_layout import ChamberLayout, analytic_walls, cha
 from softdesign.meshing.chamber_walls import Wall, chamber_lengths_mm, ring_walls, skin_walls
 from softdesign.meshing.chambers import measured_skin_walls
 from softdesign.meshing.sweep_layout import check_resolvable, layout_holes
+from softdesign.pipeline.actuation_judge import judge
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import export_workers
 from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.parallel import map_items
+from softdesign.pipeline.rod_actuation import describe_rod, device_line, rod_figures
 from softdesign.pipeline.simulate_estimates import ESTIMATE_COLUMNS, SimulateResult, estimate_cells
 from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.stages.design import DesignResult
 from softdesign.pipeline.stages.fit import FitResult
-from softdesign.pipeline.stages.judges import material_judgement
+from softdesign.pipeline.stages.judges import actuation_judgement, rule_notices
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 
 if TYPE_CHECKING:
     from softdesign.config import Case
 
-VERSION = 4  # 2: one reason per cause (a kind of wall, a bound of extension); 3: the simulate stage's pressures;
-#            4: angles in (-180, 180] degrees
+VERSION = 5  # 2: one reason per cause (a kind of wall, a bound of extension); 3: the simulate stage's pressures;
+#            4: angles in (-180, 180] degrees; 5: the rod model (supply, pressure_kpa)
 SUMMARY = "actuation/summary.json"
 TABLE = "actuation.csv"
 #: The dense q grid's size (q = 0, 0.05, ..., 1).
@@ -66,7 +69,7 @@ ARC_SAMPLES = 201
 MIN_LAYOUT_WALL_MM = 0.2
 #: Columns of actuation.csv.
 COLUMNS = ("q", "export", "section", "chamber", "angle_deg", "distance_mm", "length_mm", "extension", "arc_kappa",
-           "arc_phi", "arc_length_mm", "arc_misfit_mm")
+           "arc_phi", "arc_length_mm", "arc_misfit_mm", "pressure_kpa")
 
 
 @dataclass(frozen=True)
@@ -77,16 +80,47 @@ class ActuationResult:
     table: str
 
 
-def actuation_layout(case: Case, kinematics: KinematicsResult) -> ChamberLayout | None:
-    """The case's chambers and feeds on its links (None without ``actuation:``); end walls on the q = 0 body."""
+def actuation_layout(case: Case, kinematics: KinematicsResult,
+                     sized: ActuationResult | None = None) -> ChamberLayout | None:
+    """The case's chambers and feeds on its links (None without ``actuation:``); end walls on the q = 0 body.
+
+    ``supply: single``: the chambers this stage sized (``sized``, its result: the summary's layout with each
+    chamber's taper); a step that does not take them (the volume mesh, the finite elements) is refused.
+    """
     if case.actuation is None:
         return None
     curve0 = kinematics.chain.shape.curve_at(0.0)
     l = curve0.curve.dense_l()
+    spec = case.actuation.spec()
+    if case.actuation.supply == "single":  # one chamber per section, placed and sized by the rod model
+        spec = replace(spec, chambers_per_section=1)
     try:
-        return plan_layout(case.actuation.spec(), kinematics.chain.breaks, l, curve0.curve.arc_length(l))
+        planned = plan_layout(spec, kinematics.chain.breaks, l, curve0.curve.arc_length(l))
     except ValueError as err:
         raise ConfigError(f"actuation.end_wall_mm: {err}; use a thinner end wall or fewer links") from err
+    if case.actuation.supply != "single" or sized is None:
+        return planned
+    return sized_layout(planned, sized.summary["layout"])
+
+
+def unsized_single(case: Case, what: str) -> None:
+    """Refuse a step that would lay out ``supply: single``'s chambers without the actuation stage's sizing."""
+    if case.actuation is not None and case.actuation.supply == "single":
+        raise ConfigError(f"{what}: actuation.supply: single's chambers are sized and tapered by the rod model in the "
+                          f"actuation stage, and {what} does not take them yet; use actuation.supply: per_chamber "
+                          "for it")
+
+
+def sized_layout(planned: ChamberLayout, document: dict[str, Any]) -> ChamberLayout:
+    """The layout kept in the summary (:func:`layout_document`) over the planned one: angles, sizes, tapers."""
+    chambers = tuple(replace(c, angle=float(np.deg2rad(d["angle_deg"])), distance_mm=d["distance_mm"],
+                             diameter_mm=d["diameter_mm"], profile=tuple(tuple(p) for p in d.get("profile", ())))
+                     for c, d in zip(planned.chambers, document["chambers"], strict=True))
+    feeds = tuple(replace(f, angle=float(np.deg2rad(d["angle_deg"])), ring_mm=d["ring_mm"])
+                  for f, d in zip((f for f in planned.feeds if f.section == 0), document["feeds"], strict=True))
+    spec = replace(planned.spec, distance_mm=max(c.distance_mm for c in chambers),
+                   diameter_mm=min(c.diameter_mm for c in chambers))
+    return replace(planned, spec=spec, chambers=chambers, feeds=feeds)
 
 
 def q_grid(case: Case) -> list[tuple[float, bool]]:
@@ -202,9 +236,9 @@ def _add_estimates(rows: list[dict[str, Any]], simulated: SimulateResult | None)
         return
     for r in rows:
         cells = estimate_cells(simulated, r["q"], r["section"])
-        r["pressure_kpa"] = None if cells is None else float(cells["pressure_kpa"][r["chamber"] - 1])
-        r["pressure_arc_error_mm"] = None if cells is None else cells["pressure_arc_error_mm"]
-        r["pressure_source"] = None if cells is None else cells["pressure_source"]
+        r["fe_pressure_kpa"] = None if cells is None else float(cells["pressure_kpa"][r["chamber"] - 1])
+        r["fe_pressure_arc_error_mm"] = None if cells is None else cells["pressure_arc_error_mm"]
+        r["fe_pressure_source"] = None if cells is None else cells["pressure_source"]
 
 
 def _extensions(kinematics: KinematicsResult, layout: ChamberLayout, grid: list[float]) -> list[dict[str, Any]]:
@@ -254,45 +288,6 @@ def _meshed(case: Case, kinematics: KinematicsResult, fit: FitResult, layout: Ch
             for w in walls]
 
 
-def judge(walls: list[Wall], extensions: list[dict[str, Any]], limits: dict[str, Any] | None) -> list[str]:
-    """One reason per cause beyond the material's limits (empty when none, or no material): per kind of wall the
-    thinnest, with the q values where that kind is too thin; per bound the worst chamber extension, with how many
-    chambers cross it."""
-    if limits is None:
-        return []
-    reasons, name = [], limits["name"]
-    if limits["min_wall_mm"] is not None:
-        thin: dict[str, list[Wall]] = {}
-        for w in walls:
-            if w.thickness_mm < limits["min_wall_mm"]:
-                thin.setdefault(w.kind, []).append(w)
-        for kind, found in thin.items():
-            worst = min(found, key=lambda w: w.thickness_mm)
-            qs = sorted({w.q for w in found if w.q is not None})
-            at_q = f"; too thin at q = {', '.join(f'{q:g}' for q in qs)}" if len(qs) > 1 else ""
-            reasons.append(f"{kind} wall {worst.thickness_mm:.3f} mm < min_wall_mm {limits['min_wall_mm']:g} "
-                           f"({name}) at {worst.place()}{at_q}")
-    for key, bound, worse in (("max", "max_stretch", max), ("min", "min_stretch", min)):
-        limit = limits[bound]
-        if limit is None:
-            continue
-        crossed = [e for e in extensions if (e[key] > limit if key == "max" else e[key] < limit)]
-        if crossed:
-            e = worse(crossed, key=lambda e: e[key])
-            sign = ">" if key == "max" else "<"
-            reasons.append(f"chamber extension {e[key]:.4f} {sign} {bound} {limit:g} ({name}) at section "
-                           f"{e['section']} chamber {e['chamber']}, q={e['q_' + key]:.3f}; {len(crossed)} of "
-                           f"{len(extensions)} chambers cross it")
-    return reasons
-
-
-def degrees_wrapped(angle_rad: float) -> float:
-    """An angle in degrees in (-180, 180] (the one convention of the CSV and JSON outputs), rounded to 1e-9 deg so
-    that 30 and 390 - 360 are written as the same number."""
-    degrees = float(np.rad2deg(angle_rad)) % 360.0
-    return round(degrees - 360.0 if degrees > 180.0 else degrees, 9) + 0.0
-
-
 def layout_document(layout: ChamberLayout) -> dict[str, Any]:
     """The layout as JSON: the spec, every chamber and feed (angles in degrees)."""
     return {
@@ -300,7 +295,8 @@ def layout_document(layout: ChamberLayout) -> dict[str, Any]:
                 "the chambers' ring at their chamber's angle, from the base face into the chamber",
         "chambers": [{"section": c.section + 1, "chamber": c.index + 1, "angle_deg": degrees_wrapped(c.angle),
                       "distance_mm": c.distance_mm, "diameter_mm": c.diameter_mm, "l_start": c.l_start,
-                      "l_end": c.l_end} for c in layout.chambers],
+                      "l_end": c.l_end, **({"profile": [list(p) for p in c.profile]} if c.profile else {})}
+                     for c in layout.chambers],
         "feeds": [{"section": f.section + 1, "chamber": f.chamber + 1, "angle_deg": degrees_wrapped(f.angle),
                    "ring_mm": f.ring_mm, "diameter_mm": f.diameter_mm, "l_start": f.l_start, "l_end": f.l_end}
                   for f in layout.feeds],
@@ -313,36 +309,44 @@ def _check_sweep(case: Case, fit: FitResult, layout: ChamberLayout) -> None:
     volume = case.export.volume_mesh
     if volume is None or volume.mesher != "sweep":
         return
+    if any(c.profile for c in layout.chambers):
+        raise ConfigError("export.volume_mesh (mesher sweep): the swept mesher meshes one cross-section for the "
+                          "whole body, and actuation.supply: single tapers its chambers and sets each section's "
+                          "own angle; use export.volume_mesh.mesher: ftetwild, or drop export.volume_mesh")
     a = np.linspace(0.0, 2.0 * np.pi, case.export.angular_count, endpoint=False)
     scale = float(np.median(fit.field.evaluate_grid(0.0, np.linspace(0.0, 1.0, 65), a)))
     check_resolvable(layout, layout_holes(layout, scale, volume.size_mm), scale)
 
 
-def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult,
-                  simulated: SimulateResult | None = None) -> ActuationResult | None:
-    """Layout (or refusal), the lengths table (with the simulate stage's pressures), the walls and extensions and
-    their verdict; None without actuation."""
+def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult, simulated: SimulateResult | None = None,
+                  design: DesignResult | None = None) -> ActuationResult | None:
+    """Layout (or refusal), the lengths table with the rod model's pressures (and the simulate stage's), the walls
+    and extensions and their verdict; None without actuation."""
     layout = actuation_layout(case, kinematics)
     if layout is None:
         return None
-    sections = check_layout(layout, section_radii(fit, layout))
-    _check_sweep(case, fit, layout)
     grid = q_grid(case)
-    rows, reference = _rows_at(kinematics, layout, 0.0, 0.0 in case.export.q_values(), None)
-    for q, export in grid:
-        if q != 0.0:
-            rows += _rows_at(kinematics, layout, q, export, reference)[0]
+    rod = rod_figures(case, kinematics, fit, design, layout, grid)
+    layout = rod.layout
+    sections = rod.sections if rod.sections is not None else check_layout(layout, section_radii(fit, layout))
+    _check_sweep(case, fit, layout)
+    rows = rod.rows if rod.rows is not None else _per_chamber_rows(kinematics, layout, grid)
+    filled = rod.fill(rows)
     _add_estimates(rows, simulated)
     qs = [q for q, _ in grid]
-    walls = ring_walls(layout) + _skin(kinematics, fit, layout, qs, case.export.offset_mm)
+    walls = (rod.walls if rod.walls is not None else ring_walls(layout)) + _skin(kinematics, fit, layout, qs,
+                                                                                 case.export.offset_mm)
     walls += _meshed(case, kinematics, fit, layout)
     extensions = _extensions(kinematics, layout, qs)
     limits = case.material.limits().as_dict() if case.material is not None else None
-    reasons = judge(walls, extensions, limits)
+    reasons, warnings = judge(walls, extensions, limits)
+    reasons += rod.reasons
     thinnest = {kind: min((w for w in walls if w.kind == kind), key=lambda w: w.thickness_mm).as_dict()
                 for kind in dict.fromkeys(w.kind for w in walls)}
     summary = {
         "spec": case.actuation.model_dump() if case.actuation is not None else None,
+        **rod.summary,
+        **filled,
         "layout": layout_document(layout),
         "sections": sections,
         "thinnest": thinnest,
@@ -355,12 +359,25 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult,
         "material": limits,
         "feasible": None if limits is None else not reasons,
         "reasons": reasons if limits is not None else ["no material: in the case file: figures only, not judged"],
+        "warnings": warnings + rod.warnings,
         "method": "lengths: Zou et al. on each section's best arc at q (backbone started on the section's base "
-                  "frame); extension: the chamber's axis on the body at q over q = 0; walls in the sections' "
-                  "normal planes (chamber-skin, feed-skin at every q; between tubes constant over q), and at every "
-                  "export q the skin over each tube measured on the mesh (end caps included)",
+                  "frame), or with supply: single the rod model's chamber axis at q P*; pressure_kpa: the rod model "
+                  "(softdesign/kinematics/rod.py); extension: the chamber's axis on the body at q over q = 0; walls "
+                  "in the sections' normal planes (chamber-skin, feed-skin at every q; between tubes constant over "
+                  "q), and at every export q the skin over each tube measured on the mesh (end caps included)",
     }
+    summary["verdict_line"] = device_line(summary)
     return ActuationResult(summary, table_text(rows, estimates=simulated is not None))
+
+
+def _per_chamber_rows(kinematics: KinematicsResult, layout: ChamberLayout,
+                      grid: list[tuple[float, bool]]) -> list[dict[str, Any]]:
+    """Seed 003's lengths on each section's best arc at every q of the grid (q = 0 first: the reference)."""
+    rows, reference = _rows_at(kinematics, layout, 0.0, any(q == 0.0 and e for q, e in grid), None)
+    for q, export in grid:
+        if q != 0.0:
+            rows += _rows_at(kinematics, layout, q, export, reference)[0]
+    return rows
 
 
 def write_actuation(result: ActuationResult | None, staging: Staging) -> None:
@@ -394,20 +411,24 @@ def describe_actuation(result: ActuationResult | None) -> list[str]:
     lines.append(f"chamber extension {lo['min']:.4f} (section {lo['section']} chamber {lo['chamber']}, "
                  f"q={lo['q_min']:.3f}) to {hi['max']:.4f} (section {hi['section']} chamber {hi['chamber']}, "
                  f"q={hi['q_max']:.3f})")
-    return lines  # its verdict is the build's one (the manifest's)
+    # the rod model's figures; its verdict (the "device: " line) is in the build's one verdict (the manifest's)
+    lines += [line for line in describe_rod(s) if not line.startswith("device: ")]
+    return lines
 
 
 STAGE = Stage(
     name="actuation",
     version=VERSION,
     reads=("actuation", "export.q", "export.frames", "export.offset_mm", "export.spacing_mm", "export.angular_count",
-           "material"),
-    upstream=("kinematics", "fit", "simulate"),
-    compute=lambda case, results: run_actuation(case, results["kinematics"], results["fit"], results["simulate"]),
+           "material", "blend"),
+    upstream=("design", "kinematics", "fit", "simulate"),
+    compute=lambda case, results: run_actuation(case, results["kinematics"], results["fit"], results["simulate"],
+                                                results["design"]),
     write=write_actuation,
     load=lambda build_dir, results: load_actuation(build_dir),
     describe=describe_actuation,
     metrics=lambda result: {} if result is None else result.summary,
     figures=lambda result: {} if result is None else {TABLE: {"rows": len(result.summary["rows"])}},
-    judge=lambda result: None if result is None else material_judgement(result.summary, "chambers"),
+    warnings=lambda result: [] if result is None else rule_notices("actuation", result.summary),
+    judge=lambda result: None if result is None else actuation_judgement(result.summary),
 )

@@ -43,7 +43,7 @@ from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.output_frame import base_pose, frame_record, moved_points, moved_vectors, output_pose
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
-from softdesign.pipeline.stages.actuation import actuation_layout
+from softdesign.pipeline.stages.actuation import ActuationResult, actuation_layout, unsized_single
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
@@ -85,8 +85,9 @@ def region_name(q: float, piece: RegionPiece) -> str:
     return layout.region_path(q, piece.name)
 
 
-def solid_at(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case) -> ExportedMesh:
-    """Build and check the solid of S(q).
+def solid_at(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case,
+             sized: ActuationResult | None = None) -> ExportedMesh:
+    """Build and check the solid of S(q) (``sized``: the actuation stage's result, for ``supply: single``).
 
     Raises
     ------
@@ -97,7 +98,9 @@ def solid_at(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case)
     e = case.export
     spec = body_spec(case, fit)
     sections = body_sections(curve, fit.field, q, e.spacing_mm, e.angular_count)
-    layout = actuation_layout(case, kinematics)
+    if sized is None:
+        unsized_single(case, "the volume mesh")
+    layout = actuation_layout(case, kinematics, sized)
     solid = build_solid(sections, spec) if layout is None else build_actuated(sections, spec, curve, layout)
     integral = integrate_body(body_stations(curve, fit.field, q, e.angular_count), body_breaks(fit.field), spec)
     report = check_solid(solid.vertices, solid.faces, solid.expectation(integral.volume), label=f"q={q:.3f}")
@@ -123,10 +126,11 @@ def solid_at(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case)
     return ExportedMesh(q, solid, figures, centerline_arrays(kinematics, q), pieces)
 
 
-def _solid_naming_blend(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case) -> ExportedMesh:
+def _solid_naming_blend(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case,
+                        sized: ActuationResult | None) -> ExportedMesh:
     """:func:`solid_at`; a fold at an intermediate q of a linear blend also names the blend as the likely cause."""
     try:
-        return solid_at(kinematics, fit, q, case)
+        return solid_at(kinematics, fit, q, case, sized)
     except MeshError as err:
         if not (0.0 < q < 1.0 and kinematics.chain.shape.mode == "linear" and "folds" in str(err)):
             raise
@@ -157,12 +161,13 @@ def _mesh_label(q: float) -> str:
     return f"mesh q = {q:g}"
 
 
-def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult) -> ExportResult:
+def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult,
+               sized: ActuationResult | None = None) -> ExportResult:
     """A checked solid at every export q (on the build's worker processes: as many as fit in memory, and worth it)."""
     longest = max(key.length for key in kinematics.chain.shape.keys)
     q_values = case.export.q_values()
     counted = item_counter("export", q_values, _mesh_label)  # the command line's per-mesh bar, when it listens
-    meshes = tuple(map_items(lambda q: _solid_naming_blend(kinematics, fit, q, case), q_values,
+    meshes = tuple(map_items(lambda q: _solid_naming_blend(kinematics, fit, q, case, sized), q_values,
                              most=export_workers(case, longest), on_result=counted))
     pose = output_pose(case.export.frame, base_pose(kinematics.chain.shape))  # checked first, then moved rigidly
     meshes = tuple(_moved(m, pose) for m in meshes)
@@ -264,8 +269,8 @@ STAGE = Stage(
     # every export key but mould, which only the mould stage reads
     reads=("export.q", "export.frames", "export.offset_mm", "export.wall_mm", "export.port_mm", "export.formats",
            "export.spacing_mm", "export.angular_count", "export.split_regions", "export.frame", "actuation"),
-    upstream=("kinematics", "fit"),
-    compute=lambda case, results: run_export(case, results["kinematics"], results["fit"]),
+    upstream=("kinematics", "fit", "actuation"),
+    compute=lambda case, results: run_export(case, results["kinematics"], results["fit"], results["actuation"]),
     write=write_export,
     load=lambda build_dir, results: load_export(build_dir),
     describe=describe_export,

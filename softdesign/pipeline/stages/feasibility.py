@@ -46,17 +46,17 @@ from softdesign.meshing.volume import BodySpec
 from softdesign.meshing.wall import FD_STEP_MM, offset_metric, port_wall_mm, thinnest, wall_map
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import meshes_at_once
-from softdesign.pipeline.feasibility_judge import judge
+from softdesign.pipeline.feasibility_judge import judge, warnings_of
 from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.fit import FitResult
-from softdesign.pipeline.stages.judges import material_judgement
+from softdesign.pipeline.stages.judges import material_judgement, rule_notices
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 from softdesign.types import FramedCurve
 
-VERSION = 2  # 2: places in mm from the base (arc_mm), one reason per cause (causes)
+VERSION = 3  # 2: places in mm from the base (arc_mm), one reason per cause (causes); 3: min_stretch a warning
 SUMMARY = "feasibility/summary.json"
 #: Memory for the rest state's metrics a body keeps (:meth:`_Body.rest`), bytes: the finest grid's
 #: (E, F, G) of the 1M-triangle benchmark case is 18 MB (729,600 points), and every q asks for the same grids.
@@ -264,6 +264,7 @@ def run_feasibility(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
     summary["feasible"] = feasible
     summary["reasons"] = reasons if limits is not None else ["no material: in the case file: figures only, not judged"]
     summary["causes"] = causes
+    summary["warnings"] = warnings_of(causes)
     return FeasibilityResult(summary)
 
 
@@ -330,5 +331,6 @@ STAGE = Stage(
     load=lambda build_dir, results: load_feasibility(build_dir),
     describe=describe_feasibility,
     metrics=feasibility_metrics,
+    warnings=lambda result: rule_notices("feasibility", result.summary),
     judge=lambda result: material_judgement(result.summary),
 )

@@ -8,6 +8,7 @@ made or cannot reach the vessel; margins say by how much it can.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 from softdesign.pipeline.notices import Judgement, Notice
@@ -26,6 +27,26 @@ def material_judgement(summary: dict[str, Any] | None, what: str = "") -> Judgem
         return Judgement(judged=False)
     reasons = tuple(f"{what}: {r}" if what else r for r in summary["reasons"])
     return Judgement(judged=True, reasons=reasons, material=str(material.get("name", "")))
+
+
+def actuation_judgement(summary: dict[str, Any]) -> Judgement | None:
+    """The chambers' judgement against the material, with the single-supply device's line as a margin.
+
+    The rod model's refusals are among ``summary["reasons"]`` already; when none, the device's line ("one
+    pressure of P* kPa bends it into the vessel within X mm (rod model), walls >= W mm, thread at T % of its
+    limit") says by how much it can, judged or not.
+    """
+    judgement = material_judgement(summary, "chambers")
+    line = summary.get("verdict_line")
+    if judgement is None or not line or judgement.reasons:
+        return judgement
+    return replace(judgement, margins=(*judgement.margins, line.removeprefix("device: ")))
+
+
+def rule_notices(stage: str, summary: dict[str, Any] | None) -> list[Notice]:
+    """A warning per rule of thumb a stage's figures cross (``summary["warnings"]``: margins without a published
+    source, such as ``min_stretch``; never a reason of the verdict)."""
+    return [Notice(stage, "rule_of_thumb", "", text) for text in (summary or {}).get("warnings", [])]
 
 
 def design_judgement(document: dict[str, Any] | None) -> Judgement | None:

@@ -31,7 +31,7 @@ from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.output_frame import base_pose, moved_points, moved_vectors, output_pose
 from softdesign.pipeline.stage import Stage
-from softdesign.pipeline.stages.actuation import actuation_layout
+from softdesign.pipeline.stages.actuation import ActuationResult, actuation_layout
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.judges import mould_judgement
 from softdesign.pipeline.stages.kinematics import KinematicsResult
@@ -61,14 +61,15 @@ def _formats(case: Case) -> list[str]:
     return ["stl", *(f for f in case.export.formats if f != "stl")]
 
 
-def run_mould(case: Case, kinematics: KinematicsResult, fit: FitResult) -> MouldResult:
+def run_mould(case: Case, kinematics: KinematicsResult, fit: FitResult,
+              sized: ActuationResult | None = None) -> MouldResult:
     """The checked mould of the body at q = 0, or nothing when the case asks for none."""
     spec = mould_spec(case)
     if spec is None:
         return MouldResult((), {"requested": False})
     e = case.export
     sections = body_sections(kinematics.chain.shape.curve_at(0.0), fit.field, 0.0, e.spacing_mm, e.angular_count)
-    actuated = actuation_layout(case, kinematics)
+    actuated = actuation_layout(case, kinematics, sized)  # supply: single: the chambers as the rod model sized them
     steps = ("the parts", "their checks")
     tick = item_counter("mould", steps)  # two steps of a bar (the parts take most of the time), when one listens
     if actuated is None:
@@ -158,8 +159,8 @@ STAGE = Stage(
     version=VERSION,
     reads=("export.mould", "export.offset_mm", "export.wall_mm", "export.port_mm", "export.spacing_mm",
            "export.angular_count", "export.formats", "export.frame", "actuation"),
-    upstream=("kinematics", "fit"),
-    compute=lambda case, results: run_mould(case, results["kinematics"], results["fit"]),
+    upstream=("kinematics", "fit", "actuation"),
+    compute=lambda case, results: run_mould(case, results["kinematics"], results["fit"], results["actuation"]),
     write=write_mould,
     load=lambda build_dir, results: load_mould(build_dir),
     describe=describe_mould,

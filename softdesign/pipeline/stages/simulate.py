@@ -69,8 +69,9 @@ def _sections(case: Case, count: int) -> list[int]:
 def _meshes(case: Case, kinematics: KinematicsResult, fit: FitResult) -> dict[int, Any]:
     """Every requested section's mesh, the layout checked first and each mesh's size before any solve."""
     from softdesign.pipeline.simulate_run import check_node_count, section_mesh_of
-    from softdesign.pipeline.stages.actuation import actuation_layout, check_layout, section_radii
+    from softdesign.pipeline.stages.actuation import actuation_layout, check_layout, section_radii, unsized_single
 
+    unsized_single(case, "simulate")
     layout = actuation_layout(case, kinematics)
     if layout is None:
         raise ConfigError("simulate.enabled needs actuation chambers; add an `actuation:` block")

@@ -1,0 +1,184 @@
+"""What the rod model adds to the actuation stage: the single-supply layout and rows, or the per-chamber pressures.
+
+``supply: single``: the chambers sized for P* (:mod:`softdesign.pipeline.rod_single`) replace the layout's
+three-chamber rule, its ring walls and its table rows; ``per_chamber``: the layout stays seed 003's and every row
+gets the chamber's pressure from the rod model's inverse (:func:`~softdesign.pipeline.rod_device.per_chamber_rows`).
+Without a hoop reinforcement or a material law the rows' ``pressure_kpa`` is empty and a note says why.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from softdesign.errors import ConfigError
+from softdesign.io.format_names import q_label
+from softdesign.kinematics.pcc_fit import fit_links
+from softdesign.meshing.chamber_walls import Wall
+from softdesign.pipeline.rod_device import (
+    RodSetup,
+    layout_body,
+    layout_stations,
+    outlines_at,
+    per_chamber_rows,
+    rod_setup,
+    section_rest_lengths,
+    station_l,
+)
+from softdesign.pipeline.rod_single import single_layout, single_rows, single_summary, size_case, verdict_line
+
+if TYPE_CHECKING:
+    from softdesign.config import Case
+    from softdesign.meshing.chamber_layout import ChamberLayout
+    from softdesign.pipeline.stages.design import DesignResult
+    from softdesign.pipeline.stages.fit import FitResult
+    from softdesign.pipeline.stages.kinematics import KinematicsResult
+
+#: Backbone samples per section for its best arc (as the stage's).
+ARC_SAMPLES = 201
+#: Longest core, in diameters, the mould prints as a pin: a printed pin more slender than this bends under the
+#: pour and breaks on release (a rule of thumb, stated as such); a longer core is a steel wire or rod.
+MAX_PIN_ASPECT = 20.0
+
+
+def core_figures(lengths_mm: list[float], diameters_mm: list[float], lost: bool = False) -> list[dict[str, Any]]:
+    """Per chamber its core: length, (smallest) diameter, aspect ratio and what to make it of.
+
+    ``lost``: tapered chambers joined in series (``supply: single``) are cast on lost cores (wax or dissolvable),
+    a slender one over a steel wire of half its smallest diameter; else a straight pin, printed or, past
+    ``MAX_PIN_ASPECT``, a steel wire or rod of the chamber's diameter.
+    """
+    out = []
+    for length, diameter in zip(lengths_mm, diameters_mm, strict=True):
+        aspect = length / diameter if diameter > 0 else float("inf")
+        slender = aspect > MAX_PIN_ASPECT
+        if lost:
+            make = "lost core (wax or dissolvable), tapered as the chamber's profile" + (
+                f", cast over a steel wire of {0.5 * diameter:.2f} mm (aspect ratio {aspect:.0f} > "
+                f"{MAX_PIN_ASPECT:g})" if slender else "")
+        else:
+            make = ("printed pin (the mould's core)" if not slender else
+                    f"steel wire or rod of {diameter:.2f} mm, {length:.1f} mm long (aspect ratio {aspect:.0f} > "
+                    f"{MAX_PIN_ASPECT:g}: a printed pin this slender bends or breaks)")
+        out.append({"length_mm": length, "diameter_mm": diameter, "aspect_ratio": aspect, "make": make})
+    return out
+
+
+@dataclass(frozen=True)
+class RodFigures:
+    """The rod model's part of the actuation stage.
+
+    ``sections``, ``rows``, ``walls``: None where the stage's own (seed 003) figures stand; ``fill`` puts the
+    pressures into the rows and returns the summary's per-q pressures.
+    """
+
+    layout: ChamberLayout
+    sections: list[dict[str, Any]] | None
+    rows: list[dict[str, Any]] | None
+    walls: list[Wall] | None
+    summary: dict[str, Any]
+    reasons: list[str]
+    warnings: list[str]
+    fill: Callable[[list[dict[str, Any]]], dict[str, Any]] = field(default=lambda rows: {})
+
+
+def rod_figures(case: Case, kinematics: KinematicsResult, fit: FitResult, design: DesignResult | None,
+                layout: ChamberLayout, grid: list[tuple[float, bool]]) -> RodFigures:
+    """The single-supply device, or the per-chamber pressures, of the case (see the module notes)."""
+    setup = rod_setup(case)
+    if case.actuation is not None and case.actuation.supply == "single":
+        if isinstance(setup, str):
+            raise ConfigError(f"actuation.supply: single: {setup}")
+        if design is None:
+            raise ConfigError("actuation.supply: single sizes each designed section: add design: {tolerance_mm: 1} "
+                              "and blend: pcc")
+        return _single(case, kinematics, fit, design, layout, grid, setup)
+    head = {"supply": "per_chamber", "backbone": case.actuation.backbone if case.actuation else None,
+            "design_pressure_kpa": None}
+    if isinstance(setup, str):
+        def empty(rows: list[dict[str, Any]]) -> dict[str, Any]:
+            for r in rows:
+                r["pressure_kpa"] = None
+            return {}
+        return RodFigures(layout, None, None, None, {**head, "body_modulus_kpa": None, "rod_model": setup}, [],
+                          [f"no pressures: {setup}"], empty)
+    stations = layout_stations(layout, section_rest_lengths(kinematics))
+    body = layout_body(layout, stations, outlines_at(kinematics, fit, stations.s), setup)
+    rest = section_rest_lengths(kinematics)
+    export = [q for q, e in grid if e]
+
+    def fill(rows: list[dict[str, Any]]) -> dict[str, Any]:
+        per_chamber_rows(rows, body, rest)
+        return {"pressures_kpa": {q_label(q): [[r["pressure_kpa"] for r in rows if r["q"] == q and r["section"] == i]
+                                               for i in range(1, layout.sections + 1)] for q in export}}
+
+    inner = [float(stations.ds[(stations.section == c.section) & stations.chamber].sum()) for c in layout.chambers]
+    cores = core_figures(inner, [c.diameter_mm for c in layout.chambers])
+    return RodFigures(layout, None, None, None, {**head, "body_modulus_kpa": setup.modulus_kpa,
+                                                 "reinforcement": setup.reinforcement(), "cores": cores}, [],
+                      _core_notes(cores), fill)
+
+
+def _single(case: Case, kinematics: KinematicsResult, fit: FitResult, design: DesignResult, layout: ChamberLayout,
+            grid: list[tuple[float, bool]], setup: RodSetup) -> RodFigures:
+    single = size_case(case, kinematics, fit, design, setup)
+    summary = single_summary(case, single, setup)
+    arcs = {q: fit_links(kinematics.chain, q, ARC_SAMPLES) for q, _ in grid}
+    rows = single_rows(single, grid, arcs)
+    st, dev = single.problem.stations, single.device
+    walls = []
+    for i in range(int(st.section.max()) + 1):  # between cavities and against the thread (the skin is measured)
+        inner = [(float(dev.walls[k]), dev.wall_kind[k]) for k in np.flatnonzero(st.section == i)
+                 if not dev.wall_kind[k].endswith("-skin")]
+        if inner:
+            value, kind = min(inner)
+            walls.append(Wall(kind, value, i + 1, 0, None, None, None))
+    warnings: list[str] = []
+    if summary["rest_lengths_mm"] is not None:
+        warnings.append("backbone: free: cast each section shorter, at " + ", ".join(
+            f"{v:.2f}" for v in summary["rest_lengths_mm"]) + " mm, to reach its designed length at P* (the meshes "
+            "are at the designed lengths)")
+    sections = summary.pop("sections")
+    meshed = single_layout(layout, single, station_l(kinematics, single.problem.stations.s))
+    summary["cores"] = core_figures([s["chambers"][0]["length_mm"] for s in sections],
+                                    [min(s["chambers"][0]["diameter_mm"].values()) for s in sections], lost=True)
+    warnings += _core_notes(summary["cores"])
+    return RodFigures(meshed, sections, rows, walls, summary, list(summary["model_reasons"]), warnings)
+
+
+def _core_notes(cores: list[dict[str, Any]]) -> list[str]:
+    """One note when some cores are too slender to print: how many, and what to use."""
+    steel = [c for c in cores if c["aspect_ratio"] > MAX_PIN_ASPECT]
+    if not steel:
+        return []
+    worst = max(steel, key=lambda c: c["aspect_ratio"])
+    return [f"{len(steel)} of {len(cores)} chamber cores are longer than {MAX_PIN_ASPECT:g} diameters (up to "
+            f"{worst['aspect_ratio']:.0f}): {worst['make']} (actuation/summary.json: cores)"]
+
+
+def device_line(summary: dict[str, Any]) -> str | None:
+    """The single-supply device's verdict (None for other supplies): the rod model's line when every judged figure
+    is within its limits, else ``device: NOT feasible:`` and every reason (each names the key to change)."""
+    if summary.get("supply") != "single":
+        return None
+    if summary.get("material") is not None and summary.get("reasons"):
+        return "device: NOT feasible: " + "; ".join(summary["reasons"])
+    return verdict_line(summary)
+
+
+def describe_rod(summary: dict[str, Any]) -> list[str]:
+    """The rod model's lines: the single-supply device's chambers and verdict line, or the per-chamber pressures."""
+    if summary.get("supply") == "single":
+        lines = [f"section {s['section']}: chamber at {s['chambers'][0]['angle_rad']['middle']:.3f} rad, "
+                 f"{s['chambers'][0]['distance_mm']['middle']:.3f} mm out, diameter "
+                 f"{s['chambers'][0]['diameter_mm']['start']:.3f}-{s['chambers'][0]['diameter_mm']['end']:.3f} mm, "
+                 f"{s['chambers'][0]['turns']} turns" for s in summary.get("sections", [])]
+        return lines + [summary.get("verdict_line") or verdict_line(summary)]
+    pressures = summary.get("pressures_kpa")
+    if not pressures:
+        return [f"pressures: none ({summary.get('rod_model', 'no rod model')})"]
+    top = max((p for per_q in pressures.values() for sec in per_q for p in sec if p is not None), default=0.0)
+    return [f"pressures (rod model, per chamber): up to {top:.1f} kPa over the export q"]

@@ -1,0 +1,60 @@
+"""`softdesign pressure`: bad input refused before any stage runs (exit 2, the key), and the rod model's shape."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from softdesign.cli import app
+from tests.cli.test_cli_validate import demo_case
+from tests.helpers.cases import case_from
+from tests.helpers.paths import REPO
+
+runner = CliRunner()
+#: q P* against the pressure printed (both from one float), and the same model at --q and --pressure, kPa and mm.
+SAME_TOL = 1e-9
+
+
+def test_help_names_both_ways_of_asking():
+    result = runner.invoke(app, ["pressure", "--help"])
+    assert result.exit_code == 0 and "--q" in result.output and "--pressure" in result.output
+
+
+@pytest.mark.parametrize(("args", "sections", "message"), [
+    (["--q", "0.5", "--pressure", "100"], {"actuation": {}}, "give --q or --pressure, not both"),
+    (["--q", "1.5"], {"actuation": {}}, "--q must be in [0, 1], got 1.5"),
+    (["--pressure", "-1"], {"actuation": {}}, "--pressure must be in [0, 100000] kPa, got -1"),
+    ([], {}, "the case has no actuation: block"),
+    ([], {"actuation": {"reinforcement": {"kind": "none"}}}, "kappa = (1 - 2 nu) P A d / (E I) = 0"),
+    (["--pressure", "100"], {"actuation": {}}, "--pressure is one supply pressure (actuation.supply: single)"),
+    ([], {"actuation": {}, "material": None}, "the rod model takes E = 3 mu from the material's law"),
+])
+def test_bad_input_exits_2_naming_what_to_change(tmp_path: Path, args: list[str], sections: dict,
+                                                 message: str) -> None:
+    case = demo_case(tmp_path, **sections)
+    result = runner.invoke(app, ["pressure", str(case), "--out", str(tmp_path / "build"), *args])
+    assert result.exit_code == 2, result.output
+    assert message in result.stderr and "Traceback" not in result.output
+    assert not (tmp_path / "build").exists()  # refused before any stage ran
+
+
+@pytest.mark.slow
+def test_the_single_supply_demo_at_half_its_design_pressure(tmp_path: Path) -> None:
+    case = case_from(tmp_path, REPO / "configs" / "actuator.yaml", {})
+    out = tmp_path / "build"
+    half = runner.invoke(app, ["pressure", str(case), "--out", str(out), "--q", "0.5", "--json"])
+    assert half.exit_code == 0, half.output
+    doc = json.loads(half.stdout)
+    assert doc["supply"] == "single" and doc["q"] == 0.5
+    assert abs(doc["pressure_kpa"] - 0.5 * doc["design_pressure_kpa"]) <= SAME_TOL
+    # blend: pcc at q = 0.5 is the designed chain at half its curvature: the model follows it as closely as at P*
+    assert doc["deviation_mm"] < 2.0
+    same = runner.invoke(app, ["pressure", str(case), "--out", str(out), "--pressure",
+                               repr(doc["pressure_kpa"]), "--json"])
+    again = json.loads(same.stdout)
+    assert abs(again["q"] - 0.5) <= SAME_TOL
+    for a, b in zip(again["sections"], doc["sections"], strict=True):
+        assert abs(a["kappa"] - b["kappa"]) <= SAME_TOL and abs(a["length"] - b["length"]) <= SAME_TOL
