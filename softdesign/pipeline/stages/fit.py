@@ -119,8 +119,9 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     # the fitted body itself at every q of the morph's search, not only at q = 1 (issue 29)
     morph = fold_over_morph(chain.shape.curve_at, field, np.linspace(0.0, 1.0, MORPH_Q_SAMPLES))
     summary["morph_fold"] = morph.as_dict()
-    if morph.warning() is not None:
-        summary["warnings"] = [*summary.get("warnings", []), morph.warning()]
+    warning = morph.warning(chain.shape.mode)
+    if warning is not None:
+        summary["warnings"] = [*summary.get("warnings", []), warning]
     if chain.shape.mode == "pcc":
         summary["pcc"] = _carried_to_chain(chain, curve)
     # the end prior can hold the ends a straying centerline leaves one-sided: the fit then succeeds, so say it
