@@ -8,6 +8,7 @@ manifest.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -42,6 +43,9 @@ from softdesign.fitting.radius_field import (
 from softdesign.fitting.selection import NetworkContext, SelectionSettings, WallSelection, select_wall_points
 from softdesign.types import FloatArray, FramedCurve
 
+#: The steps of :func:`fit_wall`, told to ``WallFitOptions.progress`` as each ends.
+FIT_STEPS = ("projection", "selection", "spline", "distances", "hold-out", "fold check", "coverage")
+
 
 @dataclass(frozen=True)
 class WallFitOptions:
@@ -60,6 +64,7 @@ class WallFitOptions:
         None: as fitted
     local_caps : the fitted rho held at most a radius over stretches of the path only
         (:mod:`softdesign.fitting.local_cap`)
+    progress : told the name of each of :data:`FIT_STEPS` as it ends (None: nobody)
     mapper : runs independent pieces (the hold-out's folds, the projection's and the metrics' blocks of
         points), perhaps on other processes; the same figures for any
     """
@@ -74,6 +79,7 @@ class WallFitOptions:
     max_radius_mm: float | None = None
     local_caps: tuple[LocalCap, ...] = ()
     mapper: Mapper = serial_map
+    progress: Callable[[str], None] | None = None
 
 
 @dataclass(frozen=True)
@@ -182,8 +188,11 @@ def fit_wall(
     FitError
         The wall does not surround the path, the solve fails, or the tube folds at q = 1.
     """
+    tell = options.progress or (lambda name: None)
     polar = project_points(curve, vertices, options.mapper)
+    tell("projection")
     selection = select_wall_points(polar, curve.length, network, options.selection)
+    tell("selection")
     # in order along the path: every later evaluation then reads the splines' pieces in turn
     kept_index = np.flatnonzero(selection.keep)
     kept_index = kept_index[np.argsort(polar.l[kept_index], kind="stable")]
@@ -200,10 +209,13 @@ def fit_wall(
         keep = hold.keeps(kept.l)
         kept, kept_index = kept.subset(keep), kept_index[keep]
         settings, scores, prior, surface = _fit_kept(curve, kept, options, reference, rng)
+    tell("spline")
     measured = measure_distances(curve, surface.whole, kept, rng, mapper=options.mapper)
+    tell("distances")
     # the hold-out folds are dealt from the measured points, each starting from its closest point
     holdout = holdout_rms(curve, kept.subset(measured.sample), settings, rng, options.holdout,
                           start=measured.start, mapper=options.mapper)
+    tell("hold-out")
     metrics = measured.metrics
     radius = RadiusField.from_links(settings.breaks, surface.links, options.initial_radius_mm)
     try:
@@ -221,6 +233,7 @@ def fit_wall(
         rho = radius.evaluate_grid(1.0, l, np.linspace(0.0, 2.0 * np.pi, 96, endpoint=False)).min(axis=1)
         raise FitError(f"{str(err).split('; ')[0]}; {negative_radius_cause(prior, curve.length, l[np.argmin(rho)])}"
                        ) from err
+    tell("fold check")
     ends = end_radii(radius, reference) | {"margin": {"mm": options.end_margin_mm, "points": float((~inside).sum())}}
     if hold is not None:
         ends[f"{hold.end}_held"] = hold.as_dict(curve.length)
@@ -229,5 +242,6 @@ def fit_wall(
     coverage = measure_coverage(curve, surface.whole, polar, selection, kept_index, settings.knot_spacing_mm,
                                 reference, {} if prior is None else prior.ends, options.mapper,
                                 tuple(c.span_mm for c in options.local_caps))
+    tell("coverage")
     return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius, ends, distance,
                    coverage)

@@ -29,6 +29,7 @@ from softdesign.geometry.blend import BlendedShape
 from softdesign.geometry.morph_fold import MORPH_Q_SAMPLES
 from softdesign.kinematics.links import link_breaks
 from softdesign.pipeline.fit_options import AUTO_START_SPACING_MM, wall_fit_options
+from softdesign.pipeline.item_progress import step_counter
 
 if TYPE_CHECKING:
     from softdesign.config import Case
@@ -57,10 +58,13 @@ def body_field(case: Case, ingest: IngestResult, shape: BlendedShape) -> RadiusF
         options = replace(options, fit=replace(options.fit, knot_spacing_mm=AUTO_START_SPACING_MM))
     vertices = np.asarray(ingest.vertices, float)
     stride = max(1, -(-len(vertices) // BODY_POINTS))
+    step = step_counter("blend", ("the wall fitted for auto's look at the body",))  # seconds on a big tree
     try:
         return fit_body(curve, vertices[::stride], network, options)
     except FitError:
         return None
+    finally:
+        step("the wall fitted for auto's look at the body")
 
 
 def body_morph(shape: BlendedShape, field: RadiusField) -> MorphFold:

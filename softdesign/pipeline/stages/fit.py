@@ -11,7 +11,7 @@ joint jumps, rho * kappa at q = 1).
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -25,7 +25,7 @@ from softdesign.fitting.morph_folds import fold_over_morph
 from softdesign.fitting.projection import project_points
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.selection import NetworkContext, inscribed_profile
-from softdesign.fitting.wall_fit import fit_wall
+from softdesign.fitting.wall_fit import FIT_STEPS, fit_wall
 from softdesign.geometry.curves import SmoothCurve, measure_deviation
 from softdesign.geometry.end_cut import choose_end_cuts
 from softdesign.geometry.end_planes import rim_gap_warnings
@@ -37,6 +37,7 @@ from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import describe_backbone_fit, stretch_fit_errors
 from softdesign.pipeline.fit_options import wall_fit_options
 from softdesign.pipeline.fold_paths import with_avoiding_paths
+from softdesign.pipeline.item_progress import step_counter
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.ingest import IngestResult
@@ -95,6 +96,7 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     network = NetworkContext(path.points, tuple(p.points for p in ingest.others), *inscribed)
     fit = case.fit
     options = wall_fit_options(case, tuple(chain.breaks), map_items)  # the hold-out's folds on the build's workers
+    options = replace(options, progress=step_counter("fit", FIT_STEPS))  # a bar on a terminal
     problems = check_caps_on_path(options.local_caps, curve.length)
     if problems:
         raise ConfigError(f"{problems[0]}; move or remove that entry")
