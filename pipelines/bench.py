@@ -36,6 +36,10 @@ Start-up
     console script beside this Python), wall time from start to exit, and
     the median CPU time (user + system) of the same runs.
 
+Big tree
+    A binary tree of 511 tracts and about 1M triangles (softdesign/samples/tree_vessel.py, written once per
+    run), path 0 at defaults: ingest <= 15 s and the fit of the path <= 30 s (issue 43, item 7).
+
 Volume mesh
     The volume_mesh stage alone (pipelines/bench_volume.py, issue 32): the
     sample case solid, hollow and chambered and the aorta, CPU s against 10 s.
@@ -98,6 +102,11 @@ STARTUP_REPEATS = 5
 TARGET_REPORT_RATIO_DEMO = 1.5
 TARGET_REPORT_RATIO_LARGE = 1.0
 REPORT_REPEATS = 3
+#: The big tree (issue 43, item 7): a binary tree of 511 tracts (256 root-to-leaf paths) and about 1M surface
+#: triangles, path 0 built at defaults; ingest and the fit of that one path on 2 cores, wall seconds.
+TREE_TRIANGLES = 1_000_000
+TARGET_TREE_INGEST_S = 15.0
+TARGET_TREE_FIT_S = 30.0
 #: Time ~ size^e counts as linear up to this e (timings on a shared machine jitter by ~10 %).
 LINEAR_EXPONENT_MAX = 1.15
 #: The scaled case's links and default sizes.
@@ -354,6 +363,28 @@ def synthetic_case(folder: Path, triangles: int, frames: int) -> BenchCase:
         f"export: {{frames: {frames}}}\n"
     )
     return BenchCase(f"synthetic {triangles / 1e6:g}M triangles, {frames} frames", case, triangles, frames)
+
+
+def tree_case(folder: Path) -> BenchCase:
+    """The benchmark tree (softdesign/samples/tree_vessel.py), written once into ``folder``; path 0 at defaults."""
+    from softdesign.samples.files import CENTERLINE, TREE_SURFACE, write_tree
+
+    if not (folder / TREE_SURFACE).is_file():
+        write_tree(folder, TREE_TRIANGLES)
+    case = folder / "tree.yaml"
+    case.write_text(f"name: tree\nunits: mm\nfinal: {{centerline: {CENTERLINE}, surface: {TREE_SURFACE}, path: 0}}\n")
+    return BenchCase(f"tree of 511 tracts, {TREE_TRIANGLES / 1e6:g}M triangles (path 0)", case, TREE_TRIANGLES)
+
+
+def tree_lines(result: dict[str, Any]) -> list[str]:
+    """The tree's stage table and issue 43's two targets, each with its figure and verdict."""
+    ingest, fit = seconds(result, "ingest"), seconds(result, "fit")
+    return stage_table(result) + [
+        f"  ingest                {ingest:7.1f} s   target <= {TARGET_TREE_INGEST_S:g} s        "
+        f"{verdict(ingest <= TARGET_TREE_INGEST_S)}",
+        f"  fit of one path       {fit:7.1f} s   target <= {TARGET_TREE_FIT_S:g} s        "
+        f"{verdict(fit <= TARGET_TREE_FIT_S)}",
+    ]
 
 
 def measure(case: BenchCase, scratch: Path, profile_dir: Path | None = None, jobs: int = 1) -> dict[str, Any]:
@@ -673,6 +704,7 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
         emit([f"VMTK aorta: skipped, {AORTA_DIR} not found", ""])
     else:
         emit(stage_table(measure(aorta, scratch, jobs=args.jobs)) + [""])
+    emit(tree_lines(measure(tree_case(scratch / "tree"), scratch, jobs=args.jobs)) + [""])
     emit(script_lines("bench_volume.py") + [""])
     emit(script_lines("bench_centerline.py", ok_codes=(0,)) + [""])  # no target of its own: any failure is one
     emit(["design stage (issue 30), CPU s of the core per case and tolerance:", *script_lines("bench_design.py"), ""])

@@ -43,7 +43,13 @@ class FitError(SoftdesignError):
 
 
 class FoldError(FitError):
-    """The fitted body folds through itself (1 - rho * kappa_n <= 0); the message names the body radius that fits."""
+    """The fitted body folds through itself (1 - rho * kappa_n <= 0); the message names the body radius that fits.
+
+    ``stretches`` holds the folding stretches (:class:`softdesign.fitting.local_cap.FoldStretch`) when the fit
+    measured them, for the pipeline to name the paths that avoid them.
+    """
+
+    stretches: tuple[object, ...] = ()
 
 
 class InputFitError(FitError, InputDataError):

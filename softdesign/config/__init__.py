@@ -33,6 +33,7 @@ from pydantic import (
 
 from softdesign.config.actuation import Actuation, single_supply_problems
 from softdesign.config.design import Design, pcc_blend_problems
+from softdesign.config.fit_caps import MAX_LOCAL_CAPS, LocalMaxRadius
 from softdesign.config.material import CustomMaterial
 from softdesign.config.simulate import Simulate
 from softdesign.config.types import FiniteFloat, Flag, Integer, q_in_range
@@ -234,6 +235,11 @@ class Fit(_Section):
     max_radius_mm: FiniteFloat | None = Field(None, gt=0.0)
     """A cap on the fitted body's radius, mm: a thinner body that can make a turn tighter than the vessel is wide (the
     fix a fold's message names).
+    """
+    # the same cap over stretches of the path only, tapering back to the fit (config/fit_caps.py)
+    local_max_radius: list[LocalMaxRadius] = Field(default_factory=list, max_length=MAX_LOCAL_CAPS)
+    """Caps on the body's radius over stretches of the path only, each {from_mm, to_mm, radius_mm, taper_mm} (the fix
+    a fold at a take-off offers first).
     """
 
     @field_validator("knot_spacing_mm", mode="before")

@@ -31,7 +31,7 @@ import numpy as np
 from softdesign.fitting.bspline_surface import RadiusSpline
 from softdesign.fitting.end_prior import SEEN_GAP_RAD, largest_gap
 from softdesign.fitting.mapping import Mapper, serial_map
-from softdesign.fitting.metrics import FitMetrics, measure_distances
+from softdesign.fitting.metrics import FitMetrics, measure_distances, summarize_distances
 from softdesign.fitting.projection import PolarPoints
 from softdesign.fitting.selection import REASONS, WallSelection
 from softdesign.types import FloatArray, FramedCurve
@@ -58,6 +58,9 @@ class WallCoverage:
     stretches: tuple[dict[str, Any], ...]
     flags: tuple[str, ...]
     warnings: tuple[str, ...]
+    #: the all-wall figures outside ``spans_mm`` (None without local caps)
+    outside: FitMetrics | None = None
+    spans_mm: tuple[tuple[float, float], ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         """``all_wall`` distances (mm), ``coverage`` figures, ``flags`` and ``warnings``."""
@@ -73,7 +76,8 @@ class WallCoverage:
             },
             "flags": list(self.flags),
             "warnings": list(self.warnings),
-        }
+        } | ({} if self.outside is None else {"all_wall_outside_local_caps": {
+            **self.outside.as_dict(), "spans_mm": [list(span) for span in self.spans_mm]}})
 
 
 def own_wall(polar: PolarPoints, selection: WallSelection) -> np.ndarray:
@@ -92,6 +96,7 @@ def measure_coverage(
     reference: tuple[FloatArray, FloatArray] | None,
     held_ends: dict[str, Any],
     mapper: Mapper = serial_map,
+    spans_mm: tuple[tuple[float, float], ...] = (),
 ) -> WallCoverage:
     """True distances of the own wall to the fitted surface, the coverage, the unseen stretches and the flags.
 
@@ -106,11 +111,21 @@ def measure_coverage(
     reference : normalized l (m,) and inscribed radius (m,) mm, or None (then the fitted points' rho)
     held_ends : the end prior's per-end figures (which ends are held at the inscribed radius)
     mapper : runs the distance blocks
+    spans_mm : stretches (from, to), mm from the inlet, where local caps hold the body thinner on purpose: the
+        all-wall figures are given outside them too, and the p95 flag judges those
     """
     own = own_wall(polar, selection)
     nan = float("nan")
-    measured = measure_distances(curve, surface, polar.subset(own), np.random.default_rng(ALL_WALL_SEED),
-                                 mapper=mapper).metrics if own.any() else FitMetrics(nan, nan, nan, nan, 0)
+    measured, outside = FitMetrics(nan, nan, nan, nan, 0), None
+    if own.any():
+        found = measure_distances(curve, surface, polar.subset(own), np.random.default_rng(ALL_WALL_SEED),
+                                  mapper=mapper)
+        measured = found.metrics
+        if spans_mm:  # local caps hold the body off the wall on purpose there: judged outside them
+            s = polar.l[np.flatnonzero(own)[found.sample]] * curve.length
+            away = ~np.any([(s >= lo) & (s <= hi) for lo, hi in spans_mm], axis=0)
+            outside = summarize_distances(found.distance[away]) if away.any() else FitMetrics(nan, nan, nan, nan, 0)
+    judged = measured if outside is None else outside
     kept = polar.subset(fitted)
     radius = float(np.median(reference[1] if reference is not None else kept.rho)) if len(kept) else float("nan")
     stretches = unseen_stretches(kept, curve.length, interval_mm, reference, held_ends)
@@ -122,14 +137,15 @@ def measure_coverage(
             f"no wall seen all round over {s['length_mm']:.1f} mm at {s['from_mm']:.1f}-{s['to_mm']:.1f} mm from the "
             f"inlet, longer than the local diameter {s['diameter_mm']:.1f} mm: the body there is {s['how']}, not "
             "matched to the wall (the report's fit section shows where)" for s in long]
-    if measured.count and measured.p95_mm > ALL_WALL_P95_FRACTION * radius:
+    if judged.count and judged.p95_mm > ALL_WALL_P95_FRACTION * radius:
         flags.append(FLAG_P95)
+        where = "" if outside is None else ", outside the fit.local_max_radius stretches,"
         warnings.append(
-            f"against all of the path's own wall ({int(own.sum())} vertices, {len(fitted) / own.sum():.0%} of them "
-            f"fitted) the body's p95 distance is {measured.p95_mm:.3f} mm, above {ALL_WALL_P95_FRACTION:g} of the "
-            f"radius {radius:.3f} mm (max {measured.max_mm:.3f} mm): the kept-point figures do not describe it")
+            f"against all of the path's own wall{where} ({int(own.sum())} vertices, {len(fitted) / own.sum():.0%} "
+            f"of them fitted) the body's p95 distance is {judged.p95_mm:.3f} mm, above {ALL_WALL_P95_FRACTION:g} of "
+            f"the radius {radius:.3f} mm (max {judged.max_mm:.3f} mm): the kept-point figures do not describe it")
     return WallCoverage(measured, int(own.sum()), int(len(fitted)), radius, tuple(stretches), tuple(flags),
-                        tuple(warnings))
+                        tuple(warnings), outside, tuple(spans_mm))
 
 
 def unseen_stretches(

@@ -39,15 +39,20 @@ class MorphFold:
         return {"max_rho_kappa": r.max_rho_kappa, "q": self.q, "l": r.l, "arc_mm": r.arc_mm, "angle": r.angle,
                 "min_rho_mm": r.min_rho_mm, "q_samples": self.samples}
 
-    def warning(self) -> str | None:
-        """A line when the body folds before q = 1 (q = 1 itself is refused by the fit), else None."""
+    def warning(self, mode: str = "linear") -> str | None:
+        """A line when the body folds before q = 1 (q = 1 itself is refused by the fit), else None.
+
+        ``mode`` is the blend built: intrinsic is offered only when it is not the one in use.
+        """
         r = self.report
         if r.max_rho_kappa < 1.0 or self.q >= 1.0:
             return None
+        fix = ("hold the body thinner (fit.max_radius_mm, or fit.local_max_radius over the stretch)" if mode != "linear"
+               else "blend: intrinsic keeps the curvature within the end shapes', or hold the body thinner "
+                    "(fit.max_radius_mm)")
         return (f"the fitted body folds mid-morph: at q = {self.q:.3f}, l = {r.l:.4f} ({r.arc_mm:.1f} mm from the "
                 f"inlet), angle {np.degrees(r.angle):.0f} deg, rho * kappa = {r.max_rho_kappa:.3f} (folds at 1): "
-                "meshes at export q near it will fail; blend: intrinsic keeps the curvature within the end "
-                "shapes', or hold the body thinner (fit.max_radius_mm)")
+                f"meshes at export q near it will fail; {fix}")
 
 
 def fold_over_morph(shape_at: Callable[[float], FramedCurve], field: RadiusField, q_grid: np.ndarray) -> MorphFold:

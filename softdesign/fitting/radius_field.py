@@ -263,7 +263,7 @@ def fold_margin(curve: FramedCurve, field: RadiusField, q: float = 1.0) -> FoldR
     field : the radius field
     q : blend parameter in [0, 1]
     """
-    l, a, k_n, k_b = _fold_grid(curve, field)
+    l, a, k_n, k_b = fold_grid(curve, field)
     cos, sin = np.cos(a)[None, :], np.sin(a)[None, :]
     rows = SlopeRows(field, q, l, a, slopes=False)
     best, at, smallest = -np.inf, (0, 0), []
@@ -324,7 +324,7 @@ def fold_fix_radius(curve: FramedCurve, field: RadiusField, q: float = 1.0, reac
     (inf where none): held at most that, the body's rho * kappa_n stays at most ``reach`` there, and no larger
     elsewhere, as :func:`capped` never raises rho.  Rounded down to 0.01 mm.
     """
-    l, a, k_n_row, k_b_row = _fold_grid(curve, field)
+    l, a, k_n_row, k_b_row = fold_grid(curve, field)
     k_n = k_n_row[:, None] * np.cos(a)[None, :] + k_b_row[:, None] * np.sin(a)[None, :]
     rho = field.evaluate_grid(q, l, a)
     over = rho * k_n > reach
@@ -333,7 +333,7 @@ def fold_fix_radius(curve: FramedCurve, field: RadiusField, q: float = 1.0, reac
     return float(np.floor(100.0 * np.min(reach / k_n[over]) + 1e-9) / 100.0)  # 1e-9: 13.9999999 is 14.00
 
 
-def _fold_grid(curve: FramedCurve, field: RadiusField) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+def fold_grid(curve: FramedCurve, field: RadiusField) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """The fold checks' grid (l every FOLD_SPACING_MM, FOLD_ANGLES_PER_INTERVAL angles per interval) and the
     curvature vector's components along each l's N and B, 1/mm."""
     count = max(int(np.ceil(curve.length / FOLD_SPACING_MM)), 16) + 1

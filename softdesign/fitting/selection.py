@@ -169,14 +169,38 @@ def other_branch_mask(points: Points, network: NetworkContext, shared_tol_mm: fl
     nearer = np.zeros(len(points), bool)
     if not network.others:
         return nearer
-    to_path = polyline_distances(points, network.path)
-    for other in network.others:
-        other = np.asarray(other, float)
-        on_path = polyline_distances(other, network.path) <= shared_tol_mm
+    # every other polyline's own segments at once: nearer one of them than the path is nearer the nearest of them,
+    # the same distances (each segment's own formula) and one search instead of one per polyline (issue 43: a
+    # tree's hundreds of paths took minutes); a segment shared by several others (their common trunk) counts once
+    others = [np.asarray(other, float) for other in network.others]
+    near_path = polyline_distances(np.concatenate(others), network.path) <= shared_tol_mm  # all in one search
+    starts, ends = [], []
+    for other, on_path in zip(others, np.split(near_path, np.cumsum([len(o) for o in others])[:-1]), strict=True):
         own = ~(on_path[:-1] & on_path[1:])
-        if own.any():
-            nearer |= polyline_distances(points, other, own) < to_path
+        starts.append(other[:-1][own])
+        ends.append(other[1:][own])
+    pairs = np.unique(np.concatenate([np.concatenate(starts), np.concatenate(ends)], axis=1), axis=0)
+    if not len(pairs):
+        return nearer
+    path = np.asarray(network.path, float)
+    # bounds first: the nearest midpoint's distance m bounds a set's distance d by m - (longest half segment) <= d
+    # <= m; most points (another branch's wall far from the path, the path's wall far from the others) are settled
+    # by them, and only the rest are measured exactly
+    low_path, high_path = _midpoint_bounds(points, path[:-1], path[1:])
+    low_other, high_other = _midpoint_bounds(points, pairs[:, :3], pairs[:, 3:])
+    nearer = high_other < low_path
+    open_ = np.flatnonzero(~nearer & (low_other < high_path))
+    if open_.size:
+        to_path = polyline_distances(points[open_], path)
+        nearer[open_] = segment_distances(points[open_], pairs[:, :3], pairs[:, 3:]) < to_path
     return nearer
+
+
+def _midpoint_bounds(points: Points, start: Points, end: Points) -> tuple[FloatArray, FloatArray]:
+    """Lower and upper bounds (n,) mm of each point's distance to the segments: from the nearest midpoint."""
+    half = 0.5 * float(np.sqrt(np.max(np.einsum("ij,ij->i", end - start, end - start))))
+    nearest = np.asarray(cKDTree(0.5 * (start + end)).query(points, k=1, workers=-1)[0], float).reshape(-1)
+    return nearest - half, nearest
 
 
 def polyline_distances(points: Points, polyline: Points, segments: np.ndarray | None = None) -> FloatArray:
@@ -201,6 +225,16 @@ def polyline_distances(points: Points, polyline: Points, segments: np.ndarray | 
     start, end = polyline[:-1], polyline[1:]
     if segments is not None:
         start, end = start[segments], end[segments]
+    return segment_distances(points, start, end)
+
+
+def segment_distances(points: Points, start: Points, end: Points) -> FloatArray:
+    """Distance from each point (n, 3) to the nearest of the segments ``start``-``end`` (m, 3), m >= 1, mm.
+
+    The search of :func:`polyline_distances`, on any set of segments.
+    """
+    points = np.asarray(points, float)
+    start, end = np.asarray(start, float), np.asarray(end, float)
     edge = end - start
     edge2 = np.maximum(np.einsum("ij,ij->i", edge, edge), np.finfo(float).tiny)
     tree = cKDTree(0.5 * (start + end))

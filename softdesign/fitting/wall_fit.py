@@ -8,18 +8,20 @@ manifest.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
-from softdesign.errors import FitError
+from softdesign.errors import FitError, FoldError
 from softdesign.fitting.bspline_surface import FitSettings, SurfaceFit, fit_radius_surface
 from softdesign.fitting.coverage import WallCoverage, measure_coverage
 from softdesign.fitting.end_checks import end_radii, negative_radius_cause
 from softdesign.fitting.end_hold import negative_end
 from softdesign.fitting.end_prior import end_prior
+from softdesign.fitting.local_cap import LocalCap, fold_advice, fold_stretches, surface_capped_locally
 from softdesign.fitting.mapping import Mapper, serial_map
 from softdesign.fitting.metrics import (
     FitMetrics,
@@ -41,6 +43,9 @@ from softdesign.fitting.radius_field import (
 from softdesign.fitting.selection import NetworkContext, SelectionSettings, WallSelection, select_wall_points
 from softdesign.types import FloatArray, FramedCurve
 
+#: The steps of :func:`fit_wall`, told to ``WallFitOptions.progress`` as each ends.
+FIT_STEPS = ("projection", "selection", "spline", "distances", "hold-out", "fold check", "coverage")
+
 
 @dataclass(frozen=True)
 class WallFitOptions:
@@ -57,6 +62,9 @@ class WallFitOptions:
     end_margin_mm : kept points within this arc length of either end are left out of the fit, mm
     max_radius_mm : the fitted rho held at most this (:func:`~softdesign.fitting.radius_field.capped`), mm;
         None: as fitted
+    local_caps : the fitted rho held at most a radius over stretches of the path only
+        (:mod:`softdesign.fitting.local_cap`)
+    progress : told the name of each of :data:`FIT_STEPS` as it ends (None: nobody)
     mapper : runs independent pieces (the hold-out's folds, the projection's and the metrics' blocks of
         points), perhaps on other processes; the same figures for any
     """
@@ -69,7 +77,9 @@ class WallFitOptions:
     fold_limit: float = 1.0
     end_margin_mm: float = 0.0
     max_radius_mm: float | None = None
+    local_caps: tuple[LocalCap, ...] = ()
     mapper: Mapper = serial_map
+    progress: Callable[[str], None] | None = None
 
 
 @dataclass(frozen=True)
@@ -123,11 +133,37 @@ def _fit_kept(curve: FramedCurve, kept: PolarPoints, options: WallFitOptions,
     if options.auto_spacing:
         spacing, scores = choose_knot_spacing(curve, kept, settings, rng, options.holdout)
         settings = replace(settings, knot_spacing_mm=spacing)
-    surface = fit_radius_surface(kept, curve.length, settings)
+    surface = surface_capped_locally(fit_radius_surface(kept, curve.length, settings), options.local_caps,
+                                     curve.length, settings.breaks)
     if options.max_radius_mm is not None:  # every figure after is of the body built
         cap = options.max_radius_mm
         surface = replace(surface, whole=capped(surface.whole, cap), links=tuple(capped(s, cap) for s in surface.links))
     return settings, scores, prior, surface
+
+
+def fit_body(curve: FramedCurve, vertices: npt.ArrayLike, network: NetworkContext, options: WallFitOptions
+             ) -> RadiusField:
+    """The radius field alone, as :func:`fit_wall` fits it, for a quick look at the body before the fit stage.
+
+    The same projection, selection, end margin, end prior, caps and end hold; no hold-out (``auto_spacing``
+    keeps the settings' spacing), no metrics, no fold check (the caller judges the body).  ``blend: auto``
+    judges its morph on it (:mod:`softdesign.pipeline.blend_body`).
+    """
+    polar = project_points(curve, vertices, options.mapper)
+    selection = select_wall_points(polar, curve.length, network, options.selection)
+    kept_index = np.flatnonzero(selection.keep)
+    kept = polar.subset(kept_index[np.argsort(polar.l[kept_index], kind="stable")])
+    margin = options.end_margin_mm / curve.length
+    kept = kept.subset((kept.l >= margin) & (kept.l <= 1.0 - margin))
+    reference = None if network.inscribed_l is None or network.inscribed_radius is None else (
+        np.asarray(network.inscribed_l, float), np.asarray(network.inscribed_radius, float))
+    quick = replace(options, auto_spacing=False)
+    settings, _, _, surface = _fit_kept(curve, kept, quick, reference, np.random.default_rng(0))
+    hold = negative_end(surface.whole, curve.length, settings.knot_spacing_mm)
+    if hold is not None:
+        settings, _, _, surface = _fit_kept(curve, kept.subset(hold.keeps(kept.l)), quick, reference,
+                                            np.random.default_rng(0))
+    return RadiusField.from_links(settings.breaks, surface.links, options.initial_radius_mm)
 
 
 def fit_wall(
@@ -152,8 +188,11 @@ def fit_wall(
     FitError
         The wall does not surround the path, the solve fails, or the tube folds at q = 1.
     """
+    tell = options.progress or (lambda name: None)
     polar = project_points(curve, vertices, options.mapper)
+    tell("projection")
     selection = select_wall_points(polar, curve.length, network, options.selection)
+    tell("selection")
     # in order along the path: every later evaluation then reads the splines' pieces in turn
     kept_index = np.flatnonzero(selection.keep)
     kept_index = kept_index[np.argsort(polar.l[kept_index], kind="stable")]
@@ -170,14 +209,22 @@ def fit_wall(
         keep = hold.keeps(kept.l)
         kept, kept_index = kept.subset(keep), kept_index[keep]
         settings, scores, prior, surface = _fit_kept(curve, kept, options, reference, rng)
+    tell("spline")
     measured = measure_distances(curve, surface.whole, kept, rng, mapper=options.mapper)
+    tell("distances")
     # the hold-out folds are dealt from the measured points, each starting from its closest point
     holdout = holdout_rms(curve, kept.subset(measured.sample), settings, rng, options.holdout,
                           start=measured.start, mapper=options.mapper)
+    tell("hold-out")
     metrics = measured.metrics
     radius = RadiusField.from_links(settings.breaks, surface.links, options.initial_radius_mm)
     try:
         folding = check_self_folding(curve, radius, q=1.0, limit=options.fold_limit)
+    except FoldError as err:  # the stretches that fold, each with a cap of its own, before the whole path's
+        stretches = fold_stretches(curve, radius, 1.0)
+        refusal = FoldError(fold_advice(str(err), stretches))
+        refusal.stretches = stretches
+        raise refusal from err
     except FitError as err:
         report = fold_margin(curve, radius, 1.0)
         if report.min_rho_mm > 0.0:
@@ -186,12 +233,15 @@ def fit_wall(
         rho = radius.evaluate_grid(1.0, l, np.linspace(0.0, 2.0 * np.pi, 96, endpoint=False)).min(axis=1)
         raise FitError(f"{str(err).split('; ')[0]}; {negative_radius_cause(prior, curve.length, l[np.argmin(rho)])}"
                        ) from err
+    tell("fold check")
     ends = end_radii(radius, reference) | {"margin": {"mm": options.end_margin_mm, "points": float((~inside).sum())}}
     if hold is not None:
         ends[f"{hold.end}_held"] = hold.as_dict(curve.length)
     distance = np.full(len(polar), np.nan)
     distance[kept_index[measured.sample]] = measured.distance
     coverage = measure_coverage(curve, surface.whole, polar, selection, kept_index, settings.knot_spacing_mm,
-                                reference, {} if prior is None else prior.ends, options.mapper)
+                                reference, {} if prior is None else prior.ends, options.mapper,
+                                tuple(c.span_mm for c in options.local_caps))
+    tell("coverage")
     return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius, ends, distance,
                    coverage)

@@ -144,8 +144,8 @@ class BlendedShape:
                 if self.mode != "linear" or q in (0.0, 1.0):
                     raise
                 raise GeometryError(f"{err}; at an intermediate q the linear blend is the likelier cause (a straight-"
-                                    "to-curved linear blend shortens and kinks the middle): use blend: intrinsic "
-                                    "(or auto, the default)") from err
+                                    "to-curved linear blend shortens and kinks the middle): use blend: intrinsic"
+                                    ) from err
             self._framed[q] = framed
         return self._framed[q]
 

@@ -15,14 +15,17 @@ Without inscribed radii (a centerline file without
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from softdesign.fitting.radius_field import RadiusField
 from softdesign.geometry.blend import BlendedShape, BlendMode, blend_shapes
 from softdesign.geometry.curves import SmoothCurve, l_from_points
 from softdesign.geometry.frames import FrameMode
 from softdesign.geometry.morph_fold import MORPH_REACH_LIMIT, MorphReach, morph_reach, radius_profile_on
 from softdesign.geometry.network import SelectedPath
+from softdesign.pipeline.blend_body import body_folds, body_morph
 from softdesign.pipeline.notices import Notice
 
 #: A q = 1 shape whose reach r * kappa (r the inscribed radius) is at least this is warned about: a tube of
@@ -39,6 +42,8 @@ class BlendChoice:
     linear_reach: MorphReach | None
     reason: str
     warning: str | None = None
+    #: ``auto``'s look at the fitted body over each blend's morph, when it switched on it
+    body_morph: dict[str, Any] | None = None
 
     def summary(self) -> dict[str, Any]:
         """The blend summary's extra keys: ``requested``, ``morph`` (reach figures), ``choice`` (text)."""
@@ -48,7 +53,7 @@ class BlendChoice:
             "linear_morph": None if self.linear_reach is None else self.linear_reach.as_dict(),
             "choice": self.reason,
             "warning": self.warning,
-        }
+        } | ({} if self.body_morph is None else {"body_morph": self.body_morph})
 
 def choose_blend(
     initial: SmoothCurve,
@@ -57,32 +62,65 @@ def choose_blend(
     requested: str,
     frames: FrameMode,
     path: SelectedPath,
+    body: Callable[[BlendedShape], RadiusField | None] | None = None,
 ) -> BlendChoice:
     """Build the blend ``requested`` ("auto", "linear" or "intrinsic") and check its morph for folds.
 
     A q = 1 centerline that turns tighter than the inscribed radius gives a warning, not a refusal: the
-    fitted wall, not the inscribed sphere, decides whether the body folds.
+    fitted wall, not the inscribed sphere, decides whether the body folds.  ``body`` gives the wall fitted
+    around a shape's q = 1 centerline (:func:`softdesign.pipeline.blend_body.body_field`): ``auto`` judges
+    the linear blend's body over the morph on it, and switches to intrinsic when it folds.
     """
     mode: BlendMode = "intrinsic" if requested == "intrinsic" else "linear"
     shape = blend_shapes(initial, final, keyframes, mode, frames)
-    if path.radius is None:
-        return BlendChoice(shape, requested, None, None, f"{mode} ({requested}; no inscribed radii to check folds)")
-    profile = radius_profile_on(l_from_points(final, path.points), path.radius)
-    reach = morph_reach(shape, *profile)
+    profile = None if path.radius is None else radius_profile_on(l_from_points(final, path.points), path.radius)
+    reach = None if profile is None else morph_reach(shape, *profile)
     # the inscribed radius is no bound of the fitted wall on a bend's flatter inner side: a warning, and the
     # fit tests the fitted body itself (issue 29)
-    tight = _final_fold_message(reach, final) if reach.final_reach >= SURE_FOLD else None
-    if mode == "intrinsic" or not reach.blend_folds:
-        why = "asked for" if requested == mode else "the linear blend does not fold"
-        return BlendChoice(shape, requested, reach, None, f"{mode} ({why}: {_figure(reach)})", tight)
-    if requested == "linear":
-        warning = (f"blend: linear {_fold_text(reach)}; meshes at export q near {reach.q:.3f} will fail: use "
-                   "blend: intrinsic (or auto, the default), whose curvature stays within the end shapes'")
-        return BlendChoice(shape, requested, reach, None, f"linear (asked for: {_figure(reach)})", warning)
+    tight = _final_fold_message(reach, final) if reach is not None and reach.final_reach >= SURE_FOLD else None
+    figure = "no inscribed radii to check folds" if reach is None else _figure(reach)
+    if mode == "intrinsic":
+        return BlendChoice(shape, requested, reach, None, f"intrinsic (asked for: {figure})", tight)
+    if reach is not None and profile is not None and reach.blend_folds:
+        if requested == "linear":
+            warning = (f"blend: linear {_fold_text(reach)}; meshes at export q near {reach.q:.3f} will fail: use "
+                       "blend: intrinsic (or auto, the default), whose curvature stays within the end shapes'")
+            return BlendChoice(shape, requested, reach, None, f"linear (asked for: {figure})", warning)
+        intrinsic = blend_shapes(initial, final, keyframes, "intrinsic", frames)
+        fold = morph_reach(intrinsic, *profile)
+        why = f"intrinsic (auto: the linear blend {_fold_text(reach)}; intrinsic: {_figure(fold)})"
+        return BlendChoice(intrinsic, requested, fold, reach, why, tight)
+    if requested == "auto" and body is not None:
+        switched = _judged_on_body(shape, body, (initial, final, keyframes, frames), profile, reach, tight)
+        if switched is not None:
+            return switched
+    why = "asked for" if requested == mode else "the linear blend does not fold"
+    return BlendChoice(shape, requested, reach, None, f"linear ({why}: {figure})", tight)
+
+
+def _judged_on_body(shape: BlendedShape, body: Callable[[BlendedShape], RadiusField | None], ends: tuple[Any, ...],
+                    profile: tuple[Any, Any] | None, reach: MorphReach | None, tight: str | None
+                    ) -> BlendChoice | None:
+    """``auto``: the intrinsic blend when the linear blend's fitted body folds mid-morph and the intrinsic one's
+    folds less; else None (linear stays, with the body's figures in its summary)."""
+    field = body(shape)
+    if field is None:
+        return None
+    linear = body_morph(shape, field)
+    if not body_folds(linear):
+        return None
+    initial, final, keyframes, frames = ends
     intrinsic = blend_shapes(initial, final, keyframes, "intrinsic", frames)
-    fold = morph_reach(intrinsic, *profile)
-    why = f"intrinsic (auto: the linear blend {_fold_text(reach)}; intrinsic: {_figure(fold)})"
-    return BlendChoice(intrinsic, requested, fold, reach, why)
+    fold = body_morph(intrinsic, field)
+    if fold.report.max_rho_kappa >= linear.report.max_rho_kappa:
+        return None
+    r = linear.report
+    why = (f"intrinsic (auto: the fitted body of the linear blend folds mid-morph: rho * kappa = "
+           f"{r.max_rho_kappa:.3f} at q = {linear.q:.3f}, {r.arc_mm:.1f} mm from the inlet (folds at 1); intrinsic: "
+           f"largest rho * kappa {fold.report.max_rho_kappa:.3f} at q = {fold.q:.3f})")
+    intrinsic_reach = None if profile is None else morph_reach(intrinsic, *profile)
+    return BlendChoice(intrinsic, "auto", intrinsic_reach, reach, why, tight,
+                       {"linear": linear.as_dict(), "intrinsic": fold.as_dict()})
 
 
 def pcc_choice(shape: BlendedShape, path: SelectedPath, design: dict[str, Any]) -> dict[str, Any]:

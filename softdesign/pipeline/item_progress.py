@@ -54,3 +54,13 @@ def item_counter(stage: str, items: Sequence[T], label: Callable[[T], str] = str
         listener(stage, done, total, label(item))
 
     return on_result
+
+
+def step_counter(stage: str, steps: Sequence[str]) -> Callable[[str], None]:
+    """``step(name)``: tell the current listener that step ``name`` of ``stage``'s ``steps`` is done (one more of
+    ``len(steps)``, in any order); a no-op when nobody listens.  For a stage made of a few long steps rather
+    than many items (a big tree's ingest and fit, issue 43)."""
+    hook = item_counter(stage, list(steps))
+    if hook is None:
+        return lambda name: None
+    return lambda name: hook(name, None)

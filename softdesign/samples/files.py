@@ -14,11 +14,13 @@ from softdesign.io.polylines_vtp import write_polylines_vtp
 from softdesign.samples.cohort_vessels import COHORT_VARIANTS, VesselVariant, make_variant_vessel
 from softdesign.samples.sample_vessel import SampleVessel, make_sample_vessel
 from softdesign.samples.surfaces import sample_surface
+from softdesign.samples.tree_vessel import TreeShape, make_tree_vessel, tree_surface
 from softdesign.types import UNIT_SCALE_TO_MM
 
 CENTERLINE = "centerline.vtp"
 SURFACE = "surface.ply"
 SAMPLE_SURFACE = "surface.stl"
+TREE_SURFACE = "surface.ply"
 #: Units of the files written per cohort case (default mm): one case is in cm, as some exports are.
 COHORT_FILE_UNITS = {"coil": "cm"}
 
@@ -70,3 +72,19 @@ def write_cohort(out_root: str | Path) -> list[Path]:
     for variant in COHORT_VARIANTS:
         written += write_variant(Path(out_root) / variant.name, variant, COHORT_FILE_UNITS.get(variant.name, "mm"))
     return written
+
+
+def write_tree(out_dir: str | Path, triangles: int, shape: TreeShape | None = None) -> list[Path]:
+    """Write ``centerline.vtp`` (one polyline per leaf, root first) and ``surface.ply`` of the benchmark tree.
+
+    The wall is binary PLY, as the cohort's: shared vertices, as SimVascular's .vtp models have them (an STL
+    repeats each vertex six times and its reading merges them: a single-vessel cost of its own).
+    """
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    tree = make_tree_vessel(shape or TreeShape())
+    lines = [tree.path_points(k) for k in range(len(tree.paths))]
+    centerline = write_polylines_vtp(out_dir / CENTERLINE, [p for p, _ in lines],
+                                     {"MaximumInscribedSphereRadius": [r for _, r in lines]})
+    surface = write_mesh(out_dir / TREE_SURFACE, *tree_surface(tree, triangles))
+    return [centerline, surface]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from softdesign.centerline.closing import close_surface
 from softdesign.centerline.ends import EndTargets, ray_to_surface, reach_ends
@@ -61,3 +62,26 @@ def test_a_rounded_end_stops_one_radius_short_of_its_tip_and_a_given_point_is_no
     np.testing.assert_allclose(reached.points[-1], [0, 0, 37.0], atol=1e-9)  # tip at 40, one radius short
     np.testing.assert_allclose(reached.continued_mm, (0.0, 7.0), atol=1e-9)
     np.testing.assert_allclose(reached.points[0], points[0], atol=0)  # the inlet: a given point, not continued
+
+
+#: Issue 43, item 4: at least this fraction of the paths' ends within END_RADII inscribed radii of their opening.
+END_FRACTION, END_RADII = 0.9, 0.5
+
+
+@pytest.mark.slow
+def test_on_a_cerebral_like_tree_the_ends_land_at_the_openings_centres():
+    from softdesign.centerline.extract import extract_centerlines
+    from tests.helpers.cerebral_tree import BRANCHES, cerebral_tree
+
+    vertices, faces, centres, radii = cerebral_tree()
+    result = extract_centerlines(vertices, faces)
+    assert len(result.paths) == BRANCHES + 1  # the trunk's far end and every branch, from one inlet
+    ratios = []
+    for points in result.paths:
+        for end in (points[0], points[-1]):
+            nearest = int(np.argmin(np.linalg.norm(centres - end, axis=1)))
+            ratios.append(float(np.linalg.norm(centres[nearest] - end)) / radii[nearest])
+    ratios_array = np.array(ratios)
+    assert np.mean(ratios_array <= END_RADII) >= END_FRACTION, np.round(ratios_array, 3)
+    reached = {int(np.argmin(np.linalg.norm(centres - p[-1], axis=1))) for p in result.paths}
+    assert len(reached) == BRANCHES + 1  # every outlet is some path's end

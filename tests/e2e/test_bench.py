@@ -152,3 +152,31 @@ def test_report_figures_time_a_forced_build_and_its_report(bench, tmp_path):
     assert figures["repeats"] == 1
     assert all(figures[key] > 0 for key in ("build_s", "build_cpu_s", "report_s", "report_cpu_s"))
     assert (tmp_path / "run" / "report" / "index.html").is_file()
+
+
+def test_the_tree_lines_judge_ingest_and_fit_against_issue_43s_targets(bench):
+    quick = fake_result(bench, 1_000_000, 0, {"ingest": 6.0, "fit": 18.0})
+    slow = fake_result(bench, 1_000_000, 0, {"ingest": 16.0, "fit": 31.0})
+    fast_lines, slow_lines = bench.tree_lines(quick), bench.tree_lines(slow)
+    assert [line.split()[-1] for line in fast_lines[-2:]] == ["met", "met"]
+    assert [line.split()[-1] for line in slow_lines[-2:]] == ["MISSED", "MISSED"]
+
+
+def test_the_benchmark_tree_has_its_tracts_its_paths_and_one_closed_wall():
+    import trimesh
+
+    from softdesign.samples.tree_vessel import TreeShape, make_tree_vessel, tree_surface
+
+    shape = TreeShape(depth=3)
+    tree = make_tree_vessel(shape)
+    assert len(tree.segments) == 2 ** (shape.depth + 1) - 1 and len(tree.paths) == 2 ** shape.depth
+    for leaf in range(len(tree.paths)):
+        points, radius = tree.path_points(leaf)
+        step = np.diff(points, axis=0)
+        unit = step / np.linalg.norm(step, axis=1, keepdims=True)
+        # tangent-continuous through every junction: no turn between steps beyond a Bezier's own sampling
+        assert np.min(np.einsum("ij,ij->i", unit[:-1], unit[1:])) > np.cos(np.radians(10.0))
+        assert radius[0] == shape.root_radius_mm and np.all(np.diff(radius) <= 0)
+    vertices, faces = tree_surface(tree, 60_000)
+    mesh = trimesh.Trimesh(vertices, faces, process=False)
+    assert mesh.is_watertight and mesh.volume > 0 and 30_000 < len(faces) < 120_000

@@ -32,3 +32,7 @@ def test_a_body_folding_between_the_grid_q_is_found_and_warned_about():
     assert found.report.max_rho_kappa == pytest.approx(RHO / 4.0, rel=1e-4)
     warning = found.warning()
     assert warning is not None and "folds mid-morph: at q = 0.5" in warning and "fit.max_radius_mm" in warning
+    # issue 43: the blend in use is never the advice; intrinsic is offered only to a linear morph
+    assert "blend: intrinsic" in warning
+    on_intrinsic = found.warning("intrinsic")
+    assert on_intrinsic is not None and "blend:" not in on_intrinsic and "fit.local_max_radius" in on_intrinsic

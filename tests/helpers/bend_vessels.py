@@ -128,3 +128,25 @@ def write_takeoff_vessel(folder: Path, trunk_radius: float = 6.0, branch_radius:
     surface = write_mesh(folder / "surface.stl", np.asarray(mesh.vert_properties, float)[:, :3],
                          np.asarray(mesh.tri_verts, np.int64))
     return centerline, surface
+
+
+def write_elliptical_bend_vessel(folder: Path, radius: float, ellipticity: float, bend_mm: float, turn_deg: float,
+                                 lead_mm: float = 10.0) -> tuple[Path, Path]:
+    """A capped tube of elliptical section (semi-axes r(1 + e) in the turn's plane, r(1 - e) across it) about a
+    straight lead, a turn of ``turn_deg`` on radius ``bend_mm`` and a straight tail; the centerline's inscribed
+    radius is the minor semi-axis r(1 - e), as VMTK's is on such a lumen.
+    """
+    from softdesign.io.formats import write_mesh
+    from softdesign.io.polylines_vtp import write_polylines_vtp
+    from softdesign.samples.surfaces import framed_polyline, swept_tube
+
+    points, _ = stub_turn_axis(lead_mm, bend_mm, turn_deg, lead_mm, step=0.25)
+    framed = framed_polyline(points, "elliptical bend")
+    rings = int(np.ceil(framed.length / EDGE_MM)) + 1
+    around = int(np.ceil(2 * np.pi * radius * (1 + ellipticity) / EDGE_MM))
+    # the major axis a quarter turn from the sweep's N: in the turn's plane (B is the plane's normal)
+    vertices, faces = swept_tube(framed, rings, around, np.full(2, radius), ellipticity, np.full(2, np.pi / 2))
+    folder.mkdir(parents=True, exist_ok=True)
+    minor = np.full(len(points), radius * (1.0 - ellipticity))
+    centerline = write_polylines_vtp(folder / "centerline.vtp", [points], {"MaximumInscribedSphereRadius": [minor]})
+    return centerline, write_mesh(folder / "surface.stl", vertices, faces)

@@ -37,3 +37,28 @@ def test_the_listener_is_gone_after_the_block():
     with items_told_to(lambda *event: None):
         assert item_counter("export", [1.0]) is not None
     assert item_counter("export", [1.0]) is None
+
+
+def test_a_stage_made_of_long_steps_tells_each_step_and_the_fit_tells_all_of_its_own():
+    # issue 43, item 7: a big tree's ingest and fit take seconds per step; a terminal is told each one
+    import numpy as np
+
+    from softdesign.fitting.selection import NetworkContext
+    from softdesign.fitting.wall_fit import FIT_STEPS, WallFitOptions, fit_wall
+    from softdesign.pipeline.item_progress import step_counter
+    from tests.helpers.analytic import Arc
+    from tests.helpers.vessels import torus_section
+
+    heard: list[tuple[str, int, int, str]] = []
+    step_counter("ingest", ("a", "b"))("a")  # nobody listens: nothing happens
+    with items_told_to(lambda *event: heard.append(event)):
+        step = step_counter("ingest", ("surface", "end planes"))
+        step("surface")
+        step("end planes")
+    assert heard == [("ingest", 0, 2, ""), ("ingest", 1, 2, "surface"), ("ingest", 2, 2, "end planes")]
+    told: list[str] = []
+    vertices, _ = torus_section(bend=20.0, radius=3.0, angle=1.5, edge=0.5)
+    curve = Arc(20.0, 1.5)
+    fit_wall(curve, vertices, NetworkContext(curve.points(np.linspace(0, 1, 50))), WallFitOptions(progress=told.append),
+             np.random.default_rng(0))
+    assert tuple(told) == FIT_STEPS

@@ -288,6 +288,13 @@ def _meshed(case: Case, kinematics: KinematicsResult, fit: FitResult, layout: Ch
             for w in walls]
 
 
+def degrees_wrapped(angle_rad: float) -> float:
+    """An angle in degrees in (-180, 180] (the one convention of the CSV and JSON outputs), rounded to 1e-9 deg so
+    that 30 and 390 - 360 are written as the same number."""
+    degrees = float(np.rad2deg(angle_rad)) % 360.0
+    return round(degrees - 360.0 if degrees > 180.0 else degrees, 9) + 0.0
+
+
 def layout_document(layout: ChamberLayout) -> dict[str, Any]:
     """The layout as JSON: the spec, every chamber and feed (angles in degrees)."""
     return {

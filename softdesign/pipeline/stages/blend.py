@@ -28,6 +28,7 @@ from softdesign.geometry.frames import FrameMode
 from softdesign.geometry.initial import InitialSpec, build_initial_shape, initial_shape_from_polyline
 from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import curve_options
+from softdesign.pipeline.blend_body import body_field
 from softdesign.pipeline.blend_choice import blend_notices, choose_blend, describe_choice, pcc_choice
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.design import DesignResult, load_design
@@ -44,7 +45,8 @@ if TYPE_CHECKING:  # only annotations: the report loads stage results without th
 #: 5: sharp joints at explicit link breaks (``joints`` in blend/curves.npz when there are any).
 #: 6: the torsion reported where the curvature is at least a fifth of its largest (TORSION_REL_FLOOR), not noise.
 #: 7: ``blend: pcc`` keeps its sections' joints: each section splined on its own, every break a sample.
-VERSION = 7
+#: 8: ``blend: auto`` judges the fitted body over the morph, not only the inscribed radius (``body_morph``).
+VERSION = 8
 
 
 @dataclass(frozen=True)
@@ -84,7 +86,8 @@ def run_blend(case: Case, ingest: IngestResult, design: DesignResult | None = No
         (q, initial_shape_from_polyline(final, p.points, same_grid, case.initial.align_base))
         for q, p in ingest.keyframes
     )
-    choice = choose_blend(initial, final, keyframes, case.blend, case.frames, ingest.path)
+    choice = choose_blend(initial, final, keyframes, case.blend, case.frames, ingest.path,
+                          body=lambda shape: body_field(case, ingest, shape))
     # the shape rebuilt from the samples the folder keeps, as load_blend rebuilds it: the splines through them equal
     # the smoothed ones to round-off (1e-13 mm), not to the bit, and the stages after this one must get the same
     # shape whether the blend ran now or was loaded, or a stage re-run on cached results writes other bytes
@@ -215,7 +218,8 @@ def describe_blend(result: BlendResult) -> list[str]:
 STAGE = Stage(
     name="blend",
     version=VERSION,
-    reads=("initial", "resample", "frames", "blend", "links.breaks"),
+    # blend: auto fits the wall, with the links' breaks and the fit's settings, to judge the body's morph
+    reads=("initial", "resample", "frames", "blend", "links", "fit"),
     upstream=("ingest", "design"),
     compute=lambda case, results: run_blend(case, results["ingest"], results.get("design")),
     write=write_blend,

@@ -134,9 +134,11 @@ def _solid_naming_blend(kinematics: KinematicsResult, fit: FitResult, q: float, 
     except MeshError as err:
         if not (0.0 < q < 1.0 and kinematics.chain.shape.mode == "linear" and "folds" in str(err)):
             raise
+        # never the setting in use: auto that kept the linear blend is answered with intrinsic alone
+        other = "blend: intrinsic (or auto, the default)" if case.blend == "linear" else "blend: intrinsic"
         raise MeshError(
             f"{err}; at an intermediate q the linear blend is the likelier cause (a straight-to-curved linear "
-            "blend shortens and kinks the middle): use blend: intrinsic (or auto, the default)"
+            f"blend shortens and kinks the middle): use {other}"
         ) from err
 
 

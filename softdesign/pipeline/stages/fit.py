@@ -11,7 +11,7 @@ joint jumps, rho * kappa at q = 1).
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -19,12 +19,12 @@ import numpy as np
 
 from softdesign.errors import ConfigError, FitError, FoldError
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
-from softdesign.fitting.metrics import HoldoutSettings
+from softdesign.fitting.local_cap import check_caps_on_path
 from softdesign.fitting.morph_folds import fold_over_morph
 from softdesign.fitting.projection import project_points
 from softdesign.fitting.radius_field import RadiusField
-from softdesign.fitting.selection import NetworkContext, SelectionSettings, inscribed_profile
-from softdesign.fitting.wall_fit import WallFitOptions, fit_wall
+from softdesign.fitting.selection import NetworkContext, inscribed_profile
+from softdesign.fitting.wall_fit import FIT_STEPS, fit_wall
 from softdesign.geometry.curves import SmoothCurve, measure_deviation
 from softdesign.geometry.end_cut import choose_end_cuts
 from softdesign.geometry.morph_fold import MORPH_Q_SAMPLES
@@ -33,6 +33,9 @@ from softdesign.kinematics.links import LinkChain
 from softdesign.meshing.mould_frame import parting_frame
 from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import describe_backbone_fit, stretch_fit_errors
+from softdesign.pipeline.fit_options import wall_fit_options
+from softdesign.pipeline.fold_paths import with_avoiding_paths
+from softdesign.pipeline.item_progress import step_counter
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.fit_notices import fit_notices
@@ -44,13 +47,14 @@ from softdesign.types import FloatArray
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 8  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
+VERSION = 9  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
 # 3: points fitted in path order; distances sampled above 200k points (max still over all)
 # 4: end prior and end radii (issue 20); true distances on the regularized backbone's stretches (``backbone``)
 # 5: each end's cut plane in the end frame (``end_cut``, issue 20)
 # 6: fit/points.npz keeps the true distance of every point the metrics measured (``distance``, NaN elsewhere)
 # 7: the fit against all of the path's own wall, its coverage and flags (``all_wall``, ``coverage``, issue 29)
 # 8: the coverage warnings in an engineer's words (issue 44)
+# 9: fit.local_max_radius, and the all-wall figures outside its stretches (issue 43)
 #: Seed of the hold-out folds: the same case always gets the same folds.
 HOLDOUT_SEED = 4
 #: A failed fit is blamed on the centerline when the smoothed one strays from the input by this fraction of the
@@ -91,26 +95,15 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     inscribed = (None, None) if path.radius is None else inscribed_profile(curve, path.points, path.radius)
     network = NetworkContext(path.points, tuple(p.points for p in ingest.others), *inscribed)
     fit = case.fit
-    auto = fit.knot_spacing_mm == "auto"
-    settings = FitSettings(
-        # the only text knot_spacing_mm takes is 'auto' (then the spacing is chosen below)
-        1.0 if isinstance(fit.knot_spacing_mm, str) else fit.knot_spacing_mm,
-        fit.angular_intervals,
-        fit.smoothing,
-        tuple(chain.breaks),
-    )
-    options = WallFitOptions(
-        fit=settings,
-        auto_spacing=auto,
-        selection=SelectionSettings(outlier_factor=fit.outlier_factor),
-        holdout=HoldoutSettings(folds=fit.holdout_folds),
-        initial_radius_mm=case.initial.radius_mm,
-        end_margin_mm=case.fit.end_margin_mm,
-        max_radius_mm=case.fit.max_radius_mm,
-        mapper=map_items,  # the hold-out's folds on the build's worker processes
-    )
+    options = wall_fit_options(case, tuple(chain.breaks), map_items)  # the hold-out's folds on the build's workers
+    options = replace(options, progress=step_counter("fit", FIT_STEPS))  # a bar on a terminal
+    problems = check_caps_on_path(options.local_caps, curve.length)
+    if problems:
+        raise ConfigError(f"{problems[0]}; move or remove that entry")
     try:
         wall = fit_wall(curve, ingest.vertices, network, options, np.random.default_rng(HOLDOUT_SEED))
+    except FoldError as err:  # the paths that avoid the take-off, beside the caps the fit offers
+        raise with_avoiding_paths(err, curve, ingest.others) from err
     except FitError as err:
         stray = centerline_stray(case, curve.curve, path)
         if stray is None or isinstance(err, FoldError):  # a fold names the body radius that fits: that is the fix
@@ -128,8 +121,9 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     # the fitted body itself at every q of the morph's search, not only at q = 1 (issue 29)
     morph = fold_over_morph(chain.shape.curve_at, field, np.linspace(0.0, 1.0, MORPH_Q_SAMPLES))
     summary["morph_fold"] = morph.as_dict()
-    if morph.warning() is not None:
-        summary["warnings"] = [*summary.get("warnings", []), morph.warning()]
+    warning = morph.warning(chain.shape.mode)
+    if warning is not None:
+        summary["warnings"] = [*summary.get("warnings", []), warning]
     if chain.shape.mode == "pcc":
         summary["pcc"] = _carried_to_chain(chain, curve)
     # the end prior can hold the ends a straying centerline leaves one-sided: the fit then succeeds, so say it
@@ -240,7 +234,8 @@ def fit_metrics(result: FitResult) -> dict[str, Any]:
         # rms_mm .. max_mm above are on the kept points; the same under ``kept``, and on all of the path's own
         # wall under ``all_wall``, with the ``coverage`` and the ``flags`` the report names (issue 29)
         "kept": {k: d[k] for k in ("rms_mm", "p95_mm", "p99_mm", "max_mm", "count")},
-        **{k: s[k] for k in ("all_wall", "coverage", "flags", "warnings", "morph_fold") if k in s},
+        **{k: s[k] for k in ("all_wall", "all_wall_outside_local_caps", "coverage", "flags", "warnings", "morph_fold")
+           if k in s},
     }
 
 
@@ -277,6 +272,11 @@ def coverage_lines(summary: dict[str, Any]) -> list[str]:
         f"fitted):",
         f"  all-wall RMS {a['rms_mm']:.4f}  p95 {a['p95_mm']:.4f}  p99 {a['p99_mm']:.4f}  max {a['max_mm']:.4f}",
     ]
+    if "all_wall_outside_local_caps" in summary:  # fit.local_max_radius holds the body thinner there on purpose
+        o = summary["all_wall_outside_local_caps"]
+        spans = ", ".join(f"{lo:.1f}-{hi:.1f}" for lo, hi in o["spans_mm"])
+        lines.append(f"  outside the capped stretches ({spans} mm): RMS {o['rms_mm']:.4f}  p95 {o['p95_mm']:.4f}  "
+                     f"p99 {o['p99_mm']:.4f}  max {o['max_mm']:.4f} ({o['count']} vertices)")
     lines += [f"  wall not seen all round at {s['from_mm']:.1f}-{s['to_mm']:.1f} mm ({s['length_mm']:.1f} mm, local "
               f"diameter {s['diameter_mm']:.1f} mm): {s['how']}" for s in c["unseen_stretches"]]
     return lines

@@ -27,6 +27,7 @@ from softdesign.pipeline.auto_centerline import (
 )
 from softdesign.pipeline.backbone_step import regularized_path
 from softdesign.pipeline.end_plane_step import end_plane_summary
+from softdesign.pipeline.item_progress import step_counter
 from softdesign.pipeline.notices import NOTE, Notice
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
@@ -46,6 +47,8 @@ if TYPE_CHECKING:  # only annotations: the report loads stage results without th
 #: 7: the backbone's reach uses the wall's fold radius; a turn no smoothing brings below the target is warned
 #: about, not refused (issue 29).
 VERSION = 8  # 8: lengths in the notes in the case's unit (mm beside), wall face labels said once
+#: The steps the ingest tells a terminal as it goes (:func:`~softdesign.pipeline.item_progress.step_counter`).
+INGEST_STEPS = ("centerline", "surface", "backbone", "end planes", "summary")
 
 
 @dataclass(frozen=True)
@@ -88,20 +91,26 @@ def run_ingest(case: Case) -> IngestResult:
         The vessel's size is not a human vessel's in the declared ``units`` (checked before the surface is read).
     """
     scale = UNIT_SCALE_TO_MM[case.units]
+    step = step_counter("ingest", INGEST_STEPS)  # a bar on a terminal: a tree's steps take seconds each
     network, extracted, radius_from = _final_network(case, scale)
     inlet = None if case.final.inlet is None else np.asarray(case.final.inlet, float) * scale
     orientation = Orientation(inlet=inlet, reverse=case.final.reverse)
     path = select_path(network, case.final.path, orientation)
     check_vessel_scale(path.length, path.radius, case.units, f"final.centerline {_centerline_name(case)}")
-    others = tuple(p for p in all_paths(network, Orientation(inlet=path.points[0])) if p.index != path.index)
+    every = all_paths(network, Orientation(inlet=path.points[0]))  # once: a tree has hundreds
+    others = tuple(p for p in every if p.index != path.index)
+    step("centerline")
     notes = list(network.notes) + list(path.notes)
     if extracted is not None:
         notes += [*extracted.notes, continuation_note(extracted, case.units)]
     vertices, faces, info = _final_surface(case, path, scale)
+    step("surface")
     inlet_rule = path.notes[-1]
     path, backbone = regularized_path(case, path, vertices, others)
     notes += [n for n in path.notes if n not in notes]
+    step("backbone")
     ends = end_plane_summary(case, path, vertices, faces)
+    step("end planes")
     initial_path = None
     if case.initial.kind == "file" and case.initial.centerline is not None:
         initial_path = _one_path(case.initial.centerline, case.initial.path, scale, Orientation())
@@ -113,7 +122,8 @@ def run_ingest(case: Case) -> IngestResult:
     initial_surface = None
     if case.initial.surface is not None:
         initial_surface = read_surface(case.initial.surface, scale)
-    summary = {**_summary(case, network, path, info), "backbone": backbone, "end_planes": ends}
+    summary = {**_summary(case, network, every, path, info), "backbone": backbone, "end_planes": ends}
+    step("summary")
     summary["centerline"]["inlet_rule"] = inlet_rule
     summary["centerline"]["radius_from"] = radius_from if path.radius is not None else None
     if extracted is not None:
@@ -151,11 +161,9 @@ def _final_surface(case: Case, path: SelectedPath, scale: float) -> tuple[FloatA
     return vertices, faces, describe_surface(vertices, faces)
 
 
-def _summary(case: Case, network: CenterlineNetwork, path: SelectedPath, info: SurfaceInfo | None) -> dict[str, Any]:
-    paths = [
-        {"path": p.index, "points": int(len(p.points)), "length_mm": round(p.length, 6)}
-        for p in all_paths(network, Orientation(inlet=path.points[0]))
-    ]
+def _summary(case: Case, network: CenterlineNetwork, every: list[SelectedPath], path: SelectedPath,
+             info: SurfaceInfo | None) -> dict[str, Any]:
+    paths = [{"path": p.index, "points": int(len(p.points)), "length_mm": round(p.length, 6)} for p in every]
     radius = None if path.radius is None else [float(path.radius.min()), float(path.radius.max())]
     return {
         "units": case.units,
