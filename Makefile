@@ -77,12 +77,16 @@ demo: bytecode
 	@echo "Results in build/demo/: meshes/q_*.stl (the actuator at each q), kinematics.json,"
 	@echo "manifest.json, and the report to open in a browser: build/demo/report/index.html"
 
+# pytest-xdist: one worker per core (-n auto; CI's machines have 2), whole files to a worker (--dist loadfile:
+# a file's module caches and module-scoped builds are made once, its tests never race each other for them),
+# and the slowest 15 tests printed at the end.  How to keep a test safe in parallel: tests/conftest.py.
+PYTEST_PARALLEL := -n auto --dist loadfile --durations=15
 test: $(STAMP) $(CLUSTER_STAMP)
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest $(PYTEST_PARALLEL)
 
-# Everything but the tests marked slow (whole builds, cohorts, reports): about 2 minutes on 2 cores.
+# Everything but the tests marked slow (whole builds, cohorts, reports).
 test-fast: $(STAMP) $(CLUSTER_STAMP)
-	$(BIN)/python -m pytest -m "not slow"
+	$(BIN)/python -m pytest $(PYTEST_PARALLEL) -m "not slow"
 
 # ruff (style, imports, bugbear, pyupgrade, numpy rules) and mypy, both
 # configured in pyproject.toml; both run, and either failing fails the target.
