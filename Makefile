@@ -15,7 +15,7 @@ CLUSTER_STAMP := $(CLUSTER_VENV)/.installed-stamp
 CLUSTER_CONSTRAINTS := requirements/cluster.txt
 CLUSTER_PACKAGES = $$($(PYTHON) -c 'import tomllib; print(" ".join(tomllib.load(open("pyproject.toml", "rb"))["project"]["optional-dependencies"]["cluster"]))')
 
-.PHONY: demo test test-fast lint lock lock-cluster bench install clean bytecode
+.PHONY: demo test test-fast lint lock lock-cluster bench study install clean bytecode
 
 install: $(STAMP) $(CLUSTER_STAMP)
 
@@ -87,6 +87,12 @@ test: $(STAMP) $(CLUSTER_STAMP)
 # Everything but the tests marked slow (whole builds, cohorts, reports).
 test-fast: $(STAMP) $(CLUSTER_STAMP)
 	$(BIN)/python -m pytest $(PYTEST_PARALLEL) -m "not slow"
+
+# `make study`: re-derive the nested-refinement study's recorded finest level
+# (tests/mechanics/refinement_reference.json; about 10 minutes).  `make test` solves the two coarser levels
+# and says to run this when they no longer match the record.
+study: $(STAMP)
+	$(BIN)/python pipelines/study.py
 
 # ruff (style, imports, bugbear, pyupgrade, numpy rules) and mypy, both
 # configured in pyproject.toml; both run, and either failing fails the target.
