@@ -15,7 +15,7 @@ CLUSTER_STAMP := $(CLUSTER_VENV)/.installed-stamp
 CLUSTER_CONSTRAINTS := requirements/cluster.txt
 CLUSTER_PACKAGES = $$($(PYTHON) -c 'import tomllib; print(" ".join(tomllib.load(open("pyproject.toml", "rb"))["project"]["optional-dependencies"]["cluster"]))')
 
-.PHONY: demo test test-fast lint lock lock-cluster bench install clean bytecode
+.PHONY: demo test test-fast lint lock lock-cluster bench study install clean bytecode
 
 install: $(STAMP) $(CLUSTER_STAMP)
 
@@ -84,12 +84,22 @@ demo: bytecode
 	@echo "      kinematics.json, manifest.json, fabrication.md and the report to open: build/demo/report/index.html"
 	@$(BIN)/softdesign build configs/demo.yaml --report
 
+# pytest-xdist: one worker per core (-n auto; CI's machines have 2), whole files to a worker (--dist loadfile:
+# a file's module caches and module-scoped builds are made once, its tests never race each other for them),
+# and the slowest 15 tests printed at the end.  How to keep a test safe in parallel: tests/conftest.py.
+PYTEST_PARALLEL := -n auto --dist loadfile --durations=15
 test: $(STAMP) $(CLUSTER_STAMP)
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest $(PYTEST_PARALLEL)
 
-# Everything but the tests marked slow (whole builds, cohorts, reports): about 2 minutes on 2 cores.
+# Everything but the tests marked slow (whole builds, cohorts, reports).
 test-fast: $(STAMP) $(CLUSTER_STAMP)
-	$(BIN)/python -m pytest -m "not slow"
+	$(BIN)/python -m pytest $(PYTEST_PARALLEL) -m "not slow"
+
+# `make study`: re-derive the nested-refinement study's recorded finest level
+# (tests/mechanics/refinement_reference.json; about 10 minutes).  `make test` solves the two coarser levels
+# and says to run this when they no longer match the record.
+study: $(STAMP)
+	$(BIN)/python pipelines/study.py
 
 # ruff (style, imports, bugbear, pyupgrade, numpy rules) and mypy, both
 # configured in pyproject.toml; both run, and either failing fails the target.

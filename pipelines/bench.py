@@ -54,8 +54,13 @@ Report
     slower than the build on the sample case); the aorta and the largest
     synthetic input at the fewest frames for information.
 
+Targets
+    Every judged figure is listed again at the end with its bound and "met" or "MISSED" (a sub-benchmark's
+    lines as it judged them).  ``--fail-on-miss`` (off by default and in CI) exits 1 when one is missed by more
+    than MISS_MARGIN: for a quiet machine, where a miss is the code's and not the load's.
+
 Usage: ``python pipelines/bench.py [--triangles 250000,500000,1000000]
-[--frames 11,41] [--jobs N] [--profile] [--keep DIR]``; ``make bench`` runs the defaults.
+[--frames 11,41] [--jobs N] [--profile] [--keep DIR] [--fail-on-miss]``; ``make bench`` runs the defaults.
 """
 
 from __future__ import annotations
@@ -88,13 +93,16 @@ AORTA_DIR = REPO.parent / "shared" / "data" / "vmtk-aorta"
 STAGE_NAMES = ("ingest", "design", "blend", "links", "kinematics", "fit", "simulate", "actuation", "export", "mould",
                "volume_mesh", "feasibility")
 
-#: Targets of the scaled case (issue 5, item 9).  The build/floor ratio on 2 cores, restated in round 3: 4x (2x
-#: would need compiled kernels or subsampled fits).
-TARGET_FLOOR_RATIO = 4.0
+#: Targets of the scaled case (issue 5, item 9).  The build/floor ratio on 2 cores: 4x in round 3, 3x in issue 46.
+TARGET_FLOOR_RATIO = 3.0
 TARGET_PEAK_MIB = 2048.0
-#: Start-up targets (issue 19), seconds, median of STARTUP_REPEATS fresh processes.
+#: Start-up targets, seconds, median of STARTUP_REPEATS fresh processes: --help's wall time (issue 19),
+#: validate's CPU time (issue 46: the load of other jobs inflates wall times far more).
 TARGET_HELP_S = 0.3
 TARGET_VALIDATE_S = 0.6
+#: ``--fail-on-miss`` exits 1 when a figure exceeds its target by more than this fraction (timings on a quiet
+#: machine jitter by ~10 %); off by default and in CI, where other jobs' load inflates the figures.
+MISS_MARGIN = 0.2
 STARTUP_REPEATS = 5
 #: ``softdesign report`` against ``softdesign build`` (issue 17, restated in round 3): at most 1.5x the build on the
 #: sample case, no longer than the build on the largest scaled case; wall ratio, median of REPORT_REPEATS
@@ -120,6 +128,37 @@ FLOOR_REPEATS = 2
 #: Per profiled stage: how many functions are listed, and the smallest share of the build worth listing.
 PROFILE_ROWS = 6
 PROFILE_MIN_SHARE = 0.05
+
+
+@dataclass(frozen=True)
+class Judged:
+    """One target: its figure against its bound (lower is better), or a yes/no verdict (``figure`` None)."""
+
+    name: str
+    figure: float | None
+    bound: float | None
+    unit: str
+    ok: bool | None
+
+    def far_off(self) -> bool:
+        """Missed by more than MISS_MARGIN (a yes/no target, or a sub-benchmark's, when missed at all)."""
+        if self.ok is not False:
+            return False
+        if self.figure is None or self.bound is None:
+            return True
+        return self.figure > self.bound * (1.0 + MISS_MARGIN)
+
+
+#: Every target judged in this run, in order (the summary at the end and ``--fail-on-miss`` read it).
+JUDGED: list[Judged] = []
+
+
+def judge(name: str, figure: float | None, bound: float | None, unit: str, ok: bool | None = None) -> str:
+    """Record a target (``ok`` defaults to ``figure <= bound``) and return its verdict word."""
+    if ok is None and figure is not None and bound is not None:
+        ok = figure <= bound
+    JUDGED.append(Judged(name, figure, bound, unit, ok))
+    return verdict(ok)
 
 
 # ---------------------------------------------------------------- worker side
@@ -449,12 +488,17 @@ def startup_lines(figures: dict[str, float]) -> list[str]:
     def cpu(name: str) -> str:
         return f"  (cpu {figures[name]:.2f} s)" if name in figures else ""
 
+    # validate is judged on its CPU time when measured (issue 46), --help on its wall time (issue 19)
+    validate_clock = "validate_cpu_s" if "validate_cpu_s" in figures else "validate_s"
+    validate_word = "cpu" if validate_clock == "validate_cpu_s" else "wall"
+    help_ok = judge("softdesign --help, wall", figures["help_s"], TARGET_HELP_S, "s")
+    validate_ok = judge(f"softdesign validate, {validate_word}", figures[validate_clock], TARGET_VALIDATE_S, "s")
     return [
         f"start-up, median of {STARTUP_REPEATS} fresh processes (wall; cpu: user + system, which load inflates less):",
-        f"  softdesign --help      {figures['help_s']:6.2f} s  target <= {TARGET_HELP_S:g} s     "
-        f"{verdict(figures['help_s'] <= TARGET_HELP_S)}{cpu('help_cpu_s')}",
-        f"  softdesign validate    {figures['validate_s']:6.2f} s  target <= {TARGET_VALIDATE_S:g} s     "
-        f"{verdict(figures['validate_s'] <= TARGET_VALIDATE_S)}  (configs/demo.yaml){cpu('validate_cpu_s')}",
+        f"  softdesign --help      {figures['help_s']:6.2f} s  target <= {TARGET_HELP_S:g} s wall     "
+        f"{help_ok}{cpu('help_cpu_s')}",
+        f"  softdesign validate    {figures['validate_s']:6.2f} s  target <= {TARGET_VALIDATE_S:g} s {validate_word}"
+        f"      {validate_ok}  (configs/demo.yaml){cpu('validate_cpu_s')}",
     ]
 
 
@@ -476,7 +520,9 @@ def report_figures(case_file: Path, out: Path, repeats: int = REPORT_REPEATS) ->
 def report_line(label: str, figures: dict[str, float], target: float | None) -> str:
     """One case's build and report times and their ratio; judged against ``target`` when one is given."""
     ratio = figures["report_s"] / figures["build_s"]
-    judgement = f"  target <= {target:g}  {verdict(ratio <= target)}" if target is not None else ""
+    judgement = ""
+    if target is not None:
+        judgement = f"  target <= {target:g}  {judge(f'report / build, {label}', ratio, target, 'x')}"
     return (f"  {label:<38} build {figures['build_s']:5.2f} s (cpu {figures['build_cpu_s']:5.2f})  "
             f"report {figures['report_s']:5.2f} s (cpu {figures['report_cpu_s']:5.2f})  "
             f"report/build {ratio:4.2f}{judgement}")
@@ -613,13 +659,14 @@ def target_lines(scaled: dict[str, Any] | None, linear_triangles: bool | None, l
     floor = scaled["floor"]["read_s"] + scaled["floor"]["write_s"]
     ratio = scaled["total"]["wall_s"] / floor
     peak = scaled["total"]["peak_mib"]
+    linear = f"cpu time ~ size^e, e <= {LINEAR_EXPONENT_MAX:g}"
     return [
         f"  build / I/O floor     {ratio:7.1f}x   target <= {TARGET_FLOOR_RATIO:g}x      "
-        f"{verdict(ratio <= TARGET_FLOOR_RATIO)}",
+        f"{judge('build / I/O floor, scaled case', ratio, TARGET_FLOOR_RATIO, 'x')}",
         f"  peak memory           {peak:7.0f} MiB target < {TARGET_PEAK_MIB:.0f} MiB  "
-        f"{verdict(peak < TARGET_PEAK_MIB)}",
-        f"  linear in triangles   cpu time ~ size^e, e <= {LINEAR_EXPONENT_MAX:g}    {verdict(linear_triangles)}",
-        f"  linear in frames      cpu time ~ size^e, e <= {LINEAR_EXPONENT_MAX:g}    {verdict(linear_frames)}",
+        f"{judge('peak memory, scaled case', peak, TARGET_PEAK_MIB, 'MiB')}",
+        f"  linear in triangles   {linear}    {judge('linear in triangles', None, None, '', linear_triangles)}",
+        f"  linear in frames      {linear}    {judge('linear in frames', None, None, '', linear_frames)}",
     ]
 
 
@@ -739,7 +786,7 @@ def run_benchmark(args: argparse.Namespace, scratch: Path) -> None:
             ["", "hot spots of the scaled case (cProfile per stage; times inflated by the profiler):"]
             + profile_lines(profile_dir)
         )
-    emit(["", f"benchmark took {time.perf_counter() - started:.0f} s"])
+    emit(["", *summary_lines(JUDGED), "", f"benchmark took {time.perf_counter() - started:.0f} s"])
 
 
 def script_lines(script: str, ok_codes: tuple[int, ...] = (0, 1)) -> list[str]:
@@ -750,7 +797,26 @@ def script_lines(script: str, ok_codes: tuple[int, ...] = (0, 1)) -> list[str]:
     done = subprocess.run([sys.executable, str(REPO / "pipelines" / script)], capture_output=True, text=True, cwd=REPO)
     if done.returncode not in ok_codes:
         raise RuntimeError(f"{script} failed (exit {done.returncode}):\n{done.stderr[-3000:]}")
-    return done.stdout.splitlines()
+    lines = done.stdout.splitlines()
+    for line in lines:  # each of its judged lines, as it judged it (its figures stay in its own words)
+        said = re.search(r"\b(met|MISSED)\b", line)
+        if said:
+            judge(f"{script}: {' '.join(line.split())[:70]}", None, None, "", said.group(1) == "met")
+    return lines
+
+
+def summary_lines(judged: Sequence[Judged]) -> list[str]:
+    """Every target of the run with its figure and verdict, and how many were missed."""
+    lines = [f"every target ({len(judged)}): figure, bound, verdict"]
+    for j in judged:
+        figure = "" if j.figure is None else f"{j.figure:9.2f} {j.unit:<4}"
+        bound = "" if j.bound is None else f"<= {j.bound:g} {j.unit}"
+        lines.append(f"  {j.name:<72} {figure:>14} {bound:<14} {verdict(j.ok)}")
+    missed = [j for j in judged if j.ok is False]
+    far = [j for j in missed if j.far_off()]
+    lines.append(f"  {len(judged) - len(missed)} met or not measured, {len(missed)} missed, {len(far)} of them by more "
+                 f"than {MISS_MARGIN:.0%} (or a yes/no target)")
+    return lines
 
 
 def parse_counts(text: str) -> list[int]:
@@ -767,6 +833,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--frames", type=parse_counts, default=list(DEFAULT_FRAMES), help="synthetic frame counts")
     parser.add_argument("--profile", action="store_true", help="also profile the scaled case and list hot spots")
     parser.add_argument("--keep", type=Path, help="work in this folder and keep it (default: a temporary folder)")
+    parser.add_argument("--fail-on-miss", action="store_true",
+                        help=f"exit 1 when a target is missed by more than {MISS_MARGIN:.0%} (for a quiet machine; "
+                             "off in CI, where other jobs' load inflates the times)")
     parser.add_argument("--jobs", type=int, default=available_cores(),
                         help="worker processes per build (default: the cores available, as softdesign build)")
     parser.add_argument("--worker", nargs=2, type=Path, metavar=("CASE", "OUT"), help=argparse.SUPPRESS)
@@ -790,6 +859,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     finally:
         if args.keep is None:
             shutil.rmtree(scratch, ignore_errors=True)
+    far = [j.name for j in JUDGED if j.far_off()]
+    if args.fail_on_miss and far:
+        print(f"bench: {len(far)} target(s) missed by more than {MISS_MARGIN:.0%}: {'; '.join(far)}", file=sys.stderr)
+        return 1
     return 0
 
 

@@ -1,4 +1,23 @@
-"""Shared fixtures: the real VMTK data beside the checkout, the attack tests' prior build (helpers: tests/helpers/)."""
+"""Shared fixtures: the real VMTK data beside the checkout, the attack tests' prior build (helpers: tests/helpers/).
+
+How the suite runs: ``make test`` is ``pytest -n auto --dist loadfile --durations=15`` (pytest-xdist): one
+worker process per core, each taking whole test files.  So that a test stays right and fast there:
+
+* Write only under ``tmp_path`` (one test) or ``tmp_path_factory.mktemp(...)`` (a shared fixture): each worker
+  has its own base folder.  Never under the checkout (``build/``, ``data/``, ``tests/``) nor a fixed /tmp path;
+  a subprocess that runs ``softdesign`` gets ``--out`` under ``tmp_path``.  The one exception is the browser
+  test's screenshots (build/test-artifacts/browser/, names of their own, one file writes them).
+* A build several tests only read is built once: a ``scope="module"`` fixture (the file's tests all run in the
+  same worker) or, when several files read it, a ``scope="session"`` fixture here (built once per worker).  A
+  test that changes such a build copies it first (see ``out`` below: a copy of ``prior_build``).
+  ``functools.cache`` on a module-level builder does the same for in-memory results (meshes, solves).
+* No fixed ports, no lock files, no environment changes outside ``monkeypatch``; a child process gets its own
+  ``env=`` copy.
+* Mark a test ``@pytest.mark.slow`` when it takes about a second or more (``make test-fast`` leaves them out); a
+  study that takes minutes does not belong in the suite: record its expensive end in a reference under tests/
+  and re-derive it with a make target, as the refinement study does (tests/helpers/refinement_study.py,
+  ``make study``).
+"""
 
 from __future__ import annotations
 

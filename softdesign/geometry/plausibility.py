@@ -9,7 +9,6 @@ stage, with a hint naming the factor or the units that would explain them.
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from softdesign.errors import ConfigError, InputDataError
 from softdesign.types import UNIT_SCALE_TO_MM, FloatArray, Points
@@ -37,6 +36,8 @@ PLAUSIBLE_RADIUS_MM = (0.3, 20.0)
 #: about 1.5 m; a path between an inlet and an outlet shorter than 5 mm (eight diameters of the
 #: narrowest vessel above) is no vessel segment worth an actuator.
 PLAUSIBLE_LENGTH_MM = (5.0, 2000.0)
+#: Nearest distances by measuring every pair up to this many (a (n, V) float64 array of 32 MB), a KD-tree beyond.
+BRUTE_FORCE_PAIRS = 4_000_000
 
 
 def surrounds(points: Points, radius: FloatArray | None, vertices: Points) -> bool:
@@ -52,14 +53,34 @@ def surrounds(points: Points, radius: FloatArray | None, vertices: Points) -> bo
     inside = np.all((points >= lo - pad) & (points <= hi + pad), axis=1).mean()
     if inside < INSIDE_FRACTION:
         return False
-    # built for one query of a few hundred points: a median-split tree takes twice as long to build, and the
-    # nearest distances do not depend on how the tree is split
-    tree = cKDTree(vertices, balanced_tree=False, compact_nodes=False)
-    distance = np.median(tree.query(points)[0])
+    distance = np.median(nearest_distances(points, vertices))
     if radius is not None and np.all(np.isfinite(radius)) and np.median(radius) > 0:
         ratio = distance / float(np.median(radius))
         return bool(WALL_RATIO_BAND[0] <= ratio <= WALL_RATIO_BAND[1])
     return bool(distance < 0.25 * float(np.min(hi - lo)))
+
+
+def nearest_distances(points: Points, vertices: Points) -> FloatArray:
+    """Distance (n,) mm from each of ``points`` (n, 3) to its nearest of ``vertices`` (V, 3).
+
+    Up to BRUTE_FORCE_PAIRS point-vertex pairs, every pair is measured (numpy alone: the sample case's check
+    costs a few milliseconds, where importing scipy's KD-tree costs about 0.25 s); beyond, a KD-tree.  Both give
+    the exact nearest distance, up to rounding.
+    """
+    points, vertices = np.asarray(points, dtype=float), np.asarray(vertices, dtype=float)
+    if len(points) * len(vertices) > BRUTE_FORCE_PAIRS:
+        from scipy.spatial import cKDTree
+
+        # built for one query of a few hundred points: a median-split tree takes twice as long to build, and the
+        # nearest distances do not depend on how the tree is split
+        tree = cKDTree(vertices, balanced_tree=False, compact_nodes=False)
+        return np.asarray(tree.query(points)[0], dtype=float)
+    # |p - v|^2 = |p|^2 - 2 p.v + |v|^2, relative to the vertices' centre so that the rounding stays small
+    centre = vertices.mean(axis=0)
+    p, v = points - centre, vertices - centre
+    squared = np.einsum("ij,ij->i", p, p)[:, None] - 2.0 * (p @ v.T) + np.einsum("ij,ij->i", v, v)[None, :]
+    nearest: FloatArray = np.sqrt(np.maximum(squared.min(axis=1), 0.0))
+    return nearest
 
 
 def check_surface_surrounds(

@@ -13,12 +13,15 @@ every reader of the format accepts.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from softdesign.centerline.extract import Centerlines
 from softdesign.io.centerline import RADIUS_KEY
 from softdesign.io.polylines_vtp import write_polylines_vtp
+
+if TYPE_CHECKING:
+    from softdesign.centerline.extract import Centerlines  # its module imports scipy
 
 #: Face-label cell arrays, in the order they are looked for: SimVascular's, then VMTK's mesh generator's.
 REGION_KEYS = ("ModelFaceID", "CellEntityIds")

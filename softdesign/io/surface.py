@@ -16,6 +16,7 @@ import numpy as np
 from softdesign.errors import InputDataError
 from softdesign.io.formats import FORMATS, Mesh
 from softdesign.io.input_checks import check_input_file
+from softdesign.types import FloatArray
 
 #: The formats vessel walls come in from VMTK, 3D Slicer or ParaView (.glb is an output for viewers).
 SURFACE_FORMATS = ("stl", "ply", "obj", "vtp", "vtk")
@@ -38,7 +39,20 @@ def read_surface(path: str | Path, scale_to_mm: float = 1.0) -> Mesh:
         )
     check_input_file(path, "surface")
     vertices, faces = FORMATS[name].read(path, scale_to_mm)
-    if len(faces) == 0 or len(vertices) == 0:
+    check_surface_arrays(path, vertices, len(faces))
+    return vertices * scale_to_mm, faces
+
+
+def check_surface_arrays(path: Path, vertices: FloatArray, triangles: int) -> None:
+    """Raise InputDataError for a surface with no triangles or with coordinates that are not finite.
+
+    Parameters
+    ----------
+    path : the surface file, for the message
+    vertices : (V, 3) float, its vertices (file units)
+    triangles : its triangle count
+    """
+    if triangles == 0 or len(vertices) == 0:
         raise InputDataError(
             f"{path}: the surface is empty (0 triangles); expected the vessel wall from VMTK "
             "(e.g. vmtkmarchingcubes + vmtksurfacecapper output)"
@@ -48,4 +62,3 @@ def read_surface(path: str | Path, scale_to_mm: float = 1.0) -> Mesh:
         raise InputDataError(f"{path}: {int(bad.sum())} of its {len(vertices)} vertices have NaN or infinite "
                              f"coordinates (the first: vertex {int(np.argmax(bad))}); expected finite coordinates: "
                              "re-export the surface, or repair it (e.g. vmtksurfacecleaner)")
-    return vertices * scale_to_mm, faces

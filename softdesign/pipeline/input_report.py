@@ -22,11 +22,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from softdesign.errors import InputDataError
-from softdesign.types import UNIT_SCALE_TO_MM
+from softdesign.types import UNIT_SCALE_TO_MM, FloatArray, IntArray
 
 if TYPE_CHECKING:
     from softdesign.config import Case
     from softdesign.geometry.network import CenterlineNetwork, SelectedPath
+    from softdesign.io.file_facts import FileFacts
 
 
 def open_inputs(case: Case) -> list[str]:
@@ -103,13 +104,11 @@ def _paths_described(case: Case, network: CenterlineNetwork, index: int) -> list
 def _surface(case: Case, key: str, path: Path, final: SelectedPath | None) -> list[str]:
     """Open a surface file: its facts, its labels, the scale check against the centerline or alone."""
     from softdesign.geometry.plausibility import check_surface_surrounds, check_vessel_scale
-    from softdesign.io.centerline_vtp import read_face_regions
-    from softdesign.io.file_facts import file_facts
-    from softdesign.io.surface import read_surface
 
     units = (case.final.surface_units if key == "final.surface" else None) or case.units
-    facts = file_facts(path)
-    vertices, faces = read_surface(path, UNIT_SCALE_TO_MM[units])
+    # a missing radius is measured on the triangles (as ingest measures it); otherwise the corners suffice
+    facts, vertices, faces = _surface_arrays(path, UNIT_SCALE_TO_MM[units],
+                                             need_faces=final is not None and final.radius is None)
     if final is not None:  # as ingest checks it: a missing radius measured on this surface first
         radius = final.radius
         if radius is None:
@@ -120,9 +119,36 @@ def _surface(case: Case, key: str, path: Path, final: SelectedPath | None) -> li
     elif key == "final.surface":  # centerline: auto: the surface alone says whether the units fit
         extent = float(np.ptp(vertices, axis=0).max())
         check_vessel_scale(extent, None, units, f"{key} {path.name} (its largest extent)")
-    regions = read_face_regions(path) if path.suffix.lower() in (".vtp", ".vtk") else None
-    labels = "" if regions is None else f"; {len(np.unique(regions))} face labels"
+    labels = ""
+    if path.suffix.lower() in (".vtp", ".vtk"):
+        from softdesign.io.centerline_vtp import read_face_regions
+
+        regions = read_face_regions(path)
+        labels = "" if regions is None else f"; {len(np.unique(regions))} face labels"
     return [f"{key} {path.name}: {facts.text()}{labels}", f"  {_extent(vertices, units)}"]
+
+
+def _surface_arrays(path: Path, scale_to_mm: float, need_faces: bool) -> tuple[FileFacts, FloatArray, IntArray]:
+    """The file's facts, vertices (V, 3) mm and faces (F, 3) (empty unless ``need_faces``) of a surface.
+
+    A binary STL is read with numpy alone (:mod:`softdesign.io.stl_corners`: its distinct corners are the
+    vertices the build's reader merges them into); other files with the build's readers (trimesh, vtk).
+    """
+    from softdesign.io.file_facts import FileFacts, file_facts
+    from softdesign.io.surface import check_surface_arrays, read_surface
+
+    if path.suffix.lower() == ".stl" and not need_faces:
+        from softdesign.io.stl_corners import binary_stl_corners
+
+        corners = binary_stl_corners(path)
+        if corners is not None:
+            vertices, triangles = corners
+            check_surface_arrays(path, vertices, triangles)
+            no_faces = np.zeros((0, 3), dtype=np.int64)
+            return FileFacts("STL", len(vertices), {"triangles": triangles}), vertices * scale_to_mm, no_faces
+    facts = file_facts(path)
+    vertices, faces = read_surface(path, scale_to_mm)
+    return facts, vertices, faces
 
 
 def _path_index(case: Case, key: str) -> int:
