@@ -78,8 +78,12 @@ def test_every_row_has_the_pressure_q_times_p_star(built: tuple[Path, str]) -> N
 
 def test_the_build_ends_on_the_device_verdict(built: tuple[Path, str]) -> None:
     out, output = built
-    last = output.strip().splitlines()[-2]  # then "build folder: ..."
-    assert last.startswith("device: one pressure of ") and "mm (rod model), walls >= " in last
+    lines = output.strip().splitlines()
+    assert lines[-1].startswith("build folder: ")
+    last = lines[-2]  # the verdict's last margin: the device's line
+    assert last.startswith("  + one pressure of ") and "mm (rod model), walls >= " in last
     assert "% of its limit" in last
+    assert [line for line in lines if line.startswith("verdict: ")] == ["verdict: feasible for ecoflex-00-30"]
     manifest = json.loads((out / "manifest.json").read_text())
-    assert manifest["metrics"]["actuation"]["verdict_line"] == last
+    assert manifest["metrics"]["actuation"]["verdict_line"] == "device: " + last.removeprefix("  + ")
+    assert manifest["verdict"]["margins"][-1] == last.removeprefix("  + ")
