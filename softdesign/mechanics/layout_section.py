@@ -11,8 +11,9 @@ skin).  It differs from the body's own volume mesh in what a solve of one
 section needs and can afford:
 
 - only this section's chambers are holes; the feed lines of more distal
-  chambers that run through it are left out (solid), as is the short feed
-  from the section's base into its own chamber (the chamber is closed);
+  chambers that run through it are left out (solid) unless asked for
+  (``feeds``: cavities open at the base, capped below the tip), and the short feed from the
+  section's base into its own chamber is left out (the chamber is closed);
 - the layers are ``size_mm`` apart and the outer circle has ``angular_count``
   nodes (not the export's), so that a solve fits in its time;
 - the section's ends are planes normal to the centerline (the body's slanted
@@ -65,8 +66,22 @@ def _holes(layout: ChamberLayout, section: int, scale_mm: float, size_mm: float)
     return holes
 
 
+def _feed_holes(layout: ChamberLayout, section: int, scale_mm: float, size_mm: float) -> list[Hole]:
+    """The feeds that cross the section, as holes open at its base and closed where its chambers end (the end
+    wall below its tip: the wall the feed's pressure pulls on, for the distal part the section leaves out)."""
+    l0, l1 = layout.breaks[section], layout.breaks[section + 1]
+    cap = max((c.l_end - l0) / (l1 - l0) for c in layout.section_chambers(section))
+    holes = []
+    for f in layout.feeds_through(section):
+        nodes = max(MIN_CHAMBER_NODES, int(np.ceil(np.pi * f.diameter_mm / size_mm)))
+        centre = (f.ring_mm * np.cos(f.angle) / scale_mm, f.ring_mm * np.sin(f.angle) / scale_mm)
+        holes.append(Hole(f"s{f.section}_f{f.chamber}", Circle(centre, 0.5 * f.diameter_mm / scale_mm, nodes),
+                          (0.0, cap)))
+    return holes
+
+
 def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, layout: ChamberLayout, section: int,
-                        size_mm: float, angular_count: int, layer_mm: float) -> SectionMesh:
+                        size_mm: float, angular_count: int, layer_mm: float, feeds: bool = False) -> SectionMesh:
     """Section ``section``'s mesh at q = 0 in its base frame, with its base fixed and chamber walls named.
 
     Parameters
@@ -79,6 +94,9 @@ def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, lay
     size_mm : edge length inside the cross-section, mm
     angular_count : nodes on the outer circle
     layer_mm : spacing of the layers along the centerline, mm
+    feeds : mesh the feeds of distal chambers that cross the section as cavities (``feed_faces``: their walls
+        and a cap where the section's chambers end, which carries the pull of the feed's pressure on the
+        distal part), not solid
 
     Raises
     ------
@@ -93,8 +111,9 @@ def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, lay
     reach = max(c.distance_mm + 0.5 * c.diameter_mm for c in chambers)
     core_mm = reach + CORE_GAP_FRACTION * (float(np.min(rho)) - reach)
     holes = _holes(layout, section, scale, size_mm)
+    feed_holes = _feed_holes(layout, section, scale, size_mm) if feeds else []
     # the mesher sweeps l from 0 to 1: the section's own l, put back on the body's before placing
-    own = swept_disk(angular_count, holes, size_mm / scale, (layers - l0) / (l1 - l0))
+    own = swept_disk(angular_count, holes + feed_holes, size_mm / scale, (layers - l0) / (l1 - l0))
     mesh = replace(own, l=l0 + own.l * (l1 - l0))
     ref = SweepReference(core=core_mm / scale, scale_mm=scale)
     outer, inner = section_sweeps(mesh, ref, curve0, field, 0.0, spec, angular_count)  # type: ignore[arg-type]
@@ -107,7 +126,14 @@ def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, lay
     walls = [mesh.cavity_surface(h.name) for h in holes]
     centerline = (curve0.points(mesh.l) - origin) @ frame
     s = curve0.curve.arc_length(mesh.l)
+    # a feed's wall and cap, out of the feed; its inlet lid is on the fixed base (no work, no volume: z = 0)
+    feed_walls = [np.concatenate([mesh.group_faces(f"{h.name}_{part}") for part in ("wall", "cap")])[:, ::-1]
+                  for h in feed_holes]
+    feed_parts = (np.concatenate(feed_walls),
+                  np.concatenate([np.full(len(w), k, np.int64) for k, w in enumerate(feed_walls)]),
+                  np.array([0.5 * f.diameter_mm for f in layout.feeds_through(section)])) if feed_walls else (
+                      None, None, None)
     return SectionMesh(local, mesh.tets, mesh.node_layer == 0, np.concatenate(walls),
                        np.concatenate([np.full(len(w), k, np.int64) for k, w in enumerate(walls)]),
                        centerline, (s - s[0])[mesh.node_layer], np.array([c.angle for c in chambers]),
-                       np.array([0.5 * c.diameter_mm for c in chambers]))
+                       np.array([0.5 * c.diameter_mm for c in chambers]), *feed_parts)

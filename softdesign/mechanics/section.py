@@ -62,6 +62,10 @@ class SectionMesh:
     node_l : (V,) float, mm, each node's arc length along the centerline (its level)
     chamber_angles : (k,) float, rad, each chamber's angle from x towards y
     chamber_radii_mm : (k,) float, mm, each chamber's radius (the reinforcement's winding needs it), or None
+    feed_faces : (G, 3) int or None, the walls and end lids of the feeds that cross the section (cavities of
+        their distal chambers' pressures), normals out of the feed
+    face_feed : (G,) int or None, the feed (0 .. m-1) of each feed face
+    feed_radii_mm : (m,) float or None, each feed's radius, mm
     """
 
     points: FloatArray
@@ -73,11 +77,19 @@ class SectionMesh:
     node_l: FloatArray
     chamber_angles: FloatArray
     chamber_radii_mm: FloatArray | None = None
+    feed_faces: IntArray | None = None
+    face_feed: IntArray | None = None
+    feed_radii_mm: FloatArray | None = None
 
     @property
     def chamber_count(self) -> int:
         """How many chambers (pressures) the section takes."""
         return len(self.chamber_angles)
+
+    @property
+    def feed_count(self) -> int:
+        """How many feeds of distal chambers cross the section as cavities (0: none, or meshed solid)."""
+        return 0 if self.feed_radii_mm is None else len(self.feed_radii_mm)
 
 
 @dataclass(frozen=True)
@@ -125,12 +137,17 @@ def section_problem(section: SectionMesh, law: HyperelasticLaw, thread: HoopThre
     nodes (corners and the midpoints between them) are fixed in every
     direction and each chamber's wall carries its pressure on 6-node faces.
     With a ``thread``, every chamber's side wall carries the hoop winding's fibres
-    (:mod:`softdesign.mechanics.reinforcement`), its axis the centerline's tangent at the face's level.
+    (:mod:`softdesign.mechanics.reinforcement`), its axis the centerline's tangent at the face's level; so does
+    every feed's (the feed's core wound as the chambers', a feed that does not swell).  The feeds crossing the
+    section (``feed_faces``) are cavities after the chambers: the problem takes k + m pressures.
     """
     mesh = quadratic_mesh(check_section(section))
     fixed = quadratic_fixed(mesh, np.repeat(section.base[:, None], 3, axis=1)).ravel()
-    faces = quadratic_faces(mesh, np.asarray(section.wall_faces, np.int64))
-    chambers = np.asarray(section.face_chamber, np.int64)
+    walls, chambers = np.asarray(section.wall_faces, np.int64), np.asarray(section.face_chamber, np.int64)
+    if section.feed_count:  # the feeds are cavities k .. k + m - 1
+        walls = np.concatenate([walls, np.asarray(section.feed_faces, np.int64)])
+        chambers = np.concatenate([chambers, section.chamber_count + np.asarray(section.face_feed, np.int64)])
+    faces = quadratic_faces(mesh, walls)
     fibres = None if thread is None else _wall_fibres(section, mesh, faces, chambers, thread, law)
     return PressureProblem(mesh, law, fixed, faces, chambers, fibres)
 
@@ -145,7 +162,8 @@ def _wall_fibres(section: SectionMesh, mesh: QuadraticMesh, faces: IntArray, cha
     tangents = np.gradient(line, s, axis=0)
     level = section.node_l[faces[:, :3]].mean(axis=1)
     axes = np.stack([np.interp(level, s, tangents[:, k]) for k in range(3)], axis=1)
-    radii = np.asarray(section.chamber_radii_mm, float)[chambers]
+    radii = np.concatenate([np.asarray(section.chamber_radii_mm, float),
+                            np.zeros(0) if section.feed_radii_mm is None else section.feed_radii_mm])[chambers]
     return hoop_membrane(mesh.points, faces, axes, radii, thread, 3.0 * law.mu_kpa)  # incompressible: E = 3 mu
 
 
@@ -254,8 +272,12 @@ def measure_section(prepared: PreparedSection, u: FloatArray, pressures: FloatAr
 
 
 def simulate_section(section: SectionMesh, law: HyperelasticLaw, pressures: FloatArray,
-                     settings: NewtonSettings, thread: HoopThread | None = None) -> SectionResult:
+                     settings: NewtonSettings, thread: HoopThread | None = None,
+                     feed_pressures: FloatArray | None = None) -> SectionResult:
     """Solve the section at chamber ``pressures`` (k,) kPa and measure it (see the module's docstring).
+
+    ``feed_pressures`` (m,) kPa: those of the feeds that cross the section as cavities (their distal chambers'
+    pressures; None: 0).
 
     Raises
     ------
@@ -268,8 +290,11 @@ def simulate_section(section: SectionMesh, law: HyperelasticLaw, pressures: Floa
     pressures = np.asarray(pressures, float)
     if pressures.shape != (section.chamber_count,):
         raise ValueError(f"expected {section.chamber_count} pressures, got shape {pressures.shape}")
+    feeds = np.zeros(section.feed_count) if feed_pressures is None else np.asarray(feed_pressures, float)
+    if feeds.shape != (section.feed_count,):
+        raise ValueError(f"expected {section.feed_count} feed pressures, got shape {feeds.shape}")
     prepared = prepare_section(section, law, thread)
-    path = follow_pressures(prepared.problem, pressures, ContinuationSettings(
+    path = follow_pressures(prepared.problem, np.concatenate([pressures, feeds]), ContinuationSettings(
         first_step=1.0 / settings.load_steps, max_cutbacks=settings.max_cutbacks, newton=settings),
         solver=prepared.solver)
     if path.status != "reached":

@@ -21,6 +21,15 @@ Points
     equal steps from angle 0, or graded (``Circle.angles``) where it passes a
     narrow gap (:mod:`softdesign.meshing.section_gaps`); a graded circle's
     fronts start at its largest edge and keep off it by that edge.
+Three-fold symmetry
+    When the holes map onto themselves under a rotation by 120 degrees and
+    ``na`` is a multiple of three (issue 31's chambers and feeds), the points
+    are made orbit by orbit with the centre among them, and prisms are split
+    by a rule that turns with the rotation
+    (:mod:`softdesign.meshing.three_fold`): the mesh maps onto itself, so
+    three equal chambers at equal pressure do not bend it.  Should the
+    Delaunay triangulation of those points break a tie unevenly, the points
+    above are used instead.
 Triangulation
     Delaunay (qhull through scipy: deterministic for the same points).  The
     rings either side of a circle make its edges Delaunay; every circle edge
@@ -32,11 +41,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from softdesign.errors import MeshError
+from softdesign.meshing.three_fold import SymmetricPoints, hole_turns, keep_orbits, orbit_heads, with_copies
 from softdesign.types import FloatArray, IntArray
 
 #: Local size grows by this factor per ring away from a circle.  1.4 rather than 1.25: the aorta with chambers
@@ -104,6 +114,9 @@ class CrossSection:
     inside : (T, H) bool, triangle t lies inside hole h
     circle_nodes : tuple of H (m_h,) int64, each hole's circle nodes in counter-clockwise order
     outer_count : int, na
+    corner_order : (T, 3) int64 or None, the order of each triangle's corners that prisms over it are split
+        by (None: the points' own order); set when the section is three-fold symmetric
+        (:mod:`softdesign.meshing.three_fold`), so that the split commutes with the rotation
     """
 
     points: FloatArray
@@ -111,6 +124,7 @@ class CrossSection:
     inside: np.ndarray
     circle_nodes: tuple[IntArray, ...]
     outer_count: int
+    corner_order: IntArray | None = None
 
     def triangle_areas(self) -> FloatArray:
         """Signed area of each triangle, (T,) in squared section radii (> 0: counter-clockwise)."""
@@ -135,8 +149,9 @@ def _ring(center: FloatArray, radius: float, count: int, phase: float) -> FloatA
 
 
 def _front(center: FloatArray, radius: float, h0: float, size: float, outward: bool,
-           reach: float) -> list[tuple[int, FloatArray, float]]:
-    """Rings stepping away from a circle: (ring index from 1, points, local size)."""
+           reach: float, multiple: int = 1) -> list[tuple[int, FloatArray, float]]:
+    """Rings stepping away from a circle: (ring index from 1, points, local size); each ring's count a
+    ``multiple`` of its nearest."""
     rings, r, h, phase = [], radius, h0, 0.0
     for index in range(1, 10_000):
         step = h * math.sqrt(3.0) / 2.0
@@ -147,9 +162,14 @@ def _front(center: FloatArray, radius: float, h0: float, size: float, outward: b
             if not outward:
                 rings.append((index, center[None, :].copy(), h))
             break
-        count = max(3, round(2.0 * np.pi * r / h))
+        count = max(3, multiple * round(2.0 * np.pi * r / h / multiple))
         rings.append((index, _ring(center, r, count, phase), h))
     return rings
+
+
+def _hole_count(c: Circle, size: float, h_outer: float) -> int:
+    """Nodes on a hole's circle: its graded angles', its own, or from the local size (at least MIN_HOLE_NODES)."""
+    return len(c.angles) or c.nodes or max(MIN_HOLE_NODES, round(2.0 * np.pi * c.radius / max(size, h_outer)))
 
 
 def _check_holes(circles: Sequence[Circle]) -> None:
@@ -168,7 +188,7 @@ def _candidates(outer_count: int, circles: Sequence[Circle], size: float):
     fronts = [_front(np.zeros(2), 1.0, h_outer, max(size, h_outer), False, 2.0)]
     for c in circles:
         centre = np.asarray(c.center, float)
-        count = len(c.angles) or c.nodes or max(MIN_HOLE_NODES, round(2.0 * np.pi * c.radius / max(size, h_outer)))
+        count = _hole_count(c, size, h_outer)
         radius = c.node_radius(count)
         if c.angles:  # graded: a node's local size is its smaller edge; the fronts start at the largest
             nodes = centre + radius * np.column_stack([np.cos(c.node_angles(count)), np.sin(c.node_angles(count))])
@@ -210,6 +230,91 @@ def _keep(fixed: list[FloatArray], sizes: list[FloatArray], rings,
     return points, local
 
 
+def _symmetric_points(outer_count: int, circles: Sequence[Circle], size: float,
+                      counts: list[int]) -> SymmetricPoints | None:
+    """The points of :func:`_candidates` and :func:`_keep` made orbit by orbit under the 120-degree rotation
+    (:mod:`softdesign.meshing.three_fold`), or None when the section is not three-fold symmetric."""
+    centres = np.array([c.center for c in circles], float).reshape(-1, 2)
+    turns = hole_turns(centres, np.array([c.radius for c in circles]), counts)
+    if not circles or outer_count % 3 or turns is None or any(c.equal_area != circles[turns[i]].equal_area
+                                               for i, c in enumerate(circles)):
+        return None
+    h_outer = 2.0 * np.sin(np.pi / outer_count)
+    third = outer_count // 3
+    fixed = [_ring(np.zeros(2), 1.0, outer_count, 0.0)]
+    orbit, copy = [np.arange(outer_count) % third], [np.arange(outer_count) // third]
+    heads = orbit_heads(turns)
+    first_of = {}
+    for k, (head, once, twice) in enumerate(heads):  # graded or not, an orbit's holes take its first's nodes
+        nodes = with_copies(_circle_nodes(circles[head], counts[head]))
+        for power, hole in enumerate((head, once, twice)):
+            first_of[hole] = (nodes[power], third + sum(counts[h[0]] for h in heads[:k]), power)
+    sizes = [np.full(outer_count, h_outer)]
+    for hole in range(len(circles)):
+        nodes, start, power = first_of[hole]
+        fixed.append(nodes)
+        edges = np.linalg.norm(np.roll(nodes, -1, axis=0) - nodes, axis=1)
+        sizes.append(np.minimum(edges, np.roll(edges, 1)))  # a node's local size: its smaller edge
+        orbit.append(start + np.arange(len(nodes)))
+        copy.append(np.full(len(nodes), power))
+    big = max(size, h_outer)
+    fixed.append(np.zeros((1, 2)))  # the centre: no triangle holds a whole orbit (three copies around it)
+    orbit.append(np.array([third + sum(counts)]))
+    copy.append(np.zeros(1, np.int64))
+    fronts = [_front(np.zeros(2), 1.0, h_outer, big, False, 2.0, multiple=3)[:-1]]  # its last: the centre
+    for head, _, _ in heads:
+        c = circles[head]
+        centre, radius, h0 = np.asarray(c.center, float), c.node_radius(counts[head]), c.largest_edge(counts[head])
+        fronts += [_front(centre, radius, h0, big, outward, 2.0) for outward in (False, True)]
+    rings = sorted(((index, f, pts, h) for f, front in enumerate(fronts) for index, pts, h in front),
+                   key=lambda item: (item[0], item[1]))
+    points, local = np.concatenate(fixed), np.concatenate(sizes + [np.full(1, big)])
+    orbits, copies = np.concatenate(orbit), np.concatenate(copy)
+    for _, f, pts, h in rings:
+        if f == 0:
+            pts = pts[:len(pts) // 3]  # the axis's rings: their first third, the rest is its copies
+        pts = keep_orbits(_clear_of_circles(pts, circles, [outer_count] + counts), points, local, h, KEEP_FRACTION)
+        if not len(pts):
+            continue
+        turned, which = with_copies(pts).reshape(-1, 2), np.repeat(np.arange(3), len(pts))
+        new = orbits.max() + 1 + np.tile(np.arange(len(pts)), 3)
+        points, local = np.concatenate([points, turned]), np.concatenate([local, np.full(len(turned), h)])
+        orbits, copies = np.concatenate([orbits, new]), np.concatenate([copies, which])
+    return SymmetricPoints(points, orbits.astype(np.int64), copies.astype(np.int64))
+
+
+def _circle_nodes(c: Circle, count: int) -> FloatArray:
+    """A hole's ``count`` circle nodes (count, 2), counter-clockwise from its first angle."""
+    return np.asarray(c.center, float) + c.node_radius(count) * np.column_stack(
+        [np.cos(c.node_angles(count)), np.sin(c.node_angles(count))])
+
+
+def turned_gradings(outer_count: int, circles: Sequence[Circle], size: float) -> list[Circle]:
+    """``circles`` with each graded circle of a three-fold symmetric section given its orbit's first circle's
+    grading, turned (the section's nodes are those turned nodes); any other section's circles as they are."""
+    counts = [_hole_count(c, size, 2.0 * np.sin(np.pi / outer_count)) for c in circles]
+    turns = hole_turns(np.array([c.center for c in circles], float), np.array([c.radius for c in circles]), counts)
+    if not circles or outer_count % 3 or turns is None:
+        return list(circles)
+    out = list(circles)
+    for head, once, twice in orbit_heads(turns):
+        if circles[head].angles:
+            for power, hole in ((1, once), (2, twice)):
+                turned = np.sort(np.mod(np.asarray(circles[head].angles) + 2.0 * np.pi * power / 3, 2.0 * np.pi))
+                out[hole] = replace(circles[hole], angles=tuple(turned.tolist()))
+    return out
+
+
+def _clear_of_circles(pts: FloatArray, circles: Sequence[Circle], counts: list[int]) -> FloatArray:
+    """The points inside the unit disk and off every circle's edges' diametral disks (as :func:`_keep`)."""
+    ok = np.linalg.norm(pts, axis=1) <= 1.0
+    ok &= np.abs(np.linalg.norm(pts, axis=1) - 1.0) >= CIRCLE_CLEARANCE * 2.0 * np.sin(np.pi / counts[0])
+    for c, n in zip(circles, counts[1:], strict=True):
+        ok &= (np.abs(np.linalg.norm(pts - np.asarray(c.center), axis=1) - c.node_radius(n))
+               >= CIRCLE_CLEARANCE * c.largest_edge(n))
+    return pts[ok]
+
+
 def cross_section(outer_count: int, circles: Sequence[Circle], size: float) -> CrossSection:
     """The unit disk triangulated with ``outer_count`` nodes on its circle and conforming to ``circles``.
 
@@ -224,25 +329,43 @@ def cross_section(outer_count: int, circles: Sequence[Circle], size: float) -> C
     MeshError
         A hole outside the disk, or a circle whose edges the triangulation does not keep (a bug).
     """
-    from scipy.spatial import Delaunay
-
     if outer_count < 3 or not size > 0:
         raise ValueError(f"cross_section: outer_count >= 3 and size > 0, got {outer_count}, {size}")
     _check_holes(circles)
+    counts = [outer_count] + [_hole_count(c, size, 2.0 * np.sin(np.pi / outer_count)) for c in circles]
+    symmetric = _symmetric_points(outer_count, circles, size, counts[1:])
+    if symmetric is not None:
+        triangles = _triangulate(symmetric.points)
+        if symmetric.is_symmetric(triangles):  # else co-circular ties fell unevenly: the general points
+            return _section(symmetric.points, triangles, circles, counts, symmetric.corner_order(triangles))
     fixed, sizes, rings = _candidates(outer_count, circles, size)
     points, _ = _keep(fixed, sizes, rings, circles)
+    return _section(points, _triangulate(points), circles, counts, None)
+
+
+def _triangulate(points: FloatArray) -> IntArray:
+    """The Delaunay triangles (T, 3) of ``points``, counter-clockwise, none of zero area."""
+    from scipy.spatial import Delaunay
+
     triangles = np.asarray(Delaunay(points).simplices, np.int64)
     u, v = (points[triangles[:, k]] - points[triangles[:, 0]] for k in (1, 2))
     area2 = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
     triangles = np.where((area2 < 0)[:, None], triangles[:, [0, 2, 1]], triangles)
-    triangles = triangles[np.abs(area2) > 1e-14]
-    starts = np.cumsum([0] + [len(f) for f in fixed])
-    circle_nodes = tuple(np.arange(starts[k], starts[k + 1], dtype=np.int64) for k in range(1, len(fixed)))
+    return triangles[np.abs(area2) > 1e-14]
+
+
+def _section(points: FloatArray, triangles: IntArray, circles: Sequence[Circle], counts: list[int],
+             corner_order: IntArray | None) -> CrossSection:
+    """The cross-section of ``points`` (``counts[0]`` outer circle nodes, then ``counts[1 + h]`` of each hole
+    h, then the rest) and their ``triangles``, its circles' edges checked present."""
+    outer_count = counts[0]
+    starts = np.cumsum([0] + counts)
+    circle_nodes = tuple(np.arange(starts[k], starts[k + 1], dtype=np.int64) for k in range(1, len(counts)))
     _check_edges(triangles, [np.arange(outer_count)] + list(circle_nodes))
     centroids = points[triangles].mean(axis=1)
     inside = np.stack([np.linalg.norm(centroids - np.asarray(c.center), axis=1) < c.radius for c in circles],
                       axis=1) if circles else np.zeros((len(triangles), 0), bool)
-    return CrossSection(points, triangles, inside, circle_nodes, outer_count)
+    return CrossSection(points, triangles, inside, circle_nodes, outer_count, corner_order)
 
 
 def _check_edges(triangles: IntArray, chains: list[np.ndarray]) -> None:

@@ -15,7 +15,10 @@ Prisms into tetrahedra
     quadrilateral side's diagonal starts at its smallest global node index
     (Dompierre et al. 1999, "How to subdivide pyramids, prisms and hexahedra
     into tetrahedra"): the rule depends on the face alone, so the two prisms
-    sharing a face cut it alike and the mesh conforms.  Every tetrahedron is
+    sharing a face cut it alike and the mesh conforms.  A three-fold
+    symmetric section orders its triangles' corners by a rule of the same
+    kind that turns with its rotation (``corner_order``,
+    :mod:`softdesign.meshing.three_fold`), so that the split commutes with it.  Every tetrahedron is
     then ordered to positive volume in (x, y, l) (VTK's order).
 Named surfaces
     Boundary faces (those of one tetrahedron), outward: ``skin`` (the outer
@@ -36,7 +39,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import MeshError
-from softdesign.meshing.cross_section import Circle, CrossSection, cross_section
+from softdesign.meshing.cross_section import Circle, CrossSection, cross_section, turned_gradings
 from softdesign.types import FloatArray, IntArray
 
 #: A grid value closer than this fraction of its neighbouring step to a hole's end is dropped (no slivers).
@@ -136,16 +139,18 @@ def layer_grid(l: npt.ArrayLike, holes: Sequence[Hole]) -> FloatArray:
     return np.unique(np.concatenate([grid[keep], ends]))
 
 
-def _prism_tets(bottom: IntArray, top: IntArray) -> IntArray:
-    """Three tetrahedra per prism (bottom (k, 3), top (k, 3), top above bottom, top indices > bottom's)."""
-    # turn each prism so that its smallest node (a bottom node, as top > bottom) comes first
-    first = np.argmin(bottom, axis=1)
+def _prism_tets(bottom: IntArray, top: IntArray, key: IntArray | None = None) -> IntArray:
+    """Three tetrahedra per prism (bottom (k, 3), top (k, 3), top above bottom, top indices > bottom's); each
+    side's diagonal starts at the bottom corner of smaller ``key`` (k, 3) (default: ``bottom``, the nodes)."""
+    key = bottom if key is None else key
+    # turn each prism so that its smallest corner (a bottom node, as top > bottom) comes first
+    first = np.argmin(key, axis=1)
     order = (first[:, None] + np.arange(3)) % 3
     rows = np.arange(len(bottom))[:, None]
     a, b, c = (bottom[rows, order][:, i] for i in range(3))
     A, B, C = (top[rows, order][:, i] for i in range(3))
     # side (a b B A) and (a c C A): diagonals from a; side (b c C B): from the smaller of b and c
-    b_first = (b < c)[:, None]
+    b_first = (key[rows, order][:, 1] < key[rows, order][:, 2])[:, None]
     t1 = np.where(b_first, np.column_stack([a, b, c, C]), np.column_stack([a, b, c, B]))
     t2 = np.where(b_first, np.column_stack([a, b, C, B]), np.column_stack([a, B, c, C]))
     t3 = np.column_stack([a, B, C, A])
@@ -187,7 +192,8 @@ def sweep_mesh(section: CrossSection, l: FloatArray, holes: Sequence[Hole]) -> S
     P, tri = len(section.points), section.triangles
     solid = _solid_triangles(section, l, holes)
     layer, t = np.nonzero(solid)
-    tets = _prism_tets(layer[:, None] * P + tri[t], (layer[:, None] + 1) * P + tri[t])
+    order = None if section.corner_order is None else section.corner_order[t]
+    tets = _prism_tets(layer[:, None] * P + tri[t], (layer[:, None] + 1) * P + tri[t], order)
     tet_layer = np.repeat(layer, 3).astype(np.int64)
     used, tets = np.unique(tets, return_inverse=True)
     tets = tets.reshape(-1, 4).astype(np.int64)
@@ -260,7 +266,8 @@ def swept_disk(outer_count: int, holes: Sequence[Hole], size: float, l: npt.Arra
     to a narrow gap get more nodes (:func:`~softdesign.meshing.section_gaps.resolve_circles`)."""
     from softdesign.meshing.section_gaps import resolve_circles
 
-    circles = resolve_circles([h.circle for h in holes])
+    # a three-fold symmetric section's orbits share their first circle's grading, turned (its nodes are those)
+    circles = turned_gradings(outer_count, resolve_circles([h.circle for h in holes]), size)
     holes = [replace(h, circle=c) for h, c in zip(holes, circles, strict=True)]
     section = cross_section(outer_count, circles, size)
     return sweep_mesh(section, layer_grid(l, holes), holes)

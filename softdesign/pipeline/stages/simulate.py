@@ -42,7 +42,7 @@ if TYPE_CHECKING:
     from softdesign.pipeline.stages.fit import FitResult
     from softdesign.pipeline.stages.kinematics import KinematicsResult
 
-VERSION = 1
+VERSION = 2  # 2: the section meshes three-fold symmetric (equal chambers at equal pressure do not bend)
 SUMMARY = "simulate/summary.json"
 
 

@@ -62,9 +62,9 @@ from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 from softdesign.types import FloatArray, IntArray
 
-VERSION = 6  # 3: export.frame (the meshes in the patient's or the base frame); 4: VTK's .vtu, no times in the summary;
+VERSION = 7  # 3: export.frame (the meshes in the patient's or the base frame); 4: VTK's .vtu, no times in the summary;
 # 5: the swept section's GROWTH 1.4, sections and chambers named from 1, a solid body's end layers at its crease;
-# 6: the .vtu names its surface codes in field data
+# 6: the .vtu names its surface codes in field data; 7: a three-fold symmetric chambered section meshed symmetric
 #: The function the child process runs: (vertices, faces, TetSettings) -> (points, tets).  A module attribute,
 #: so that a test can put a crashing or hanging stand-in in its place.
 MESHER = tetrahedralize
