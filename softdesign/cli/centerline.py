@@ -129,8 +129,8 @@ def _short(short: list[float], units: str) -> str:
 
 
 def _length(value: float, units: str) -> str:
-    """A length of the payload (in ``units``) as messages print it (:func:`softdesign.lengths.length_text`)."""
-    from softdesign.lengths import length_text
+    """A length of the payload (in ``units``) (:func:`~softdesign.pipeline.length_text.length_text`)."""
+    from softdesign.pipeline.length_text import length_text
     from softdesign.types import UNIT_SCALE_TO_MM
 
     return length_text(value * UNIT_SCALE_TO_MM[units], units)

@@ -42,16 +42,16 @@ Openings
     The far ends of the paths, one opening for ends within the leave
     tolerance of each other, numbered from 1 in path order (0 is the inlet).
 
-Pure: numpy and scipy only; lengths in the paths' own unit.
+Pure: numpy (and scipy's KD-tree for long paths only, so that ``softdesign validate`` on a
+usual centerline does not import scipy); lengths in the paths' own unit.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from softdesign.types import FloatArray, Points
 
@@ -118,10 +118,39 @@ def _tolerance(points: Points, radius: FloatArray | None) -> FloatArray:
     return np.full(len(points), LEAVE_STEPS * step)
 
 
-def distances_to_polyline(points: Points, polyline: Points, tree: cKDTree | None = None) -> FloatArray:
+#: Up to this many point-vertex pairs the nearest vertex is found by direct distances (numpy), above by a KD-tree.
+DIRECT_PAIRS = 4_000_000
+#: Points per block of the direct search (a block's distances: DIRECT_BLOCK x vertices floats).
+DIRECT_BLOCK = 2048
+NearestVertex = Callable[[Points], np.ndarray]
+
+
+def nearest_vertex_of(polyline: Points, queries: int) -> NearestVertex:
+    """A function giving, for points (n, 3), the index (n,) of the nearest vertex of ``polyline`` (m, 3): direct
+    distances when ``queries`` x m is at most :data:`DIRECT_PAIRS`, else scipy's KD-tree (the same answer)."""
+    polyline = np.asarray(polyline, float)
+    if queries * len(polyline) > DIRECT_PAIRS:
+        from scipy.spatial import cKDTree
+
+        tree = cKDTree(polyline)
+        return lambda points: np.asarray(tree.query(points)[1], np.int64)
+
+    def direct(points: Points) -> np.ndarray:
+        points = np.asarray(points, float)
+        out = np.empty(len(points), np.int64)
+        for start in range(0, len(points), DIRECT_BLOCK):
+            block = points[start:start + DIRECT_BLOCK]
+            d2 = np.einsum("ijk,ijk->ij", block[:, None, :] - polyline[None], block[:, None, :] - polyline[None])
+            out[start:start + DIRECT_BLOCK] = np.argmin(d2, axis=1)
+        return out
+
+    return direct
+
+
+def distances_to_polyline(points: Points, polyline: Points, nearest_of: NearestVertex | None = None) -> FloatArray:
     """Distance (n,) from each point (n, 3) to the polyline (m, 3): to the segments beside its nearest vertex."""
-    tree = cKDTree(polyline) if tree is None else tree
-    _, nearest = tree.query(points)
+    nearest_of = nearest_vertex_of(polyline, len(points)) if nearest_of is None else nearest_of
+    nearest = nearest_of(points)
     best = np.linalg.norm(points - polyline[nearest], axis=1)
     for first in (nearest - 1, nearest):  # the segments ending and starting at the nearest vertex
         ok = (first >= 0) & (first + 1 < len(polyline))
@@ -133,12 +162,13 @@ def distances_to_polyline(points: Points, polyline: Points, tree: cKDTree | None
     return best
 
 
-def leave_length(points: Points, radius: FloatArray | None, other: Points, tree: cKDTree | None = None) -> float:
+def leave_length(points: Points, radius: FloatArray | None, other: Points,
+                 nearest_of: NearestVertex | None = None) -> float:
     """Arc length along ``points`` (from its first point) where it leaves ``other`` (see the module notes).
 
     0 when its first point is already off ``other``; its whole length when it never leaves.
     """
-    off = distances_to_polyline(points, other, tree) > _tolerance(points, radius)
+    off = distances_to_polyline(points, other, nearest_of) > _tolerance(points, radius)
     s = arc_lengths(points)
     return float(s[int(np.argmax(off))]) if off.any() else float(s[-1])
 
@@ -153,7 +183,8 @@ def survey_paths(paths: Sequence[tuple[int, Points, FloatArray | None]]) -> list
     own = [_own_facts(index, points, radius) for index, points, radius in paths]
     main = next(k for k, f in enumerate(own) if f.index == main_path(own))
     partners = range(len(paths)) if len(paths) <= MAX_PAIRWISE_PATHS else [main]
-    trees = {j: cKDTree(paths[j][1]) for j in partners}
+    longest = max(len(points) for _, points, _ in paths)
+    trees = {j: nearest_vertex_of(paths[j][1], longest) for j in partners}
     ends: list[FloatArray] = []
     out = []
     for k, (_, points, radius) in enumerate(paths):

@@ -72,7 +72,7 @@ def extraction_summary(extracted: Centerlines) -> dict[str, Any]:
 def continuation_note(extracted: Centerlines, units: str = "mm") -> str:
     """How far each extracted path's ends were continued straight past the Voronoi diagram, for the ingest notes
     (lengths in the case's ``units``, with mm beside them otherwise)."""
-    from softdesign.lengths import length_text
+    from softdesign.pipeline.length_text import length_text
 
     ends = "; ".join(f"path {k}: {length_text(a, units)} at the inlet, {length_text(b, units)} at the outlet"
                      for k, (a, b) in enumerate(extracted.continued_mm))

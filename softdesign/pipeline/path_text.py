@@ -5,7 +5,7 @@ and at the end, where it leaves the others (mm from the inlet) and which
 opening it ends at, the main vessel marked
 (:mod:`softdesign.geometry.path_survey` has the facts and the rule).
 Lengths are printed in the files' unit with mm beside them
-(:func:`softdesign.lengths.length_text`).
+(:func:`softdesign.pipeline.length_text.length_text`).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from softdesign.geometry.path_survey import PathFacts
-from softdesign.lengths import length_text
+from softdesign.pipeline.length_text import length_text
 from softdesign.types import UNIT_SCALE_TO_MM, FloatArray
 
 #: How the main vessel is marked in the list.

@@ -75,7 +75,7 @@ def test_lengths_are_printed_with_three_figures_and_mm_beside_other_units(tmp_pa
 
 
 def test_lengths_in_mm_are_not_repeated():
-    from softdesign.lengths import length_text
+    from softdesign.pipeline.length_text import length_text
 
     assert length_text(70.31, "mm") == "70.3 mm"
     assert length_text(70.31, "m") == "0.0703 m (70.3 mm)"

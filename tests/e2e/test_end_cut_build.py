@@ -180,7 +180,8 @@ def test_a_pose_with_one_q_per_link_is_cut_like_the_export(tmp_path):
 
     mine, built = trimesh.load(output), trimesh.load(out / "meshes" / "q_1.000.stl")
     assert compare_meshes(mine.vertices, mine.faces, built.vertices, built.faces).distance_max_mm < 1e-6
-    result = runner.invoke(app, ["pose", str(case), "--q", "0,1,0.5", "--output", str(output), "--out", str(out)])
+    result = runner.invoke(app, ["pose", str(case), "--q", "0,1,0.5", "--output", str(output), "--out", str(out),
+                                 "--force"])  # replaces the first pose's file
     assert result.exit_code == 0, result.output
     # the pose's own check of the solid it built (watertight, one body, the volume with the cuts' wedges)
     assert "NOT watertight" not in result.output and "watertight" in result.output

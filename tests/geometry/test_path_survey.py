@@ -44,3 +44,13 @@ def test_a_big_tree_is_measured_against_the_main_vessel(count):
         assert isinstance(f, PathFacts) and f.leaves is not None and f.leaves[0] == 0
         at = (int(2 * 2.5 * k) % 380 + 10) * 0.5
         np.testing.assert_allclose(f.leaves[1], at, rtol=0, atol=LEAVE_TOL_MM)
+
+
+def test_the_nearest_vertex_is_the_same_found_directly_or_by_the_kd_tree():
+    from softdesign.geometry.path_survey import DIRECT_PAIRS, nearest_vertex_of
+
+    rng = np.random.default_rng(7)
+    polyline, points = rng.normal(size=(300, 3)), rng.normal(size=(5000, 3))
+    direct = nearest_vertex_of(polyline, 10)(points)  # few queries: direct distances
+    tree = nearest_vertex_of(polyline, DIRECT_PAIRS)(points)  # DIRECT_PAIRS x 300 pairs: the KD-tree
+    np.testing.assert_array_equal(direct, tree)
