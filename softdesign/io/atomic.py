@@ -19,19 +19,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from softdesign.errors import ConfigError
-
-
-def file_kind(mode: int) -> str:
-    """What a file that is not a regular one is, for messages ('a folder', 'a FIFO (named pipe)', ...)."""
-    kinds = [
-        (stat.S_ISLNK, "a symbolic link"),
-        (stat.S_ISDIR, "a folder"),
-        (stat.S_ISFIFO, "a FIFO (named pipe)"),
-        (stat.S_ISCHR, "a character device"),
-        (stat.S_ISBLK, "a block device"),
-        (stat.S_ISSOCK, "a socket"),
-    ]
-    return next((name for test, name in kinds if test(mode)), "not a regular file")
+from softdesign.io.case_yaml import file_kind
 
 
 def check_replaceable(path: str | Path) -> None:

@@ -92,8 +92,10 @@ def _read_regular(path: Path, fd: int) -> bytes:
 
 
 def file_kind(mode: int) -> str:
-    """What a non-regular file is, for messages ('a folder', 'a FIFO (named pipe)', ...)."""
+    """What a non-regular file is, for messages ('a folder', 'a FIFO (named pipe)', ...); a symbolic link is named
+    only when ``mode`` comes from ``lstat`` (``stat`` follows it)."""
     kinds = [
+        (stat.S_ISLNK, "a symbolic link"),
         (stat.S_ISDIR, "a folder"),
         (stat.S_ISFIFO, "a FIFO (named pipe)"),
         (stat.S_ISCHR, "a character device"),
