@@ -294,9 +294,10 @@ def simulate_section(section: SectionMesh, law: HyperelasticLaw, pressures: Floa
     if feeds.shape != (section.feed_count,):
         raise ValueError(f"expected {section.feed_count} feed pressures, got shape {feeds.shape}")
     prepared = prepare_section(section, law, thread)
-    path = follow_pressures(prepared.problem, np.concatenate([pressures, feeds]), ContinuationSettings(
+    every = np.concatenate([pressures, feeds])  # the chambers', then the feeds'
+    path = follow_pressures(prepared.problem, every, ContinuationSettings(
         first_step=1.0 / settings.load_steps, max_cutbacks=settings.max_cutbacks, newton=settings),
         solver=prepared.solver)
     if path.status != "reached":
-        raise SolveError(path.stopped_because(pressures))
+        raise SolveError(path.stopped_because(every))
     return measure_section(prepared, path.end.u, pressures, path.record())
