@@ -15,15 +15,15 @@
     chamber.  The chambers are fed in series: one supply line, a feed on the
     first chamber's ring and angle, runs from the base face into section 1's
     chamber (it crosses that section's proximal end wall, and is in the model
-    there), and each next chamber is fed from the one before by a short
-    channel through the joint's two end walls, in the joint's plane: it
-    crosses no station and adds no load (an assumption: its length along the
-    body is its diameter).  No feed runs through a section, which is what
-    leaves room for a chamber in a 3 mm vessel.  Every station is solved at
-    once (nothing but its own chamber is pressurised there).  The end walls hold no chamber: the chamber's
-    stations bend by ``w_i L_i / L_chamber``, so that the section turns
-    through its designed angle (the end walls stay straight; the section is
-    an arc to within that).
+    there), and each next chamber is fed from the one before by a series
+    channel through the joint's two end walls (its course, diameter and
+    length: :mod:`softdesign.kinematics.rod_channels`); it is a pressurised
+    cavity of the end-wall stations it crosses.  No feed runs through a
+    section, which is what leaves room for a chamber in a 3 mm vessel.  Every
+    station is solved at once (nothing but its own chamber is pressurised
+    there).  The end walls hold no chamber: the chamber's stations turn the
+    section through its designed angle less what the end walls turn under
+    the supply line and the channels (the section is an arc to within that).
     The design pressure P* is the lowest at which every wall (chamber-skin,
     chamber-feed, feed-feed, feed-skin, and against the backbone thread) is at
     least the material's; a higher pressure needs smaller chambers, but loads
@@ -50,15 +50,18 @@ from softdesign.kinematics.rod import (
     rod_body,
     strains,
 )
+from softdesign.kinematics.rod_channels import ChannelCourse, course_walls, series_courses, station_cavities
 from softdesign.types import FloatArray, IntArray
 
 #: Newton steps of a station's chamber solve, and its convergence (relative to the target's bending).
 NEWTON_STEPS = 30
 NEWTON_RTOL = 1e-13
-#: Solves of a single-supply design: the first, then again with the end walls' turn (the supply line's) taken off
-#: each chamber's goal (the feed's place moves with the first chamber's size; on the demo the third pass moves
-#: section 1's curvature by 2e-6 relative, a fourth by none at 6 digits).
-END_WALL_PASSES = 3
+#: Solves of a single-supply design: the first, then again with the end walls' turn (the supply line's and the
+#: series channels') taken off each chamber's goal, until that turn moves by at most END_WALL_ATOL_RAD (the feed's
+#: and the channels' places move with the chambers; each pass cuts the change about 50-fold: a section's turn
+#: was 8.7e-7 rad off after 3 passes, 1.6e-8 after 4, within 1e-9 after 5 on a three-section test body).
+END_WALL_PASSES = 8
+END_WALL_ATOL_RAD = 1e-11
 #: Finite-difference steps of the 2 x 2 Jacobian: rad and mm.
 STEP_ANGLE, STEP_DIAMETER = 1e-7, 1e-7
 #: P*: from the thread's bound, the first of TRIALS log-spaced pressures that fits, then bisection in log P
@@ -127,6 +130,7 @@ class SingleSupply:
     feed_until : (n,) mm, rest arc length where each feed ends (0: none crosses a station but the supply line)
     body : the rod (every chamber and feed on channel 0)
     walls : (k,) mm, each station's thinnest wall;  wall_kind : (k,) its kind
+    channels : the series channels, section 1's chamber to section 2's first
     """
 
     pressure_kpa: float
@@ -139,6 +143,7 @@ class SingleSupply:
     body: RodBody
     walls: FloatArray
     wall_kind: tuple[str, ...]
+    channels: tuple[ChannelCourse, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -228,9 +233,10 @@ def _solve_stations(problem: Problem, at: IntArray, fixed: tuple[FloatArray, Flo
     return angle, diameter
 
 
-def _walls(problem: Problem, centers: FloatArray, radii: FloatArray, kinds: list[str]) -> tuple[FloatArray,
-                                                                                                list[str]]:
-    """Each station's thinnest wall (mm) and its kind: between cavities, to the skin, to the axis thread."""
+def _walls(problem: Problem, centers: FloatArray, radii: FloatArray, kinds: list[str],
+           extra: tuple[tuple[str, FloatArray], ...] = ()) -> tuple[FloatArray, list[str]]:
+    """Each station's thinnest wall (mm) and its kind: between cavities, to the skin, to the axis thread, or one
+    of ``extra``'s (kind, (k,) mm)."""
     r_min = problem.skin()
     present = radii > 0.0
     reach = np.hypot(centers[..., 0], centers[..., 1])
@@ -240,10 +246,11 @@ def _walls(problem: Problem, centers: FloatArray, radii: FloatArray, kinds: list
     both = present[:, :, None] & present[:, None, :] & ~np.eye(radii.shape[1], dtype=bool)[None]
     between = np.where(both, gap, np.inf)
     h = radii.shape[1]
-    every = np.concatenate([skin, thread, between.reshape(len(r_min), h * h)], axis=1)
+    every = np.concatenate([skin, thread, between.reshape(len(r_min), h * h)] + [v[:, None] for _, v in extra],
+                           axis=1)
     best = np.argmin(every, axis=1)
     names = ([f"{kinds[j]}-skin" for j in range(h)] + [f"{kinds[j]}-thread" for j in range(h)]
-             + [f"{kinds[a]}-{kinds[b]}" for a in range(h) for b in range(h)])
+             + [f"{kinds[a]}-{kinds[b]}" for a in range(h) for b in range(h)] + [kind for kind, _ in extra])
     return every[np.arange(len(r_min)), best], [names[j] for j in best]
 
 
@@ -253,7 +260,8 @@ def size_single(problem: Problem, pressure: float) -> SingleSupply:
     In series no feed crosses a chamber's station, so every station is solved at once; the supply line runs from
     the base face into section 1's chamber on its ring and angle.  The end walls hold no chamber: the chamber's
     stations turn the section through its designed angle less what the end walls turn (the supply line bends
-    section 1's proximal one), found from the assembled rod and solved again (``END_WALL_PASSES`` times).
+    section 1's proximal one, the channels the others), found from the assembled rod and solved again until it
+    settles (``END_WALL_ATOL_RAD``, at most ``END_WALL_PASSES`` solves).
     """
     st, n = problem.stations, int(problem.stations.section.max()) + 1
     at = np.flatnonzero(st.chamber)
@@ -269,8 +277,11 @@ def size_single(problem: Problem, pressure: float) -> SingleSupply:
         angle[at], diameter[at] = _solve_stations(problem, at, empty, goal[st.section[at]], pressure, start)
         device = _assemble(problem, angle.copy(), diameter.copy(), pressure)
         w = strains(device.body, [pressure])[1]
-        walls_turn = np.array([np.sum(st.ds[(st.section == i) & ~st.chamber, None]
-                                      * w[(st.section == i) & ~st.chamber], axis=0) for i in range(n)])
+        used, walls_turn = walls_turn, np.array([np.sum(st.ds[(st.section == i) & ~st.chamber, None]
+                                                        * w[(st.section == i) & ~st.chamber], axis=0)
+                                                 for i in range(n)])
+        if np.max(np.abs(walls_turn - used)) <= END_WALL_ATOL_RAD:
+            break
     assert device is not None  # END_WALL_PASSES >= 1
     return device
 
@@ -291,15 +302,42 @@ def _assemble(problem: Problem, angle: FloatArray, diameter: FloatArray, pressur
     feed_ring = np.maximum(np.minimum(centre, own), centre - np.maximum(0.5 * diameter[first] - f, 0.0))
     distance = np.where(st.chamber, r_min - problem.limits.wall_mm - 0.5 * diameter, 0.0)
     chamber_at = st.section[:, None] == np.arange(n)[None, :]
+    courses = _courses(problem, angle, distance)
+    lower, upper = st.s - 0.5 * st.ds, st.s + 0.5 * st.ds
+    through, through_radii = station_cavities(courses, lower, upper, ~st.chamber)
     centers = np.concatenate([np.broadcast_to(_polar(distance, angle)[:, None, :], (k, n, 2)),
                               np.broadcast_to(_polar(feed_ring, feed_angle)[None], (k, n, 2))], axis=1)
     radii = np.concatenate([np.where(chamber_at & st.chamber[:, None], 0.5 * diameter[:, None], 0.0),
                             np.where(st.s[:, None] < feed_until[None, :], f, 0.0)], axis=1)
-    body = rod_body(st.ds, st.section, problem.outlines, Cavities(centers, radii, np.zeros(2 * n, np.int64)),
-                    problem.modulus_kpa, problem.backbone)
-    walls, kinds = _walls(problem, centers, radii, ["chamber"] * n + ["feed"] * n)
+    cavities = Cavities(np.concatenate([centers, through], axis=1), np.concatenate([radii, through_radii], axis=1),
+                        np.zeros(2 * n + len(courses), np.int64))
+    body = rod_body(st.ds, st.section, problem.outlines, cavities, problem.modulus_kpa, problem.backbone)
+    skin, thread = course_walls(courses, lower, upper, ~st.chamber, r_min, problem.limits.thread_diameter_mm)
+    walls, kinds = _walls(problem, centers, radii, ["chamber"] * n + ["feed"] * n,
+                          (("channel-skin", skin), ("channel-thread", thread)))
     return SingleSupply(pressure, angle, distance, diameter, feed_angle, feed_ring, feed_until, body, walls,
-                        tuple(kinds))
+                        tuple(kinds), tuple(courses))
+
+
+def middle_angles(stations: Stations, angle: FloatArray) -> FloatArray:
+    """(n,) rad: each section's chamber angle at its middle rest arc length (the angle it is meshed at)."""
+    out = []
+    for i in range(int(stations.section.max()) + 1):
+        at = np.flatnonzero((stations.section == i) & stations.chamber)
+        s = stations.s[at]
+        out.append(float(np.interp(0.5 * (s[0] + s[-1]), s, np.unwrap(angle[at]))))
+    return np.asarray(out)
+
+
+def _courses(problem: Problem, angle: FloatArray, distance: FloatArray) -> list[ChannelCourse]:
+    """The series channels between the chambers as meshed (middle angle, end distances), the case's feed size."""
+    st, n = problem.stations, int(problem.stations.section.max()) + 1
+    ends, rings = np.zeros((n, 2)), np.zeros((n, 2))
+    for i in range(n):
+        at = np.flatnonzero((st.section == i) & st.chamber)
+        ends[i] = st.s[at[0]] - 0.5 * st.ds[at[0]], st.s[at[-1]] + 0.5 * st.ds[at[-1]]
+        rings[i] = distance[at[0]], distance[at[-1]]
+    return series_courses(ends, middle_angles(st, angle), rings, problem.limits.feed_diameter_mm)
 
 
 def _fits(device: SingleSupply, wall_mm: float) -> bool:

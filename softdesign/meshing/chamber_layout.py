@@ -119,13 +119,56 @@ class Feed:
 
 
 @dataclass(frozen=True)
+class Channel:
+    """A series channel (``supply: single``): from section ``section - 1``'s chamber into section ``section``'s.
+
+    Its course (:mod:`softdesign.kinematics.rod_channels`) runs from inside the proximal chamber, on its axis,
+    through the two end walls at the joint, turning round the body's axis the short way, into the distal chamber
+    on its axis; the mesher sweeps a circle of ``diameter_mm`` in the body's normal plane along it.
+
+    Attributes
+    ----------
+    section : the chamber it feeds (1 for section 1's chamber to section 2's), 0-based
+    diameter_mm : mm, in the body's normal planes (across its slanted stretch it is ``diameter cos(slant)`` wide)
+    course : (l, angle rad, ring mm) samples, l increasing, the angle continuous (not wrapped); linear between
+        them: its first and last samples lie inside the two chambers
+    """
+
+    section: int
+    diameter_mm: float
+    course: tuple[tuple[float, float, float], ...]
+
+    @property
+    def l_start(self) -> float:
+        """Normalized l where it starts (inside the proximal chamber)."""
+        return self.course[0][0]
+
+    @property
+    def l_end(self) -> float:
+        """Normalized l where it ends (inside the distal chamber)."""
+        return self.course[-1][0]
+
+    def angle_at(self, l: npt.ArrayLike) -> FloatArray:
+        """Its angle (rad, from N towards B) at normalized ``l`` (array)."""
+        p = np.asarray(self.course, float)
+        return np.interp(np.asarray(l, float), p[:, 0], p[:, 1])
+
+    def ring_at(self, l: npt.ArrayLike) -> FloatArray:
+        """Its distance from the centerline (mm) at normalized ``l`` (array)."""
+        p = np.asarray(self.course, float)
+        return np.interp(np.asarray(l, float), p[:, 0], p[:, 2])
+
+
+@dataclass(frozen=True)
 class ChamberLayout:
-    """Every chamber and feed of a body, sections proximal to distal, chambers by index."""
+    """Every chamber and feed of a body, sections proximal to distal, chambers by index; a single supply's series
+    channels (``channels``: empty for Zou et al.'s three chambers, each on its own feed)."""
 
     spec: ActuationSpec
     breaks: tuple[float, ...]
     chambers: tuple[Chamber, ...]
     feeds: tuple[Feed, ...]
+    channels: tuple[Channel, ...] = ()
 
     @property
     def sections(self) -> int:

@@ -65,7 +65,8 @@ class Wall:
         """``section 2 chamber 1 q=0.500 l=0.3120 angle 95 deg`` (parts that are None left out)."""
         if self.chamber == 0:  # a ring wall: the same for every chamber of the section, at every q and l
             return f"section {self.section} (every chamber, q and l)"
-        feed = "feed of " if self.kind.startswith("feed") else ""
+        feed = ("feed of " if self.kind.startswith("feed") else "channel into " if self.kind.startswith("channel")
+                else "")
         parts = [f"{feed}section {self.section} chamber {self.chamber}"]
         if self.q is not None:
             parts.append(f"q={self.q:.3f}")
@@ -100,7 +101,7 @@ def _members(layout: ChamberLayout) -> list[tuple[str, int, int, float, float, f
 
 def skin_walls(curve: FramedSpline, field: RadiusField, q: float, layout: ChamberLayout,
                offset_mm: float = 0.0) -> list[Wall]:
-    """The thinnest skin over every chamber and every feed at q, each with its l and the skin's angle.
+    """The thinnest skin over every chamber, feed and series channel at q, each with its l and the skin's angle.
 
     The radius field is evaluated once on rings ``1 / RINGS_PER_MM`` mm apart (every member's ends added);
     the gap from a circle centred at c to the skin point rho u is ``sqrt(rho^2 - 2 rho u.c + |c|^2) - r``.
@@ -108,10 +109,9 @@ def skin_walls(curve: FramedSpline, field: RadiusField, q: float, layout: Chambe
     a = angle_grid(SKIN_ANGLES)
     members = _members(layout)
     rings = max(3, int(np.ceil(RINGS_PER_MM * curve.length)) + 1)
-    ends = [v for m in members for v in m[6:8]]
+    ends = [v for m in members for v in m[6:8]] + [p[0] for c in layout.channels for p in c.course]
     l = np.unique(np.concatenate([np.linspace(0.0, 1.0, rings), ends]))
     rho = field.evaluate_grid(q, l, a) + offset_mm
-    rho2 = rho * rho
     out = []
     tapered = {(c.section, c.index): c for c in layout.chambers if c.profile}
     for kind, section, chamber, distance, angle, radius, l_start, l_end in members:
@@ -119,12 +119,23 @@ def skin_walls(curve: FramedSpline, field: RadiusField, q: float, layout: Chambe
         member = tapered.get((section, chamber)) if kind == "chamber-skin" else None
         d = np.full(len(rows), distance) if member is None else member.distance_at(l[rows])
         r = np.full(len(rows), radius) if member is None else 0.5 * member.diameter_at(l[rows])
-        along = d[:, None] * np.cos(a - angle)[None, :]  # u . c
-        gap = np.sqrt(np.maximum(rho2[rows] - 2.0 * rho[rows] * along + (d * d)[:, None], 0.0)) - r[:, None]
-        i, k = np.unravel_index(int(np.argmin(gap)), gap.shape)
-        out.append(Wall(kind, float(gap[i, k]), section + 1, chamber + 1, float(q), float(l[rows[i]]),
-                        float(np.rad2deg(a[k]))))
+        out.append(_thinnest(kind, section, chamber, q, l, rows, a, rho, d, np.full(len(rows), angle), r))
+    for channel in layout.channels:  # its course: the ring and angle change along it
+        rows = np.flatnonzero((l >= channel.l_start) & (l <= channel.l_end))
+        out.append(_thinnest("channel-skin", channel.section, 0, q, l, rows, a, rho, channel.ring_at(l[rows]),
+                             channel.angle_at(l[rows]), np.full(len(rows), 0.5 * channel.diameter_mm)))
     return out
+
+
+def _thinnest(kind: str, section: int, chamber: int, q: float, l: FloatArray, rows: np.ndarray, a: FloatArray,
+              rho: FloatArray, d: FloatArray, angle: FloatArray, r: FloatArray) -> Wall:
+    """The thinnest gap from circles (centre ``d`` (cos, sin) ``angle``, radius ``r`` at each ring ``rows``) to
+    the skin ``rho`` (rings, angles ``a``)."""
+    along = d[:, None] * np.cos(a[None, :] - angle[:, None])  # u . c
+    gap = np.sqrt(np.maximum(rho[rows] ** 2 - 2.0 * rho[rows] * along + (d * d)[:, None], 0.0)) - r[:, None]
+    i, k = np.unravel_index(int(np.argmin(gap)), gap.shape)
+    return Wall(kind, float(gap[i, k]), section + 1, chamber + 1, float(q), float(l[rows[i]]),
+                float(np.rad2deg(a[k])))
 
 
 def chamber_lengths_mm(curve: FramedSpline, layout: ChamberLayout) -> FloatArray:

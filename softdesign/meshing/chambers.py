@@ -16,7 +16,10 @@ A feed starts ``feed_extension_mm`` before the base plane (along -T(0)) so it
 opens through the base face (also when the base is cut on a tilted plane), and
 ends inside its chamber, coaxial and narrower, so each chamber and its feed
 form one blind cavity open only at the base face: the result is one shell of
-genus 0 (Euler 2), with 3n dents.  Manifold booleans: the union of every
+genus 0 (Euler 2), with 3n dents.  A single supply's chambers are one cavity:
+the supply line into section 1's chamber, each next chamber reached by its
+series channel (:class:`~softdesign.meshing.chamber_layout.Channel`), swept on
+its course's own samples with the feeds' polygon; still Euler 2, one dent.  Manifold booleans: the union of every
 cavity, subtracted from the body once.
 """
 
@@ -32,7 +35,7 @@ import numpy.typing as npt
 
 from softdesign.geometry.frames import FramedSpline
 from softdesign.meshing.body import curvature_components
-from softdesign.meshing.chamber_layout import Chamber, ChamberLayout, Feed, offset_points
+from softdesign.meshing.chamber_layout import Chamber, ChamberLayout, Channel, Feed, offset_points
 from softdesign.meshing.solids import Solid, _regions_after, checked, cut_body, manifold_from_mesh, welded_as_written
 from softdesign.meshing.tessellate import Region, Sweep, TubeMesh, TubeSections, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec
@@ -74,12 +77,13 @@ def _grid(l_body: FloatArray, l_start: float, l_end: float) -> FloatArray:
     return np.concatenate([[l_start], inside, [l_end]])
 
 
-def _tube(curve: FramedSpline, q: float, l: FloatArray, distance: npt.ArrayLike, angle: float,
+def _tube(curve: FramedSpline, q: float, l: FloatArray, distance: npt.ArrayLike, angle: npt.ArrayLike,
           diameter: npt.ArrayLike, segments: int, before_mm: float = 0.0, phase: float = 0.0) -> Sweep:
     """A tube of ``diameter`` about the offset curve over ``l``; ``before_mm`` > 0 starts it ``before_mm`` before
     ``l[0]`` along -T, in place of the ring at ``l[0]``.
 
-    ``distance`` and ``diameter`` (mm) are one number, or one per ring of ``l`` (a tapered chamber).
+    ``distance``, ``diameter`` (mm) and ``angle`` (rad) are one number, or one per ring of ``l`` (a tapered
+    chamber, a series channel's course).
     The ring at ``l[0]`` (the base, l = 0) is dropped when ``before_mm`` > 0: it would lie in the base cap's plane,
     and the boolean cuts the tube there into faces of a few 1e-7 mm that single precision (STL) folds to zero
     area, leaving non-manifold edges once coincident vertices are merged (issue 43).  The tube runs straight from
@@ -89,6 +93,7 @@ def _tube(curve: FramedSpline, q: float, l: FloatArray, distance: npt.ArrayLike,
     s = curve.curve.arc_length(l)
     distance = np.broadcast_to(np.asarray(distance, float), l.shape)
     diameter = np.broadcast_to(np.asarray(diameter, float), l.shape)
+    angle = np.broadcast_to(np.asarray(angle, float), l.shape)[:, None]
     if before_mm > 0.0:
         centers = np.concatenate([[centers[0] - before_mm * frames[0][:, 2]], centers[1:]])
         s = np.concatenate([[s[0] - before_mm], s[1:]])
@@ -101,7 +106,8 @@ def _tube(curve: FramedSpline, q: float, l: FloatArray, distance: npt.ArrayLike,
 
 def cavity_sweeps(curve: FramedSpline, q: float, layout: ChamberLayout, l_body: FloatArray,
                   feed_extension_mm: float = FEED_EXTENSION_MM) -> tuple[Cavity, ...]:
-    """Every chamber and feed of ``layout`` on the body's ring grid ``l_body`` at q, chambers first."""
+    """Every chamber and feed of ``layout`` on the body's ring grid ``l_body`` at q, chambers first, then the
+    series channels on their courses' own samples (kind ``channel``, ``section`` the chamber each one feeds)."""
     out = []
     for c in layout.chambers:
         l = _grid(l_body, c.l_start, c.l_end)
@@ -113,6 +119,14 @@ def cavity_sweeps(curve: FramedSpline, q: float, layout: ChamberLayout, l_body: 
                          f.ring_mm, f.angle, f.diameter_mm, FEED_SEGMENTS, before_mm=feed_extension_mm,
                          phase=FEED_PHASE))
             for f in layout.feeds]
+    ends = {c.section: (c.l_start, c.l_end) for c in layout.chambers}
+    for channel in layout.channels:
+        l = np.asarray([p[0] for p in channel.course], float)
+        for plane in (ends[channel.section - 1][1], ends[channel.section][0]):  # off both chambers' flat ends
+            l = _clear_of(l, plane, l_body)
+        out.append(Cavity("channel", channel.section, 0,
+                          _tube(curve, q, l, channel.ring_at(l), channel.angle_at(l), channel.diameter_mm,
+                                FEED_SEGMENTS, phase=FEED_PHASE)))
     return tuple(out)
 
 
@@ -130,7 +144,7 @@ def carve_cavities(body: TubeMesh, cavities: Sequence[Cavity], max_rho_kappa: fl
     """``body`` minus the union of ``cavities``: one shell, Euler 2 (each cavity opens at the base face through its
     feed; a chamber without a feed is a closed void, Euler 2 more each).
 
-    Regions: a chamber's wall CHAMBER, its flat ends CHAMBER_CAP; a feed's faces PORT.
+    Regions: a chamber's wall CHAMBER, its flat ends CHAMBER_CAP; a feed's and a series channel's faces PORT.
     """
     body_manifold, body_id = manifold_from_mesh(body.vertices, body.faces, f"{label}: body")
     sources = {body_id: body.regions}
@@ -142,15 +156,14 @@ def carve_cavities(body: TubeMesh, cavities: Sequence[Cavity], max_rho_kappa: fl
         if cavity.kind == "chamber":
             caps = mesh.regions != Region.WALL
             sources[mesh_id] = np.where(caps, Region.CHAMBER_CAP, Region.CHAMBER).astype(np.int8)
-        else:
+        else:  # a feed or a series channel
             sources[mesh_id] = np.array([Region.PORT], np.int8)
         tubes.append(manifold)
     union = checked(m3.Manifold.batch_boolean(tubes, m3.OpType.Add), f"{label}: chambers and feeds")
     result = checked(body_manifold - union, f"{label}: actuated body")
     vertices, faces, regions = welded_as_written(*_regions_after(result, sources))
-    # a chamber with no feed of its own (supply: single feeds them in series through channels not meshed) is a
-    # closed void: one more sphere-like shell, Euler 2 more
-    fed = {(c.section, c.chamber) for c in cavities if c.kind == "feed"}
+    # a chamber with no feed and no series channel into it is a closed void: one more sphere-like shell, Euler 2
+    fed = {(c.section, c.chamber) for c in cavities if c.kind in ("feed", "channel")}
     closed = sum(1 for c in cavities if c.kind == "chamber" and (c.section, c.chamber) not in fed)
     return Solid(vertices, faces, regions, 2 + 2 * closed, "actuated", max_rho_kappa)
 
@@ -202,7 +215,24 @@ def cavity_volume_mm3(curve: FramedSpline, layout: ChamberLayout) -> float:
     for f in layout.feeds:
         reach = piecewise_axis_length(curve, layout.breaks, 0.0, starts[f.section, f.chamber], f.ring_mm, f.angle)
         total += np.pi * (0.5 * f.diameter_mm) ** 2 * reach
+    ends = {c.section: (c.l_start, c.l_end) for c in layout.chambers}
+    for channel in layout.channels:  # between the two chambers' flat ends (inside them it is not counted twice)
+        a, b = ends[channel.section - 1][1], ends[channel.section][0]
+        joints = [a, *(x for x in layout.breaks if a < x < b), b]
+        total += np.pi * (0.5 * channel.diameter_mm) ** 2 * sum(
+            _course_length(curve, channel, u, v) for u, v in zip(joints[:-1], joints[1:], strict=True))
     return float(total)
+
+
+def _course_length(curve: FramedSpline, channel: Channel, l_start: float, l_end: float, nodes: int = 64) -> float:
+    """``integral (1 - ring (k1 cos angle + k2 sin angle)) ds`` along a channel's course over [l_start, l_end], mm:
+    times the channel's area, the volume of its normal-plane sections (as :func:`axis_lengths`, the offset varying)."""
+    x, w = _gauss_legendre(nodes)
+    l = 0.5 * (l_end - l_start) * (x + 1.0) + l_start
+    k = curvature_components(curve, l, curve.frames(l))
+    angle, ring = channel.angle_at(l), channel.ring_at(l)
+    stretch = 1.0 - ring * (k[:, 0] * np.cos(angle) + k[:, 1] * np.sin(angle))
+    return float(0.5 * (l_end - l_start) * (w @ (stretch * curve.curve.speed(l))))
 
 
 def member_axis(curve: FramedSpline, member: Chamber | Feed, l: FloatArray) -> FloatArray:
@@ -244,9 +274,10 @@ def measured_skin_walls(sections: TubeSections, spec: BodySpec, curve: FramedSpl
     vertices of its tube to the body's outer mesh, mm.
 
     Returns (kind, thickness_mm, section, chamber, l) with kind ``chamber-skin (mesh)`` (to the whole outer
-    mesh: a chamber's end walls count, cut on a slant or not) or ``feed-skin (mesh)`` (to the side wall only:
-    a feed opens through the base face).  Along a tube the skin's nearest point faces away from the backbone,
-    so the outer half of each ring is measured, and the end rings whole.  A check of the exported geometry
+    mesh: a chamber's end walls count, cut on a slant or not), ``feed-skin (mesh)`` (to the side wall only:
+    a feed opens through the base face) or ``channel-skin (mesh)`` (a series channel's, every ring whole).
+    Along a tube the skin's nearest point faces away from the backbone, so the outer half of each ring is
+    measured, and the end rings whole.  A check of the exported geometry
     itself beside the in-section figures of :mod:`chamber_walls`: the tubes' polygons are area-matched, so a
     vertex lies up to ``r (sqrt(2 pi / (n sin(2 pi / n))) - 1)`` outside the design circle (0.3 % of r at 32
     sides) and the figure errs low by that much.
@@ -256,18 +287,22 @@ def measured_skin_walls(sections: TubeSections, spec: BodySpec, curve: FramedSpl
 
     outer = sweep_from_sections(sections, spec.offset_mm, spec.min_radius_mm)
     body, _ = cut_body(outer, spec, f"q={sections.q:.3f}")
-    targets = {"chamber": body.faces, "feed": body.faces[body.regions == Region.WALL]}
-    picked: dict[str, list[tuple[Cavity, FloatArray, FloatArray]]] = {"chamber": [], "feed": []}
+    targets = {"chamber": body.faces, "feed": body.faces[body.regions == Region.WALL], "channel": body.faces}
+    picked: dict[str, list[tuple[Cavity, FloatArray, FloatArray]]] = {"chamber": [], "feed": [], "channel": []}
     for cavity in cavity_sweeps(curve, sections.q, layout, sections.l, 0.0):
         sweep = cavity.sweep
         centre = sweep.xy[0].mean(axis=0)
         half = (sweep.xy[0] - centre) @ centre >= -1e-12
+        if cavity.kind == "channel":  # its centre moves round the axis: every ring whole
+            half = np.ones(len(half), bool)
         rings = ring_points(sweep)
         points = np.concatenate([rings[1:-1, half].reshape(-1, 3), rings[[0, -1]].reshape(-1, 3)])
         owner = np.concatenate([np.repeat(sweep.l[1:-1], half.sum()), np.repeat(sweep.l[[0, -1]], rings.shape[1])])
         picked[cavity.kind].append((cavity, points, owner))
     out = []
     for kind, tubes in picked.items():
+        if not tubes:
+            continue
         gaps = np.sqrt(squared_distances(np.concatenate([p for _, p, _ in tubes]), body.vertices, targets[kind]))
         start = 0  # one locator for every tube of the kind
         for cavity, points, l in tubes:

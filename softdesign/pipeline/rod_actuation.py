@@ -142,7 +142,7 @@ def _single(case: Case, kinematics: KinematicsResult, fit: FitResult, design: De
             f"{v:.2f}" for v in summary["rest_lengths_mm"]) + " mm, to reach its designed length at P* (the meshes "
             "are at the designed lengths)")
     sections = summary.pop("sections")
-    meshed = single_layout(layout, single, station_l(kinematics, single.problem.stations.s))
+    meshed = single_layout(layout, single, lambda s: station_l(kinematics, s))
     summary["cores"] = core_figures([s["chambers"][0]["length_mm"] for s in sections],
                                     [min(s["chambers"][0]["diameter_mm"].values()) for s in sections], lost=True)
     warnings += _core_notes(summary["cores"])

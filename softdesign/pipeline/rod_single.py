@@ -10,6 +10,7 @@ the stress at P*.  The meshes and the mould carry the tapered chambers (:func:`s
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
@@ -27,6 +28,7 @@ from softdesign.kinematics.rod_sizing import (
     size_single,
     stations_along,
 )
+from softdesign.meshing.chamber_layout import Channel
 from softdesign.pipeline.rod_device import STATIONS_PER_SECTION, RodSetup, outlines_at, skin_radii
 from softdesign.types import FloatArray
 
@@ -40,6 +42,9 @@ if TYPE_CHECKING:
 #: Sized walls are this much over the material's: the meshes' polygons (equal-area chambers, a faceted skin) reach
 #: up to about 0.005 mm further than the circles the rod model sizes, and the build measures walls on the meshes.
 MESH_MARGIN_MM = 0.01
+#: Samples of a series channel's course over its turning stretch in the layout (the mesher's rings are these and
+#: the body's rings between them): 2 degrees of a 180-degree turn apart at most.
+COURSE_SAMPLES = 91
 ANGLE_CONVENTION = ("angle_rad: a chamber's axis in its section's base frame, from N towards B (0 along N); the "
                     "section bends away from its chamber, towards phi = angle - pi")
 
@@ -163,12 +168,15 @@ def stress_kpa(body: RodBody, pressure_kpa: float, outlines: FloatArray) -> floa
     return float(max(body.modulus_kpa * np.max(np.abs(eps)), pressure_kpa))
 
 
-def single_layout(layout: ChamberLayout, single: SingleDesign, station_l: FloatArray) -> ChamberLayout:
+def single_layout(layout: ChamberLayout, single: SingleDesign, l_of: Callable[[FloatArray], FloatArray]
+                  ) -> ChamberLayout:
     """The meshes' and mould's layout: each section's chamber tapered as sized (its profile at the stations'
-    normalized l ``station_l`` (k,), held over the end half-stations), at its middle angle; the supply line into
-    section 1's chamber, coaxial (the channels joining consecutive chambers are not meshed)."""
+    normalized l, ``l_of`` rest arc lengths (k,) mm, held over the end half-stations), at its middle angle; the
+    supply line into section 1's chamber, coaxial; the series channels on their courses (``COURSE_SAMPLES``
+    samples over each one's turning stretch: linear in s as the rod model's)."""
     st, dev = single.problem.stations, single.device
     angle, distance, diameter = middle_chambers(single)
+    station_l = l_of(st.s)
     chambers = []
     for c in layout.chambers:
         at = np.flatnonzero((st.section == c.section) & st.chamber)
@@ -180,7 +188,13 @@ def single_layout(layout: ChamberLayout, single: SingleDesign, station_l: FloatA
                   for f in layout.feeds if f.section == 0)
     spec = replace(layout.spec, distance_mm=float(dev.distance_mm[st.chamber].max()),
                    diameter_mm=float(dev.diameter_mm[st.chamber].min()))
-    return replace(layout, spec=spec, chambers=tuple(chambers), feeds=feeds)
+    channels = []
+    for course in dev.channels:
+        s = np.concatenate([course.s[:2], np.linspace(course.s[1], course.s[2], COURSE_SAMPLES)[1:-1], course.s[2:]])
+        a, ring = course.at(s)
+        channels.append(Channel(course.index + 1, course.diameter_mm,
+                                tuple(zip(l_of(s).tolist(), a.tolist(), ring.tolist(), strict=True))))
+    return replace(layout, spec=spec, chambers=tuple(chambers), feeds=feeds, channels=tuple(channels))
 
 
 def chamber_lengths_mm(single: SingleDesign, pressure_kpa: float) -> FloatArray:

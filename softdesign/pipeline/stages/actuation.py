@@ -35,7 +35,7 @@ from softdesign.io.format_names import q_label
 from softdesign.kinematics.chamber_lengths import chamber_lengths_from_arc
 from softdesign.kinematics.pcc_fit import fit_links
 from softdesign.meshing.body import body_sections
-from softdesign.meshing.chamber_layout import ChamberLayout, analytic_walls, chamber_angles, plan_layout
+from softdesign.meshing.chamber_layout import ChamberLayout, Channel, analytic_walls, chamber_angles, plan_layout
 from softdesign.meshing.chamber_walls import Wall, chamber_lengths_mm, ring_walls, skin_walls
 from softdesign.meshing.chambers import measured_skin_walls
 from softdesign.meshing.sweep_layout import check_resolvable, layout_holes
@@ -56,8 +56,8 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:
     from softdesign.config import Case
 
-VERSION = 5  # 2: one reason per cause (a kind of wall, a bound of extension); 3: the simulate stage's pressures;
-#            4: angles in (-180, 180] degrees; 5: the rod model (supply, pressure_kpa)
+VERSION = 6  # 2: one reason per cause (a kind of wall, a bound of extension); 3: the simulate stage's pressures;
+#            4: angles in (-180, 180] degrees; 5: the rod model (supply, pressure_kpa); 6: series channels
 SUMMARY = "actuation/summary.json"
 TABLE = "actuation.csv"
 #: The dense q grid's size (q = 0, 0.05, ..., 1).
@@ -120,7 +120,9 @@ def sized_layout(planned: ChamberLayout, document: dict[str, Any]) -> ChamberLay
                   for f, d in zip((f for f in planned.feeds if f.section == 0), document["feeds"], strict=True))
     spec = replace(planned.spec, distance_mm=max(c.distance_mm for c in chambers),
                    diameter_mm=min(c.diameter_mm for c in chambers))
-    return replace(planned, spec=spec, chambers=chambers, feeds=feeds)
+    channels = tuple(Channel(d["section"] - 1, d["diameter_mm"], tuple(tuple(p) for p in d["course"]))
+                     for d in document.get("channels", ()))
+    return replace(planned, spec=spec, chambers=chambers, feeds=feeds, channels=channels)
 
 
 def q_grid(case: Case) -> list[tuple[float, bool]]:
@@ -258,11 +260,11 @@ def _extensions(kinematics: KinematicsResult, layout: ChamberLayout, grid: list[
 
 def _skin(kinematics: KinematicsResult, fit: FitResult, layout: ChamberLayout, grid: list[float],
           offset_mm: float) -> list[Wall]:
-    """The thinnest chamber-skin and feed-skin wall at every q of the grid."""
+    """The thinnest chamber-skin, feed-skin and (series) channel-skin wall at every q of the grid."""
     out: list[Wall] = []
     for q in grid:
         walls = skin_walls(kinematics.chain.shape.curve_at(q), fit.field, q, layout, offset_mm)
-        for kind in ("chamber-skin", "feed-skin"):
+        for kind in ("chamber-skin", "feed-skin", "channel-skin"):
             of_kind = [w for w in walls if w.kind == kind]
             if of_kind:
                 out.append(min(of_kind, key=lambda w: w.thickness_mm))
@@ -307,6 +309,10 @@ def layout_document(layout: ChamberLayout) -> dict[str, Any]:
         "feeds": [{"section": f.section + 1, "chamber": f.chamber + 1, "angle_deg": degrees_wrapped(f.angle),
                    "ring_mm": f.ring_mm, "diameter_mm": f.diameter_mm, "l_start": f.l_start, "l_end": f.l_end}
                   for f in layout.feeds],
+        **({"channels": [{"section": c.section + 1, "from_section": c.section, "diameter_mm": c.diameter_mm,
+                          "l_start": c.l_start, "l_end": c.l_end, "course": [list(p) for p in c.course],
+                          "course_columns": ["l", "angle_rad (continuous)", "ring_mm"]}
+                         for c in layout.channels]} if layout.channels else {}),
     }
 
 
