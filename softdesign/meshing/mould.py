@@ -166,11 +166,13 @@ def _slice_points(body: m3.Manifold) -> FloatArray:
 
 
 def _channel_points(body: m3.Manifold, up: FloatArray, spec: MouldSpec,
-                    print_line: tuple[FloatArray, FloatArray, float] | None = None) -> tuple[FloatArray, FloatArray]:
+                    print_lines: tuple[tuple[FloatArray, FloatArray, float], ...] = ()
+                    ) -> tuple[FloatArray, FloatArray]:
     """Vent at the parting line's highest point; pour at the highest point far enough from the vent.
 
-    ``print_line`` (a point and unit direction in the parting plane, and the print's radius, mm): a core print
-    running up beside the channels; a channel is kept off it (the build still checks that none meets the core).
+    ``print_lines`` (each a point and unit direction in the parting plane, and a radius, mm): a core print or a
+    thread's hole running up beside the channels; a channel is kept off each (the build still checks that none
+    meets the core).
     A square end's face is level, so its highest points include its rim; a cut end's face leans, and the
     highest point far enough from the vent is next to the print, on the face's middle.
     """
@@ -179,12 +181,12 @@ def _channel_points(body: m3.Manifold, up: FloatArray, spec: MouldSpec,
     across = np.array([-up[1], up[0]])
 
     def clear(radius: float) -> npt.NDArray[np.bool_]:
-        if print_line is None:
-            return np.ones(len(pts), bool)
-        point, direction, print_radius = print_line
-        off = pts - point
-        distance = np.abs(off[:, 0] * direction[1] - off[:, 1] * direction[0])
-        return distance >= radius + print_radius
+        ok = np.ones(len(pts), bool)
+        for point, direction, print_radius in print_lines:
+            off = pts - point
+            distance = np.abs(off[:, 0] * direction[1] - off[:, 1] * direction[0])
+            ok &= distance >= radius + print_radius
+        return ok
 
     vent_ok, pour_ok = clear(0.5 * spec.vent_mm), clear(0.5 * spec.pour_mm)
     if not np.any(vent_ok):
@@ -215,7 +217,8 @@ def _channel(at: FloatArray, up: FloatArray, radius: float, top: float, spec: Mo
 
 
 def build_mould(body: m3.Manifold, casting: m3.Manifold, core: Core | None, frame: PartingFrame,
-                spec: MouldSpec, up_world: FloatArray | None = None) -> MouldParts:
+                spec: MouldSpec, up_world: FloatArray | None = None,
+                keep_off: tuple[tuple[FloatArray, FloatArray, float], ...] = ()) -> MouldParts:
     """The mould's parts in the mould frame (see the module docstring).
 
     Parameters
@@ -226,6 +229,8 @@ def build_mould(body: m3.Manifold, casting: m3.Manifold, core: Core | None, fram
     frame, spec : the parting frame and the case's mould keys
     up_world : (3,) float, the casting's up direction (its part in the parting plane is used); default the
         frame's -x (``spec.up == "base"``) or +x
+    keep_off : lines the pour and vent keep off (world point, unit direction, radius mm): an axis thread's
+        holes, the prints of an actuated body's cores
     """
     to_frame = frame.frame_from_world()
     body_f, casting_f = body.transform(to_frame), casting.transform(to_frame)
@@ -239,12 +244,16 @@ def build_mould(body: m3.Manifold, casting: m3.Manifold, core: Core | None, fram
                         for z in (box_lo[2], box_hi[2])])
     top = float(np.max(corners @ up))
     core_f = None if core is None else _core(core, frame, box_lo, box_hi, spec).as_original()
-    print_line = None
+    lines = []
     if core is not None:
         base, axis = frame.to_frame(core.base), frame.direction_to_frame(core.axis)
         if -axis @ up > 0:  # the core print runs up, beside the channels: keep them off it
-            print_line = (base[:2], -axis[:2] / np.linalg.norm(axis[:2]), core.port_radius_mm)
-    pour_at, vent_at = _channel_points(body_f, up, spec, print_line)
+            lines.append((base[:2], -axis[:2] / np.linalg.norm(axis[:2]), core.port_radius_mm))
+    for point, direction, radius in keep_off:
+        along = frame.direction_to_frame(direction)[:2]
+        if np.linalg.norm(along) > 0.5:  # in (near) the parting plane: it runs beside the channels
+            lines.append((frame.to_frame(point)[:2], along / np.linalg.norm(along), radius))
+    pour_at, vent_at = _channel_points(body_f, up, spec, tuple(lines))
     channels = _union([_channel(pour_at, up, 0.5 * spec.pour_mm, top, spec),
                        _channel(vent_at, up, 0.5 * spec.vent_mm, top, spec)]).as_original()
     if core_f is not None and (channels ^ core_f).volume() > 0:

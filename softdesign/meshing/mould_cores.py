@@ -12,6 +12,12 @@ outer body, then split and cored):
              single core's print on the parting plane; 3n prints around the axis
              cannot all lie on the parting plane
     halves   the rest of the two halves, minus the cores
+    single   a single supply's chambers, joined in series by their channels,
+             are one lost core (the supply line's print in the plate): wax,
+             :data:`LOST_CORE_NOTE` says why
+    thread   with an axis thread (``backbone: inextensible``) on a straight
+             q = 0 body, a hole on the axis through each end of the mould
+             (the plate at the base, the halves at the tip) to tension it
 Demoulding (each step checked as the round-2 mould is, :func:`pull_check`):
     1. plate and cores together along the base tangent, out of the body: the
        plate and the prints (the cores outside the body) are checked against
@@ -33,6 +39,7 @@ part equals the cast part within ``CAVITY_RTOL``.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Any
 
 import manifold3d as m3
@@ -40,7 +47,7 @@ import numpy as np
 
 from softdesign.meshing.chamber_layout import ChamberLayout
 from softdesign.meshing.chambers import Cavity, build_actuated, cavity_sweeps
-from softdesign.meshing.mould import MouldParts, MouldRefused, MouldSpec, build_mould
+from softdesign.meshing.mould import MouldParts, MouldRefused, MouldSpec, _cylinder, build_mould
 from softdesign.meshing.mould_checks import (
     CAVITY_RTOL,
     DISJOINT_RTOL,
@@ -59,11 +66,32 @@ from softdesign.types import FloatArray
 
 #: A base face whose points lie within this of one plane normal to T(0) is square (not cut on a slant), mm.
 SQUARE_TOL_MM = 1e-9
+#: The axis thread's holes are this much wider than the thread, mm (it slides through under tension; the silicone,
+#: thick when poured, does not run out through 0.05 mm round a thread: a rule of thumb, stated as such).
+THREAD_HOLE_CLEARANCE_MM = 0.1
+#: How far inside the body's end faces a thread hole starts, mm (it overlaps the cavity: no coplanar faces).
+THREAD_HOLE_INSIDE_MM = 0.5
+#: A single supply's lost core: what it is made of, and why.
+LOST_CORE_MATERIAL = "wax"
+LOST_CORE_NOTE = (
+    "the chambers are joined in series by slanted channels, so no rigid pin can be drawn out of them: make the one "
+    "core (the supply line, every chamber and channel) in wax (a jewellery casting or carving wax, printed on a wax "
+    "printer or cast in a printed two-part mould of the core file), wind each chamber's hoop thread on it, seat its "
+    "print in the core plate; after curing melt the wax at 70-90 C and blow it out through the supply port. Wax "
+    "rather than a water-soluble print (PVA, BVOH): it leaves the whole series path as a liquid through the one "
+    "port, where a solvent would have to reach every chamber through channels of a few tenths of a mm, and the "
+    "platinum-cure silicones of the presets cure against it")
 
 
 def _cores(curve, sections: TubeSections, layout: ChamberLayout, reach_mm: float) -> list[tuple[str, m3.Manifold]]:
-    """(name, chamber united with its feed) per chamber, world frame; feeds start ``reach_mm`` before the base."""
+    """(name, chamber united with its feed) per chamber, world frame; feeds start ``reach_mm`` before the base.
+
+    A single supply's chambers, joined by their series channels, are one core (``core``): the supply line, every
+    chamber and every channel united."""
     cavities = cavity_sweeps(curve, 0.0, layout, sections.l, reach_mm)
+    if layout.channels:
+        tubes = [manifold_from_mesh(*_mesh(c), f"mould core: section {c.section + 1} {c.kind}")[0] for c in cavities]
+        return [("core", checked(m3.Manifold.batch_boolean(tubes, m3.OpType.Add), "mould core"))]
     by_chamber: dict[tuple[int, int], list[Cavity]] = {}
     for cavity in cavities:
         by_chamber.setdefault((cavity.section, cavity.chamber), []).append(cavity)
@@ -116,9 +144,26 @@ def _split(parts: MouldParts, frame: PartingFrame, plane: tuple[FloatArray, floa
     return (checked(half_a, "mould half A"), checked(half_b, "mould half B"), checked(plate, "mould core plate"))
 
 
+def _thread_holes(outer: Sweep, frame: PartingFrame, hole_mm: float, box_size: float, segments: int
+                  ) -> m3.Manifold:
+    """The axis thread's two holes (mould frame): from ``THREAD_HOLE_INSIDE_MM`` inside the body's base and tip
+    faces, on the axis, out along -T(0) and T(1) through the box (the thread is tensioned through them)."""
+    holes = []
+    for at, outward in ((0, -outer.frames[0][:, 2]), (-1, outer.frames[-1][:, 2])):
+        start = frame.to_frame(outer.centers[at] - THREAD_HOLE_INSIDE_MM * outward)
+        holes.append(_cylinder(start, frame.direction_to_frame(outward), box_size + THREAD_HOLE_INSIDE_MM,
+                               0.5 * hole_mm, segments))
+    return checked(m3.Manifold.batch_boolean(holes, m3.OpType.Add), "mould: the axis thread's holes")
+
+
 def make_actuated_mould(sections: TubeSections, body_spec: BodySpec, spec: MouldSpec, curve,
-                        layout: ChamberLayout, link_of: Callable[[FloatArray], Any]) -> Mould:
+                        layout: ChamberLayout, link_of: Callable[[FloatArray], Any],
+                        thread_mm: float | None = None) -> Mould:
     """The checked mould of the actuated body at q = 0 (see the module docstring).
+
+    ``thread_mm``: the diameter of the axis thread (``backbone: inextensible``), None without one: holes of
+    ``thread_mm + THREAD_HOLE_CLEARANCE_MM`` on the axis through both ends of the mould (a straight q = 0 body
+    only: a curved axis cannot hold a tensioned thread, and the core figures say so).
 
     Raises
     ------
@@ -134,10 +179,17 @@ def make_actuated_mould(sections: TubeSections, body_spec: BodySpec, spec: Mould
     casting, _ = manifold_from_mesh(solid.vertices, solid.faces, "mould: cast part")
     frame = parting_frame(sections.centers, sections.frames[0])
     up = -sections.frames[0][:, 2] if spec.up == "base" else sections.frames[-1][:, 2]
-    parts = build_mould(body, casting, None, frame, spec, up)
+    held = thread_mm is not None and frame.straight
+    hole_mm = (thread_mm or 0.0) + THREAD_HOLE_CLEARANCE_MM
+    keep_off = ((outer.centers[0], outer.frames[0][:, 2], 0.5 * hole_mm),) if held else ()
+    parts = build_mould(body, casting, None, frame, spec, up, keep_off)
     base, outward = outer.centers[0], -outer.frames[0][:, 2]
     at = _plate_plane(body_mesh, base, outward)
     box_size = float(np.linalg.norm(np.subtract(*np.reshape(parts.box.bounding_box(), (2, 3)))))
+    if held:  # the holes join the pour and vent: voids of every part that are not the cast body
+        holes = _thread_holes(outer, frame, hole_mm, box_size, spec.segments)
+        parts = replace(parts, channels=checked(parts.channels + holes, "mould: channels and thread holes"
+                                                ).as_original())
     cores = [(name, core.transform(frame.frame_from_world()).as_original())
              for name, core in _cores(curve, sections, layout, at + box_size + spec.print_mm)]
     all_cores = m3.Manifold.batch_boolean([c for _, c in cores], m3.OpType.Add)
@@ -145,9 +197,11 @@ def make_actuated_mould(sections: TubeSections, body_spec: BodySpec, spec: Mould
     square = -_plate_plane(body_mesh, base, -outward) - at <= SQUARE_TOL_MM  # the base face lies on the plane
     prism = _base_prism(outer, box_size).transform(frame.frame_from_world()) if square else None
     half_a, half_b, plate = _split(parts, frame, (n, float(frame.to_frame(base) @ n + at)), all_cores, prism)
+    lost = bool(layout.channels) or not frame.straight
     figures = _check(parts, half_a, half_b, plate, cores, frame, frame.direction_to_frame(outward),
-                     facet_tolerance(outer.xy.shape[1]))
-    figures["core"] = _core_note(frame, layout, len(cores))
+                     facet_tolerance(outer.xy.shape[1]), lost)
+    figures["core"] = _core_note(frame, layout, cores)
+    figures["thread"] = _thread_note(thread_mm, hole_mm, frame.straight)
     named = [("half_a", half_a), ("half_b", half_b), ("core_plate", plate), *cores]
     to_world = frame.world_from_frame()
     meshes = []
@@ -160,8 +214,30 @@ def make_actuated_mould(sections: TubeSections, body_spec: BodySpec, spec: Mould
     return Mould(tuple(meshes), figures)
 
 
-def _core_note(frame: PartingFrame, layout: ChamberLayout, count: int) -> dict[str, Any]:
+def _thread_note(thread_mm: float | None, hole_mm: float, straight: bool) -> dict[str, Any] | None:
+    """How the axis thread is held in the mould (None without ``backbone: inextensible``)."""
+    if thread_mm is None:
+        return None
+    if not straight:
+        return {"diameter_mm": thread_mm, "hole_mm": None,
+                "note": "the body is not straight at q = 0: a tensioned thread cannot follow its curved axis; no "
+                        "thread holes (cast it straight, initial.kind: straight, or lay the thread in by hand)"}
+    return {"diameter_mm": thread_mm, "hole_mm": hole_mm,
+            "note": f"thread the {thread_mm:.2f} mm axis thread through the {hole_mm:.2f} mm holes on the axis at "
+                    "both ends of the mould (core plate and halves' tip end; drill them to size, a printed hole that "
+                    "small closes up), tension it by hand and tape it outside before pouring; cut it flush with the "
+                    "base and tip faces after demoulding"}
+
+
+def _core_note(frame: PartingFrame, layout: ChamberLayout, cores: list[tuple[str, m3.Manifold]]) -> dict[str, Any]:
+    count = len(cores)
     stretch = layout.spec.diameter_mm / layout.spec.feed_diameter_mm
+    if layout.channels:
+        widest = max(float(np.max(np.asarray(c.profile)[:, 2])) if c.profile else c.diameter_mm
+                     for c in layout.chambers)
+        return {"process": "lost-core", "note": LOST_CORE_NOTE, "cores": 1, "material": LOST_CORE_MATERIAL,
+                "stretch_to_release": None, "chamber_diameter_mm": widest,
+                "feed_diameter_mm": layout.spec.feed_diameter_mm, "volume_mm3": float(cores[0][1].volume())}
     if frame.straight:
         process, note = "removable", (
             f"the body is straight at q = 0: the {count} cores are straight pins held in the core plate; pull the "
@@ -177,8 +253,8 @@ def _core_note(frame: PartingFrame, layout: ChamberLayout, count: int) -> dict[s
 
 
 def _check(parts: MouldParts, half_a: m3.Manifold, half_b: m3.Manifold, plate: m3.Manifold,
-           cores: list[tuple[str, m3.Manifold]], frame: PartingFrame, outward: FloatArray, facet_tol: float
-           ) -> dict[str, Any]:
+           cores: list[tuple[str, m3.Manifold]], frame: PartingFrame, outward: FloatArray, facet_tol: float,
+           lost: bool) -> dict[str, Any]:
     """The round-2 checks with the plate and cores: parts, disjoint, cavity, and the two pulls."""
     solids = {"half_a": half_a, "half_b": half_b, "core_plate": plate, **dict(cores)}
     figures: dict[str, Any] = {"parts": {k: part_figures(v) for k, v in solids.items()}}
@@ -196,7 +272,7 @@ def _check(parts: MouldParts, half_a: m3.Manifold, half_b: m3.Manifold, plate: m
                                           parts.channels, parts.bumps, parts.sockets), "tolerance": CAVITY_RTOL}
     # inside the cast part a pin passes its narrower feed by stretching it (figures["core"]); the plate slides off
     # the halves, and the pins are prisms along the pull
-    figures["pull"] = _pulls(parts, half_a, half_b, plate, pins, frame, outward, facet_tol)
+    figures["pull"] = _pulls(parts, half_a, half_b, plate, pins, frame, outward, facet_tol, lost)
     checks_passed(figures, frame)
     return figures
 
@@ -222,9 +298,10 @@ def _pin_lean(pins: m3.Manifold, pull: FloatArray) -> float:
 
 
 def _pulls(parts: MouldParts, half_a: m3.Manifold, half_b: m3.Manifold, plate: m3.Manifold, pins: m3.Manifold,
-           frame: PartingFrame, outward: FloatArray, facet_tol: float) -> dict[str, Any]:
+           frame: PartingFrame, outward: FloatArray, facet_tol: float, lost: bool) -> dict[str, Any]:
     """Step 1 (straight body): the plate along the base tangent, the halves staying; the pins' sides parallel to
-    it.  Step 2: each half along the parting plane's normal, the cast part and the other half staying."""
+    it (not for lost cores: they are melted out first, and the plate comes off their prints' holes alone).
+    Step 2: each half along the parting plane's normal, the cast part and the other half staying."""
     pulls: dict[str, Any] = {}
     box_id = parts.box.original_id()
     if frame.straight:
@@ -237,7 +314,7 @@ def _pulls(parts: MouldParts, half_a: m3.Manifold, half_b: m3.Manifold, plate: m
         failures = [f for f in failures if f not in sprue]
         result = {**result, "ok": not failures, "against_pull": result["against_pull"] - len(sprue),
                   "sprue_nub_faces": len(sprue)}
-        lean = _pin_lean(pins, outward)
+        lean = 0.0 if lost else _pin_lean(pins, outward)
         if failures or lean > PIN_SIDE_TOL:
             raise MouldRefused(f"export.mould: the core plate does not pull free along the base tangent "
                                f"({len(failures)} faces against the pull or blocked by a half; pins' sides lean "

@@ -35,7 +35,7 @@ def sheet_lines(figures: dict[str, Any]) -> list[str]:
     lines += _material(figures.get("material"))
     mould = figures.get("mould")
     lines += _mould(mould) if mould else ["## Mould", "", "No mould in the case (add `export.mould: {}`).", ""]
-    lines += _cores(figures.get("cores", []))
+    lines += _cores(figures.get("cores", []), (figures.get("supply") or {}).get("mode") == "single")
     lines += _supply(figures.get("supply"))
     lines += _winding(figures.get("reinforcement"))
     if mould:
@@ -69,9 +69,18 @@ def _mould(mould: dict[str, Any]) -> list[str]:
     return [*lines, ""]
 
 
-def _cores(cores: list[dict[str, Any]]) -> list[str]:
+def _cores(cores: list[dict[str, Any]], single: bool = False) -> list[str]:
     if not cores:
         return []
+    if single:  # one lost core: the supply line, the chambers and the series channels joining them
+        lines = ["## Core (one lost wax core)", "",
+                 "The supply line, every chamber and the series channels between them are one core "
+                 "(`meshes/mould/core.stl`), made in wax and melted out after curing (the demoulding steps below "
+                 "say how, and why wax). Its parts:", "",
+                 "| part | diameter mm | length mm | length / diameter |", "|---|---|---|---|"]
+        lines += [f"| {core['name']} {s['what']} | {s['diameter_mm']:.2f} | {s['length_mm']:.1f} | "
+                  f"{s['length_mm'] / s['diameter_mm']:.0f} |" for core in cores for s in core["segments"]]
+        return [*lines, ""]
     lines = ["## Cores", "",
              f"A core longer than {WIRE_ASPECT_LIMIT:g} times its diameter is a straight steel wire of that diameter "
              "(a printed pin that slender bends or breaks); shorter ones are printed with the mould. Where the table "

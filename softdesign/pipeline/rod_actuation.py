@@ -28,7 +28,14 @@ from softdesign.pipeline.rod_device import (
     section_rest_lengths,
     station_l,
 )
-from softdesign.pipeline.rod_single import single_layout, single_rows, single_summary, size_case, verdict_line
+from softdesign.pipeline.rod_single import (
+    SingleDesign,
+    single_layout,
+    single_rows,
+    single_summary,
+    size_case,
+    verdict_line,
+)
 
 if TYPE_CHECKING:
     from softdesign.config import Case
@@ -39,26 +46,37 @@ if TYPE_CHECKING:
 
 #: Backbone samples per section for its best arc (as the stage's).
 ARC_SAMPLES = 201
+#: A series channel narrower than this fraction of its diameter across its slanted stretch (a slant over 60 deg)
+#: is named in a warning: its part of the wax core is that much thinner than the supply line's.
+MIN_CHANNEL_WIDTH_FRACTION = 0.5
+#: A lost core's strand (the monofilament a slender part is cast over) is this fraction of the narrowest width
+#: across a series channel, so that it can be drawn out along them (a rule of thumb).
+STRAND_FRACTION = 0.5
 #: Longest core, in diameters, the mould prints as a pin: a printed pin more slender than this bends under the
 #: pour and breaks on release (a rule of thumb, stated as such); a longer core is a steel wire or rod.
 MAX_PIN_ASPECT = 20.0
 
 
-def core_figures(lengths_mm: list[float], diameters_mm: list[float], lost: bool = False) -> list[dict[str, Any]]:
+def core_figures(lengths_mm: list[float], diameters_mm: list[float], lost: bool = False,
+                 strand_mm: float | None = None) -> list[dict[str, Any]]:
     """Per chamber its core: length, (smallest) diameter, aspect ratio and what to make it of.
 
-    ``lost``: tapered chambers joined in series (``supply: single``) are cast on lost cores (wax or dissolvable),
-    a slender one over a steel wire of half its smallest diameter; else a straight pin, printed or, past
-    ``MAX_PIN_ASPECT``, a steel wire or rod of the chamber's diameter.
+    ``lost``: tapered chambers joined in series (``supply: single``) are parts of one lost wax core (the mould's
+    note: :mod:`softdesign.meshing.mould_cores`); a part past ``MAX_PIN_ASPECT`` is cast over a nylon monofilament
+    of ``strand_mm`` running the whole core (wax alone that slender breaks when the hoop thread is wound on it; a
+    flexible strand, unlike a steel wire, can be drawn out along the slanted channels through the supply port once
+    the wax is melted: a rule of thumb, stated as such).  Else a straight pin, printed or, past ``MAX_PIN_ASPECT``,
+    a steel wire or rod of the chamber's diameter.
     """
     out = []
     for length, diameter in zip(lengths_mm, diameters_mm, strict=True):
         aspect = length / diameter if diameter > 0 else float("inf")
         slender = aspect > MAX_PIN_ASPECT
         if lost:
-            make = "lost core (wax or dissolvable), tapered as the chamber's profile" + (
-                f", cast over a steel wire of {0.5 * diameter:.2f} mm (aspect ratio {aspect:.0f} > "
-                f"{MAX_PIN_ASPECT:g})" if slender else "")
+            make = "part of the one lost wax core, tapered as the chamber's profile" + (
+                f", cast over a nylon monofilament of {strand_mm or 0.0:.2f} mm through the whole core (aspect ratio "
+                f"{aspect:.0f} > {MAX_PIN_ASPECT:g}), drawn out through the supply port after the wax is melted"
+                if slender else "")
         else:
             make = ("printed pin (the mould's core)" if not slender else
                     f"steel wire or rod of {diameter:.2f} mm, {length:.1f} mm long (aspect ratio {aspect:.0f} > "
@@ -143,10 +161,37 @@ def _single(case: Case, kinematics: KinematicsResult, fit: FitResult, design: De
             "are at the designed lengths)")
     sections = summary.pop("sections")
     meshed = single_layout(layout, single, lambda s: station_l(kinematics, s))
+    summary["channels"] = channel_figures(single)
+    narrowest = min((c["width_mm"] for c in summary["channels"]), default=case.actuation.feed_diameter_mm
+                    if case.actuation is not None else 0.0)
     summary["cores"] = core_figures([s["chambers"][0]["length_mm"] for s in sections],
-                                    [min(s["chambers"][0]["diameter_mm"].values()) for s in sections], lost=True)
+                                    [min(s["chambers"][0]["diameter_mm"].values()) for s in sections], lost=True,
+                                    strand_mm=STRAND_FRACTION * narrowest)
     warnings += _core_notes(summary["cores"])
+    warnings += [_slant_note(c) for c in summary["channels"]
+                 if c["width_mm"] < MIN_CHANNEL_WIDTH_FRACTION * c["diameter_mm"]]
     return RodFigures(meshed, sections, rows, walls, summary, list(summary["model_reasons"]), warnings)
+
+
+def channel_figures(single: SingleDesign) -> list[dict[str, Any]]:
+    """Per series channel: the sections it joins, its diameter (normal plane), length along the body (between the
+    chambers' flat ends), largest slant and its width across its course there (``D cos(slant)``), mm and rad."""
+    out = []
+    for course in single.device.channels:
+        slant = course.slant_max()
+        out.append({"from_section": course.index + 1, "to_section": course.index + 2,
+                    "diameter_mm": course.diameter_mm, "length_mm": course.between[1] - course.between[0],
+                    "slant_max_rad": slant, "width_mm": course.diameter_mm * float(np.cos(slant))})
+    return out
+
+
+def _slant_note(channel: dict[str, Any]) -> str:
+    """A warning for a series channel that slants steeply between its chambers."""
+    slant = float(np.rad2deg(channel["slant_max_rad"]))
+    return (f"the series channel from section {channel['from_section']} to {channel['to_section']} slants "
+            f"{slant:.0f} deg round the axis between their chambers: {channel['width_mm']:.2f} mm across (of "
+            f"{channel['diameter_mm']:g} mm), a fragile part of the wax core; a longer end wall "
+            "(actuation.end_wall_mm) lowers the slant")
 
 
 def _core_notes(cores: list[dict[str, Any]]) -> list[str]:

@@ -60,8 +60,8 @@ def test_supply_reinforcement_and_backbone_defaults(tmp_path: Path) -> None:
     ({"supply": "single"}, {}, "add design: {tolerance_mm: 1} and blend: pcc"),
     ({"supply": "single", "diameter_mm": 1.0}, {"design": {"tolerance_mm": 1.0}, "blend": "pcc"},
      "supply: single sizes diameter_mm itself"),
-    ({"supply": "single"}, {"design": {"tolerance_mm": 1.0}, "blend": "pcc", "export": {"mould": {}}},
-     "export.mould does not take actuation.supply: single's tapered chambers"),
+    ({"supply": "single"}, {"design": {"tolerance_mm": 1.0}, "blend": "pcc", "export": {"volume_mesh": {}}},
+     "export.volume_mesh does not take actuation.supply: single's tapered chambers"),
     ({"supply": "both"}, {}, "supply"),
     ({"backbone": "stiff"}, {}, "backbone"),
     ({"reinforcement": {"kind": "braid"}}, {}, "reinforcement.kind"),
@@ -81,3 +81,10 @@ def test_bad_supply_keys_are_refused_naming_the_key(tmp_path: Path, actuation: d
 def test_single_supply_with_a_design_and_pcc_is_valid(tmp_path: Path) -> None:
     case = load_case(demo_case(tmp_path, actuation={"supply": "single"}, design={"tolerance_mm": 1.0}, blend="pcc"))
     assert case.actuation is not None and case.actuation.supply == "single"
+
+
+def test_a_single_supply_takes_a_mould(tmp_path: Path) -> None:
+    case = demo_case(tmp_path, actuation={"supply": "single"}, design={"tolerance_mm": 1.0}, blend="pcc",
+                     export={"mould": {}})
+    result = runner.invoke(app, ["validate", str(case)])
+    assert result.exit_code == 0, result.output

@@ -37,7 +37,8 @@ from softdesign.pipeline.stages.judges import mould_judgement
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.pipeline.store import Staging
 
-VERSION = 3  # 2: export.frame (the parts in the patient's or the base frame); 3: parts welded as float32 writes them
+VERSION = 4  # 2: export.frame (the parts in the patient's or the base frame); 3: parts welded as float32 writes them;
+#            4: supply: single's one lost core, the axis thread's holes
 
 
 @dataclass(frozen=True)
@@ -55,6 +56,15 @@ def mould_spec(case: Case) -> MouldSpec | None:
         return None
     return MouldSpec(margin_mm=m.margin_mm, clearance_mm=m.clearance_mm, key_mm=m.key_mm, pour_mm=m.pour_mm,
                      vent_mm=m.vent_mm, print_mm=m.print_mm, up=m.up)
+
+
+def axis_thread_mm(case: Case) -> float | None:
+    """The axis thread's diameter (mm, the reinforcement's thread) with ``backbone: inextensible``, else None."""
+    if case.actuation is None or case.actuation.backbone != "inextensible":
+        return None
+    from softdesign.materials.threads import thread_presets
+
+    return float(thread_presets()[case.actuation.reinforcement.thread.name].diameter_mm)
 
 
 def _formats(case: Case) -> list[str]:
@@ -76,7 +86,7 @@ def run_mould(case: Case, kinematics: KinematicsResult, fit: FitResult,
         mould = make_mould(sections, body_spec(case, fit), spec, fit.field.link_of)
     else:
         mould = make_actuated_mould(sections, body_spec(case, fit), spec, kinematics.chain.shape.curve_at(0.0),
-                                    actuated, fit.field.link_of)
+                                    actuated, fit.field.link_of, axis_thread_mm(case))
     if tick is not None:
         tick(steps[0], None)
     files: dict[str, Any] = {}
@@ -138,6 +148,8 @@ def describe_mould(result: MouldResult) -> list[str]:
     lines.append(f"pull: {pulls}")
     if s["core"] is not None:
         lines.append(f"core: {s['core']['process']}: {s['core']['note']}")
+    if s.get("thread"):
+        lines.append(f"axis thread: {s['thread']['note']}")
     return lines
 
 
