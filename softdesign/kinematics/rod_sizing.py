@@ -24,9 +24,11 @@
     there).  The end walls hold no chamber: the chamber's stations turn the
     section through its designed angle less what the end walls turn under
     the supply line and the channels (the section is an arc to within that).
-    The design pressure P* is the lowest at which every wall (chamber-skin,
-    chamber-feed, feed-feed, feed-skin, and against the backbone thread) is at
-    least the material's; a higher pressure needs smaller chambers, but loads
+    The design pressure P* is the lowest at which every material wall
+    (chamber-skin, chamber-feed, feed-feed, feed-skin, channel-skin) is at
+    least the material's and every cavity keeps its gap to the axis thread
+    (:mod:`softdesign.kinematics.rod_walls`: two thread diameters, not a
+    material wall); a higher pressure needs smaller chambers, but loads
     the threads more (their check follows P*).
 ``supply: per_chamber``
     Seed 003's three chambers per section: :mod:`softdesign.kinematics.rod_inverse`.
@@ -51,6 +53,7 @@ from softdesign.kinematics.rod import (
     strains,
 )
 from softdesign.kinematics.rod_channels import ChannelCourse, course_walls, series_courses, station_cavities
+from softdesign.kinematics.rod_walls import cavity_walls, thread_gap_mm, thread_gaps
 from softdesign.types import FloatArray, IntArray
 
 #: Newton steps of a station's chamber solve, and its convergence (relative to the target's bending).
@@ -129,7 +132,8 @@ class SingleSupply:
     feed_angle, feed_ring_mm : (n,) where each chamber's inlet is (section 1's: the supply line's ring and angle)
     feed_until : (n,) mm, rest arc length where each feed ends (0: none crosses a station but the supply line)
     body : the rod (every chamber and feed on channel 0)
-    walls : (k,) mm, each station's thinnest wall;  wall_kind : (k,) its kind
+    walls : (k,) mm, each station's thinnest material wall;  wall_kind : (k,) its kind
+    thread_gaps : (k,) mm, each station's smallest gap from a cavity to the axis thread (:mod:`rod_walls`)
     channels : the series channels, section 1's chamber to section 2's first
     """
 
@@ -143,6 +147,7 @@ class SingleSupply:
     body: RodBody
     walls: FloatArray
     wall_kind: tuple[str, ...]
+    thread_gaps: FloatArray
     channels: tuple[ChannelCourse, ...] = ()
 
 
@@ -233,27 +238,6 @@ def _solve_stations(problem: Problem, at: IntArray, fixed: tuple[FloatArray, Flo
     return angle, diameter
 
 
-def _walls(problem: Problem, centers: FloatArray, radii: FloatArray, kinds: list[str],
-           extra: tuple[tuple[str, FloatArray], ...] = ()) -> tuple[FloatArray, list[str]]:
-    """Each station's thinnest wall (mm) and its kind: between cavities, to the skin, to the axis thread, or one
-    of ``extra``'s (kind, (k,) mm)."""
-    r_min = problem.skin()
-    present = radii > 0.0
-    reach = np.hypot(centers[..., 0], centers[..., 1])
-    skin = np.where(present, r_min[:, None] - reach - radii, np.inf)
-    thread = np.where(present, reach - radii - 0.5 * problem.limits.thread_diameter_mm, np.inf)
-    gap = np.linalg.norm(centers[:, :, None, :] - centers[:, None, :, :], axis=3) - radii[:, :, None] - radii[:, None]
-    both = present[:, :, None] & present[:, None, :] & ~np.eye(radii.shape[1], dtype=bool)[None]
-    between = np.where(both, gap, np.inf)
-    h = radii.shape[1]
-    every = np.concatenate([skin, thread, between.reshape(len(r_min), h * h)] + [v[:, None] for _, v in extra],
-                           axis=1)
-    best = np.argmin(every, axis=1)
-    names = ([f"{kinds[j]}-skin" for j in range(h)] + [f"{kinds[j]}-thread" for j in range(h)]
-             + [f"{kinds[a]}-{kinds[b]}" for a in range(h) for b in range(h)] + [kind for kind, _ in extra])
-    return every[np.arange(len(r_min)), best], [names[j] for j in best]
-
-
 def size_single(problem: Problem, pressure: float) -> SingleSupply:
     """The chambers (and the supply line) that bend every section into its designed arc at ``pressure`` kPa.
 
@@ -312,11 +296,11 @@ def _assemble(problem: Problem, angle: FloatArray, diameter: FloatArray, pressur
     cavities = Cavities(np.concatenate([centers, through], axis=1), np.concatenate([radii, through_radii], axis=1),
                         np.zeros(2 * n + len(courses), np.int64))
     body = rod_body(st.ds, st.section, problem.outlines, cavities, problem.modulus_kpa, problem.backbone)
-    skin, thread = course_walls(courses, lower, upper, ~st.chamber, r_min, problem.limits.thread_diameter_mm)
-    walls, kinds = _walls(problem, centers, radii, ["chamber"] * n + ["feed"] * n,
-                          (("channel-skin", skin), ("channel-thread", thread)))
+    t = problem.limits.thread_diameter_mm
+    skin, thread = course_walls(courses, lower, upper, ~st.chamber, r_min, t)
+    walls, kinds = cavity_walls(r_min, centers, radii, ["chamber"] * n + ["feed"] * n, (("channel-skin", skin),))
     return SingleSupply(pressure, angle, distance, diameter, feed_angle, feed_ring, feed_until, body, walls,
-                        tuple(kinds), tuple(courses))
+                        tuple(kinds), thread_gaps(centers, radii, t, thread), tuple(courses))
 
 
 def middle_angles(stations: Stations, angle: FloatArray) -> FloatArray:
@@ -340,22 +324,34 @@ def _courses(problem: Problem, angle: FloatArray, distance: FloatArray) -> list[
     return series_courses(ends, middle_angles(st, angle), rings, problem.limits.feed_diameter_mm)
 
 
-def _fits(device: SingleSupply, wall_mm: float) -> bool:
-    return bool(np.all(device.walls >= wall_mm * (1.0 - 1e-12)))
+def fits(device: SingleSupply, limits: Limits) -> bool:
+    """Whether every material wall is at least ``limits.wall_mm`` and every gap to the axis thread at least
+    :func:`~softdesign.kinematics.rod_walls.thread_gap_mm` (to 1e-12 relative)."""
+    gap = thread_gap_mm(limits.thread_diameter_mm)
+    return bool(np.all(device.walls >= limits.wall_mm * (1.0 - 1e-12))
+                and np.all(device.thread_gaps >= gap * (1.0 - 1e-12)))
+
+
+def _biggest(problem: Problem, at: IntArray) -> FloatArray:
+    """The widest chamber (mm) at stations ``at`` that keeps the skin wall and the gap to the axis thread:
+    ``D = R_skin - wall - gap - t / 2`` (the chamber at ``R_skin - wall - D / 2``)."""
+    lim = problem.limits
+    return np.asarray(problem.skin()[at] - lim.wall_mm - thread_gap_mm(lim.thread_diameter_mm)
+                      - 0.5 * lim.thread_diameter_mm, float)
 
 
 def thread_bound_kpa(problem: Problem) -> float:
     """The pressure below which some station's chamber would reach past its wall to the axis thread, kPa.
 
     At a fixed chamber the bending is linear in the pressure: with the largest chamber the skin and thread walls
-    allow (``D = R_skin - 2 wall - t / 2``), placed opposite its target, a station needs ``|target| / |w(1 kPa)|``.
+    allow (:func:`_biggest`), placed opposite its target, a station needs ``|target| / |w(1 kPa)|``.
     """
-    st, lim = problem.stations, problem.limits
+    st = problem.stations
     at = np.flatnonzero(st.chamber)
     n = int(st.section.max()) + 1
     spread = np.array([st.ds[st.section == i].sum() / st.ds[(st.section == i) & st.chamber].sum() for i in range(n)])
     target = (spread[:, None] * problem.w)[st.section[at]]
-    biggest = problem.skin()[at] - 2.0 * lim.wall_mm - 0.5 * lim.thread_diameter_mm
+    biggest = _biggest(problem, at)
     if np.any(biggest <= 0.0):
         return float("inf")
     angle = np.arctan2(target[:, 1], target[:, 0]) + np.pi
@@ -372,7 +368,7 @@ def design_pressure(problem: Problem) -> SingleSupply | None:
     pressures up to the limit (the fit is not monotone: at high pressures a chamber shrinks below its supply line)
     and bisects below the first that fits.
     """
-    wall, top = problem.limits.wall_mm, problem.limits.max_pressure_kpa
+    top = problem.limits.max_pressure_kpa
     start = thread_bound_kpa(problem)
     if not start <= top:
         return None
@@ -380,7 +376,7 @@ def design_pressure(problem: Problem) -> SingleSupply | None:
     high: SingleSupply | None = None
     for p in np.concatenate([[start], np.geomspace(start, top, TRIALS)[1:]]):
         device = size_single(problem, float(p))
-        if _fits(device, wall):
+        if fits(device, problem.limits):
             high = device
             break
         low = float(p)
@@ -389,7 +385,7 @@ def design_pressure(problem: Problem) -> SingleSupply | None:
     while high.pressure_kpa - low > BISECT_RTOL * high.pressure_kpa:
         middle = float(np.sqrt(low * high.pressure_kpa))
         device = size_single(problem, middle)
-        if _fits(device, wall):
+        if fits(device, problem.limits):
             high = device
         else:
             low = middle
@@ -401,8 +397,7 @@ def largest_fitting_kappa(problem: Problem, section: int, pressure: float) -> fl
     chamber its walls allow (skin and axis thread; feeds ignored), bending as designed."""
     st = problem.stations
     at = np.flatnonzero((st.section == section) & st.chamber)
-    lim = problem.limits
-    biggest = np.maximum(problem.skin()[at] - 2.0 * lim.wall_mm - 0.5 * lim.thread_diameter_mm, 0.0)
+    biggest = np.maximum(_biggest(problem, at), 0.0)
     target = problem.w[section]
     angle = np.full(len(at), float(np.arctan2(target[1], target[0]) + np.pi))
     empty = (np.zeros((len(at), 0, 2)), np.zeros((len(at), 0)))

@@ -28,6 +28,7 @@ from softdesign.kinematics.rod_sizing import (
     size_single,
     stations_along,
 )
+from softdesign.kinematics.rod_walls import THREAD_GAP_DIAMETERS, thread_gap_mm
 from softdesign.meshing.chamber_layout import Channel
 from softdesign.pipeline.rod_device import STATIONS_PER_SECTION, RodSetup, outlines_at, skin_radii
 from softdesign.types import FloatArray
@@ -45,6 +46,9 @@ MESH_MARGIN_MM = 0.01
 #: Samples of a series channel's course over its turning stretch in the layout (the mesher's rings are these and
 #: the body's rings between them): 2 degrees of a 180-degree turn apart at most.
 COURSE_SAMPLES = 91
+THREAD_GAP_RULE = (f"a chamber's or channel's surface keeps {THREAD_GAP_DIAMETERS:g} thread diameters from the axis "
+                   "thread's surface (its own hoop winding, then silicone): the thread is not a cavity, so "
+                   "min_wall_mm does not apply (softdesign/kinematics/rod_walls.py)")
 ANGLE_CONVENTION = ("angle_rad: a chamber's axis in its section's base frame, from N towards B (0 along N); the "
                     "section bends away from its chamber, towards phi = angle - pi")
 
@@ -257,6 +261,9 @@ def single_summary(case: Case, single: SingleDesign, setup: RodSetup) -> dict[st
         "model_deviation_mm": deviation.get("1", chain_deviation_mm(dev.body, p, design, 1.0)),
         "model_deviation_by_q_mm": deviation,
         "wall_min_mm": wall,
+        "thread_gap_min_mm": float(dev.thread_gaps.min()),
+        "thread_gap_rule_mm": thread_gap_mm(single.problem.limits.thread_diameter_mm),
+        "thread_gap_rule": THREAD_GAP_RULE,
         "stress_max_kpa": stress,
         "tension_max_n": tension,
         "tension_limit_n": setup.tension_limit_n,

@@ -64,6 +64,8 @@ def test_the_summary_gives_the_device(built: tuple[Path, str]) -> None:
                                                                  abs=TURN_ATOL_RAD)
     assert s["model_deviation_by_q_mm"]["0"] == pytest.approx(0.0, abs=1e-9)
     assert s["wall_min_mm"] >= s["material"]["min_wall_mm"]
+    # the axis thread is not a cavity: two thread diameters from a cavity's surface, not min_wall_mm
+    assert s["thread_gap_rule_mm"] == 2.0 * r["thread"]["diameter_mm"] <= s["thread_gap_min_mm"]
     assert s["feasible"] is True and s["reasons"] == []
 
 

@@ -12,9 +12,11 @@ from softdesign.kinematics.rod_sizing import (
     Limits,
     Problem,
     design_pressure,
+    fits,
     size_single,
     stations_along,
 )
+from softdesign.kinematics.rod_walls import thread_gap_mm
 
 #: The sizing's Newton converges to 1e-13 of the target's bending; constant within this relative spread.
 TAPER_RTOL = 1e-6
@@ -63,14 +65,16 @@ def test_single_supply_round_trip_reaches_the_designed_chain_and_blends_as_pcc()
         poses = station_poses(eps0, bend, device.body.ds, np.eye(4))
         designed = chain_points_at(np.eye(4), fraction * w, lengths, ends)
         np.testing.assert_allclose(poses[:, :3, 3], designed, rtol=0, atol=CHAIN_ATOL_MM)
-    # P* is the lowest that fits: just below it, a wall is too thin
+    # P* is the lowest that fits: just below it, a wall or the gap to the axis thread is too thin
+    assert fits(device, LIMITS)
     below = size_single(problem, device.pressure_kpa * (1 - 1e-6))
-    assert np.min(below.walls) < LIMITS.wall_mm
+    assert not fits(below, LIMITS)
+    assert np.min(below.walls) < LIMITS.wall_mm or np.min(below.thread_gaps) < thread_gap_mm(0.2)
 
 
 def test_single_supply_refuses_when_no_pressure_fits():
     lengths, w = _designed()
-    problem = _problem(lengths, 1.05, w)  # skin and thread walls of 0.5 mm and the 0.2 mm thread fill 1.1 mm
+    problem = _problem(lengths, 0.95, w)  # a skin wall of 0.5 mm, the 0.4 mm gap and half the thread fill 1.0 mm
     assert design_pressure(problem) is None
 
 
