@@ -35,28 +35,33 @@ def pressure(
     json_out: JsonOpt = False,
     out: OutOpt = None,
 ) -> None:
-    """The rod model's shape, chamber lengths and deviation at one q or pressure, without meshes.
+    """The rod model's shape, chamber lengths and deviation at one q or pressure, from the build's rod model.
 
-    Runs the build through fit (cached), sizes the chambers as the build does and evaluates the rod model
-    (docs/reference.md: the rod model).  supply: single: the design pressure P*, the pressure and q = P / P*,
-    each section's arc (kappa 1/mm, phi rad, length mm), each chamber's length and the largest distance from the
-    designed chain at q; per_chamber: every chamber's pressure at q (kPa) and each section's arc.  JSON: those
-    keys, with "centerline" (the model's points, mm) for a single supply and "seconds" (the model's time).
-    Default: q = 1.
+    Reads actuation/rod.json, which `softdesign build CASE` writes (with --out DIR, give the same --out), after
+    checking that the case file and its inputs are those the build was made from (docs/reference.md: the rod
+    model).  supply: single: the design pressure P*, the pressure and q = P / P*, each section's arc (kappa 1/mm,
+    phi rad, length mm), each chamber's length and the largest distance from the designed chain at q;
+    per_chamber: every chamber's pressure at q (kPa) and each section's arc (a q off the build's grid runs the
+    stages through fit, cached, in seconds).  JSON: those keys, with "centerline" (the model's points, mm) for a
+    single supply and "seconds" (the model's time).  Default: q = 1.
     """
 
     def action() -> None:
         from softdesign.config import load_case
-        from softdesign.pipeline.api import build_through
-        from softdesign.pipeline.rod_pressure import check_pressure_case, pressure_document
+        from softdesign.pipeline.rod_pressure import check_pressure_case, pressure_from_build
 
         _check(q, pressure_kpa)
         case = load_case(case_file)
         with errors_named_for(case_file):
             check_pressure_case(case, pressure_kpa)
-        outcome = build_through(case_file, out, target="fit", progress=note, case=case)
-        with errors_named_for(case_file):
-            document = pressure_document(outcome, q, pressure_kpa)
+            document = pressure_from_build(case, str(case_file), out, q, pressure_kpa)
+        if document is None:  # a per-chamber q off the build's grid: the stages through fit, as the build has them
+            from softdesign.pipeline.api import build_through
+            from softdesign.pipeline.rod_pressure import pressure_document
+
+            outcome = build_through(case_file, out, target="fit", progress=note, case=case)
+            with errors_named_for(case_file):
+                document = pressure_document(outcome, q, pressure_kpa)
         if json_out:
             emit_json(document)
             return

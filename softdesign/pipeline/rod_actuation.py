@@ -28,8 +28,10 @@ from softdesign.pipeline.rod_device import (
     section_rest_lengths,
     station_l,
 )
+from softdesign.pipeline.rod_file import rod_document
 from softdesign.pipeline.rod_single import (
     SingleDesign,
+    rod_extra,
     single_layout,
     single_rows,
     single_summary,
@@ -90,7 +92,8 @@ class RodFigures:
     """The rod model's part of the actuation stage.
 
     ``sections``, ``rows``, ``walls``: None where the stage's own (seed 003) figures stand; ``fill`` puts the
-    pressures into the rows and returns the summary's per-q pressures.
+    pressures into the rows and returns the summary's per-q pressures; ``rod_file`` makes the build's rod file of
+    the filled rows (:mod:`softdesign.pipeline.rod_file`; None when the rod model does not apply).
     """
 
     layout: ChamberLayout
@@ -101,6 +104,7 @@ class RodFigures:
     reasons: list[str]
     warnings: list[str]
     fill: Callable[[list[dict[str, Any]]], dict[str, Any]] = field(default=lambda rows: {})
+    rod_file: Callable[[list[dict[str, Any]]], dict[str, Any] | None] = field(default=lambda rows: None)
 
 
 def rod_figures(case: Case, kinematics: KinematicsResult, fit: FitResult, design: DesignResult | None,
@@ -133,11 +137,20 @@ def rod_figures(case: Case, kinematics: KinematicsResult, fit: FitResult, design
         return {"pressures_kpa": {q_label(q): [[r["pressure_kpa"] for r in rows if r["q"] == q and r["section"] == i]
                                                for i in range(1, layout.sections + 1)] for q in export}}
 
+    def rod_file(rows: list[dict[str, Any]]) -> dict[str, Any]:
+        qs = sorted({r["q"] for r in rows})
+        arcs = [[q, [[r["arc_kappa"], r["arc_phi"], r["arc_length_mm"]] for r in rows
+                     if r["q"] == q and r["chamber"] == 1]] for q in qs]
+        lengths = [[[r["length_mm"] for r in rows if r["q"] == q and r["section"] == i + 1]
+                    for i in range(layout.sections)] for q in qs]
+        return rod_document(case, body, stations.chamber, {"supply": "per_chamber", "per_chamber": {
+            "rest_lengths_mm": rest.tolist(), "arcs": arcs, "chamber_lengths_mm": lengths}})
+
     inner = [float(stations.ds[(stations.section == c.section) & stations.chamber].sum()) for c in layout.chambers]
     cores = core_figures(inner, [c.diameter_mm for c in layout.chambers])
     return RodFigures(layout, None, None, None, {**head, "body_modulus_kpa": setup.modulus_kpa,
                                                  "reinforcement": setup.reinforcement(), "cores": cores}, [],
-                      _core_notes(cores), fill)
+                      _core_notes(cores), fill, rod_file)
 
 
 def _single(case: Case, kinematics: KinematicsResult, fit: FitResult, design: DesignResult, layout: ChamberLayout,
@@ -170,7 +183,9 @@ def _single(case: Case, kinematics: KinematicsResult, fit: FitResult, design: De
     warnings += _core_notes(summary["cores"])
     warnings += [_slant_note(c) for c in summary["channels"]
                  if c["width_mm"] < MIN_CHANNEL_WIDTH_FRACTION * c["diameter_mm"]]
-    return RodFigures(meshed, sections, rows, walls, summary, list(summary["model_reasons"]), warnings)
+    document = rod_document(case, single.device.body, single.problem.stations.chamber, rod_extra(single))
+    return RodFigures(meshed, sections, rows, walls, summary, list(summary["model_reasons"]), warnings,
+                      rod_file=lambda rows: document)
 
 
 def channel_figures(single: SingleDesign) -> list[dict[str, Any]]:

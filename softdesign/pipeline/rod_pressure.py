@@ -1,19 +1,23 @@
 """``softdesign pressure``: the rod model's shape, chamber lengths and deviation at one q or one pressure.
 
-The stages through ``fit`` run (cached in the build folder); the chambers are sized as the build sizes them
-(:mod:`softdesign.pipeline.rod_single`) and the rod model is evaluated at ``q P*`` (``supply: single``), or its
-inverse gives every chamber's pressure at q (``per_chamber``).  No meshes, no walls measured on meshes.
+From the build's rod file (:mod:`softdesign.pipeline.rod_file`): ``supply: single`` evaluates the rod model at
+``q P*``, ``per_chamber`` its inverse at a q of the build's grid (every chamber's pressure).  Only numpy and the
+rod model are imported: milliseconds.  A per-chamber q off the build's grid runs the stages through ``fit``
+(cached in the build folder) and sizes as the build does (:func:`pressure_document`): seconds.
 """
 
 from __future__ import annotations
 
 import time
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from softdesign.errors import ConfigError
 from softdesign.kinematics.rod import section_arcs, station_poses, strains
+from softdesign.pipeline.rod_evaluate import per_chamber_from_rod, single_from_rod
+from softdesign.pipeline.rod_file import read_rod
 
 if TYPE_CHECKING:
     from softdesign.config import Case
@@ -21,25 +25,48 @@ if TYPE_CHECKING:
     from softdesign.pipeline.rod_device import RodSetup
 
 
-def check_pressure_case(case: Case, pressure_kpa: float | None) -> RodSetup:
-    """The rod model's numbers for ``softdesign pressure``, or ConfigError (before any stage runs) saying why not."""
-    from softdesign.pipeline.rod_device import rod_setup
-
+def check_pressure_case(case: Case, pressure_kpa: float | None) -> None:
+    """ConfigError (before any file is read) when ``softdesign pressure`` cannot answer for this case."""
     if case.actuation is None:
         raise ConfigError("pressure: the case has no actuation: block (the chambers the rod model pressurises)")
-    setup = rod_setup(case)
-    if isinstance(setup, str):
-        raise ConfigError(f"pressure: {setup}")
+    if case.actuation.reinforcement.kind == "none" or case.material is None:
+        from softdesign.pipeline.rod_device import rod_setup
+
+        setup = rod_setup(case)
+        if isinstance(setup, str):
+            raise ConfigError(f"pressure: {setup}")
     if pressure_kpa is not None and case.actuation.supply != "single":
         raise ConfigError("pressure: --pressure is one supply pressure (actuation.supply: single); this case has a "
                           "pressure per chamber: give --q")
-    return setup
+
+
+def pressure_from_build(case: Case, case_file: str, out: Path | None, q: float | None,
+                        pressure_kpa: float | None) -> dict[str, Any] | None:
+    """The answer from the build's rod file (ConfigError when there is none, or it is not this case's); None for a
+    per-chamber q off the build's grid (the caller then runs the stages through fit)."""
+    start = time.perf_counter()
+    build_dir = out if out is not None else Path("build") / case.name
+    rod = read_rod(case, build_dir, case_file)
+    if rod["supply"] == "single":
+        document = single_from_rod(rod, q, pressure_kpa)
+    else:
+        found = per_chamber_from_rod(rod, 1.0 if q is None else q)
+        if found is None:
+            return None
+        document = found
+    document["seconds"] = time.perf_counter() - start
+    return document
 
 
 def pressure_document(outcome: BuildOutcome, q: float | None, pressure_kpa: float | None) -> dict[str, Any]:
     """The rod model at ``q`` (or one supply pressure): JSON-ready (see ``softdesign pressure --help``)."""
+    from softdesign.pipeline.rod_device import rod_setup
+
     case = outcome.case
-    setup = check_pressure_case(case, pressure_kpa)
+    check_pressure_case(case, pressure_kpa)
+    setup = rod_setup(case)
+    if isinstance(setup, str):
+        raise ConfigError(f"pressure: {setup}")
     start = time.perf_counter()
     if case.actuation is not None and case.actuation.supply == "single":
         document = _single(outcome, setup, q, pressure_kpa)

@@ -17,7 +17,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from softdesign.errors import ConfigError
-from softdesign.kinematics.pcc_chain import feet_on_chain, section_poses
 from softdesign.kinematics.rod import RodBody, section_arcs, station_poses, strains
 from softdesign.kinematics.rod_sizing import (
     Limits,
@@ -31,6 +30,7 @@ from softdesign.kinematics.rod_sizing import (
 from softdesign.kinematics.rod_walls import THREAD_GAP_DIAMETERS, thread_gap_mm
 from softdesign.meshing.chamber_layout import Channel
 from softdesign.pipeline.rod_device import STATIONS_PER_SECTION, RodSetup, outlines_at, skin_radii
+from softdesign.pipeline.rod_evaluate import chain_deviation, chamber_axis_lengths
 from softdesign.types import FloatArray
 
 if TYPE_CHECKING:
@@ -111,12 +111,8 @@ def middle_chambers(single: SingleDesign) -> tuple[FloatArray, FloatArray, Float
 
 def chain_deviation_mm(body: RodBody, pressure_kpa: float, design: DesignResult, q: float) -> float:
     """Largest true distance (mm) from the rod model's centreline at ``pressure_kpa`` to the designed chain at q
-    (``blend: pcc``: each section's curvature times q), the stations' ends and the tip."""
-    eps0, w, _ = strains(body, [pressure_kpa])
-    poses = station_poses(eps0, w, body.ds, design.base2world)
-    bases, _ = section_poses(design.base2world, q * design.w, design.lengths)
-    _, distance, _ = feet_on_chain(poses[:, :3, 3], bases, q * design.w, design.lengths)
-    return float(np.max(distance))
+    (:func:`~softdesign.pipeline.rod_evaluate.chain_deviation`)."""
+    return chain_deviation(body, pressure_kpa, design.base2world, design.w, design.lengths, q)
 
 
 def _at_ends(values: FloatArray, s: FloatArray) -> dict[str, float]:
@@ -202,13 +198,19 @@ def single_layout(layout: ChamberLayout, single: SingleDesign, l_of: Callable[[F
 
 
 def chamber_lengths_mm(single: SingleDesign, pressure_kpa: float) -> FloatArray:
-    """Each section's chamber axis length (n,) mm at ``pressure_kpa``: ``sum ds (1 + eps0 - w . p)``."""
-    st, dev = single.problem.stations, single.device
-    eps0, w, _ = strains(dev.body, [pressure_kpa])
-    p = np.stack([dev.distance_mm * np.cos(dev.angle), dev.distance_mm * np.sin(dev.angle)], axis=1)
-    along = st.ds * (1.0 + eps0 - np.einsum("ki,ki->k", w, p))
-    n = int(st.section.max()) + 1
-    return np.array([along[(st.section == i) & st.chamber].sum() for i in range(n)])
+    """Each section's chamber axis length (n,) mm at ``pressure_kpa``
+    (:func:`~softdesign.pipeline.rod_evaluate.chamber_axis_lengths`)."""
+    dev = single.device
+    return chamber_axis_lengths(dev.body, pressure_kpa, dev.distance_mm, dev.angle, single.problem.stations.chamber)
+
+
+def rod_extra(single: SingleDesign) -> dict[str, Any]:
+    """The rod file's ``single`` part (:mod:`softdesign.pipeline.rod_file`)."""
+    dev, design = single.device, single.design
+    return {"supply": "single", "single": {
+        "design_pressure_kpa": dev.pressure_kpa, "distance_mm": dev.distance_mm.tolist(), "angle": dev.angle.tolist(),
+        "base2world": np.asarray(design.base2world, float).tolist(), "w": np.asarray(design.w, float).tolist(),
+        "lengths": np.asarray(design.lengths, float).tolist()}}
 
 
 def single_rows(single: SingleDesign, grid: list[tuple[float, bool]], arcs: dict[float, list[Any]]

@@ -45,6 +45,7 @@ from softdesign.pipeline.bounds import export_workers
 from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.rod_actuation import describe_rod, device_line, rod_figures
+from softdesign.pipeline.rod_file import ROD_FILE
 from softdesign.pipeline.simulate_estimates import ESTIMATE_COLUMNS, SimulateResult, estimate_cells
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.design import DesignResult
@@ -57,7 +58,8 @@ if TYPE_CHECKING:
     from softdesign.config import Case
 
 VERSION = 6  # 2: one reason per cause (a kind of wall, a bound of extension); 3: the simulate stage's pressures;
-#            4: angles in (-180, 180] degrees; 5: the rod model (supply, pressure_kpa); 6: series channels
+#            4: angles in (-180, 180] degrees; 5: the rod model (supply, pressure_kpa); 6: series channels,
+#            the rod file (actuation/rod.json)
 SUMMARY = "actuation/summary.json"
 TABLE = "actuation.csv"
 #: The dense q grid's size (q = 0, 0.05, ..., 1).
@@ -78,6 +80,7 @@ class ActuationResult:
 
     summary: dict[str, Any]
     table: str
+    rod: dict[str, Any] | None = None  # the rod file (actuation/rod.json) the pressure command reads
 
 
 def actuation_layout(case: Case, kinematics: KinematicsResult,
@@ -380,7 +383,7 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult, simu
                   "q), and at every export q the skin over each tube measured on the mesh (end caps included)",
     }
     summary["verdict_line"] = device_line(summary)
-    return ActuationResult(summary, table_text(rows, estimates=simulated is not None))
+    return ActuationResult(summary, table_text(rows, estimates=simulated is not None), rod.rod_file(rows))
 
 
 def _per_chamber_rows(kinematics: KinematicsResult, layout: ChamberLayout,
@@ -399,6 +402,8 @@ def write_actuation(result: ActuationResult | None, staging: Staging) -> None:
         return
     staging.write_bytes(TABLE, result.table.encode("utf-8"))
     staging.write_json(SUMMARY, result.summary)
+    if result.rod is not None:
+        staging.write_json(ROD_FILE, result.rod)
 
 
 def load_actuation(build_dir: Path) -> ActuationResult | None:
