@@ -1,4 +1,4 @@
-"""`softdesign pressure CASE [--q Q | --pressure P] [--json]`: the rod model's shape without a build.
+"""`softdesign pressure CASE [--q Q | --pressure P] [--json]`: the rod model's shape, from the build's rod model.
 
 Parsing and printing live here; the numbers are :mod:`softdesign.pipeline.rod_pressure`'s.
 """

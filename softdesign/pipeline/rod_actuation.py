@@ -77,7 +77,7 @@ def core_figures(lengths_mm: list[float], diameters_mm: list[float], lost: bool 
         if lost:
             make = "part of the one lost wax core, tapered as the chamber's profile" + (
                 f", cast over a nylon monofilament of {strand_mm or 0.0:.2f} mm through the whole core (aspect ratio "
-                f"{aspect:.0f} > {MAX_PIN_ASPECT:g}), drawn out through the supply port after the wax is melted"
+                f"{aspect:.1f} > {MAX_PIN_ASPECT:g}), drawn out through the supply port after the wax is melted"
                 if slender else "")
         else:
             make = ("printed pin (the mould's core)" if not slender else
