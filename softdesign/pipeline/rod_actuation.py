@@ -26,7 +26,6 @@ from softdesign.pipeline.rod_device import (
     per_chamber_rows,
     rod_setup,
     section_rest_lengths,
-    station_l,
 )
 from softdesign.pipeline.rod_file import rod_document
 from softdesign.pipeline.rod_single import (
@@ -169,11 +168,11 @@ def _single(case: Case, kinematics: KinematicsResult, fit: FitResult, design: De
             walls.append(Wall(kind, value, i + 1, 0, None, None, None))
     warnings: list[str] = []
     if summary["rest_lengths_mm"] is not None:
-        warnings.append("backbone: free: cast each section shorter, at " + ", ".join(
-            f"{v:.2f}" for v in summary["rest_lengths_mm"]) + " mm, to reach its designed length at P* (the meshes "
-            "are at the designed lengths)")
+        warnings.append("backbone: free: each section is cast shorter, at " + ", ".join(
+            f"{v:.2f}" for v in summary["rest_lengths_mm"]) + " mm, and reaches its designed length at P* (the meshes "
+            "and the mould are at these rest lengths at q = 0, the rod model's lengths at every q)")
     sections = summary.pop("sections")
-    meshed = single_layout(layout, single, lambda s: station_l(kinematics, s))
+    meshed = single_layout(layout, single, single.l_of(kinematics))
     summary["channels"] = channel_figures(single)
     narrowest = min((c["width_mm"] for c in summary["channels"]), default=case.actuation.feed_diameter_mm
                     if case.actuation is not None else 0.0)

@@ -9,6 +9,7 @@ in :mod:`softdesign.pipeline.rod_single`, the per-chamber pressures in :func:`pe
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -112,15 +113,25 @@ def station_l(kinematics: KinematicsResult, s: FloatArray) -> FloatArray:
 
 def outlines_at(kinematics: KinematicsResult, fit: FitResult, s: FloatArray, q: float = 0.0) -> FloatArray:
     """The body's radii (k, OUTLINE_ANGLES) mm at q (0: as cast) at rest arc lengths ``s`` (k,) mm from the base."""
+    return outlines_at_l(fit, station_l(kinematics, s), q)
+
+
+def outlines_at_l(fit: FitResult, l: FloatArray, q: float = 0.0) -> FloatArray:
+    """The body's radii (k, OUTLINE_ANGLES) mm at q at normalized ``l`` (k,)."""
     a = 2.0 * np.pi * np.arange(OUTLINE_ANGLES) / OUTLINE_ANGLES
-    return np.asarray(fit.field.evaluate_grid(q, station_l(kinematics, s), a), float)
+    return np.asarray(fit.field.evaluate_grid(q, np.clip(l, 0.0, 1.0), a), float)
 
 
 def skin_radii(kinematics: KinematicsResult, fit: FitResult, stations: Stations) -> FloatArray:
     """(k,) mm: each station's smallest radius over its length (both ends and middle), every angle, at q = 0 and
     1: the skin the build measures walls against at every q (the radius profile morphs with q)."""
-    s = np.concatenate([stations.s - 0.5 * stations.ds, stations.s, stations.s + 0.5 * stations.ds])
-    radii = np.minimum(outlines_at(kinematics, fit, s, 0.0), outlines_at(kinematics, fit, s, 1.0)).min(axis=1)
+    return skin_radii_l(fit, stations, lambda s: station_l(kinematics, s))
+
+
+def skin_radii_l(fit: FitResult, stations: Stations, l_of: Callable[[FloatArray], FloatArray]) -> FloatArray:
+    """:func:`skin_radii` with the stations' rest arc lengths mapped to l by ``l_of``."""
+    l = l_of(np.concatenate([stations.s - 0.5 * stations.ds, stations.s, stations.s + 0.5 * stations.ds]))
+    radii = np.minimum(outlines_at_l(fit, l, 0.0), outlines_at_l(fit, l, 1.0)).min(axis=1)
     return np.asarray(radii.reshape(3, -1).min(axis=0), float)
 
 

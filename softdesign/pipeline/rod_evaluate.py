@@ -21,16 +21,20 @@ GRID_Q_ATOL = 1e-12
 
 
 def chain_deviation(body: RodBody, pressure_kpa: float, base2world: FloatArray, w: FloatArray, lengths: FloatArray,
-                    q: float) -> float:
+                    q: float, rest: FloatArray | None = None) -> float:
     """Largest true distance (mm) from the rod model's centreline at ``pressure_kpa`` to the designed chain at q
     (``blend: pcc``: each section's curvature ``w`` (n, 2) 1/mm times q, ``lengths`` (n,) mm), the stations' ends
-    and the tip."""
+    and the tip.  ``rest`` (n,) mm: a free backbone's rest lengths, the chain at q then the rest-length morph's
+    (:func:`~softdesign.pipeline.rod_free.morph_chain`)."""
     from softdesign.kinematics.pcc_chain import feet_on_chain, section_poses
+    from softdesign.pipeline.rod_free import morph_chain
 
     eps0, bend, _ = strains(body, [pressure_kpa])
     poses = station_poses(eps0, bend, body.ds, base2world)
-    bases, _ = section_poses(base2world, q * w, lengths)
-    _, distance, _ = feet_on_chain(poses[:, :3, 3], bases, q * w, lengths)
+    w_q, lengths_q = (q * np.asarray(w, float), np.asarray(lengths, float)) if rest is None else morph_chain(
+        w, lengths, rest, q)
+    bases, _ = section_poses(base2world, w_q, lengths_q)
+    _, distance, _ = feet_on_chain(poses[:, :3, 3], bases, w_q, lengths_q)
     return float(np.max(distance))
 
 
@@ -62,7 +66,9 @@ def single_from_rod(rod: dict[str, Any], q: float | None, pressure_kpa: float | 
                      for i in range(len(kappa))],
         "chamber_lengths_mm": chamber_axis_lengths(body, p, np.asarray(single["distance_mm"], float),
                                                    np.asarray(single["angle"], float), chamber).tolist(),
-        "deviation_mm": chain_deviation(body, p, base2world, w, lengths, q),
+        "deviation_mm": chain_deviation(body, p, base2world, w, lengths, q,
+                                        None if single.get("rest_lengths") is None
+                                        else np.asarray(single["rest_lengths"], float)),
         "centerline": poses[:, :3, 3].tolist(),
         "deviation_of": "the designed chain with each section's curvature times q (blend: pcc)",
     }

@@ -59,7 +59,8 @@ def pressure_from_build(case: Case, case_file: str, out: Path | None, q: float |
 
 
 def pressure_document(outcome: BuildOutcome, q: float | None, pressure_kpa: float | None) -> dict[str, Any]:
-    """The rod model at ``q`` (or one supply pressure): JSON-ready (see ``softdesign pressure --help``)."""
+    """The per-chamber rod model at a ``q`` off the build's grid, from the stages through fit: JSON-ready (see
+    ``softdesign pressure --help``; a single supply is always answered from its rod file)."""
     from softdesign.pipeline.rod_device import rod_setup
 
     case = outcome.case
@@ -68,38 +69,9 @@ def pressure_document(outcome: BuildOutcome, q: float | None, pressure_kpa: floa
     if isinstance(setup, str):
         raise ConfigError(f"pressure: {setup}")
     start = time.perf_counter()
-    if case.actuation is not None and case.actuation.supply == "single":
-        document = _single(outcome, setup, q, pressure_kpa)
-    else:
-        document = _per_chamber(outcome, setup, 1.0 if q is None else q)
+    document = _per_chamber(outcome, setup, 1.0 if q is None else q)
     document["seconds"] = time.perf_counter() - start
     return document
-
-
-def _single(outcome: BuildOutcome, setup: RodSetup, q: float | None, pressure_kpa: float | None) -> dict[str, Any]:
-    from softdesign.pipeline.rod_single import chain_deviation_mm, chamber_lengths_mm, size_case
-
-    results = outcome.results
-    design = results["design"]
-    single = size_case(outcome.case, results["kinematics"], results["fit"], design, setup)
-    top = single.device.pressure_kpa
-    if pressure_kpa is not None:
-        q = pressure_kpa / top
-    q = 1.0 if q is None else q
-    p = q * top
-    body = single.device.body
-    eps0, w, _ = strains(body, [p])
-    poses = station_poses(eps0, w, body.ds, design.base2world)
-    kappa, phi, length = section_arcs(body, poses, eps0)
-    return {
-        "supply": "single", "design_pressure_kpa": top, "pressure_kpa": p, "q": q,
-        "sections": [{"section": i + 1, "kappa": float(kappa[i]), "phi": float(phi[i]), "length": float(length[i])}
-                     for i in range(len(kappa))],
-        "chamber_lengths_mm": chamber_lengths_mm(single, p).tolist(),
-        "deviation_mm": chain_deviation_mm(body, p, design, q),
-        "centerline": poses[:, :3, 3].tolist(),
-        "deviation_of": "the designed chain with each section's curvature times q (blend: pcc)",
-    }
 
 
 def _per_chamber(outcome: BuildOutcome, setup: RodSetup, q: float) -> dict[str, Any]:

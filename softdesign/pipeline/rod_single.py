@@ -10,6 +10,7 @@ the stress at P*.  The meshes and the mould carry the tapered chambers (:func:`s
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
@@ -22,15 +23,25 @@ from softdesign.kinematics.rod_sizing import (
     Limits,
     Problem,
     SingleSupply,
+    Stations,
     design_pressure,
     largest_fitting_kappa,
     size_single,
     stations_along,
 )
 from softdesign.kinematics.rod_walls import THREAD_GAP_DIAMETERS, thread_gap_mm
-from softdesign.meshing.chamber_layout import Channel
-from softdesign.pipeline.rod_device import STATIONS_PER_SECTION, RodSetup, outlines_at, skin_radii
+from softdesign.meshing.chamber_layout import Channel, Feed
+from softdesign.pipeline.rod_device import (
+    STATIONS_PER_SECTION,
+    RodSetup,
+    outlines_at,
+    outlines_at_l,
+    skin_radii,
+    skin_radii_l,
+    station_l,
+)
 from softdesign.pipeline.rod_evaluate import chain_deviation, chamber_axis_lengths
+from softdesign.pipeline.rod_free import REST_SIZINGS, l_from_s, morph_document, settled
 from softdesign.types import FloatArray
 
 if TYPE_CHECKING:
@@ -55,30 +66,66 @@ ANGLE_CONVENTION = ("angle_rad: a chamber's axis in its section's base frame, fr
 
 @dataclass(frozen=True)
 class SingleDesign:
-    """The sized device and what it was sized on."""
+    """The sized device and what it was sized on; ``rest_lengths`` (n,) mm with ``backbone: free`` (the cast
+    sections, :mod:`softdesign.pipeline.rod_free`), None when the axis thread keeps the designed lengths."""
 
     problem: Problem
     device: SingleSupply
     design: DesignResult
+    rest_lengths: FloatArray | None = None
+
+    def l_of(self, kinematics: KinematicsResult) -> Callable[[FloatArray], FloatArray]:
+        """Rest arc length (mm) -> the body's normalized l."""
+        if self.rest_lengths is None:
+            return lambda s: station_l(kinematics, s)
+        rest, breaks = self.rest_lengths, self.design.breaks
+        return lambda s: l_from_s(breaks, rest, s)
 
 
 def size_case(case: Case, kinematics: KinematicsResult, fit: FitResult, design: DesignResult,
               setup: RodSetup) -> SingleDesign:
-    """The single-supply device of the case at P*, or ConfigError naming the section, wall and reachable kappa."""
+    """The single-supply device of the case at P*, or ConfigError naming the section, wall and reachable kappa.
+
+    ``backbone: free``: sized on the rest lengths, solved in turn with them until they settle (:mod:`rod_free`)."""
     if case.actuation is None:
         raise ConfigError("actuation: the case has no actuation: block")
-    try:
-        stations = stations_along(design.lengths, STATIONS_PER_SECTION, case.actuation.end_wall_mm)
-    except ValueError as err:
-        raise ConfigError(f"actuation.end_wall_mm: {err}; use a thinner end wall or longer sections") from err
     limits = Limits(setup.wall_mm + MESH_MARGIN_MM, case.actuation.feed_diameter_mm, setup.thread.diameter_mm,
                     setup.max_pressure_kpa)
-    problem = Problem(stations, outlines_at(kinematics, fit, stations.s, 0.0), design.w, setup.modulus_kpa,
-                      setup.backbone, limits, skin_radii(kinematics, fit, stations))
+    if setup.backbone != "free":
+        stations = _stations(case, design.lengths)
+        problem = Problem(stations, outlines_at(kinematics, fit, stations.s, 0.0), design.w, setup.modulus_kpa,
+                          setup.backbone, limits, skin_radii(kinematics, fit, stations))
+        return SingleDesign(problem, _sized(problem, setup), design)
+    rest = np.asarray(design.lengths, float)
+    for _ in range(REST_SIZINGS):
+        stations = _stations(case, rest)
+        l_of = functools.partial(l_from_s, design.breaks, rest)
+        turn = design.w * (design.lengths / rest)[:, None]  # the designed turn over the rest length
+        problem = Problem(stations, outlines_at_l(fit, l_of(stations.s), 0.0), turn, setup.modulus_kpa,
+                          setup.backbone, limits, skin_radii_l(fit, stations, l_of))
+        device = _sized(problem, setup)
+        eps0 = strains(device.body, [device.pressure_kpa])[0]
+        mean = np.array([np.average(eps0[stations.section == i], weights=stations.ds[stations.section == i])
+                         for i in range(len(rest))])
+        rest, before = np.asarray(design.lengths, float) / (1.0 + mean), rest
+        if settled(before, rest):
+            break
+    return SingleDesign(problem, device, design, before)
+
+
+def _stations(case: Case, lengths: FloatArray) -> Stations:
+    assert case.actuation is not None
+    try:
+        return stations_along(lengths, STATIONS_PER_SECTION, case.actuation.end_wall_mm)
+    except ValueError as err:
+        raise ConfigError(f"actuation.end_wall_mm: {err}; use a thinner end wall or longer sections") from err
+
+
+def _sized(problem: Problem, setup: RodSetup) -> SingleSupply:
     device = design_pressure(problem)
     if device is None:
         raise ConfigError(_refusal(problem, setup))
-    return SingleDesign(problem, device, design)
+    return device
 
 
 def _refusal(problem: Problem, setup: RodSetup) -> str:
@@ -109,10 +156,11 @@ def middle_chambers(single: SingleDesign) -> tuple[FloatArray, FloatArray, Float
     return out[0], out[1], out[2]
 
 
-def chain_deviation_mm(body: RodBody, pressure_kpa: float, design: DesignResult, q: float) -> float:
+def chain_deviation_mm(body: RodBody, pressure_kpa: float, design: DesignResult, q: float,
+                       rest: FloatArray | None = None) -> float:
     """Largest true distance (mm) from the rod model's centreline at ``pressure_kpa`` to the designed chain at q
-    (:func:`~softdesign.pipeline.rod_evaluate.chain_deviation`)."""
-    return chain_deviation(body, pressure_kpa, design.base2world, design.w, design.lengths, q)
+    (:func:`~softdesign.pipeline.rod_evaluate.chain_deviation`; ``rest``: the free backbone's rest lengths)."""
+    return chain_deviation(body, pressure_kpa, design.base2world, design.w, design.lengths, q, rest)
 
 
 def _at_ends(values: FloatArray, s: FloatArray) -> dict[str, float]:
@@ -183,9 +231,14 @@ def single_layout(layout: ChamberLayout, single: SingleDesign, l_of: Callable[[F
         profile = tuple((float(station_l[k]), float(dev.distance_mm[k]), float(dev.diameter_mm[k])) for k in at)
         chambers.append(replace(c, angle=float(angle[c.section]), distance_mm=float(distance[c.section]),
                                 diameter_mm=float(diameter[c.section]), profile=profile))
+        if single.rest_lengths is not None:  # the planned ends are on the designed lengths: the rest body's here
+            edges = l_of(np.array([st.s[at[0]] - 0.5 * st.ds[at[0]], st.s[at[-1]] + 0.5 * st.ds[at[-1]]]))
+            chambers[-1] = replace(chambers[-1], l_start=float(edges[0]), l_end=float(edges[1]))
     first = chambers[0]
     feeds = tuple(replace(f, angle=first.angle, ring_mm=float(dev.feed_ring_mm[0]))
                   for f in layout.feeds if f.section == 0)
+    if single.rest_lengths is not None:  # the supply line ends inside chamber 1 as planned (its reach in mm)
+        feeds = tuple(replace(f, l_end=float(l_of(np.array([_reach_s(layout, f, st)]))[0])) for f in feeds)
     spec = replace(layout.spec, distance_mm=float(dev.distance_mm[st.chamber].max()),
                    diameter_mm=float(dev.diameter_mm[st.chamber].min()))
     channels = []
@@ -195,6 +248,16 @@ def single_layout(layout: ChamberLayout, single: SingleDesign, l_of: Callable[[F
         channels.append(Channel(course.index + 1, course.diameter_mm,
                                 tuple(zip(l_of(s).tolist(), a.tolist(), ring.tolist(), strict=True))))
     return replace(layout, spec=spec, chambers=tuple(chambers), feeds=feeds, channels=tuple(channels))
+
+
+def _reach_s(layout: ChamberLayout, feed: Feed, st: Stations) -> float:
+    """Rest arc length (mm) where the supply line ends: as far into chamber 1 as planned (the planned reach in l
+    over the planned chamber's length in l, times the rest chamber's length in mm)."""
+    planned = layout.chambers[0]
+    at = np.flatnonzero((st.section == 0) & st.chamber)
+    start, end = st.s[at[0]] - 0.5 * st.ds[at[0]], st.s[at[-1]] + 0.5 * st.ds[at[-1]]
+    fraction = (feed.l_end - planned.l_start) / (planned.l_end - planned.l_start)
+    return float(start + fraction * (end - start))
 
 
 def chamber_lengths_mm(single: SingleDesign, pressure_kpa: float) -> FloatArray:
@@ -210,7 +273,8 @@ def rod_extra(single: SingleDesign) -> dict[str, Any]:
     return {"supply": "single", "single": {
         "design_pressure_kpa": dev.pressure_kpa, "distance_mm": dev.distance_mm.tolist(), "angle": dev.angle.tolist(),
         "base2world": np.asarray(design.base2world, float).tolist(), "w": np.asarray(design.w, float).tolist(),
-        "lengths": np.asarray(design.lengths, float).tolist()}}
+        "lengths": np.asarray(design.lengths, float).tolist(),
+        "rest_lengths": None if single.rest_lengths is None else single.rest_lengths.tolist()}}
 
 
 def single_rows(single: SingleDesign, grid: list[tuple[float, bool]], arcs: dict[float, list[Any]]
@@ -239,7 +303,8 @@ def single_summary(case: Case, single: SingleDesign, setup: RodSetup) -> dict[st
     dev, design = single.device, single.design
     p = dev.pressure_kpa
     sections = section_figures(single, setup)
-    deviation = {f"{q:g}": chain_deviation_mm(dev.body, q * p, design, q) for q in case.export.q_values()}
+    rest = single.rest_lengths
+    deviation = {f"{q:g}": chain_deviation_mm(dev.body, q * p, design, q, rest) for q in case.export.q_values()}
     tension = max(c["tension_per_turn_n"] for s in sections for c in s["chambers"])
     stress = stress_kpa(dev.body, p, single.problem.outlines)
     wall = float(dev.walls.min())
@@ -260,7 +325,7 @@ def single_summary(case: Case, single: SingleDesign, setup: RodSetup) -> dict[st
         "reinforcement": setup.reinforcement(),
         "angle_convention": ANGLE_CONVENTION,
         "sections": sections,
-        "model_deviation_mm": deviation.get("1", chain_deviation_mm(dev.body, p, design, 1.0)),
+        "model_deviation_mm": deviation.get("1", chain_deviation_mm(dev.body, p, design, 1.0, rest)),
         "model_deviation_by_q_mm": deviation,
         "wall_min_mm": wall,
         "thread_gap_min_mm": float(dev.thread_gaps.min()),
@@ -272,19 +337,11 @@ def single_summary(case: Case, single: SingleDesign, setup: RodSetup) -> dict[st
         "model_reasons": reasons,
         "margins": {"wall_mm": wall - setup.wall_mm, "thread_fraction": tension / setup.tension_limit_n,
                     "stress_fraction": None if setup.tensile_kpa is None else stress / setup.tensile_kpa,
-                    "model_deviation_mm": deviation.get("1", chain_deviation_mm(dev.body, p, design, 1.0))},
-        "rest_lengths_mm": _rest_lengths(single) if setup.backbone == "free" else None,
+                    "model_deviation_mm": deviation.get("1", chain_deviation_mm(dev.body, p, design, 1.0, rest))},
+        "rest_lengths_mm": None if rest is None else rest.tolist(),
+        "free_morph": None if rest is None else morph_document(design.base2world, design.w, design.lengths, rest,
+                                                               design.breaks),
     }
-
-
-def _rest_lengths(single: SingleDesign) -> list[float]:
-    """``backbone: free``: each section's cast length for its designed length at P* (L / (1 + mean stretch))."""
-    st, dev = single.problem.stations, single.device
-    eps0, _, _ = strains(dev.body, [dev.pressure_kpa])
-    n = int(st.section.max()) + 1
-    return [float(single.design.lengths[i] / (1.0 + np.average(eps0[st.section == i],
-                                                               weights=st.ds[st.section == i])))
-            for i in range(n)]
 
 
 def verdict_line(summary: dict[str, Any]) -> str:

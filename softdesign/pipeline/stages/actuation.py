@@ -46,6 +46,7 @@ from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.rod_actuation import describe_rod, device_line, rod_figures
 from softdesign.pipeline.rod_file import ROD_FILE
+from softdesign.pipeline.rod_free import body_curve_at
 from softdesign.pipeline.simulate_estimates import ESTIMATE_COLUMNS, SimulateResult, estimate_cells
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.design import DesignResult
@@ -262,11 +263,12 @@ def _extensions(kinematics: KinematicsResult, layout: ChamberLayout, grid: list[
 
 
 def _skin(kinematics: KinematicsResult, fit: FitResult, layout: ChamberLayout, grid: list[float],
-          offset_mm: float) -> list[Wall]:
-    """The thinnest chamber-skin, feed-skin and (series) channel-skin wall at every q of the grid."""
+          offset_mm: float, rod: dict[str, Any] | None = None) -> list[Wall]:
+    """The thinnest chamber-skin, feed-skin and (series) channel-skin wall at every q of the grid (on the body the
+    meshes take: :func:`~softdesign.pipeline.rod_free.body_curve_at` of the rod model's summary ``rod``)."""
     out: list[Wall] = []
     for q in grid:
-        walls = skin_walls(kinematics.chain.shape.curve_at(q), fit.field, q, layout, offset_mm)
+        walls = skin_walls(body_curve_at(kinematics, rod, q), fit.field, q, layout, offset_mm)
         for kind in ("chamber-skin", "feed-skin", "channel-skin"):
             of_kind = [w for w in walls if w.kind == kind]
             if of_kind:
@@ -274,13 +276,14 @@ def _skin(kinematics: KinematicsResult, fit: FitResult, layout: ChamberLayout, g
     return out
 
 
-def _meshed(case: Case, kinematics: KinematicsResult, fit: FitResult, layout: ChamberLayout) -> list[Wall]:
+def _meshed(case: Case, kinematics: KinematicsResult, fit: FitResult, layout: ChamberLayout,
+            rod: dict[str, Any] | None = None) -> list[Wall]:
     """At every export q (on the build's worker processes), the thinnest skin over chambers and feeds measured
     on the meshes the export makes."""
     e, spec = case.export, body_spec(case, fit)
 
     def at(q: float) -> list[Wall]:
-        curve = kinematics.chain.shape.curve_at(q)
+        curve = body_curve_at(kinematics, rod, q)
         sections = body_sections(curve, fit.field, q, e.spacing_mm, e.angular_count)
         walls = [Wall(kind, value, section + 1, chamber + 1, q, l, None)
                  for kind, value, section, chamber, l in measured_skin_walls(sections, spec, curve, layout)]
@@ -351,8 +354,8 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult, simu
     _add_estimates(rows, simulated)
     qs = [q for q, _ in grid]
     walls = (rod.walls if rod.walls is not None else ring_walls(layout)) + _skin(kinematics, fit, layout, qs,
-                                                                                 case.export.offset_mm)
-    walls += _meshed(case, kinematics, fit, layout)
+                                                                                 case.export.offset_mm, rod.summary)
+    walls += _meshed(case, kinematics, fit, layout, rod.summary)
     extensions = _extensions(kinematics, layout, qs)
     limits = case.material.limits().as_dict() if case.material is not None else None
     reasons, warnings = judge(walls, extensions, limits)

@@ -42,6 +42,7 @@ from softdesign.pipeline.bounds import export_workers
 from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.output_frame import base_pose, frame_record, moved_points, moved_vectors, output_pose
 from softdesign.pipeline.parallel import map_items
+from softdesign.pipeline.rod_free import body_curve_at
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.actuation import ActuationResult, actuation_layout, unsized_single
 from softdesign.pipeline.stages.fit import FitResult
@@ -94,7 +95,7 @@ def solid_at(kinematics: KinematicsResult, fit: FitResult, q: float, case: Case,
     MeshError
         Naming q and l: a fold, a wall too thick, or a failed check (with figures).
     """
-    curve = kinematics.chain.shape.curve_at(q)
+    curve = body_curve_at(kinematics, None if sized is None else sized.summary, q)  # backbone: free: rest lengths
     e = case.export
     spec = body_spec(case, fit)
     sections = body_sections(curve, fit.field, q, e.spacing_mm, e.angular_count)

@@ -30,6 +30,7 @@ from softdesign.pipeline import layout
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.output_frame import base_pose, moved_points, moved_vectors, output_pose
+from softdesign.pipeline.rod_free import body_curve_at
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.stages.actuation import ActuationResult, actuation_layout
 from softdesign.pipeline.stages.fit import FitResult
@@ -78,15 +79,16 @@ def run_mould(case: Case, kinematics: KinematicsResult, fit: FitResult,
     if spec is None:
         return MouldResult((), {"requested": False})
     e = case.export
-    sections = body_sections(kinematics.chain.shape.curve_at(0.0), fit.field, 0.0, e.spacing_mm, e.angular_count)
+    curve0 = body_curve_at(kinematics, None if sized is None else sized.summary, 0.0)  # backbone: free: rest lengths
+    sections = body_sections(curve0, fit.field, 0.0, e.spacing_mm, e.angular_count)
     actuated = actuation_layout(case, kinematics, sized)  # supply: single: the chambers as the rod model sized them
     steps = ("the parts", "their checks")
     tick = item_counter("mould", steps)  # two steps of a bar (the parts take most of the time), when one listens
     if actuated is None:
         mould = make_mould(sections, body_spec(case, fit), spec, fit.field.link_of)
     else:
-        mould = make_actuated_mould(sections, body_spec(case, fit), spec, kinematics.chain.shape.curve_at(0.0),
-                                    actuated, fit.field.link_of, axis_thread_mm(case))
+        mould = make_actuated_mould(sections, body_spec(case, fit), spec, curve0, actuated, fit.field.link_of,
+                                    axis_thread_mm(case))
     if tick is not None:
         tick(steps[0], None)
     files: dict[str, Any] = {}
