@@ -247,10 +247,11 @@ def _add_estimates(rows: list[dict[str, Any]], simulated: SimulateResult | None)
         r["fe_pressure_source"] = None if cells is None else cells["pressure_source"]
 
 
-def _extensions(kinematics: KinematicsResult, layout: ChamberLayout, grid: list[float]) -> list[dict[str, Any]]:
-    """Each chamber's axis length over the grid (on the body itself): its largest and smallest extension."""
-    shape = kinematics.chain.shape
-    lengths = np.array([chamber_lengths_mm(shape.curve_at(q), layout) for q in grid])
+def _extensions(kinematics: KinematicsResult, layout: ChamberLayout, grid: list[float],
+                rod: dict[str, Any] | None = None) -> list[dict[str, Any]]:
+    """Each chamber's axis length over the grid (on the body itself, as the meshes take it: the rod model's
+    summary ``rod``): its largest and smallest extension."""
+    lengths = np.array([chamber_lengths_mm(body_curve_at(kinematics, rod, q), layout) for q in grid])
     ratio = lengths / lengths[grid.index(0.0)]
     out = []
     for c in layout.chambers:
@@ -356,7 +357,7 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult, simu
     walls = (rod.walls if rod.walls is not None else ring_walls(layout)) + _skin(kinematics, fit, layout, qs,
                                                                                  case.export.offset_mm, rod.summary)
     walls += _meshed(case, kinematics, fit, layout, rod.summary)
-    extensions = _extensions(kinematics, layout, qs)
+    extensions = _extensions(kinematics, layout, qs, rod.summary)
     limits = case.material.limits().as_dict() if case.material is not None else None
     reasons, warnings = judge(walls, extensions, limits)
     reasons += rod.reasons
