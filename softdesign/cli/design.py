@@ -28,8 +28,8 @@ from softdesign.cli.common import (
     note,
     run_guarded,
 )
-from softdesign.config.design import MAX_DESIGN_LINKS
 from softdesign.errors import ConfigError, SoftdesignError
+from softdesign.limits.design import MAX_DESIGN_LINKS
 
 if TYPE_CHECKING:  # numpy is imported where it is used: `softdesign --help` starts without it
     import numpy as np

@@ -10,9 +10,7 @@ from __future__ import annotations
 from pydantic import BaseModel, ConfigDict, Field
 
 from softdesign.config.types import FiniteFloat, Integer
-
-#: Most sections a design may search: each k is one joint optimisation (about 0.1 to 0.5 s).
-MAX_DESIGN_LINKS = 40
+from softdesign.limits.design import MAX_DESIGN_LINKS
 
 
 class Design(BaseModel):
