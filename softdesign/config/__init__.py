@@ -59,7 +59,7 @@ from softdesign.limits.shape import (
 )
 from softdesign.limits.volume import MAX_MESHER_SECONDS, MAX_VOLUME_MESHES, MIN_TET_SIZE_MM
 from softdesign.materials import MaterialLimits, PresetName, resolve_material
-from softdesign.meshing.mould_spec import MIN_MOULD_WALL_MM
+from softdesign.meshing.mould.spec import MIN_MOULD_WALL_MM
 from softdesign.meshing.volume_tolerance import (
     MAX_CAVITY_SHARE,
     MIN_ANGULAR_COUNT,
@@ -277,7 +277,7 @@ class Mould(_Section):
 
     @model_validator(mode="after")
     def _keys_fit(self) -> Mould:
-        # the keys sit margin_mm / 2 beside the body (softdesign.meshing.mould), a wall from the cavity
+        # the keys sit margin_mm / 2 beside the body (softdesign.meshing.mould.parts), a wall from the cavity
         need = 2.0 * (0.5 * self.key_mm + self.clearance_mm + MIN_MOULD_WALL_MM)
         if self.margin_mm < need:
             raise ValueError(

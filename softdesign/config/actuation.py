@@ -55,7 +55,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 from softdesign.config.types import FiniteFloat, Integer
 
 if TYPE_CHECKING:  # numpy stays out of `softdesign validate`
-    from softdesign.meshing.chamber_layout import ActuationSpec
+    from softdesign.meshing.chambers.layout import ActuationSpec
 
 #: The largest size any actuation key takes, mm (a vessel is at most 20 mm in median radius, limits at ingest).
 MAX_ACTUATION_MM = 50.0
@@ -156,7 +156,7 @@ class Actuation(BaseModel):
 
     def spec(self) -> ActuationSpec:
         """The layout's numbers."""
-        from softdesign.meshing.chamber_layout import ActuationSpec
+        from softdesign.meshing.chambers.layout import ActuationSpec
 
         return ActuationSpec(self.distance_mm, self.diameter_mm, self.feed_diameter_mm, self.end_wall_mm,
                              self.first_angle_deg, self.chambers_per_section)

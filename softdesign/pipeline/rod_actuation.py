@@ -17,7 +17,7 @@ import numpy as np
 from softdesign.errors import ConfigError
 from softdesign.io.format_names import q_label
 from softdesign.kinematics.pcc_fit import fit_links
-from softdesign.meshing.chamber_walls import Wall
+from softdesign.meshing.chambers.walls import Wall
 from softdesign.pipeline.rod_device import (
     RodSetup,
     layout_body,
@@ -32,7 +32,7 @@ from softdesign.pipeline.rod_single import single_layout, single_rows, single_su
 
 if TYPE_CHECKING:
     from softdesign.config import Case
-    from softdesign.meshing.chamber_layout import ChamberLayout
+    from softdesign.meshing.chambers.layout import ChamberLayout
     from softdesign.pipeline.stages.design import DesignResult
     from softdesign.pipeline.stages.fit import FitResult
     from softdesign.pipeline.stages.kinematics import KinematicsResult

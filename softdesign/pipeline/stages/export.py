@@ -12,7 +12,7 @@ carrying the frames (N, B, T) and the axial stretch, for VMTK, ParaView and
 3D Slicer.  ``centerlines.pvd`` (and ``meshes.pvd`` when .vtp is exported)
 lists those files as a ParaView time series with q as the time; with .glb and
 two or more q, ``morph.glb`` holds the outer surface with a morph target per q
-and an animation over q (see :mod:`softdesign.meshing.morph_body`).
+and an animation over q (see :mod:`softdesign.meshing.body.morph`).
 """
 
 from __future__ import annotations
@@ -29,10 +29,10 @@ from softdesign.io.formats import FILE_UNITS, mesh_bytes
 from softdesign.io.gltf_morph import morph_glb_bytes
 from softdesign.io.polylines_vtp import write_polylines_vtp
 from softdesign.io.pvd import pvd_bytes
-from softdesign.meshing.body import body_breaks, body_sections, body_stations
-from softdesign.meshing.chambers import build_actuated
+from softdesign.meshing.body.morph import MorphSurfaces, morph_surfaces
+from softdesign.meshing.body.sections import body_breaks, body_sections, body_stations
+from softdesign.meshing.chambers.carve import build_actuated
 from softdesign.meshing.checks import check_solid
-from softdesign.meshing.morph_body import MorphSurfaces, morph_surfaces
 from softdesign.meshing.regions import RegionPiece, split_by_region
 from softdesign.meshing.solids import Solid, build_solid
 from softdesign.meshing.volume import integrate_body

@@ -1,6 +1,6 @@
 """The mould of an actuated body: the two halves, a core plate at the base, one core per chamber and feed.
 
-Parts (built on :func:`softdesign.meshing.mould.build_mould`'s halves of the
+Parts (built on :func:`softdesign.meshing.mould.parts.build_mould`'s halves of the
 outer body, then split and cored):
 
     cores    one per chamber: the chamber's tube united with its feed's, the
@@ -38,10 +38,9 @@ from typing import Any
 import manifold3d as m3
 import numpy as np
 
-from softdesign.meshing.chamber_layout import ChamberLayout
-from softdesign.meshing.chambers import Cavity, build_actuated, cavity_sweeps
-from softdesign.meshing.mould import MouldParts, MouldRefused, MouldSpec, build_mould
-from softdesign.meshing.mould_checks import (
+from softdesign.meshing.chambers.carve import Cavity, build_actuated, cavity_sweeps
+from softdesign.meshing.chambers.layout import ChamberLayout
+from softdesign.meshing.mould.checks import (
     CAVITY_RTOL,
     DISJOINT_RTOL,
     cavity_figures,
@@ -50,8 +49,9 @@ from softdesign.meshing.mould_checks import (
     pull_check,
     shared_volume,
 )
-from softdesign.meshing.mould_frame import PartingFrame, parting_frame
-from softdesign.meshing.mould_make import Mould, MouldMesh, checks_passed
+from softdesign.meshing.mould.frame import PartingFrame, parting_frame
+from softdesign.meshing.mould.make import Mould, MouldMesh, checks_passed
+from softdesign.meshing.mould.parts import MouldParts, MouldRefused, MouldSpec, build_mould
 from softdesign.meshing.solids import checked, cut_body, manifold_from_mesh, welded_as_written
 from softdesign.meshing.tessellate import Region, Sweep, TubeMesh, TubeSections, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec
