@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softdesign.errors import MeshError
+from softdesign.errors import ConfigError, MeshError
 from softdesign.io.formats import FILE_UNITS, mesh_bytes
 from softdesign.io.gltf_morph import morph_glb_bytes
 from softdesign.io.polylines_vtp import write_polylines_vtp
@@ -32,6 +32,7 @@ from softdesign.io.pvd import pvd_bytes
 from softdesign.meshing.body.morph import MorphSurfaces, morph_surfaces
 from softdesign.meshing.body.sections import body_breaks, body_sections, body_stations
 from softdesign.meshing.chambers.carve import build_actuated
+from softdesign.meshing.chambers.end_walls import end_wall_problem
 from softdesign.meshing.checks import check_solid
 from softdesign.meshing.regions import RegionPiece, split_by_region
 from softdesign.meshing.solids import Solid, build_solid
@@ -163,9 +164,22 @@ def _mesh_label(q: float) -> str:
     return f"mesh q = {q:g}"
 
 
+def _refuse_breached_ends(case: Case, kinematics: KinematicsResult, fit: FitResult,
+                          sized: ActuationResult | None) -> None:
+    """Refuse, before any mesh, end walls a tilted end cut breaks through (ConfigError with the value that works)."""
+    if case.actuation is None or (case.actuation.supply == "single" and sized is None):
+        return  # no chambers, or a single supply's unsized ones (solid_at refuses those)
+    chambers = actuation_layout(case, kinematics, sized)
+    problem = None if chambers is None else end_wall_problem(chambers, body_spec(case, fit).end_cuts,
+                                                             case.actuation.end_wall_mm)
+    if problem is not None:
+        raise ConfigError(problem)
+
+
 def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult,
                sized: ActuationResult | None = None) -> ExportResult:
     """A checked solid at every export q (on the build's worker processes: as many as fit in memory, and worth it)."""
+    _refuse_breached_ends(case, kinematics, fit, sized)
     longest = max(key.length for key in kinematics.chain.shape.keys)
     q_values = case.export.q_values()
     counted = item_counter("export", q_values, _mesh_label)  # the command line's per-mesh bar, when it listens
