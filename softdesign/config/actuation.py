@@ -123,7 +123,8 @@ class Actuation(BaseModel):
     feed_diameter_mm: FiniteFloat = Field(0.4, gt=0.0, le=MAX_ACTUATION_MM)
     """Diameter of each chamber's feed line, mm."""
     end_wall_mm: FiniteFloat = Field(1.0, gt=0.0, le=MAX_ACTUATION_MM)
-    """Wall at each end of a chamber, mm."""
+    """Wall at each end of a chamber, mm, along the centerline: more than a slanted end face (fit.end_cut) reaches
+    over an end chamber (the build names the value before it meshes)."""
     first_angle_deg: FiniteFloat = Field(90.0, ge=-360.0, le=360.0)
     """Angle of the first chamber from the section's base N, degrees (Zou et al.'s first encoder is at 90)."""
 

@@ -97,7 +97,8 @@ class Export(CaseBlock):
     formats: list[Literal[MESH_FORMATS]] = Field(["stl"], min_length=1)  # type: ignore[valid-type]
     """Mesh formats: stl ply obj glb vtp (ply and vtp carry each face's region)."""
     spacing_mm: FiniteFloat = Field(0.5, gt=0.0)
-    """Ring spacing of the meshes along l, mm."""
+    """Ring spacing of the meshes along l, mm: at most the fitted wall's knot spacing (the build says so before it
+    meshes)."""
     _offset_bound = field_validator("offset_mm")(size_bound(-MAX_OFFSET_MM, MAX_OFFSET_MM))
     angular_count: Integer = Field(64, ge=MIN_ANGULAR_COUNT, le=MAX_ANGULAR_COUNT)
     """Vertices around each ring of the meshes."""

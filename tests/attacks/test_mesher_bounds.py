@@ -71,3 +71,21 @@ def test_the_chambered_demo_builds_at_the_end_wall_the_refusal_names(tmp_path):
     case = demo_case(tmp_path, actuation={"end_wall_mm": DEMO_END_WALL_THAT_WORKS_MM})
     result = run_limited("build", str(case), "--out", str(tmp_path / "b"), "--jobs", "1", timeout=BUILD_TIMEOUT_S)
     assert result.returncode == 0, result.stderr
+
+
+@pytest.mark.slow
+def test_rings_further_apart_than_the_walls_knots_are_refused_with_the_spacing_that_works(tmp_path):
+    # export.spacing_mm 5 on the sample case (knots every 1.5 mm) passed validate, then failed the mesh volume check
+    # at q = 1 by -1.07 % (exit 1), with or without chambers
+    case = demo_case(tmp_path, export={"spacing_mm": 5})
+    out = tmp_path / "b"
+    result = run_limited("build", str(case), "--out", str(out), "--jobs", "1", timeout=BUILD_TIMEOUT_S)
+    assert_refused(result, "export.spacing_mm 5", "knots (1.5 mm)", "export.spacing_mm: 1.5 or less")
+    assert not (out / "manifest.json").exists()
+
+
+@pytest.mark.slow
+def test_the_demo_builds_with_rings_as_far_apart_as_its_knots(tmp_path):
+    case = demo_case(tmp_path, export={"spacing_mm": 1.5}, actuation={})
+    result = run_limited("build", str(case), "--out", str(tmp_path / "b"), "--jobs", "1", timeout=BUILD_TIMEOUT_S)
+    assert result.returncode == 0, result.stderr

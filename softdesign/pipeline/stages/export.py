@@ -176,10 +176,28 @@ def _refuse_breached_ends(case: Case, kinematics: KinematicsResult, fit: FitResu
         raise ConfigError(problem)
 
 
+def _refuse_rings_sparser_than_knots(case: Case, fit: FitResult) -> None:
+    """Refuse, before any mesh, rings further apart than the fitted wall's knots (ConfigError with the fix).
+
+    The wall rho(l, a) is a spline with a knot every ``knot_spacing_mm`` along l; rings further apart than that
+    skip whole spans of it, and the straight segments between them miss its bulges: on the sample case the mesh
+    volume missed by 0.17 % at 2 mm (knots 1.5 mm), 0.41 % at 3 mm and 0.91 % at 5 mm beyond the polygon's own
+    0.16 %, against the check's 0.5 % (issue 45).  One ring per knot span at least keeps the mesh on every span.
+    """
+    knots = float(fit.summary["settings"]["knot_spacing_mm"])
+    spacing = case.export.spacing_mm
+    if spacing > knots:
+        chosen = " (chosen by fit.knot_spacing_mm: auto)" if case.fit.knot_spacing_mm == "auto" else ""
+        raise ConfigError(f"export.spacing_mm {spacing:g} puts the rings further apart than the fitted wall's knots "
+                          f"({knots:g} mm{chosen}): the mesh would skip spans of the surface and miss its volume; use "
+                          f"export.spacing_mm: {knots:g} or less (or a larger fit.knot_spacing_mm, a smoother wall)")
+
+
 def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult,
                sized: ActuationResult | None = None) -> ExportResult:
     """A checked solid at every export q (on the build's worker processes: as many as fit in memory, and worth it)."""
     _refuse_breached_ends(case, kinematics, fit, sized)
+    _refuse_rings_sparser_than_knots(case, fit)
     longest = max(key.length for key in kinematics.chain.shape.keys)
     q_values = case.export.q_values()
     counted = item_counter("export", q_values, _mesh_label)  # the command line's per-mesh bar, when it listens
