@@ -239,9 +239,13 @@ def _pulls(parts: MouldParts, half_a: m3.Manifold, half_b: m3.Manifold, plate: m
                   "sprue_nub_faces": len(sprue)}
         lean = _pin_lean(pins, outward)
         if failures or lean > PIN_SIDE_TOL:
+            worst = max((f.component for f in failures), default=0.0)
             raise MouldRefused(f"export.mould: the core plate does not pull free along the base tangent "
-                               f"({len(failures)} faces against the pull or blocked by a half; pins' sides lean "
-                               f"{lean:.2e} off it)")
+                               f"({len(failures)} faces against the pull or blocked by a half, leaning up to "
+                               f"{worst:.3g} where a facet may lean {facet_tol:.3g}, sin(pi / export.angular_count); "
+                               f"pins' sides lean {lean:.2e} off it): a slanted base face leaves the plate a wedge "
+                               "of the body's wall to slide off; use fit.end_cut: normal (a square base face, which "
+                               "the plate meets on one plane), or fewer export.angular_count")
         pulls["core_plate"] = {**result, "pin_side_lean": lean, "pull": (frame.axes.T @ outward).tolist()}
     for half, solid, other, pull in (("A", half_a, half_b, np.array([0.0, 0.0, 1.0])),
                                      ("B", half_b, half_a, np.array([0.0, 0.0, -1.0]))):
