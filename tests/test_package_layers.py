@@ -24,8 +24,17 @@ FORBIDDEN = {
     "geometry": ("io", "pipeline", "cli", "report", "regression", "cohort", "kinematics", "fitting", "meshing"),
     "kinematics": ("io", "pipeline", "cli", "report", "regression", "cohort"),
     "fitting": ("io", "pipeline", "cli", "report", "regression", "cohort"),
-    "meshing": ("io", "pipeline", "cli", "report", "regression", "cohort"),
+    "meshing": ("io", "pipeline", "cli", "report", "regression", "cohort", "mechanics"),
     "mechanics": ("io", "pipeline", "cli", "report", "regression", "cohort"),
+    # the material math under both the meshes and the finite elements (issue 45): numpy and the array types only
+    "continuum": ("io", "pipeline", "cli", "report", "regression", "cohort", "geometry", "kinematics", "fitting",
+                  "meshing", "mechanics", "config", "limits", "materials", "centerline", "samples"),
+    # meshing's rooms, by what they make: the body, then the chambers cut into it, then the mould and the volume
+    # mesh made around or of the chambered body (neither of which needs the other)
+    "meshing.body": ("meshing.chambers", "meshing.mould", "meshing.volume_mesh"),
+    "meshing.chambers": ("meshing.mould", "meshing.volume_mesh"),
+    "meshing.mould": ("meshing.volume_mesh",),
+    "meshing.volume_mesh": ("meshing.mould",),
     "config": ("pipeline", "cli", "report", "regression", "cohort"),
     "limits": ("pipeline", "cli", "report", "regression", "cohort"),
     "materials": ("pipeline", "cli", "report", "regression", "cohort"),
@@ -125,4 +134,20 @@ def test_a_layer_imports_nothing_above_it(layer):
     home = (f"softdesign.{layer}",)
     wrong = sorted(f"{module} -> {target}" for module, targets in GRAPH.items() if within(module, home)
                    for target in targets if within(target, above))
+    assert wrong == []
+
+
+#: meshing's rooms; the modules beside them (checks, topology, solids, tessellation, ...) are what every room shares.
+MESHING_ROOMS = ("body", "chambers", "mould", "volume_mesh")
+
+
+def test_meshings_shared_modules_import_none_of_its_rooms():
+    for room in MESHING_ROOMS:
+        assert (PACKAGE / "meshing" / room / "__init__.py").is_file()
+    shared = [name for name in GRAPH if name.count(".") == 2 and name.startswith("softdesign.meshing.")
+              and name.rsplit(".", 1)[1] not in MESHING_ROOMS]
+    assert "softdesign.meshing.topology" in shared  # the selection is not empty
+    rooms = tuple(f"softdesign.meshing.{room}" for room in MESHING_ROOMS)
+    wrong = sorted(f"{module} -> {target}" for module in shared for target in GRAPH[module]
+                   if any(target == r or target.startswith(f"{r}.") for r in rooms))
     assert wrong == []

@@ -1,7 +1,7 @@
 """`softdesign pose CASE.yaml --q Q -o FILE`: the body with one q per link, checked and written.
 
 Parsing, the build folder, files and printing live here; the geometry is
-:mod:`softdesign.meshing.pose_body`.  :mod:`softdesign.cli` registers the
+:mod:`softdesign.meshing.body.pose`.  :mod:`softdesign.cli` registers the
 command with ``app.command()(pose)``.
 """
 
@@ -125,8 +125,8 @@ def _print_pose(payload: dict[str, Any], seconds: float) -> None:
 
 def _make_pose(case_file: Path, q: list[float], out: Path | None, force: bool) -> Any:
     """Build (cached) through every stage, then the pose body; errors name the case file."""
+    from softdesign.meshing.body.pose import PoseSpec, pose_body
     from softdesign.meshing.end_cut import end_cuts_from_record
-    from softdesign.meshing.pose_body import PoseSpec, pose_body
     from softdesign.pipeline.api import build_through
 
     outcome = build_through(case_file, out, None, force, progress=note)

@@ -10,7 +10,16 @@ from typing import Annotated, Any
 
 import typer
 
-from softdesign.cli.common import CaseArg, JsonOpt, OutOpt, emit_json, finite_number, note, run_guarded
+from softdesign.cli.common import (
+    CaseArg,
+    JsonOpt,
+    OutOpt,
+    check_output_file,
+    emit_json,
+    finite_number,
+    note,
+    run_guarded,
+)
 from softdesign.errors import ConfigError
 
 SectionOpt = Annotated[int, typer.Option(
@@ -32,6 +41,7 @@ TimeLimitOpt = Annotated[float | None, typer.Option(
     "--time-limit", help="With --target: stop the search after the trial that passes this many seconds, keeping "
     "its best (exit 1: not converged). Below --timeout.")]
 MaxPressureOpt = Annotated[float, typer.Option("--max-pressure", help="Upper bound of the inverse search, kPa.")]
+ReplaceFigureOpt = Annotated[bool, typer.Option("--force", help="Replace the --figure file if it exists.")]
 
 PRESSURES_FIX = "give three numbers in kPa separated by commas, e.g. --pressures 40,0,0"
 
@@ -44,14 +54,17 @@ def pressures_from_text(text: str) -> tuple[float, ...]:
     return tuple(finite_number(p, f"--pressures value {k + 1}", PRESSURES_FIX) for k, p in enumerate(parts))
 
 
-def _check_figure_path(figure: Path | None) -> None:
-    """Refuse a ``--figure`` that is not a .png in an existing folder, before any work."""
+def _check_figure_path(figure: Path | None, force: bool) -> None:
+    """Refuse a ``--figure`` that is not a .png in an existing folder, or that writing would damage (an existing
+    file without ``force``, anything but a regular file, a file in a build folder: as every ``--output``), before
+    any work."""
     if figure is None:
         return
     if figure.suffix.lower() != ".png":
         raise ConfigError(f"--figure {figure}: expected a .png file, got the suffix {figure.suffix!r}")
     if not figure.parent.resolve().is_dir():
         raise ConfigError(f"--figure {figure}: the folder {figure.parent} does not exist; create it first")
+    check_output_file("--figure", figure, force)
 
 
 def _print(payload: dict[str, Any]) -> None:
@@ -95,6 +108,7 @@ def simulate(
     timeout: TimeoutOpt = 600.0,
     time_limit: TimeLimitOpt = None,
     figure: FigureOpt = None,
+    force: ReplaceFigureOpt = False,
     write: WriteOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
@@ -111,7 +125,7 @@ def simulate(
         from softdesign.pipeline.simulate_command import run_simulate, write_to_table
         from softdesign.pipeline.simulate_run import SimulateOptions
 
-        _check_figure_path(figure)
+        _check_figure_path(figure, force)
         if section < 1:
             raise ConfigError(f"simulate --section: got {section}; sections are numbered from 1 at the base, as "
                               "actuation.csv numbers them")

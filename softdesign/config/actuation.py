@@ -55,7 +55,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 from softdesign.config.types import FiniteFloat, Integer
 
 if TYPE_CHECKING:  # numpy stays out of `softdesign validate`
-    from softdesign.meshing.chamber_layout import ActuationSpec
+    from softdesign.meshing.chambers.layout import ActuationSpec
 
 #: The largest size any actuation key takes, mm (a vessel is at most 20 mm in median radius, limits at ingest).
 MAX_ACTUATION_MM = 50.0
@@ -123,7 +123,8 @@ class Actuation(BaseModel):
     feed_diameter_mm: FiniteFloat = Field(0.4, gt=0.0, le=MAX_ACTUATION_MM)
     """Diameter of each chamber's feed line, mm."""
     end_wall_mm: FiniteFloat = Field(1.0, gt=0.0, le=MAX_ACTUATION_MM)
-    """Wall at each end of a chamber, mm."""
+    """Wall at each end of a chamber, mm, along the centerline: more than a slanted end face (fit.end_cut) reaches
+    over an end chamber (the build names the value before it meshes)."""
     first_angle_deg: FiniteFloat = Field(90.0, ge=-360.0, le=360.0)
     """Angle of the first chamber from the section's base N, degrees (Zou et al.'s first encoder is at 90)."""
 
@@ -156,7 +157,7 @@ class Actuation(BaseModel):
 
     def spec(self) -> ActuationSpec:
         """The layout's numbers."""
-        from softdesign.meshing.chamber_layout import ActuationSpec
+        from softdesign.meshing.chambers.layout import ActuationSpec
 
         return ActuationSpec(self.distance_mm, self.diameter_mm, self.feed_diameter_mm, self.end_wall_mm,
                              self.first_angle_deg, self.chambers_per_section)
@@ -166,7 +167,7 @@ def single_supply_problems(actuation: Actuation | None, blend: str, designed: bo
                            volume_mesh: bool) -> list[str]:
     """Why ``supply: single`` cannot build this case (empty when it can): it sizes each designed arc, and its
     tapered chambers, joined in series, are not yet in the volume mesh.  The mould casts them on one lost core
-    (:mod:`softdesign.meshing.mould_cores`): ``mould`` is no longer a problem."""
+    (:mod:`softdesign.meshing.mould.cores`): ``mould`` is no longer a problem."""
     if actuation is None or actuation.supply != "single":
         return []
     mould = False  # the mould casts them (one lost core): only the volume mesh below is still refused

@@ -12,11 +12,13 @@ elongation at break) unless ``material.max_stretch`` says otherwise.
 from __future__ import annotations
 
 import unicodedata
+from dataclasses import replace
 from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from softdesign.materials import DESIGN_FRACTION, MaterialLimits
+from softdesign.config.types import CaseBlock
+from softdesign.materials import DESIGN_FRACTION, MaterialLimits, PresetName, resolve_material
 
 #: The smallest C1 a law may have, kPa: a tenth of the softest silicone gels' (C1 about 1 kPa). Below it the finite
 #: elements' shear stiffness vanishes beside their bulk term and the factorization is singular (c1_kpa: 1e-300
@@ -83,3 +85,34 @@ class CustomMaterial(BaseModel):
                 f"{DESIGN_FRACTION:g} x elongation at break (the presets' rule)")
         return MaterialLimits(self.name, 1.0 + DESIGN_FRACTION * self.elongation_at_break_pct / 100.0, None, None,
                               rule)
+
+
+class Material(CaseBlock):
+    """Limits the design is judged against: a preset (``name``) and/or explicit numbers, which win."""
+
+    name: PresetName | None = None
+    """A preset (softdesign materials lists them with their sources)."""
+    #: a material of the user's own, every figure given (CustomMaterial above); not with ``name``
+    custom: CustomMaterial | None = None
+    """Your own material: every key required."""
+    max_stretch: float | None = Field(None, gt=1.0, le=100.0)
+    """The largest principal stretch allowed (overrides the preset's)."""
+    min_stretch: float | None = Field(None, gt=0.0, lt=1.0)
+    """The smallest principal stretch allowed before a thin skin wrinkles (overrides the preset's)."""
+    min_wall_mm: float | None = Field(None, gt=0.0, le=100.0)
+    """The thinnest wall allowed, mm (overrides the preset's)."""
+
+    @model_validator(mode="after")
+    def _one_source(self) -> Material:
+        if self.name is not None and self.custom is not None:
+            raise ValueError("give name (a preset) or custom (your own material), not both")
+        return self
+
+    def limits(self) -> MaterialLimits:
+        """The preset's (or the custom material's) numbers with the explicit ones put over them."""
+        explicit = (self.max_stretch, self.min_stretch, self.min_wall_mm)
+        if self.custom is None:
+            return resolve_material(self.name, *explicit)
+        base = self.custom.limits()
+        return replace(base, max_stretch=self.max_stretch or base.max_stretch, min_stretch=self.min_stretch,
+                       min_wall_mm=self.min_wall_mm)

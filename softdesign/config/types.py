@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any
 
-from pydantic import AllowInfNan, BeforeValidator, Strict
+from pydantic import AllowInfNan, BaseModel, BeforeValidator, ConfigDict, Strict
 
 
 def _not_a_bool(value: Any) -> Any:
@@ -37,3 +37,9 @@ def q_in_range(values: list[float]) -> list[float]:
     if bad:
         raise ValueError(f"q values must lie in [0, 1], got {bad}")
     return values
+
+
+class CaseBlock(BaseModel):
+    """A block of the case file: unknown keys refused, frozen, each key's docstring its description."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)

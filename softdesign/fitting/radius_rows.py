@@ -58,7 +58,7 @@ class SlopeRows:
     stay in the processor's cache costs far less than the whole grid's arrays at once.  With
     ``slopes=False`` only rho is prepared (:meth:`values`); with ``angular=False`` rho and rho_l
     (:meth:`along`), for a caller that takes the a-derivative otherwise (the offset surfaces of
-    :mod:`softdesign.meshing.wall`).
+    :mod:`softdesign.meshing.body.wall`).
     """
 
     def __init__(self, field: LinkBases, q: float, l: npt.ArrayLike, a: npt.ArrayLike, slopes: bool = True,

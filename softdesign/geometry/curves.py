@@ -30,29 +30,28 @@ from functools import cached_property
 
 import numpy as np
 import numpy.typing as npt
-from scipy.interpolate import BSpline, PPoly, make_interp_spline, splprep
+from scipy.interpolate import BSpline, PPoly, make_interp_spline
 
 from softdesign.errors import ConfigError, GeometryError
 from softdesign.geometry.curve_joints import checked_grid, joint_cuts, pieces_spline
-from softdesign.types import POINT_TOL_MM, FloatArray, Points
+from softdesign.geometry.polyline_spline import (
+    ARC_REL_TOL,
+    MIN_POLYLINE_POINTS,
+    NEWTON_STEPS,
+    arc_length_table,
+    chord_spline,
+    distinct_points,
+    points_at_arc_length,
+    speed_integral,
+)
+from softdesign.types import FloatArray, Points
 
 #: Degree of the spline in l (5: torsion, a third derivative, is still C2).
 DEGREE = 5
-#: Gauss-Legendre nodes per interval for arc-length integrals.
-GAUSS_NODES = 8
-_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(GAUSS_NODES)
 #: Dense evaluation grid (frames, reports): at least this many per sample interval ...
 DENSE_PER_INTERVAL = 8
 #: ... and no coarser than this arc step, mm.
 DENSE_STEP_MM = 0.05
-#: Newton iterations allowed to invert s(u) = target; converges in 3-4 on smooth splines.
-NEWTON_STEPS = 8
-#: Relative tolerance on arc length when inverting s(u), and on l at the domain ends.
-ARC_REL_TOL = 1e-13
-#: A FITPACK warning is accepted when the residual sum of squares is within this factor of its target s.
-SMOOTHING_SLACK = 1.5
-#: Fewest distinct input points: a cubic (torsion needs a third derivative) needs 4.
-MIN_POLYLINE_POINTS = 4
 #: Weight of a joint's vertex in the smoothing of the pieces it ends: a pin.  The spline may leave a point of
 #: weight w by at most sqrt(s) / w (s the smoothing's sum of squares, n * smoothing_mm**2): 6e-4 mm for 36 points
 #: at 0.1 mm; on seed 003's arcs it leaves it by 1e-9 mm.
@@ -130,7 +129,7 @@ class SmoothCurve:
     @cached_property
     def arc_length_table(self) -> FloatArray:
         """Arc length from l = 0 to each ``l_grid`` sample, mm."""
-        return _arc_length_table(self.spline, self.l_grid)
+        return arc_length_table(self.spline, self.l_grid)
 
     def points(self, l: npt.ArrayLike) -> Points:
         """Positions c(l), (n, 3) mm, for l (n,) in [0, 1]."""
@@ -181,7 +180,7 @@ class SmoothCurve:
         l = checked_l(l)
         table = self.arc_length_table
         k = np.clip(np.searchsorted(self.l_grid, l, side="right") - 1, 0, len(self.l_grid) - 2)
-        return table[k] + _speed_integral(self.pieces, self.l_grid[k], l)
+        return table[k] + speed_integral(self.pieces, self.l_grid[k], l)
 
     @cached_property
     def uniform(self) -> bool:
@@ -287,7 +286,7 @@ def smooth_curve_from_samples(
         spline = pieces_spline(l_grid, samples, joints, DEGREE)
     else:
         spline = make_interp_spline(l_grid, samples, k=DEGREE)
-    length = float(_arc_length_table(spline, l_grid)[-1])
+    length = float(arc_length_table(spline, l_grid)[-1])
     return SmoothCurve(spline, length, l_grid, tuple(int(j) for j in joints))
 
 
@@ -311,9 +310,9 @@ def smooth_curve_from_polyline(
         Bad options (negative sizes, count < 6, ends longer than half the path).
     """
     _check_options(options)
-    points = _distinct_points(points)
-    spline, u = _chord_spline(points, options.smoothing_mm)
-    table = _arc_length_table(spline, u)
+    points = distinct_points(points)
+    spline, u = chord_spline(points, options.smoothing_mm, DEGREE)
+    table = arc_length_table(spline, u)
     total = float(table[-1])
     end = options.end_straight_mm
     if 2.0 * end >= total:
@@ -327,7 +326,7 @@ def smooth_curve_from_polyline(
         return smooth_curve_from_samples(*pieced)
     count = _sample_count(options, total)
     s_target = np.linspace(0.0, total, count)
-    samples = _points_at_arc_length(spline, u, table, s_target, end)
+    samples = points_at_arc_length(spline, u, table, s_target, end)
     return smooth_curve_from_samples(samples)
 
 
@@ -345,8 +344,8 @@ def _pieced_samples(points: Points, options: CurveOptions, joints: FloatArray) -
     smoothing, far more than :data:`~softdesign.geometry.curve_joints.JOINT_TOL_SPACINGS` allows.  The grid is
     that spline's length's; each piece then keeps its own length (:func:`_samples_by_piece`).
     """
-    spline, u = _chord_spline(points, 0.0)
-    table = _arc_length_table(spline, u)
+    spline, u = chord_spline(points, 0.0, DEGREE)
+    table = arc_length_table(spline, u)
     count = _sample_count(options, float(table[-1]))
     cuts = joint_cuts(table, count, joints)
     samples = _samples_by_piece(points, options, cuts, count) if cuts else None
@@ -371,12 +370,12 @@ def _samples_by_piece(points: Points, options: CurveOptions, cuts: list[tuple[in
             return None
         weights = np.ones(vb - va + 1)
         weights[[0, -1]] = (JOINT_WEIGHT if i > 0 else 1.0), (JOINT_WEIGHT if i < len(vertices) - 2 else 1.0)
-        spline, u = _chord_spline(points[va : vb + 1], options.smoothing_mm, weights)
-        table = _arc_length_table(spline, u)
+        spline, u = chord_spline(points[va : vb + 1], options.smoothing_mm, DEGREE, weights)
+        table = arc_length_table(spline, u)
         start, stop = (end_mm if i == 0 else 0.0), (end_mm if i == len(vertices) - 2 else 0.0)
         if start + stop >= table[-1]:
             return None
-        pieces.append(_points_at_arc_length(spline, u, table, np.linspace(0.0, table[-1], gb - ga + 1), start, stop))
+        pieces.append(points_at_arc_length(spline, u, table, np.linspace(0.0, table[-1], gb - ga + 1), start, stop))
     for left, right in zip(pieces[:-1], pieces[1:], strict=True):
         right[0] = 0.5 * (left[-1] + right[0])
     return np.concatenate([pieces[0]] + [piece[1:] for piece in pieces[1:]])
@@ -418,83 +417,3 @@ def _check_options(options: CurveOptions) -> None:
     for key in ("smoothing_mm", "end_straight_mm"):
         if not getattr(options, key) >= 0.0:
             raise ConfigError(f"resample.{key} must be >= 0 mm, got {getattr(options, key)}")
-
-
-def _distinct_points(points: npt.ArrayLike) -> Points:
-    points = np.asarray(points, float)
-    if points.ndim != 2 or points.shape[1] != 3 or not np.all(np.isfinite(points)):
-        raise GeometryError(f"centerline: expected finite (n, 3) points in mm, got shape {points.shape}")
-    step = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    kept = points[np.concatenate([[True], step > POINT_TOL_MM])]
-    if len(kept) < MIN_POLYLINE_POINTS:
-        raise GeometryError(
-            f"centerline: expected at least {MIN_POLYLINE_POINTS} distinct points, got {len(kept)}; "
-            "the path is too short to carry curvature and torsion - pick another path or re-export it"
-        )
-    return kept
-
-
-def _chord_spline(points: Points, smoothing_mm: float, weights: FloatArray | None = None) -> tuple[BSpline, FloatArray]:
-    """Spline on the chord-length parameter u (mm) and the parameters of the input points.
-
-    ``weights`` (n,) scale the points' residuals in the smoothing's sum of squares (default 1; unused when
-    interpolating): a large weight pins the spline to that point.
-    """
-    u = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
-    k = DEGREE if len(points) > DEGREE else 3
-    if smoothing_mm == 0.0:
-        return make_interp_spline(u, points, k=k), u
-    s = len(points) * smoothing_mm**2
-    # splprep returns [t, c, k] with the k it was given
-    ((t, c, _), _), fp, ier, msg = splprep(points.T, w=weights, u=u, k=k, s=s, full_output=True, quiet=True)
-    # FITPACK: ier <= 0 success, 1..3 warnings (then check the residual it reached), >= 10 bad input.
-    if ier >= 10 or (ier > 0 and fp > SMOOTHING_SLACK * s):
-        raise GeometryError(
-            f"centerline: the smoothing spline failed (FITPACK ier = {ier}: {msg}); "
-            "raise resample.smoothing_mm or check the centerline for loops"
-        )
-    return BSpline(np.asarray(t), np.asarray(c).T, k), u
-
-
-def _speed_integral(spline: BSpline | PPoly, a: FloatArray, b: FloatArray) -> FloatArray:
-    """Integral of |spline'| from a to b (element-wise), Gauss-Legendre."""
-    x, w = _GAUSS_X, _GAUSS_W
-    half = 0.5 * (np.asarray(b) - np.asarray(a))
-    nodes = 0.5 * (np.asarray(a) + np.asarray(b))[..., None] + half[..., None] * x
-    speed = np.linalg.norm(spline(nodes.ravel(), nu=1), axis=1).reshape(nodes.shape)
-    return half * (speed @ w)
-
-
-def _arc_length_table(spline: BSpline, u: FloatArray) -> FloatArray:
-    """Cumulative arc length at the parameters u (m,), mm."""
-    return np.concatenate([[0.0], np.cumsum(_speed_integral(spline, u[:-1], u[1:]))])
-
-
-def _u_at_arc_length(spline: BSpline, u: FloatArray, table: FloatArray, s: FloatArray) -> FloatArray:
-    """Parameters where the arc length equals s (Newton from linear interpolation of the table)."""
-    k = np.clip(np.searchsorted(table, s, side="right") - 1, 0, len(u) - 2)
-    frac = (s - table[k]) / (table[k + 1] - table[k])
-    ut = u[k] + frac * (u[k + 1] - u[k])
-    for _ in range(NEWTON_STEPS):
-        err = table[k] + _speed_integral(spline, u[k], ut) - s
-        if np.max(np.abs(err)) <= ARC_REL_TOL * table[-1]:
-            break
-        ut = np.clip(ut - err / np.linalg.norm(spline(ut, nu=1), axis=1), u[0], u[-1])
-    return ut
-
-
-def _points_at_arc_length(
-    spline: BSpline, u: FloatArray, table: FloatArray, s: FloatArray, end_mm: float, stop_mm: float | None = None
-) -> Points:
-    """Points at arc lengths s; within end_mm of the start (stop_mm of the end, default end_mm), a straight
-    extension of the tangent there."""
-    total = table[-1]
-    stop_mm = end_mm if stop_mm is None else stop_mm
-    inner = np.clip(s, end_mm, total - stop_mm)
-    ut = _u_at_arc_length(spline, u, table, inner)
-    out = spline(ut)
-    if end_mm > 0.0 or stop_mm > 0.0:
-        tangent = spline(ut, nu=1)
-        tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
-        out = out + (s - inner)[:, None] * tangent
-    return out

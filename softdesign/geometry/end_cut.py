@@ -81,7 +81,7 @@ def choose_end_cuts(
         ``parting_lean_deg``); without ``parting_local`` (a curved q = 0 body) the ends stay square.  The case
         file refuses ``cap_plane`` with a mould.
     parting_local : (2, 3) the parting plane's unit normal in each end frame's (N, B, T) coordinates at q = 0
-        (:func:`~softdesign.meshing.mould_frame.parting_frame` of a straight q = 0 body), or None
+        (:func:`~softdesign.meshing.mould.frame.parting_frame` of a straight q = 0 body), or None
 
     Returns
     -------

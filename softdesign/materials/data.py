@@ -15,7 +15,7 @@ from importlib import resources
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from softdesign.mechanics.laws import HyperelasticLaw
+    from softdesign.continuum.laws import HyperelasticLaw
 
 #: kPa per unit of a datasheet's stress.
 KPA_PER_UNIT = {"psi": 6.894757293168361, "MPa": 1000.0, "kPa": 1.0}
@@ -89,7 +89,7 @@ def _stress_kpa(entry: dict[str, Any] | None, name: str, key: str) -> float | No
 
 def law_from(kind: str, c1: float, c2: float, c3: float, source: str) -> HyperelasticLaw:
     """A law with the module's bulk modulus (``BULK_RATIO`` x mu)."""
-    from softdesign.mechanics.laws import HyperelasticLaw
+    from softdesign.continuum.laws import HyperelasticLaw
 
     return HyperelasticLaw(kind, c1, c2, c3, BULK_RATIO * 2.0 * c1, source)
 

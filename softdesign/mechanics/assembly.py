@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from softdesign.mechanics.laws import HyperelasticLaw, isochoric_stress, isochoric_tangent
+from softdesign.continuum.laws import HyperelasticLaw, isochoric_stress, isochoric_tangent
 from softdesign.mechanics.tets import TetMesh, deformation_gradients, summed
 from softdesign.types import FloatArray, IntArray
 

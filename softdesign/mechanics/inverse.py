@@ -34,8 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.errors import SolveError
-from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.newton import NewtonSettings, pressure_sensitivity, solve_pressures
 from softdesign.mechanics.reinforcement import HoopThread
 from softdesign.mechanics.section import SectionMesh, SectionResult, arc_of, measure_section, prepare_section

@@ -1,11 +1,11 @@
 """One section of a chambered body as a finite-element mesh: issue 32's swept mesh over the section alone.
 
 The section i of a body with issue 31's chambers is meshed on its own with
-the parametric mesher (:func:`softdesign.meshing.sweep_mesh.swept_disk`): the
+the parametric mesher (:func:`softdesign.meshing.volume_mesh.sweep_mesh.swept_disk`): the
 unit disk with the section's three chamber circles, swept through layers
 from the section's start ``l0`` to its end ``l1``, and placed on the body at
 q = 0 (the cast, unloaded state) the way the volume mesh is
-(:mod:`softdesign.meshing.sweep_body`: a rigid core keeps the chambers
+(:mod:`softdesign.meshing.volume_mesh.sweep_body`: a rigid core keeps the chambers
 round and at their distance, the annulus outside it is stretched to the
 skin).  It differs from the body's own volume mesh in what a solve of one
 section needs and can afford:
@@ -32,11 +32,11 @@ import numpy as np
 
 from softdesign.geometry.frames import FramedSpline
 from softdesign.mechanics.section import SectionMesh
-from softdesign.meshing.chamber_layout import ChamberLayout
-from softdesign.meshing.cross_section import Circle
-from softdesign.meshing.sweep_body import SweepReference, section_sweeps, section_xy
-from softdesign.meshing.sweep_mesh import Hole, swept_disk
+from softdesign.meshing.chambers.layout import ChamberLayout
 from softdesign.meshing.volume import BodySpec, angle_grid
+from softdesign.meshing.volume_mesh.cross_section import Circle
+from softdesign.meshing.volume_mesh.sweep_body import SweepReference, section_sweeps, section_xy
+from softdesign.meshing.volume_mesh.sweep_mesh import Hole, swept_disk
 from softdesign.types import FloatArray
 
 #: The rigid core reaches this fraction of the way from the chambers' outer edge to the thinnest skin (as issue 32).

@@ -47,6 +47,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.errors import SolveError
 from softdesign.mechanics.assembly import (
     InvertedElementError,
@@ -55,7 +56,6 @@ from softdesign.mechanics.assembly import (
     internal_force,
     volumetric_state,
 )
-from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.linear_solve import TangentSolver
 from softdesign.mechanics.pressure import pressure_load
 from softdesign.mechanics.quadratic import (

@@ -37,8 +37,8 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
+from softdesign.continuum.laws import HyperelasticLaw, isochoric_stress, isochoric_tangent
 from softdesign.mechanics.assembly import InvertedElementError
-from softdesign.mechanics.laws import HyperelasticLaw, isochoric_stress, isochoric_tangent
 from softdesign.mechanics.tets import TetMesh, summed
 from softdesign.types import FloatArray, IntArray
 

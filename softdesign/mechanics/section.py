@@ -23,10 +23,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from softdesign.continuum.laws import HyperelasticLaw, cauchy_stress
 from softdesign.errors import MeshError, SolveError
 from softdesign.kinematics.pcc_fit import arc_points, fit_arc, trapezoid_weights
 from softdesign.mechanics.continuation import ContinuationSettings, follow_pressures
-from softdesign.mechanics.laws import HyperelasticLaw, cauchy_stress
 from softdesign.mechanics.linear_solve import TangentSolver
 from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord
 from softdesign.mechanics.quadratic import (

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from softdesign.meshing.chamber_walls import Wall
+from softdesign.meshing.chambers.walls import Wall
 
 
 def judge(walls: list[Wall], extensions: list[dict[str, Any]],

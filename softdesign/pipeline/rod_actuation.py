@@ -17,7 +17,7 @@ import numpy as np
 from softdesign.errors import ConfigError
 from softdesign.io.format_names import q_label
 from softdesign.kinematics.pcc_fit import fit_links
-from softdesign.meshing.chamber_walls import Wall
+from softdesign.meshing.chambers.walls import Wall
 from softdesign.pipeline.rod_device import (
     RodSetup,
     layout_body,
@@ -40,7 +40,7 @@ from softdesign.pipeline.rod_single import (
 
 if TYPE_CHECKING:
     from softdesign.config import Case
-    from softdesign.meshing.chamber_layout import ChamberLayout
+    from softdesign.meshing.chambers.layout import ChamberLayout
     from softdesign.pipeline.stages.design import DesignResult
     from softdesign.pipeline.stages.fit import FitResult
     from softdesign.pipeline.stages.kinematics import KinematicsResult
@@ -63,7 +63,7 @@ def core_figures(lengths_mm: list[float], diameters_mm: list[float], lost: bool 
     """Per chamber its core: length, (smallest) diameter, aspect ratio and what to make it of.
 
     ``lost``: tapered chambers joined in series (``supply: single``) are parts of one lost wax core (the mould's
-    note: :mod:`softdesign.meshing.mould_cores`); a part past ``MAX_PIN_ASPECT`` is cast over a nylon monofilament
+    note: :mod:`softdesign.meshing.mould.cores`); a part past ``MAX_PIN_ASPECT`` is cast over a nylon monofilament
     of ``strand_mm`` running the whole core (wax alone that slender breaks when the hoop thread is wound on it; a
     flexible strand, unlike a steel wire, can be drawn out along the slanted channels through the supply port once
     the wax is melted: a rule of thumb, stated as such).  Else a straight pin, printed or, past ``MAX_PIN_ASPECT``,

@@ -24,7 +24,7 @@ from softdesign.types import FloatArray
 
 if TYPE_CHECKING:
     from softdesign.config import Case
-    from softdesign.meshing.chamber_layout import ChamberLayout
+    from softdesign.meshing.chambers.layout import ChamberLayout
     from softdesign.pipeline.stages.fit import FitResult
     from softdesign.pipeline.stages.kinematics import KinematicsResult
 

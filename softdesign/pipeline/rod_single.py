@@ -30,7 +30,7 @@ from softdesign.kinematics.rod_sizing import (
     stations_along,
 )
 from softdesign.kinematics.rod_walls import THREAD_GAP_DIAMETERS, thread_gap_mm
-from softdesign.meshing.chamber_layout import Channel, Feed
+from softdesign.meshing.chambers.layout import Channel, Feed
 from softdesign.pipeline.rod_device import (
     STATIONS_PER_SECTION,
     RodSetup,
@@ -46,7 +46,7 @@ from softdesign.types import FloatArray
 
 if TYPE_CHECKING:
     from softdesign.config import Case
-    from softdesign.meshing.chamber_layout import ChamberLayout
+    from softdesign.meshing.chambers.layout import ChamberLayout
     from softdesign.pipeline.stages.design import DesignResult
     from softdesign.pipeline.stages.fit import FitResult
     from softdesign.pipeline.stages.kinematics import KinematicsResult

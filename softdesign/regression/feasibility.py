@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from softdesign.meshing.skin_stretch import STRETCH_TOL as CONVERGENCE_TOL
+from softdesign.meshing.body.skin_stretch import STRETCH_TOL as CONVERGENCE_TOL
 from softdesign.regression.figures import Figure, missing_figure, scalar_figure
 
 #: Largest change of a stretch figure between two builds that counts as the same.

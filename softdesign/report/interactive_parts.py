@@ -98,7 +98,7 @@ def chamber_mesh(data: BuildData, q: float, rings: int, angles: int) -> tuple[Fl
     MeshError
         As the export would at this q: a fold, or a wall the local radius cannot take.
     """
-    from softdesign.meshing.body import sections_on_grid
+    from softdesign.meshing.body.sections import sections_on_grid
     from softdesign.meshing.tessellate import sweep_from_sections, tessellate
     from softdesign.meshing.volume import angle_grid
 

@@ -4,7 +4,7 @@ The stretches are those of the feasibility stage (:mod:`softdesign.fitting.strai
 rest state q = 0), evaluated on a regular (l, a) grid for drawing; the
 worst q is the one of the morph's extreme (``metrics.feasibility.morph``)
 farthest from 1 in log-stretch.  A hollow body adds its wall thickness at q = 1
-(:func:`softdesign.meshing.wall.wall_map`).
+(:func:`softdesign.meshing.body.wall.wall_map`).
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 
 from softdesign.fitting.strain import principal_stretches, skin_metric
+from softdesign.meshing.body.wall import wall_map
 from softdesign.meshing.volume import BodySpec
-from softdesign.meshing.wall import wall_map
 from softdesign.report.build_folder import BuildData
 from softdesign.report.plotting import Picture, fixed_figure, picture, styled
 from softdesign.report.projection import shaded_triangles

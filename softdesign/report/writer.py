@@ -9,21 +9,17 @@ manifest are only read.
 
 from __future__ import annotations
 
-import gc
 import json
 import os
-import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any
 
 from softdesign.errors import ConfigError
 from softdesign.pipeline.layout import MANIFEST, REPORT_DIR, RUN_LOG
 from softdesign.pipeline.lock import BuildLock
 from softdesign.pipeline.out_folder import folder_errors
-from softdesign.pipeline.parallel import jobs_for_build, map_items, working_on
 from softdesign.report import (
     actuation_figures,
     animation,
@@ -42,6 +38,7 @@ from softdesign.report import (
 from softdesign.report.build_check import changed_since_build, unreadable_build
 from softdesign.report.build_folder import BuildData, load_build, require_build
 from softdesign.report.commit import commit_folder
+from softdesign.report.drawing_run import PartTimer, Progress, collector_for_figures
 from softdesign.report.html_page import (
     Section,
     banner_html,
@@ -66,8 +63,6 @@ from softdesign.report.tables import (
 )
 from softdesign.report.verdict import build_verdict, checks_html, verdict_html
 from softdesign.report.volume_mesh_tables import volume_mesh_checks, volume_mesh_table
-
-T = TypeVar("T")
 
 PAGE = "index.html"
 #: What differs from run to run or folder to folder (the build folder's path, the build's and the report's times):
@@ -104,91 +99,6 @@ class ReportOptions:
     q_samples: int = kinematics_figures.Q_SAMPLES
     gif_frames: int = animation.FRAMES
     view_frames: int = interactive.FRAMES
-
-
-#: Called after each part of the report with its name and the seconds it took (the CLI prints progress).
-Progress = Callable[[str, float], None]
-
-
-class _Timer:
-    """Runs each part of the report, records its time and tells ``progress``.
-
-    :meth:`prefetch` draws independent parts on ``jobs`` forked workers
-    (:func:`softdesign.pipeline.parallel.map_items`) ahead of their turn; the
-    part's later call returns the worker's result.  Each part is drawn by the
-    same code on the same data wherever it runs, so the files do not depend on ``jobs``.
-    """
-
-    def __init__(self, progress: Progress | None, jobs: int = 1) -> None:
-        self.progress = progress
-        self.jobs = jobs
-        self.seconds: dict[str, float] = {}
-        self._ready: dict[str, Any] = {}
-
-    def __call__(self, name: str, action: Callable[[], T]) -> T:
-        if name in self._ready:
-            ready: T = self._ready.pop(name)
-            return ready
-        start = time.perf_counter()
-        result = action()
-        self._record(name, time.perf_counter() - start)
-        return result
-
-    def prefetch(self, parts: dict[str, Callable[[], Any]]) -> None:
-        """Draw ``parts`` (name: action; slowest first balances the workers best) on the workers now."""
-
-        def timed(name: str) -> tuple[Any, float]:
-            start = time.perf_counter()
-            return parts[name](), time.perf_counter() - start
-
-        def arrived(name: str, outcome: tuple[Any, float]) -> None:
-            self._ready[name] = outcome[0]
-            self._record(name, outcome[1])
-
-        with jobs_for_build(self.jobs), working_on("the report", "the previous report is kept"):
-            map_items(timed, list(parts), on_result=arrived)
-
-    def _record(self, name: str, seconds: float) -> None:
-        self.seconds[name] = seconds
-        if self.progress is not None:
-            self.progress(name, seconds)
-
-
-#: Python's cyclic garbage collector runs after this many new container objects while figures are drawn (its
-#: default, 700, had it run some 600 times over the demo's figures).
-GC_THRESHOLD = 5000
-
-
-@contextmanager
-def _collector_for_figures() -> Iterator[None]:
-    """Let the cyclic garbage collector skip what is already loaded and run less often while figures are drawn.
-
-    Drawing makes hundreds of thousands of short-lived matplotlib objects, and each full collection walked the
-    hundred thousand objects of the imported libraries as well: about 1 s of the demo's 7 s of drawing.
-    :func:`gc.freeze` moves the objects alive now out of the collector's reach (forked workers inherit that, and
-    no longer touch those pages, which the kernel would otherwise copy), and a higher first-generation threshold
-    lets fewer collections run.  What the figures leave in reference cycles is still collected.
-    """
-    _import_drawing_libraries()  # here, not once per forked worker, and frozen with the rest
-    threshold = gc.get_threshold()
-    gc.freeze()
-    gc.set_threshold(GC_THRESHOLD, *threshold[1:])
-    try:
-        yield
-    finally:
-        gc.set_threshold(*threshold)
-        gc.unfreeze()
-
-
-def _import_drawing_libraries() -> None:
-    """Import what the figures draw with (about half a second): forked workers inherit it, none imports it again."""
-    import matplotlib.backends.backend_agg  # noqa: F401
-    import matplotlib.collections  # noqa: F401
-    import matplotlib.figure  # noqa: F401
-    import PIL.Image  # noqa: F401
-    import plotly.io  # noqa: F401
-
-    import softdesign.report.flat_triangles  # noqa: F401
 
 
 @dataclass(frozen=True)
@@ -234,9 +144,9 @@ def write_report(
 
 
 def _write_report(build_dir: Path, options: ReportOptions, progress: Progress | None, jobs: int) -> ReportResult:
-    timer = _Timer(progress, jobs)
+    timer = PartTimer(progress, jobs)
     data = timer("load the build", lambda: load_build(build_dir))
-    with _collector_for_figures():
+    with collector_for_figures():
         sections, checks, notes = report_sections(data, options, timer)
     passed = sum(c.passed for c in checks)
     summary = _summary(data)
@@ -261,10 +171,10 @@ def _write_report(build_dir: Path, options: ReportOptions, progress: Progress | 
 
 
 def report_sections(
-    data: BuildData, options: ReportOptions, timer: _Timer | None = None
+    data: BuildData, options: ReportOptions, timer: PartTimer | None = None
 ) -> tuple[list[Section], list[Check], list[str]]:
     """The sections of the page, every check, and the notes on what was left out."""
-    run = timer or _Timer(None)
+    run = timer or PartTimer(None)
     run.prefetch(_slow_parts(data, options))
     notes: list[str] = []
     view = _view_section(data, options, run)
@@ -351,7 +261,7 @@ def _kinematics_picture(data: BuildData, options: ReportOptions) -> Any:
     return kinematics_figures.kinematics_picture(series)
 
 
-def _fabrication_section(data: BuildData, run: _Timer) -> Section | None:
+def _fabrication_section(data: BuildData, run: PartTimer) -> Section | None:
     """The casting mould (exploded view) and the volume meshes' quality, when the build has them."""
     mould = run(mould_figures.NAME, lambda: mould_figures.mould_picture(data))
     table = volume_mesh_table(_volume_summary(data))
@@ -373,7 +283,7 @@ def _volume_summary(data: BuildData) -> dict[str, Any] | None:
     return block if isinstance(block, dict) else None
 
 
-def _view_section(data: BuildData, options: ReportOptions, run: _Timer) -> Section:
+def _view_section(data: BuildData, options: ReportOptions, run: PartTimer) -> Section:
     """The interactive 3D view of the morph over the patient's vessel."""
     html, display_notes = run("3D view", lambda: interactive.morph_html(data, options.view_frames))
     what = "the actuator (coloured by link)" if data.fit is not None else "the centerline (no fit in this build)"
@@ -385,7 +295,7 @@ def _view_section(data: BuildData, options: ReportOptions, run: _Timer) -> Secti
     return Section("view", "The morph in 3D (interactive)", notes=[note], embeds=[html])
 
 
-def _kinematics_section(data: BuildData, options: ReportOptions, notes: list[str], run: _Timer) -> Section:
+def _kinematics_section(data: BuildData, options: ReportOptions, notes: list[str], run: PartTimer) -> Section:
     section = Section("kinematics", "Kinematics over q",
                       pictures=[run("kinematics.png", lambda: _kinematics_picture(data, options))])
     if options.pcc_d is None:

@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 from softdesign.cli import app
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.strain import skin_metric
-from softdesign.meshing.skin_stretch import (
+from softdesign.meshing.body.skin_stretch import (
     START_ANGLES_PER_INTERVAL,
     START_SPACING_MM,
     STRETCH_TOL,

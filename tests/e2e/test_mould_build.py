@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 from softdesign.cli import app
 from softdesign.io.formats import read_mesh
 from softdesign.meshing.checks import inspect_mesh
-from softdesign.meshing.mould_checks import CAVITY_RTOL
+from softdesign.meshing.mould.checks import CAVITY_RTOL
 from softdesign.meshing.solids import manifold_from_mesh
 from softdesign.report.mould_figures import mould_figure_png
 from softdesign.report.writer import EXPECTED_SIZES, write_report

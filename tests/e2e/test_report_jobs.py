@@ -46,11 +46,11 @@ def test_the_garbage_collector_is_given_back_as_it_was_even_when_drawing_fails()
     settings): both are restored afterwards, also when a figure raises."""
     import gc
 
-    from softdesign.report.writer import GC_THRESHOLD, _collector_for_figures
+    from softdesign.report.drawing_run import GC_THRESHOLD, collector_for_figures
 
     before = gc.get_threshold()
     assert before[0] != GC_THRESHOLD
-    with pytest.raises(ZeroDivisionError), _collector_for_figures():
+    with pytest.raises(ZeroDivisionError), collector_for_figures():
         assert gc.get_threshold()[0] == GC_THRESHOLD and gc.get_freeze_count() > 0
         _ = 1 / 0
     assert gc.get_threshold() == before and gc.get_freeze_count() == 0

@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 from softdesign.cli import app
 from softdesign.io.formats import read_mesh
 from softdesign.meshing.checks import inspect_mesh
-from softdesign.meshing.mould_checks import CAVITY_RTOL
+from softdesign.meshing.mould.checks import CAVITY_RTOL
 from tests.helpers.cases import case_from, write_case
 from tests.helpers.paths import REPO
 

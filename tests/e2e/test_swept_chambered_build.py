@@ -18,8 +18,8 @@ from typer.testing import CliRunner
 from softdesign.cli import app
 from softdesign.io.formats import read_mesh
 from softdesign.io.volume_formats import read_volume_mesh
-from softdesign.meshing.tet_quality import boundary_faces, tet_volumes
 from softdesign.meshing.topology import mesh_topology
+from softdesign.meshing.volume_mesh.tet_quality import boundary_faces, tet_volumes
 from tests.e2e.test_actuation_build import demo_case
 
 runner = CliRunner()

@@ -18,8 +18,8 @@ from typer.testing import CliRunner
 from softdesign.cli import app
 from softdesign.io.formats import read_mesh
 from softdesign.io.volume_formats import read_volume_mesh
-from softdesign.meshing.tet_quality import boundary_faces, tet_volumes
 from softdesign.meshing.topology import mesh_topology
+from softdesign.meshing.volume_mesh.tet_quality import boundary_faces, tet_volumes
 from tests.e2e.test_volume_mesh_build import tube_case
 
 runner = CliRunner()
@@ -151,7 +151,7 @@ def test_the_aortas_skin_stretches_agree_with_the_feasibility_stages(tmp_path, a
 
     The extremes are a narrow peak 2.5 mm from the base (at q = 1 the stretch rises from 1.29 to 1.59 and falls
     to 1.38 within 1.2 mm); even layers 1.9 mm apart gave 1.417 (-10.8 %), the layers graded by the skin's
-    stretch (softdesign/meshing/sweep_grading.py) meet it.
+    stretch (softdesign/meshing/volume_mesh/sweep_grading.py) meet it.
     """
     import yaml
 

@@ -18,8 +18,8 @@ from softdesign.cli import app
 from softdesign.io.formats import read_mesh
 from softdesign.io.polylines_vtp import write_polylines_vtp
 from softdesign.io.volume_formats import read_volume_mesh
-from softdesign.meshing.tet_quality import tet_centroids, tet_volumes
 from softdesign.meshing.topology import mesh_topology
+from softdesign.meshing.volume_mesh.tet_quality import tet_centroids, tet_volumes
 from softdesign.pipeline.stages import volume_mesh
 from softdesign.report.writer import write_report
 from tests.helpers.cases import write_case

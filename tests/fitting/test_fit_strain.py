@@ -19,8 +19,8 @@ from softdesign.fitting.strain import (
 from softdesign.geometry.blend import blend_shapes
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
 from softdesign.geometry.initial import straight_initial_shape
-from softdesign.meshing.body import sections_on_grid
-from softdesign.meshing.skin_stretch import (
+from softdesign.meshing.body.sections import sections_on_grid
+from softdesign.meshing.body.skin_stretch import (
     START_ANGLES_PER_INTERVAL,
     START_SPACING_MM,
     STRETCH_TOL,

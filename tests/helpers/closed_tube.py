@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from softdesign.mechanics.laws import HyperelasticLaw
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.mechanics.newton import PressureProblem
 from softdesign.mechanics.quadratic import quadratic_faces, quadratic_fixed, quadratic_mesh
 from softdesign.mechanics.tets import boundary_faces, make_tet_mesh

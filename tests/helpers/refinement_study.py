@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from softdesign.mechanics.laws import HyperelasticLaw
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.mechanics.newton import NewtonSettings
 from softdesign.mechanics.refine import refine_section
 from softdesign.mechanics.section import SectionMesh, simulate_section

@@ -15,7 +15,7 @@ from tests.io.test_volume_formats import cube
 
 def named_cube() -> tuple[np.ndarray, np.ndarray, NamedSets]:
     """The cube with two named surfaces (its boundary split by the first node), a node set and a figure."""
-    from softdesign.meshing.tet_quality import boundary_faces
+    from softdesign.meshing.volume_mesh.tet_quality import boundary_faces
 
     points, tets = cube()
     points = points + np.array([1e-7, np.pi, -2.0 / 3.0])  # digits a short format would lose

@@ -18,7 +18,7 @@ import scipy.sparse as sp
 from skfem import Basis, BilinearForm, ElementTetP0, ElementTetP2, ElementVector, MeshTet
 from skfem.helpers import ddot, div, eye, sym_grad, trace
 
-from softdesign.mechanics.laws import HyperelasticLaw
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.mechanics.quadratic import QuadraticMesh, quadratic_force_and_tangent, quadratic_mesh, quadratic_state
 from softdesign.mechanics.tets import make_tet_mesh
 from tests.helpers.fe_meshes import quarter_tube

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.mechanics.assembly import force_and_tangent, internal_force, volumetric_state
-from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.pressure import pressure_load
 from softdesign.mechanics.tets import boundary_faces, make_tet_mesh
 from tests.helpers.fe_meshes import quarter_tube

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import brentq
 
-from softdesign.mechanics.laws import HyperelasticLaw
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.mechanics.newton import NewtonSettings, PressureProblem, solve_pressures
 from softdesign.mechanics.tets import boundary_faces, make_tet_mesh
 from tests.helpers.fe_meshes import grid_tets, oriented

@@ -20,8 +20,8 @@ import pytest
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.mechanics.continuation import ContinuationSettings, PathResult, follow_pressures
-from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.newton import PressureProblem
 from tests.helpers.closed_tube import closed_tube_problem, stretches
 from tests.helpers.tube_analytic import closed_end_axial, closed_end_limit, closed_end_pressure

@@ -14,7 +14,7 @@ from softdesign.geometry.initial import straight_initial_shape
 from softdesign.mechanics.layout_section import layout_section_mesh
 from softdesign.mechanics.newton import NewtonSettings
 from softdesign.mechanics.section import SectionMesh, simulate_section
-from softdesign.meshing.chamber_layout import ChamberLayout, plan_layout
+from softdesign.meshing.chambers.layout import ChamberLayout, plan_layout
 from softdesign.meshing.volume import BodySpec
 from tests.fitting.test_fit_strain import _constant_field
 from tests.mechanics.test_section_symmetry import LAW, MU, RADIUS_MM, SPEC

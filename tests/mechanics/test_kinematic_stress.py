@@ -5,14 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from softdesign.mechanics.kinematic_stress import (
+from softdesign.continuum.kinematic_stress import (
     cauchy_stress,
     deformation_gradients,
     element_strain,
     principal_stresses,
     principal_stretches_3d,
 )
-from softdesign.mechanics.laws import HyperelasticLaw
+from softdesign.continuum.laws import HyperelasticLaw
 
 #: Closed-form expressions evaluated in float64: agreement to round-off.
 EXACT_RTOL = 1e-10
@@ -66,7 +66,7 @@ def test_closed_form_eigenvalues_match_lapack():
     A = M + M.transpose(0, 2, 1)
     A[:10] = np.eye(3)  # a triple root
     A[10:20] = np.diag([2.0, 1.0, 1.0])  # a double root
-    from softdesign.mechanics.kinematic_stress import symmetric_eigenvalues
+    from softdesign.continuum.kinematic_stress import symmetric_eigenvalues
 
     # near a repeated root the trigonometric form keeps about half the digits
     np.testing.assert_allclose(symmetric_eigenvalues(A), np.linalg.eigvalsh(A)[:, ::-1], rtol=0, atol=1e-7)
@@ -90,7 +90,7 @@ def test_the_largest_stress_without_the_tensor_is_the_tensor_s(free):
 def test_chunks_and_batches_change_no_bit():
     """strains on more tetrahedra than a chunk, and on a stack of moved states, gives each tetrahedron's figures
     exactly as alone (element by element arithmetic), the stack's as each state's."""
-    from softdesign.mechanics.kinematic_stress import STRAIN_CHUNK, _strains, rest_state, strains
+    from softdesign.continuum.kinematic_stress import STRAIN_CHUNK, _strains, rest_state, strains
 
     rng = np.random.default_rng(5)
     F = np.eye(3) + 0.2 * rng.normal(size=(STRAIN_CHUNK + 1000, 3, 3))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from softdesign.mechanics.laws import HyperelasticLaw, cauchy_stress, isochoric_stress, isochoric_tangent
+from softdesign.continuum.laws import HyperelasticLaw, cauchy_stress, isochoric_stress, isochoric_tangent
 
 #: Central differences of a smooth function at step 1e-6: error ~ 1e-10 relative, far below this.
 FD_RTOL = 1e-6

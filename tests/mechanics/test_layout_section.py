@@ -9,7 +9,7 @@ from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
 from softdesign.geometry.initial import straight_initial_shape
 from softdesign.mechanics.layout_section import layout_section_mesh
 from softdesign.mechanics.section import check_section
-from softdesign.meshing.chamber_layout import ActuationSpec, plan_layout
+from softdesign.meshing.chambers.layout import ActuationSpec, plan_layout
 from softdesign.meshing.volume import BodySpec
 from tests.fitting.test_fit_strain import _constant_field
 

@@ -8,7 +8,7 @@ import functools
 import numpy as np
 import pytest
 
-from softdesign.mechanics.laws import HyperelasticLaw
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.mechanics.newton import NewtonSettings
 from softdesign.mechanics.reinforcement import HoopThread
 from softdesign.mechanics.section import SectionMesh, SectionResult, simulate_section

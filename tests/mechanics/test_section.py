@@ -9,9 +9,9 @@ import re
 import numpy as np
 import pytest
 
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.errors import MeshError
 from softdesign.mechanics.inverse import InverseSettings, find_pressures
-from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.newton import NewtonSettings
 from softdesign.mechanics.section import SectionMesh, SectionResult, check_section, simulate_section
 from softdesign.types import FloatArray

@@ -1,6 +1,6 @@
 """Issue 42's symmetry known answer on the pipeline's own section mesh: three equal chambers at equal pressure
 barely bend the section, with and without the hoop thread (the mesh is three-fold symmetric,
-:mod:`softdesign.meshing.three_fold`)."""
+:mod:`softdesign.meshing.volume_mesh.three_fold`)."""
 
 from __future__ import annotations
 
@@ -9,15 +9,15 @@ import functools
 import numpy as np
 import pytest
 
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.geometry.blend import blend_shapes
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
 from softdesign.geometry.initial import straight_initial_shape
-from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.layout_section import layout_section_mesh
 from softdesign.mechanics.newton import NewtonSettings
 from softdesign.mechanics.reinforcement import HoopThread
 from softdesign.mechanics.section import SectionMesh, simulate_section
-from softdesign.meshing.chamber_layout import ActuationSpec, plan_layout
+from softdesign.meshing.chambers.layout import ActuationSpec, plan_layout
 from softdesign.meshing.volume import BodySpec
 from softdesign.pipeline.simulate_run import SimulateOptions
 from tests.fitting.test_fit_strain import _constant_field

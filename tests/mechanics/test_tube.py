@@ -9,9 +9,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.errors import SolveError
 from softdesign.mechanics.continuation import ContinuationSettings, follow_pressures
-from softdesign.mechanics.laws import HyperelasticLaw
 from softdesign.mechanics.newton import NewtonSettings, PressureProblem, pressure_sensitivity, solve_pressures
 from softdesign.mechanics.quadratic import quadratic_faces, quadratic_fixed, quadratic_mesh
 from softdesign.mechanics.tets import boundary_faces, make_tet_mesh

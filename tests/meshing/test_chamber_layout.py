@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from softdesign.meshing.chamber_layout import ActuationSpec, analytic_walls, chamber_angles, offset_points, plan_layout
+from softdesign.meshing.chambers.layout import ActuationSpec, analytic_walls, chamber_angles, offset_points, plan_layout
 
 TOL = 1e-12
 SPEC = ActuationSpec(distance_mm=2.0, diameter_mm=0.8, feed_diameter_mm=0.4, end_wall_mm=1.0, first_angle_deg=90.0)

@@ -13,10 +13,10 @@ from softdesign.geometry.curves import smooth_curve_from_samples
 from softdesign.geometry.frames import FramedSpline, framed_curve
 from softdesign.kinematics.chamber_lengths import arcs_from_chamber_lengths, chamber_lengths_from_arc
 from softdesign.kinematics.pcc_fit import fit_link
-from softdesign.meshing.body import sections_on_grid
-from softdesign.meshing.chamber_layout import ActuationSpec, ChamberLayout, plan_layout
-from softdesign.meshing.chamber_walls import chamber_lengths_mm, ring_walls, skin_walls
-from softdesign.meshing.chambers import build_actuated, cavity_sweeps, feed_extension_mm, measured_skin_walls
+from softdesign.meshing.body.sections import sections_on_grid
+from softdesign.meshing.chambers.carve import build_actuated, cavity_sweeps, feed_extension_mm, measured_skin_walls
+from softdesign.meshing.chambers.layout import ActuationSpec, ChamberLayout, plan_layout
+from softdesign.meshing.chambers.walls import chamber_lengths_mm, ring_walls, skin_walls
 from softdesign.meshing.checks import Expectation, check_solid
 from softdesign.meshing.solids import manifold_from_mesh
 from softdesign.meshing.tessellate import tessellate
@@ -201,7 +201,7 @@ def test_measured_skin_over_a_straight_body_is_the_analytic_wall() -> None:
 def test_a_tapered_chamber_holds_the_frustum_volume_and_its_walls_follow_the_taper() -> None:
     from dataclasses import replace
 
-    from softdesign.meshing.chambers import cavity_volume_mm3
+    from softdesign.meshing.chambers.carve import cavity_volume_mm3
 
     curve = straight()
     planned = layout_on(curve)

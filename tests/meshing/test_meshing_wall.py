@@ -11,11 +11,8 @@ from softdesign.fitting.strain import metric_from_sections, principal_stretches,
 from softdesign.geometry.blend import blend_shapes
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
 from softdesign.geometry.initial import straight_initial_shape
-from softdesign.meshing.body import body_sections
-from softdesign.meshing.solids import _chamber
-from softdesign.meshing.tessellate import Sweep, ring_points, sweep_from_sections, tessellate
-from softdesign.meshing.volume import BodySpec, angle_grid
-from softdesign.meshing.wall import (
+from softdesign.meshing.body.sections import body_sections
+from softdesign.meshing.body.wall import (
     offset_metric,
     offset_sections,
     port_wall_mm,
@@ -23,6 +20,9 @@ from softdesign.meshing.wall import (
     thinnest,
     wall_distances,
 )
+from softdesign.meshing.solids import _chamber
+from softdesign.meshing.tessellate import Sweep, ring_points, sweep_from_sections, tessellate
+from softdesign.meshing.volume import BodySpec, angle_grid
 from tests.fitting.test_fit_strain import _constant_field
 
 RADIUS_MM, WALL_MM, LENGTH_MM, NA = 3.0, 1.0, 30.0, 64

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from softdesign.meshing.mould import MouldRefused, MouldSpec, build_mould
-from softdesign.meshing.mould_frame import parting_frame
-from softdesign.meshing.mould_make import make_mould
+from softdesign.meshing.mould.frame import parting_frame
+from softdesign.meshing.mould.make import make_mould
+from softdesign.meshing.mould.parts import MouldRefused, MouldSpec, build_mould
 from softdesign.meshing.solids import manifold_from_mesh
 from softdesign.meshing.tessellate import TubeSections, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec, angle_grid

@@ -28,10 +28,10 @@ from softdesign.geometry.blend import blend_shapes
 from softdesign.geometry.curves import smooth_curve_from_samples
 from softdesign.geometry.initial import straight_initial_shape
 from softdesign.kinematics.links import LinkChain
+from softdesign.meshing.body.pose import PoseSpec, check_distinct_when_written, pose_body
+from softdesign.meshing.body.pose_stitch import JOINT_MERGE_TOL_MM, radii_on_rays, stitch_joint
 from softdesign.meshing.checks import inspect_mesh
 from softdesign.meshing.compare import compare_meshes
-from softdesign.meshing.pose_body import PoseSpec, check_distinct_when_written, pose_body
-from softdesign.meshing.pose_stitch import JOINT_MERGE_TOL_MM, radii_on_rays, stitch_joint
 from softdesign.meshing.tessellate import Region
 from tests.helpers.paths import REPO
 

@@ -5,14 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.geometry.blend import blend_shapes
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
 from softdesign.geometry.initial import straight_initial_shape
-from softdesign.mechanics.laws import HyperelasticLaw
-from softdesign.meshing.sweep_body import place_mesh, plan_mesh
-from softdesign.meshing.sweep_strain import free_directions, skin_stretches, strain_at
 from softdesign.meshing.topology import mesh_topology
 from softdesign.meshing.volume import BodySpec, polygon_area_ratio
+from softdesign.meshing.volume_mesh.sweep_body import place_mesh, plan_mesh
+from softdesign.meshing.volume_mesh.sweep_strain import free_directions, skin_stretches, strain_at
 from tests.fitting.test_fit_strain import _constant_field
 
 RADIUS_MM, WALL_MM, LENGTH_MM, BEND_RADIUS_MM, NA = 3.0, 1.0, 30.0, 40.0, 48
@@ -72,7 +72,7 @@ def test_bent_tube_axial_stretch_is_one_plus_kappa_r(bent, wall):
     assert _volumes(moved, mesh.tets).min() > 0
     p0, p1 = rest[mesh.tets], moved[mesh.tets]
     # F maps the axis's direction at rest (z) to the bent one; its length is the axial stretch
-    from softdesign.mechanics.kinematic_stress import deformation_gradients
+    from softdesign.continuum.kinematic_stress import deformation_gradients
 
     F = deformation_gradients(rest, moved, mesh.tets)
     axial = np.linalg.norm(F[:, :, 2], axis=1)
@@ -105,7 +105,7 @@ def test_skin_stretches_match_the_surface_metric(bent):
     """The skin quads' in-plane stretches against the feasibility stage's metric at the same material points
     (every quad's centre), within the issue's 1 %."""
     from softdesign.fitting.strain import principal_stretches, skin_metric
-    from softdesign.meshing.sweep_strain import skin_places
+    from softdesign.meshing.volume_mesh.sweep_strain import skin_places
 
     shape, field = bent
     spec = BodySpec()
@@ -122,7 +122,7 @@ def test_skin_stretches_match_the_surface_metric(bent):
 
 
 def _layout(shape):
-    from softdesign.meshing.chamber_layout import ActuationSpec, plan_layout
+    from softdesign.meshing.chambers.layout import ActuationSpec, plan_layout
 
     curve0 = shape.curve_at(0.0)
     l = curve0.curve.dense_l()

@@ -11,13 +11,13 @@ from softdesign.errors import ConfigError
 from softdesign.geometry.blend import blend_shapes
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
 from softdesign.geometry.initial import straight_initial_shape
-from softdesign.meshing.chamber_layout import ActuationSpec, plan_layout
-from softdesign.meshing.cross_section import Circle
-from softdesign.meshing.section_gaps import pair_gaps, resolve_circles, unresolved
-from softdesign.meshing.sweep_body import place_mesh, plan_mesh
-from softdesign.meshing.tet_quality import boundary_faces
+from softdesign.meshing.chambers.layout import ActuationSpec, plan_layout
 from softdesign.meshing.topology import mesh_topology
 from softdesign.meshing.volume import BodySpec
+from softdesign.meshing.volume_mesh.cross_section import Circle
+from softdesign.meshing.volume_mesh.section_gaps import pair_gaps, resolve_circles, unresolved
+from softdesign.meshing.volume_mesh.sweep_body import place_mesh, plan_mesh
+from softdesign.meshing.volume_mesh.tet_quality import boundary_faces
 from tests.fitting.test_fit_strain import _constant_field
 
 RADIUS_MM, BEND_RADIUS_MM, NA, SECTION_MM = 3.3, 60.0, 48, 8.0
@@ -133,8 +133,8 @@ def test_crossing_chambers_refused_before_meshing():
 
 def test_graded_mesh_same_bytes_twice():
     """Five sections at the defaults (graded circles): the same section, tetrahedra and names on a second run."""
-    from softdesign.meshing.sweep_layout import check_resolvable, layout_holes
-    from softdesign.meshing.sweep_mesh import swept_disk
+    from softdesign.meshing.volume_mesh.sweep_layout import check_resolvable, layout_holes
+    from softdesign.meshing.volume_mesh.sweep_mesh import swept_disk
 
     shape, _, _ = _body(5)
     layout = _layout(shape, 5, 0.8, 0.4)

@@ -1,4 +1,4 @@
-"""softdesign/meshing/sweep_grading.py on known profiles: a narrow peak between two even layers is found and
+"""softdesign/meshing/volume_mesh/sweep_grading.py on known profiles: a narrow peak between two even layers is found and
 followed to within the step, a flat stretch adds no layer, and a count over the bound is refused."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from softdesign.errors import ConfigError
-from softdesign.meshing.sweep_grading import Grading, graded_layers
+from softdesign.meshing.volume_mesh.sweep_grading import Grading, graded_layers
 
 LENGTH_MM = 60.0
 STEP = 0.01

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from softdesign.meshing.cross_section import Circle
-from softdesign.meshing.sweep_layout import MIN_CHAMBER_NODES, MIN_FEED_NODES, circle_nodes
+from softdesign.meshing.volume_mesh.cross_section import Circle
+from softdesign.meshing.volume_mesh.sweep_layout import MIN_CHAMBER_NODES, MIN_FEED_NODES, circle_nodes
 
 
 @pytest.mark.parametrize(("diameter", "size", "least", "expected"), [

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from softdesign.meshing.cross_section import Circle, cross_section
-from softdesign.meshing.sweep_mesh import Hole, layer_grid, sweep_mesh, swept_disk
 from softdesign.meshing.topology import mesh_topology
 from softdesign.meshing.volume import polygon_area_ratio
+from softdesign.meshing.volume_mesh.cross_section import Circle, cross_section
+from softdesign.meshing.volume_mesh.sweep_mesh import Hole, layer_grid, sweep_mesh, swept_disk
 
 #: Sums of many float64 products: relative round-off well under this.
 SUM_RTOL = 1e-9

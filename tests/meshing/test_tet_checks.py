@@ -10,8 +10,8 @@ import trimesh
 
 from softdesign.errors import MeshError
 from softdesign.meshing.enclosed import points_inside
-from softdesign.meshing.tet_checks import TET_VOLUME_RTOL, check_tet_mesh, expected_tets
-from softdesign.meshing.tet_quality import tet_volumes
+from softdesign.meshing.volume_mesh.tet_checks import TET_VOLUME_RTOL, check_tet_mesh, expected_tets
+from softdesign.meshing.volume_mesh.tet_quality import tet_volumes
 
 #: Sums of 162 exact sixths: float64 rounding only.
 EXACT = 1e-12

@@ -7,7 +7,8 @@ import itertools
 import numpy as np
 import pytest
 
-from softdesign.meshing.tet_quality import (
+from softdesign.meshing.topology import mesh_topology, signed_volume
+from softdesign.meshing.volume_mesh.tet_quality import (
     boundary_faces,
     dihedral_angles,
     radius_edge_ratios,
@@ -15,7 +16,6 @@ from softdesign.meshing.tet_quality import (
     tet_quality,
     tet_volumes,
 )
-from softdesign.meshing.topology import mesh_topology, signed_volume
 
 #: Closed-form figures computed in float64: a few ulps of their magnitude.
 EXACT = 1e-12

@@ -1,13 +1,13 @@
 """A three-fold symmetric layout gives a cross-section and a swept mesh that the 120-degree rotation maps onto
-themselves (:mod:`softdesign.meshing.three_fold`); any other layout is meshed as before."""
+themselves (:mod:`softdesign.meshing.volume_mesh.three_fold`); any other layout is meshed as before."""
 
 from __future__ import annotations
 
 import numpy as np
 from scipy.spatial import cKDTree
 
-from softdesign.meshing.cross_section import Circle, cross_section
-from softdesign.meshing.sweep_mesh import Hole, swept_disk
+from softdesign.meshing.volume_mesh.cross_section import Circle, cross_section
+from softdesign.meshing.volume_mesh.sweep_mesh import Hole, swept_disk
 from softdesign.types import FloatArray, IntArray
 from tests.mechanics.test_section_symmetry import pipeline_section
 

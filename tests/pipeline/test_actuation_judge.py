@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from softdesign.meshing.chamber_walls import Wall
+from softdesign.meshing.chambers.walls import Wall
 from softdesign.pipeline.actuation_judge import judge
 
 LIMITS = {"name": "ecoflex-00-30", "max_stretch": 5.5, "min_stretch": 0.9, "min_wall_mm": 1.0}

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from softdesign.config import load_case
-from softdesign.meshing.skin_stretch import make_grid
-from softdesign.meshing.wall import FD_STEP_MM
+from softdesign.meshing.body.skin_stretch import make_grid
+from softdesign.meshing.body.wall import FD_STEP_MM
 from softdesign.pipeline.api import build_through
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.parallel import jobs_for_build

@@ -1,7 +1,7 @@
 """Stage: actuation -- the chambers' layout (refused when it cannot fit), lengths per q, walls and extensions.
 
 With ``actuation:`` in the case, every link is a seed 003 section with three
-chambers and their feeds (:mod:`softdesign.meshing.chamber_layout`).  This
+chambers and their feeds (:mod:`softdesign.meshing.chambers.layout`).  This
 stage, before export:
 
 1. lays them out and refuses (exit 2) a layout whose walls cannot fit the
@@ -34,11 +34,11 @@ from softdesign.errors import ConfigError
 from softdesign.io.format_names import q_label
 from softdesign.kinematics.chamber_lengths import chamber_lengths_from_arc
 from softdesign.kinematics.pcc_fit import fit_links
-from softdesign.meshing.body import body_sections
-from softdesign.meshing.chamber_layout import ChamberLayout, Channel, analytic_walls, chamber_angles, plan_layout
-from softdesign.meshing.chamber_walls import Wall, chamber_lengths_mm, ring_walls, skin_walls
-from softdesign.meshing.chambers import measured_skin_walls
-from softdesign.meshing.sweep_layout import check_resolvable, layout_holes
+from softdesign.meshing.body.sections import body_sections
+from softdesign.meshing.chambers.carve import measured_skin_walls
+from softdesign.meshing.chambers.layout import ChamberLayout, Channel, analytic_walls, chamber_angles, plan_layout
+from softdesign.meshing.chambers.walls import Wall, chamber_lengths_mm, ring_walls, skin_walls
+from softdesign.meshing.volume_mesh.sweep_layout import check_resolvable, layout_holes
 from softdesign.pipeline.actuation_judge import judge
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import export_workers
@@ -324,8 +324,9 @@ def layout_document(layout: ChamberLayout) -> dict[str, Any]:
 
 
 def _check_sweep(case: Case, fit: FitResult, layout: ChamberLayout) -> None:
-    """The swept volume mesher's check of the layout (:func:`~softdesign.meshing.sweep_layout.check_resolvable`),
-    made here too so that a layout it cannot mesh is refused before the export, mould and volume stages run."""
+    """The swept volume mesher's check of the layout
+    (:func:`~softdesign.meshing.volume_mesh.sweep_layout.check_resolvable`), made here too so that a layout it
+    cannot mesh is refused before the export, mould and volume stages run."""
     volume = case.export.volume_mesh
     if volume is None or volume.mesher != "sweep":
         return

@@ -4,8 +4,8 @@ Reads the blended shape (kinematics) and the radius field (fit), and the
 export keys that shape the solid (offset, wall, port, mesh resolution).
 Per export q: the principal stretches of the outer skin (and of the chamber
 of a hollow body) against q = 0, converged on a grid
-(:mod:`softdesign.meshing.skin_stretch`), the largest rho * kappa, the true
-wall thickness and the port's wall (:mod:`softdesign.meshing.wall`); over
+(:mod:`softdesign.meshing.body.skin_stretch`), the largest rho * kappa, the true
+wall thickness and the port's wall (:mod:`softdesign.meshing.body.wall`); over
 the whole morph q in [0, 1], the extremes of the skin's stretches by a
 search in q.  Judged against ``material:`` when the case has one
 (:mod:`softdesign.materials`); without it ``feasible`` is null.
@@ -26,7 +26,7 @@ from softdesign.config import Case
 from softdesign.fitting.radius_field import RadiusField, fold_margin
 from softdesign.fitting.strain import skin_metric
 from softdesign.geometry.blend import BlendedShape
-from softdesign.meshing.skin_stretch import (
+from softdesign.meshing.body.skin_stretch import (
     Q_SAMPLES,
     Q_XTOL,
     START_ANGLES_PER_INTERVAL,
@@ -41,9 +41,9 @@ from softdesign.meshing.skin_stretch import (
     morph_samples,
     search_morph,
 )
+from softdesign.meshing.body.wall import FD_STEP_MM, offset_metric, port_wall_mm, thinnest, wall_map
 from softdesign.meshing.tessellate import ring_points
 from softdesign.meshing.volume import BodySpec
-from softdesign.meshing.wall import FD_STEP_MM, offset_metric, port_wall_mm, thinnest, wall_map
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import meshes_at_once
 from softdesign.pipeline.feasibility_judge import judge, warnings_of

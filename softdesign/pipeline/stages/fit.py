@@ -30,7 +30,7 @@ from softdesign.geometry.end_cut import choose_end_cuts
 from softdesign.geometry.morph_fold import MORPH_Q_SAMPLES
 from softdesign.geometry.network import SelectedPath
 from softdesign.kinematics.links import LinkChain
-from softdesign.meshing.mould_frame import parting_frame
+from softdesign.meshing.mould.frame import parting_frame
 from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import describe_backbone_fit, stretch_fit_errors
 from softdesign.pipeline.fit_options import wall_fit_options

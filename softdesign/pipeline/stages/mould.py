@@ -3,7 +3,7 @@
 Runs only when the case has ``export.mould``; otherwise it writes nothing.
 The body, its chamber and its port are the export's own (same grid, offset,
 wall and port), at q = 0, the state the actuator is cast in.  Geometry and
-checks: :mod:`softdesign.meshing.mould_make`.  Every part is checked again,
+checks: :mod:`softdesign.meshing.mould.make`.  Every part is checked again,
 as written, by the project's own topology checks (watertight, consistently
 wound, one body, Euler 2).  Outputs: ``meshes/mould/{half_a,half_b,core}.stl``
 (and every other format of ``export.formats``), ``mould/summary.json``; the
@@ -21,11 +21,11 @@ import numpy as np
 
 from softdesign.config import Case
 from softdesign.io.formats import mesh_bytes
-from softdesign.meshing.body import body_sections
+from softdesign.meshing.body.sections import body_sections
 from softdesign.meshing.checks import Expectation, check_solid
-from softdesign.meshing.mould import MouldSpec
-from softdesign.meshing.mould_cores import make_actuated_mould
-from softdesign.meshing.mould_make import MouldMesh, make_mould
+from softdesign.meshing.mould.cores import make_actuated_mould
+from softdesign.meshing.mould.make import MouldMesh, make_mould
+from softdesign.meshing.mould.parts import MouldSpec
 from softdesign.pipeline import layout
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.item_progress import item_counter
@@ -51,7 +51,7 @@ class MouldResult:
 
 
 def mould_spec(case: Case) -> MouldSpec | None:
-    """The case's ``export.mould`` as a :class:`~softdesign.meshing.mould.MouldSpec`, None when absent."""
+    """The case's ``export.mould`` as a :class:`~softdesign.meshing.mould.parts.MouldSpec`, None when absent."""
     m = case.export.mould
     if m is None:
         return None

@@ -1,8 +1,9 @@
-"""The swept mesh's layers (the l stations of :mod:`softdesign.meshing.sweep_mesh`), planned on the body at q = 0.
+"""The swept mesh's layers (the l stations of :mod:`softdesign.meshing.volume_mesh.sweep_mesh`), planned on the body at
+q = 0.
 
 Layers evenly ``size_mm`` apart in arc length (the finest grid of the q
 values meshed, every link joint a layer), then graded by the skin's stretch near its extremes at every
-exported q (:mod:`softdesign.meshing.sweep_grading`), so that the mesh's skin
+exported q (:mod:`softdesign.meshing.volume_mesh.sweep_grading`), so that the mesh's skin
 figures meet the feasibility stage's within issue 32's 1 %; the tetrahedra
 they make bounded by ``MAX_VOLUME_TETS`` before the grading and after it.
 """
@@ -19,8 +20,8 @@ from softdesign.config import VolumeMesh as VolumeMeshSpec
 from softdesign.errors import ConfigError
 from softdesign.fitting.strain import principal_stretches, skin_metric
 from softdesign.limits.volume import MAX_VOLUME_TETS
-from softdesign.meshing.body import export_l_grid
-from softdesign.meshing.sweep_grading import Grading, graded_layers
+from softdesign.meshing.body.sections import export_l_grid
+from softdesign.meshing.volume_mesh.sweep_grading import Grading, graded_layers
 from softdesign.pipeline.stages.fit import FitResult
 from softdesign.pipeline.stages.kinematics import KinematicsResult
 from softdesign.types import FloatArray
@@ -66,7 +67,7 @@ def floor_spacing_mm(case: Case, fit: FitResult) -> float:
 def swept_layers(case: Case, kinematics: KinematicsResult, fit: FitResult, vm: VolumeMeshSpec,
                  spacing: float) -> tuple[FloatArray, FloatArray]:
     """The layers (n,) l: the even ones (``spacing`` mm apart, the finest grid of the q meshed), graded by
-    the skin's stretch near its extremes at every q exported (:mod:`softdesign.meshing.sweep_grading`), the
+    the skin's stretch near its extremes at every q exported (:mod:`softdesign.meshing.volume_mesh.sweep_grading`), the
     count checked; and the even ones (m,) l, a subset (where the reference section is measured)."""
     shape = kinematics.chain.shape
     grids = [export_l_grid(shape.curve_at(q), fit.field, spacing) for q in sorted({0.0, *vm.q})]

@@ -10,11 +10,11 @@ per element in the figures.  ``mesher: ftetwild`` is issue 16's, below.
 At each of its q values (by default q = 0 alone, the state the
 actuator is cast in and that a simulator deforms) the body is the export's
 own checked solid (same grid, offset, wall and port), and fTetWild fills it
-with tetrahedra of the target size (:mod:`softdesign.meshing.tetmesh`) in a
+with tetrahedra of the target size (:mod:`softdesign.meshing.volume_mesh.tetmesh`) in a
 child process with the case's time limit (:mod:`softdesign.pipeline.child`):
 a crash or a hang in its native code fails the stage with a clear message
 (exit 1), not a dead build.  The count of tetrahedra the size asks for is
-bounded before the mesher starts.  Checks (:mod:`softdesign.meshing.tet_checks`):
+bounded before the mesher starts.  Checks (:mod:`softdesign.meshing.volume_mesh.tet_checks`):
 every tetrahedron positive, their volume within 1 % of the body's, a hollow
 body's chamber empty.  Outputs: ``meshes/volume/q_0.000.vtu`` (ASCII XML,
 inline data: what SOFA's MeshVTKLoader reads), ``.msh`` (Gmsh 2.2, SOFA's
@@ -22,7 +22,7 @@ MeshGmshLoader), for a hollow body ``meshes/volume/chamber_q_0.000.stl`` (the
 closed chamber, normals outwards: SOFA's SurfacePressureConstraint), and
 ``volume/summary.json``; the manifest lists each file with its figures.
 
-fTetWild is not deterministic (:mod:`softdesign.meshing.tetmesh`): unlike
+fTetWild is not deterministic (:mod:`softdesign.meshing.volume_mesh.tetmesh`): unlike
 every other output, these files differ from run to run of the mesher (their
 figures agree within the checks).  The build's cache keeps them while the
 inputs are unchanged.
@@ -45,11 +45,11 @@ from softdesign.errors import ConfigError
 from softdesign.io.formats import mesh_bytes
 from softdesign.io.volume_formats import VOLUME_FORMATS, NamedSets, volume_mesh_bytes
 from softdesign.limits.volume import MAX_VOLUME_TETS, MESHER_MEMORY_BYTES
-from softdesign.meshing.body import body_sections
-from softdesign.meshing.chamber import chamber_surface
-from softdesign.meshing.tet_checks import REGULAR_TET_FACTOR, check_tet_mesh, expected_tets
-from softdesign.meshing.tetmesh import TetSettings, tetrahedralize
+from softdesign.meshing.body.sections import body_sections
+from softdesign.meshing.chambers.surface import chamber_surface
 from softdesign.meshing.topology import mesh_topology
+from softdesign.meshing.volume_mesh.tet_checks import REGULAR_TET_FACTOR, check_tet_mesh, expected_tets
+from softdesign.meshing.volume_mesh.tetmesh import TetSettings, tetrahedralize
 from softdesign.pipeline import layout
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.child import run_in_child
@@ -189,7 +189,7 @@ def _run_sweep(case: Case, kinematics: KinematicsResult, fit: FitResult) -> Volu
     judged = material.max_stretch is not None or material.tensile_strength_kpa is not None
     first = run.bodies[0].mesh
     summary = {"requested": True, "spec": vm.model_dump(mode="json"),
-               "mesher": {"name": "sweep: softdesign.meshing.sweep_mesh, one mesh of the parameter domain",
+               "mesher": {"name": "sweep: softdesign.meshing.volume_mesh.sweep_mesh, one mesh of the parameter domain",
                           "meshio": metadata.version("meshio")},
                "deterministic": True, "surfaces": list(first.groups) + list(first.lids),
                "node_sets": ["base_nodes"], "per_q": run.per_q, "morph": run.morph,

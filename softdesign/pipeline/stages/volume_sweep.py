@@ -1,17 +1,17 @@
 """The volume_mesh stage's swept mesher: one mesh in the body's parameter domain, placed at every q, with figures.
 
 ``export.volume_mesh.mesher: sweep`` (the default).  The mesh
-(:mod:`softdesign.meshing.sweep_mesh`) is laid out once on the body at q = 0,
+(:mod:`softdesign.meshing.volume_mesh.sweep_mesh`) is laid out once on the body at q = 0,
 its layers from :mod:`softdesign.pipeline.stages.volume_layers` (even, then
 graded by the skin's stretch), the section's nodes on the export's angles,
-its inside at ``size_mm``; :mod:`softdesign.meshing.sweep_body` places it at each q.
+its inside at ``size_mm``; :mod:`softdesign.meshing.volume_mesh.sweep_body` places it at each q.
 Checks at each q: every tetrahedron positive (else MeshError naming the
 worst one's section, l, angle and depth), the volume within
 ``VOLUME_RTOL`` of the export's surface mesh at that q, the boundary
 watertight.  Figures: round 2's quality figures with the worst element
-named, and the 3D strain and stress (:mod:`softdesign.meshing.sweep_strain`)
+named, and the 3D strain and stress (:mod:`softdesign.meshing.volume_mesh.sweep_strain`)
 at each q and over the morph's q samples
-(:func:`softdesign.meshing.skin_stretch.morph_samples`), judged against the
+(:func:`softdesign.meshing.body.skin_stretch.morph_samples`), judged against the
 material (stretch vs max_stretch, stress vs tensile strength).
 """
 
@@ -25,15 +25,15 @@ import numpy as np
 
 from softdesign.config import Case
 from softdesign.config import VolumeMesh as VolumeMeshSpec
+from softdesign.continuum.kinematic_stress import ElementStrain, RestState, rest_inverses, rest_state, strains
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.errors import MeshError
-from softdesign.mechanics.kinematic_stress import ElementStrain, RestState, rest_inverses, rest_state, strains
-from softdesign.mechanics.laws import HyperelasticLaw
-from softdesign.meshing.skin_stretch import morph_samples
-from softdesign.meshing.sweep_body import SweepReference, place_mesh, plan_mesh
-from softdesign.meshing.sweep_mesh import SweptMesh
-from softdesign.meshing.sweep_strain import extreme_of, free_directions, skin_stretches, tet_places
-from softdesign.meshing.tet_quality import tet_measures, tet_volumes
+from softdesign.meshing.body.skin_stretch import morph_samples
 from softdesign.meshing.topology import mesh_topology
+from softdesign.meshing.volume_mesh.sweep_body import SweepReference, place_mesh, plan_mesh
+from softdesign.meshing.volume_mesh.sweep_mesh import SweptMesh
+from softdesign.meshing.volume_mesh.sweep_strain import extreme_of, free_directions, skin_stretches, tet_places
+from softdesign.meshing.volume_mesh.tet_quality import tet_measures, tet_volumes
 from softdesign.meshing.volume_tolerance import VOLUME_RTOL
 from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.item_progress import item_counter
@@ -84,8 +84,8 @@ def _where(places: Places, index: int) -> dict[str, Any]:
 
 def _measures(points: FloatArray, tets: Any) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Volumes, least and largest dihedral angles (rad) and radius-edge ratios, each (T,), QUALITY_CHUNK
-    tetrahedra at a time (:func:`~softdesign.meshing.tet_quality.tet_measures`: the aorta with chambers' three
-    q, 297k tetrahedra, 1.9 -> 0.5 s; the chunks keep its temporaries in the processor's cache)."""
+    tetrahedra at a time (:func:`~softdesign.meshing.volume_mesh.tet_quality.tet_measures`: the aorta with chambers'
+    three q, 297k tetrahedra, 1.9 -> 0.5 s; the chunks keep its temporaries in the processor's cache)."""
     parts = [tet_measures(points, t) for t in (tets[k:k + QUALITY_CHUNK] for k in range(0, len(tets), QUALITY_CHUNK))]
     volumes, least, largest, ratio = (np.concatenate([p[i] for p in parts]) for i in range(4))
     return volumes, least, largest, ratio

@@ -8,7 +8,7 @@ When it applies
     chambers and the feeds on one ring ``120 / n`` degrees apart.  Otherwise
     :func:`symmetric_points` returns None and the section is meshed as before.
 How
-    The points are those of :mod:`softdesign.meshing.cross_section` (circle
+    The points are those of :mod:`softdesign.meshing.volume_mesh.cross_section` (circle
     nodes, then fronts of rings kept greedily in order of their distance from a
     circle), but every point comes with its two turned copies: the holes of an
     orbit take the first one's nodes turned; the outer circle's fronts (centred
@@ -20,7 +20,7 @@ How
 Prism split
     Each point has an orbit and a copy (0, 1, 2: R^copy of the orbit's first;
     the centre, always a point, is an orbit of one).  A side of a prism
-    (:mod:`softdesign.meshing.sweep_mesh`) has its diagonal start at the
+    (:mod:`softdesign.meshing.volume_mesh.sweep_mesh`) has its diagonal start at the
     corner of the lower orbit, or between two copies of one orbit at the copy
     that R takes to the other: a rule that turns with R and depends on the
     side alone (neighbours conform).  It splits every prism unless a triangle

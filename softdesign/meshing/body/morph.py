@@ -19,7 +19,7 @@ import numpy as np
 from softdesign.errors import MeshError
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.geometry.blend import BlendedShape
-from softdesign.meshing.body import export_l_grid, sections_on_grid
+from softdesign.meshing.body.sections import export_l_grid, sections_on_grid
 from softdesign.meshing.solids import cut_body
 from softdesign.meshing.tessellate import sweep_from_sections
 from softdesign.meshing.volume import BodySpec, angle_grid

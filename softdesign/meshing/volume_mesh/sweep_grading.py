@@ -2,7 +2,7 @@
 
 Why
     The swept mesh measures the skin's stretch at the centres of its skin
-    quads, half a layer from each layer (:func:`softdesign.meshing.sweep_strain.
+    quads, half a layer from each layer (:func:`softdesign.meshing.volume_mesh.sweep_strain.
     skin_stretches`).  Layers evenly ``size_mm`` apart miss a narrow peak: on
     the VMTK aorta at q = 1 the skin's stretch rises from 1.29 to 1.59 and falls
     to 1.38 within 1.2 mm, 2.5 mm from the base, and layers 1.9 mm apart gave

@@ -1,4 +1,4 @@
-"""The swept mesh of :mod:`softdesign.meshing.sweep_mesh` placed in space: the body at q, node by node.
+"""The swept mesh of :mod:`softdesign.meshing.volume_mesh.sweep_mesh` placed in space: the body at q, node by node.
 
 Map
     Layer j at q is the export's section at ``l_j(q)``: centre c, frame (N, B),
@@ -51,13 +51,13 @@ import numpy as np
 from softdesign.errors import MeshError
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.geometry.frames import FramedSpline
-from softdesign.meshing.body import sections_on_grid
-from softdesign.meshing.chamber_layout import ChamberLayout
+from softdesign.meshing.body.sections import sections_on_grid
+from softdesign.meshing.chambers.layout import ChamberLayout
 from softdesign.meshing.end_cut import CutPlane, along_generators, crease_targets, cut_planes, cut_targets
-from softdesign.meshing.sweep_layout import MIN_FEED_NODES, check_resolvable, layout_holes
-from softdesign.meshing.sweep_mesh import Hole, SweptMesh
 from softdesign.meshing.tessellate import Sweep, sweep_from_sections
 from softdesign.meshing.volume import BodySpec, angle_grid
+from softdesign.meshing.volume_mesh.sweep_layout import MIN_FEED_NODES, check_resolvable, layout_holes
+from softdesign.meshing.volume_mesh.sweep_mesh import Hole, SweptMesh
 from softdesign.types import FloatArray
 
 
@@ -275,15 +275,16 @@ def plan_mesh(curve0: FramedSpline, field: RadiusField, layers: FloatArray, spec
     size_mm : the largest edge inside the section, mm
     layout : issue 31's chambers and feeds (a solid body's), or None
     reference_l : (m,) float, the l at which the section's scale and the chamber's reference radius are taken
-        (None: ``layers``); layers graded finer somewhere (:mod:`softdesign.meshing.sweep_grading`) pass their
-        even grid, so that where the layers crowd does not move the reference section
+        (None: ``layers``); layers graded finer somewhere
+        (:mod:`softdesign.meshing.volume_mesh.sweep_grading`) pass their even grid, so that where the layers
+        crowd does not move the reference section
 
     The chamber's reference radius is the median ratio of the chamber's to the outer section's radius
     at q = 0 (so the depth coordinate is about uniform); the port's is its radius over the chamber's
     base section's mean radius, in the chamber's units.
     """
-    from softdesign.meshing.cross_section import Circle
-    from softdesign.meshing.sweep_mesh import Hole, swept_disk
+    from softdesign.meshing.volume_mesh.cross_section import Circle
+    from softdesign.meshing.volume_mesh.sweep_mesh import Hole, swept_disk
 
     a = angle_grid(angular_count)
     even = layers if reference_l is None else np.asarray(reference_l, float)
@@ -342,7 +343,8 @@ def holes_from_layout(layout: ChamberLayout, scale_mm: float, rho_min_mm: float,
     ``s{i}_c{j}_wall``, ``_cap``); its feed ``s{i}_c{j}_feed`` belongs to the same cavity and opens at the base
     (``s{i}_c{j}_feed_inlet``).
     ``scale_mm`` (R0) is mm per reference unit, ``rho_min_mm`` the thinnest section's radius over the morph,
-    ``size_mm`` the element size the circles' nodes follow (:func:`~softdesign.meshing.sweep_layout.circle_nodes`).
+    ``size_mm`` the element size the circles' nodes follow
+    (:func:`~softdesign.meshing.volume_mesh.sweep_layout.circle_nodes`).
     """
     reach = max([c.distance_mm + 0.5 * c.diameter_mm for c in layout.chambers]
                 + [f.ring_mm + 0.5 * f.diameter_mm for f in layout.feeds])

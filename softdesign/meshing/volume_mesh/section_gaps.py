@@ -1,6 +1,6 @@
 """How finely a cross-section's circles must be noded so that the triangulation keeps them all.
 
-The swept mesher (:mod:`softdesign.meshing.cross_section`) lays every hole
+The swept mesher (:mod:`softdesign.meshing.volume_mesh.cross_section`) lays every hole
 of the body in one reference section: with issue 31's layout, every
 section's three chambers and every feed, 3n ring members ``120 / n``
 degrees apart, the chambers of neighbouring sections only
@@ -14,7 +14,7 @@ that reach is at most ``GAP_REACH`` of its smallest gap to another circle's
 nodes (two disjoint circles: centre distance less both radii; nested:
 outer radius less inner radius less the centre offset).  The circles keep
 uniform nodes, so their polygons keep the circle's area
-(:attr:`~softdesign.meshing.cross_section.Circle.equal_area`).  Refining
+(:attr:`~softdesign.meshing.volume_mesh.cross_section.Circle.equal_area`).  Refining
 the gaps' circles, not the whole section, keeps the mesh small: only the
 circles next to a narrow gap get more nodes.
 
@@ -30,7 +30,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from softdesign.meshing.cross_section import Circle
+from softdesign.meshing.volume_mesh.cross_section import Circle
 from softdesign.types import FloatArray
 
 #: An edge's diametral disk may reach at most this fraction of the circle's smallest gap off the circle.

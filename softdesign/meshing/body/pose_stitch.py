@@ -10,7 +10,7 @@ Joints
     Offset sections (``offset_mm``) are not radial: at an unmerged joint both rings first slide
     along their own section polygon onto the rays (polar resampling).
 
-:mod:`softdesign.meshing.pose_body` places the pieces and checks the solid.
+:mod:`softdesign.meshing.body.pose` places the pieces and checks the solid.
 """
 
 from __future__ import annotations

@@ -34,8 +34,8 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.geometry.frames import FramedSpline
-from softdesign.meshing.body import curvature_components
-from softdesign.meshing.chamber_layout import Chamber, ChamberLayout, Channel, Feed, offset_points
+from softdesign.meshing.body.sections import curvature_components
+from softdesign.meshing.chambers.layout import Chamber, ChamberLayout, Channel, Feed, offset_points
 from softdesign.meshing.solids import Solid, _regions_after, checked, cut_body, manifold_from_mesh, welded_as_written
 from softdesign.meshing.tessellate import Region, Sweep, TubeMesh, TubeSections, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec
@@ -277,10 +277,10 @@ def measured_skin_walls(sections: TubeSections, spec: BodySpec, curve: FramedSpl
     mesh: a chamber's end walls count, cut on a slant or not), ``feed-skin (mesh)`` (to the side wall only:
     a feed opens through the base face) or ``channel-skin (mesh)`` (a series channel's, every ring whole).
     Along a tube the skin's nearest point faces away from the backbone, so the outer half of each ring is
-    measured, and the end rings whole.  A check of the exported geometry
-    itself beside the in-section figures of :mod:`chamber_walls`: the tubes' polygons are area-matched, so a
-    vertex lies up to ``r (sqrt(2 pi / (n sin(2 pi / n))) - 1)`` outside the design circle (0.3 % of r at 32
-    sides) and the figure errs low by that much.
+    measured, and the end rings whole.  A check of the exported geometry itself beside the in-section figures
+    of :mod:`~softdesign.meshing.chambers.walls`: the tubes' polygons are area-matched, so a vertex lies up to
+    ``r (sqrt(2 pi / (n sin(2 pi / n))) - 1)`` outside the design circle (0.3 % of r at 32 sides) and the figure
+    errs low by that much.
     """
     from softdesign.meshing.compare import squared_distances
     from softdesign.meshing.tessellate import ring_points

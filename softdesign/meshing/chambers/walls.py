@@ -2,7 +2,7 @@
 
 In-section measure
     Chambers and feeds are tubes whose sections are circles in the body's
-    normal planes (:mod:`softdesign.meshing.chambers`), and the offset axes'
+    normal planes (:mod:`softdesign.meshing.chambers.carve`), and the offset axes'
     tangents are parallel to T there, so between two tubes at the same l the
     in-plane gap is a critical point of their 3D distance: on a section of a
     torus, the nearest points of two such tubes lie in one normal plane.  Two
@@ -15,7 +15,7 @@ In-section measure
     normal, which is in-plane but for the slope rho_s).
 Extension
     A chamber's length is its axis's, ``integral (1 - d (k1 cos beta + k2 sin
-    beta)) ds`` over its l-range (:func:`~softdesign.meshing.chambers.axis_lengths`);
+    beta)) ds`` over its l-range (:func:`~softdesign.meshing.chambers.carve.axis_lengths`);
     its extension is that at q over that at q = 0.
 """
 
@@ -28,8 +28,8 @@ import numpy as np
 
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.geometry.frames import FramedSpline
-from softdesign.meshing.chamber_layout import ChamberLayout, analytic_walls
-from softdesign.meshing.chambers import piecewise_axis_length
+from softdesign.meshing.chambers.carve import piecewise_axis_length
+from softdesign.meshing.chambers.layout import ChamberLayout, analytic_walls
 from softdesign.meshing.volume import angle_grid
 from softdesign.types import FloatArray
 

@@ -1,6 +1,6 @@
 """The mould of an actuated body: the two halves, a core plate at the base, one core per chamber and feed.
 
-Parts (built on :func:`softdesign.meshing.mould.build_mould`'s halves of the
+Parts (built on :func:`softdesign.meshing.mould.parts.build_mould`'s halves of the
 outer body, then split and cored):
 
     cores    one per chamber: the chamber's tube united with its feed's, the
@@ -45,10 +45,9 @@ from typing import Any
 import manifold3d as m3
 import numpy as np
 
-from softdesign.meshing.chamber_layout import ChamberLayout
-from softdesign.meshing.chambers import Cavity, build_actuated, cavity_sweeps
-from softdesign.meshing.mould import MouldParts, MouldRefused, MouldSpec, _cylinder, build_mould
-from softdesign.meshing.mould_checks import (
+from softdesign.meshing.chambers.carve import Cavity, build_actuated, cavity_sweeps
+from softdesign.meshing.chambers.layout import ChamberLayout
+from softdesign.meshing.mould.checks import (
     CAVITY_RTOL,
     DISJOINT_RTOL,
     cavity_figures,
@@ -57,8 +56,9 @@ from softdesign.meshing.mould_checks import (
     pull_check,
     shared_volume,
 )
-from softdesign.meshing.mould_frame import PartingFrame, parting_frame
-from softdesign.meshing.mould_make import Mould, MouldMesh, checks_passed
+from softdesign.meshing.mould.frame import PartingFrame, parting_frame
+from softdesign.meshing.mould.make import Mould, MouldMesh, checks_passed
+from softdesign.meshing.mould.parts import MouldParts, MouldRefused, MouldSpec, _cylinder, build_mould
 from softdesign.meshing.solids import checked, cut_body, manifold_from_mesh, welded_as_written
 from softdesign.meshing.tessellate import Region, Sweep, TubeMesh, TubeSections, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec
@@ -316,9 +316,13 @@ def _pulls(parts: MouldParts, half_a: m3.Manifold, half_b: m3.Manifold, plate: m
                   "sprue_nub_faces": len(sprue)}
         lean = 0.0 if lost else _pin_lean(pins, outward)
         if failures or lean > PIN_SIDE_TOL:
+            worst = max((f.component for f in failures), default=0.0)
             raise MouldRefused(f"export.mould: the core plate does not pull free along the base tangent "
-                               f"({len(failures)} faces against the pull or blocked by a half; pins' sides lean "
-                               f"{lean:.2e} off it)")
+                               f"({len(failures)} faces against the pull or blocked by a half, leaning up to "
+                               f"{worst:.3g} where a facet may lean {facet_tol:.3g}, sin(pi / export.angular_count); "
+                               f"pins' sides lean {lean:.2e} off it): a slanted base face leaves the plate a wedge "
+                               "of the body's wall to slide off; use fit.end_cut: normal (a square base face, which "
+                               "the plate meets on one plane), or fewer export.angular_count")
         pulls["core_plate"] = {**result, "pin_side_lean": lean, "pull": (frame.axes.T @ outward).tolist()}
     for half, solid, other, pull in (("A", half_a, half_b, np.array([0.0, 0.0, 1.0])),
                                      ("B", half_b, half_a, np.array([0.0, 0.0, -1.0]))):

@@ -2,9 +2,9 @@
 
 :func:`make_mould` joins :mod:`~softdesign.meshing.solids` (the body, its
 chamber and port, exactly as the export builds them), the parting frame,
-:func:`~softdesign.meshing.mould.build_mould` and the checks of
-:mod:`~softdesign.meshing.mould_checks`.  An undercut refuses the mould
-(:class:`~softdesign.meshing.mould.MouldRefused`, exit 2) naming the link, l
+:func:`~softdesign.meshing.mould.parts.build_mould` and the checks of
+:mod:`~softdesign.meshing.mould.checks`.  An undercut refuses the mould
+(:class:`~softdesign.meshing.mould.parts.MouldRefused`, exit 2) naming the link, l
 and angle of the body's faces that cause it; any other failed check is a bug
 (MeshError).  Returns the parts as plain arrays in the body's coordinates.
 """
@@ -18,8 +18,7 @@ from typing import Any
 import numpy as np
 
 from softdesign.errors import MeshError
-from softdesign.meshing.mould import Core, MouldParts, MouldRefused, MouldSpec, build_mould, inside_mm
-from softdesign.meshing.mould_checks import (
+from softdesign.meshing.mould.checks import (
     CAVITY_RTOL,
     DISJOINT_RTOL,
     cavity_figures,
@@ -28,7 +27,8 @@ from softdesign.meshing.mould_checks import (
     pull_check,
     shared_volume,
 )
-from softdesign.meshing.mould_frame import PartingFrame, parting_frame
+from softdesign.meshing.mould.frame import PartingFrame, parting_frame
+from softdesign.meshing.mould.parts import Core, MouldParts, MouldRefused, MouldSpec, build_mould, inside_mm
 from softdesign.meshing.solids import (
     build_solid,
     cut_body,
@@ -174,7 +174,7 @@ def checks_passed(figures: dict[str, Any], frame: PartingFrame) -> None:
 
 
 def _check(parts: MouldParts, frame: PartingFrame, name: Callable[[int, int], str], facet_tol: float) -> dict:
-    """Every check of :mod:`~softdesign.meshing.mould_checks`; refuse an undercut, MeshError on anything else."""
+    """Every check of :mod:`~softdesign.meshing.mould.checks`; refuse an undercut, MeshError on anything else."""
     solids = {"half_a": parts.half_a, "half_b": parts.half_b}
     if parts.core is not None:
         solids["core"] = parts.core

@@ -1,6 +1,6 @@
 """A two-part casting mould (and a core for a hollow body) around the body at q = 0, with manifold3d.
 
-Built in the mould frame of :mod:`softdesign.meshing.mould_frame` (z the
+Built in the mould frame of :mod:`softdesign.meshing.mould.frame` (z the
 parting plane's normal), then mapped back to the body's coordinates:
 
     box      the body's bounding box grown by ``margin_mm`` on every side
@@ -33,8 +33,8 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import InputDataError, MeshError
-from softdesign.meshing.mould_frame import PartingFrame
-from softdesign.meshing.mould_spec import MIN_MOULD_WALL_MM, MouldSpec
+from softdesign.meshing.mould.frame import PartingFrame
+from softdesign.meshing.mould.spec import MIN_MOULD_WALL_MM, MouldSpec
 from softdesign.meshing.solids import PORT_INSIDE_WALLS, checked
 from softdesign.types import FloatArray
 

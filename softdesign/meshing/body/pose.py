@@ -13,7 +13,7 @@ Placement
     start2world_{j+1}: the end ring of link j and the start ring of link j+1 lie in one plane,
     about one centre, with one N axis (angle 0), whatever the two q are.
 Joints
-    See :mod:`softdesign.meshing.pose_stitch`: rings on the rays of the joint frame, shared
+    See :mod:`softdesign.meshing.body.pose_stitch`: rings on the rays of the joint frame, shared
     where they coincide, else closed by a planar annulus.
 Hollow (``wall_mm``, ``port_mm``)
     The chamber is posed like the body: each link's piece offset inward by ``wall_mm``, stitched
@@ -45,10 +45,10 @@ from softdesign.fitting.radius_field import RadiusField
 from softdesign.geometry.frames import FramedSpline
 from softdesign.geometry.se3 import inverse_pose
 from softdesign.kinematics.links import LinkChain
-from softdesign.meshing.body import body_breaks, body_stations, export_l_grid, sections_on_grid
+from softdesign.meshing.body.pose_stitch import JointStep, JointStitch, assemble, placed, resampled_joints
+from softdesign.meshing.body.sections import body_breaks, body_stations, export_l_grid, sections_on_grid
 from softdesign.meshing.checks import Expectation, MeshReport, check_solid
 from softdesign.meshing.end_cut import CutPlane, cut_planes, end_cut_volume
-from softdesign.meshing.pose_stitch import JointStep, JointStitch, assemble, placed, resampled_joints
 from softdesign.meshing.solids import carve_chamber, manifold_from_mesh
 from softdesign.meshing.tessellate import Sweep, TubeMesh, TubeSections, sweep_from_sections, trim_sweep
 from softdesign.meshing.volume import (

@@ -1,7 +1,7 @@
 """The 3D strain and stress of the swept mesh between q = 0 and q, with where the extremes sit.
 
-Every node of :mod:`softdesign.meshing.sweep_body` is one material point at
-every q, so :mod:`softdesign.mechanics.kinematic_stress` gives each
+Every node of :mod:`softdesign.meshing.volume_mesh.sweep_body` is one material point at
+every q, so :mod:`softdesign.continuum.kinematic_stress` gives each
 tetrahedron's strain from its nodes at q = 0 and at q.  The traction-free
 direction of the stress is the normal of the surfaces of constant depth
 (``t = sqrt(x^2 + y^2)`` of the reference disk: the skin, and the chamber's
@@ -29,11 +29,11 @@ from typing import Any
 
 import numpy as np
 
+from softdesign.continuum.kinematic_stress import ElementStrain, element_strain, rest_inverses
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.fitting.strain import principal_stretches
-from softdesign.mechanics.kinematic_stress import ElementStrain, element_strain, rest_inverses
-from softdesign.mechanics.laws import HyperelasticLaw
-from softdesign.meshing.sweep_body import SweepReference
-from softdesign.meshing.sweep_mesh import SweptMesh
+from softdesign.meshing.volume_mesh.sweep_body import SweepReference
+from softdesign.meshing.volume_mesh.sweep_mesh import SweptMesh
 from softdesign.types import FloatArray, IntArray
 
 
@@ -56,7 +56,7 @@ class Extreme:
 
 def free_directions(mesh: SweptMesh, rest: FloatArray, inverses: FloatArray | None = None) -> FloatArray:
     """(T, 3) unit normals at q = 0 of the surfaces of constant depth through each tetrahedron (module notes);
-    ``inverses``: :func:`~softdesign.mechanics.kinematic_stress.rest_inverses` of ``rest``, when at hand."""
+    ``inverses``: :func:`~softdesign.continuum.kinematic_stress.rest_inverses` of ``rest``, when at hand."""
     param = mesh.reference_points()
     t = mesh.tets
     dp = (param[t[:, 1:]] - param[t[:, :1]]).transpose(0, 2, 1)
@@ -91,7 +91,7 @@ def extreme_of(values: FloatArray, places: tuple[IntArray, FloatArray, FloatArra
 def strain_at(mesh: SweptMesh, rest: FloatArray, moved: FloatArray, law: HyperelasticLaw | None,
               free: FloatArray, inverses: FloatArray | None = None) -> ElementStrain:
     """Every tetrahedron's strain (and stress, with a law) between ``rest`` (q = 0) and ``moved``;
-    ``inverses`` (:func:`~softdesign.mechanics.kinematic_stress.rest_inverses`) computed once for every q."""
+    ``inverses`` (:func:`~softdesign.continuum.kinematic_stress.rest_inverses`) computed once for every q."""
     return element_strain(rest, moved, mesh.tets, law, free, inverses)
 
 

@@ -6,7 +6,7 @@ envelope of the input surface; a closed inner shell (a hollow body's chamber)
 stays empty, since it fills by winding number.  Its target edge length and
 envelope are given here in mm (pytetwild takes the envelope relative to the
 bounding box diagonal).  The result is in VTK's and Gmsh's node order (every
-tetrahedron positive, :mod:`softdesign.meshing.tet_quality`).
+tetrahedron positive, :mod:`softdesign.meshing.volume_mesh.tet_quality`).
 
 fTetWild is not deterministic: two runs on the same surface give different
 tetrahedra (the same volume, within the envelope), as pytetwild's maintainers

@@ -34,7 +34,7 @@ from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.radius_rows import SlopeRows, row_blocks
 from softdesign.fitting.strain import SectionDerivatives, curve_terms, metric_from_planes
 from softdesign.geometry.frames import FramedSpline
-from softdesign.meshing.body import body_sections
+from softdesign.meshing.body.sections import body_sections
 from softdesign.meshing.compare import squared_distances
 from softdesign.meshing.tessellate import Sweep, ring_points, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec, angle_grid, angular_derivative, section_curves

@@ -8,7 +8,7 @@ principal stretches
     lambda_i, square roots of the eigenvalues of ``C = F^T F`` (sorted
     descending); the largest principal Green strain is ``(lambda_1^2 - 1) / 2``.
 Cauchy stress
-    The laws of :mod:`softdesign.mechanics.laws` (neo-Hookean, Yeoh) taken
+    The laws of :mod:`softdesign.continuum.laws` (neo-Hookean, Yeoh) taken
     incompressible: ``sigma = 2 W'(I1_bar) B_bar - p I`` with ``B_bar =
     J^(-2/3) F F^T``.  The morph does not say p (it is what equilibrium would
     fix), so it is taken from a traction-free direction: ``n . sigma n = 0``
@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from softdesign.mechanics.laws import HyperelasticLaw
+from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.types import FloatArray, IntArray
 
 

@@ -1,7 +1,7 @@
 """What a casting mould is asked to be (the case file's ``export.mould``), free of geometry imports.
 
 The case file's schema checks against these numbers before any work starts;
-:mod:`softdesign.meshing.mould` builds the mould.
+:mod:`softdesign.meshing.mould.parts` builds the mould.
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ the tetrahedra fill the body's volume up to that envelope: within
 body's chamber must stay empty: no tetrahedron's centroid inside the closed
 chamber surface (fTetWild fills by winding number, so a chamber wound
 inwards stays out; a tetrahedron inside would also show in the volume).
-The figures are those of :mod:`softdesign.meshing.tet_quality`, with the
+The figures are those of :mod:`softdesign.meshing.volume_mesh.tet_quality`, with the
 boundary's topology (the faces of one tetrahedron only).
 """
 
@@ -19,8 +19,8 @@ import numpy as np
 
 from softdesign.errors import MeshError
 from softdesign.meshing.enclosed import points_inside
-from softdesign.meshing.tet_quality import boundary_faces, tet_centroids, tet_quality
 from softdesign.meshing.topology import mesh_topology
+from softdesign.meshing.volume_mesh.tet_quality import boundary_faces, tet_centroids, tet_quality
 from softdesign.types import FloatArray, IntArray
 
 #: The tetrahedra's volume against the body's, relative (issue 16).

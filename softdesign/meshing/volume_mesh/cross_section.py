@@ -8,7 +8,7 @@ Reference plane
     that the triangulation conforms to: its circle is a chain of edges, every
     triangle lies wholly inside or outside it.  The hole's inside is meshed
     too: a chamber exists only over part of the length, and where it does not
-    the section is solid (:mod:`softdesign.meshing.sweep_mesh` drops the
+    the section is solid (:mod:`softdesign.meshing.volume_mesh.sweep_mesh` drops the
     hole's triangles layer by layer).
 Points
     Each circle (the outer one and every hole's) is a front: its own nodes,
@@ -19,14 +19,14 @@ Points
     their ring's distance from a circle; one closer than ``KEEP_FRACTION`` of
     the smaller local size to a kept point is dropped.  A circle's nodes are
     equal steps from angle 0, or graded (``Circle.angles``) where it passes a
-    narrow gap (:mod:`softdesign.meshing.section_gaps`); a graded circle's
+    narrow gap (:mod:`softdesign.meshing.volume_mesh.section_gaps`); a graded circle's
     fronts start at its largest edge and keep off it by that edge.
 Three-fold symmetry
     When the holes map onto themselves under a rotation by 120 degrees and
     ``na`` is a multiple of three (issue 31's chambers and feeds), the points
     are made orbit by orbit with the centre among them, and prisms are split
     by a rule that turns with the rotation
-    (:mod:`softdesign.meshing.three_fold`): the mesh maps onto itself, so
+    (:mod:`softdesign.meshing.volume_mesh.three_fold`): the mesh maps onto itself, so
     three equal chambers at equal pressure do not bend it.  Should the
     Delaunay triangulation of those points break a tie unevenly, the points
     above are used instead.
@@ -46,7 +46,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from softdesign.errors import MeshError
-from softdesign.meshing.three_fold import SymmetricPoints, hole_turns, keep_orbits, orbit_heads, with_copies
+from softdesign.meshing.volume_mesh.three_fold import SymmetricPoints, hole_turns, keep_orbits, orbit_heads, with_copies
 from softdesign.types import FloatArray, IntArray
 
 #: Local size grows by this factor per ring away from a circle.  1.4 rather than 1.25: the aorta with chambers
@@ -75,7 +75,7 @@ class Circle:
     #: few nodes: r sqrt(h / sin h), h = 2 pi / nodes) rather than on the circle itself
     equal_area: bool = False
     #: the nodes' angles (rad, increasing from 0), graded where the circle passes a narrow gap
-    #: (:func:`softdesign.meshing.section_gaps.resolve_circles`); empty: ``nodes`` equal steps from angle 0
+    #: (:func:`softdesign.meshing.volume_mesh.section_gaps.resolve_circles`); empty: ``nodes`` equal steps from angle 0
     angles: tuple[float, ...] = ()
 
     def node_angles(self, count: int) -> FloatArray:
@@ -116,7 +116,7 @@ class CrossSection:
     outer_count : int, na
     corner_order : (T, 3) int64 or None, the order of each triangle's corners that prisms over it are split
         by (None: the points' own order); set when the section is three-fold symmetric
-        (:mod:`softdesign.meshing.three_fold`), so that the split commutes with the rotation
+        (:mod:`softdesign.meshing.volume_mesh.three_fold`), so that the split commutes with the rotation
     """
 
     points: FloatArray
@@ -233,7 +233,7 @@ def _keep(fixed: list[FloatArray], sizes: list[FloatArray], rings,
 def _symmetric_points(outer_count: int, circles: Sequence[Circle], size: float,
                       counts: list[int]) -> SymmetricPoints | None:
     """The points of :func:`_candidates` and :func:`_keep` made orbit by orbit under the 120-degree rotation
-    (:mod:`softdesign.meshing.three_fold`), or None when the section is not three-fold symmetric."""
+    (:mod:`softdesign.meshing.volume_mesh.three_fold`), or None when the section is not three-fold symmetric."""
     centres = np.array([c.center for c in circles], float).reshape(-1, 2)
     turns = hole_turns(centres, np.array([c.radius for c in circles]), counts)
     if not circles or outer_count % 3 or turns is None or any(c.equal_area != circles[turns[i]].equal_area

@@ -1,13 +1,13 @@
 """Issue 31's layout as the swept mesher's holes, and the check that its one cross-section can hold them.
 
-The swept mesh (:mod:`softdesign.meshing.sweep_mesh`) has one cross-section
+The swept mesh (:mod:`softdesign.meshing.volume_mesh.sweep_mesh`) has one cross-section
 for the whole body, so every section's chambers and every feed are holes of
 it at once, each existing over its own l-range.  On issue 31's layout they
 all lie on one ring, 3n of them ``120 / n`` degrees apart, and neighbouring
 sections' chambers come ``2 d sin(60 deg / n) - D`` apart there, closer than
 the layout's own walls (which only count what exists at one l): 0.032 mm on
 the demo's defaults at five sections, 0 or less when ``D - f`` exceeds twice
-the layout's thinnest wall.  :mod:`softdesign.meshing.section_gaps` grades
+the layout's thinnest wall.  :mod:`softdesign.meshing.volume_mesh.section_gaps` grades
 the circles' nodes at such gaps; :func:`check_resolvable` refuses, before
 any meshing, a layout whose gaps no grading resolves, with the keys and
 the values that would fit.
@@ -20,14 +20,14 @@ from dataclasses import replace
 import numpy as np
 
 from softdesign.errors import ConfigError
-from softdesign.meshing.chamber_layout import ChamberLayout
-from softdesign.meshing.cross_section import Circle
-from softdesign.meshing.sweep_mesh import Hole
+from softdesign.meshing.chambers.layout import ChamberLayout
+from softdesign.meshing.volume_mesh.cross_section import Circle
+from softdesign.meshing.volume_mesh.sweep_mesh import Hole
 
 #: Nodes on a chamber's and a feed's circle (at least).  Their polygons have the circle's area
 #: (Circle.equal_area: nodes on r sqrt(h / sin h), h = 2 pi / n), so the cavity's volume is the layout's at any
 #: count; an inscribed polygon would lose 1 - sin(h) / h of it, 2.5 % at 16 nodes and under 1 % from 26.  The
-#: floors keep the circle round enough for the gap grading's reach (:func:`~softdesign.meshing.section_gaps.
+#: floors keep the circle round enough for the gap grading's reach (:func:`~softdesign.meshing.volume_mesh.section_gaps.
 #: smallest_gap` is stated at MIN_CHAMBER_NODES); more nodes where the skin's are closer.
 MIN_CHAMBER_NODES, MIN_FEED_NODES = 16, 12
 
@@ -65,15 +65,15 @@ def layout_holes(layout: ChamberLayout, scale_mm: float, size_mm: float) -> list
 
 
 def check_resolvable(layout: ChamberLayout, holes: list[Hole], scale_mm: float) -> list[Hole]:
-    """``holes`` with their circles graded at narrow gaps (:func:`~softdesign.meshing.section_gaps.
+    """``holes`` with their circles graded at narrow gaps (:func:`~softdesign.meshing.volume_mesh.section_gaps.
     resolve_circles`); ConfigError (exit 2) for a layout whose chambers and feeds the one cross-section
     cannot resolve.
 
     The section holds every section's chambers and feeds at once
-    (:mod:`softdesign.meshing.section_gaps`): neighbouring sections' chambers are ``2 d sin(60 deg / n) - D``
-    apart there, less than the layout's own walls.  Checked before any meshing.
+    (:mod:`softdesign.meshing.volume_mesh.section_gaps`): neighbouring sections' chambers are
+    ``2 d sin(60 deg / n) - D`` apart there, less than the layout's own walls.  Checked before any meshing.
     """
-    from softdesign.meshing.section_gaps import resolve_circles, smallest_gap, unresolved
+    from softdesign.meshing.volume_mesh.section_gaps import resolve_circles, smallest_gap, unresolved
 
     circles = [h.circle for h in holes]
     crossing = unresolved(circles, circles)  # touching or crossing only: no grading yet
@@ -88,7 +88,7 @@ def check_resolvable(layout: ChamberLayout, holes: list[Hole], scale_mm: float) 
 
 def _refusal(layout: ChamberLayout, first: str, second: str, gap_mm: float, nodes: int, floor_mm: float) -> str:
     """What cannot be resolved, where, and the values that would (``floor_mm``: the narrowest gap resolved)."""
-    from softdesign.meshing.section_gaps import MAX_CIRCLE_NODES
+    from softdesign.meshing.volume_mesh.section_gaps import MAX_CIRCLE_NODES
 
     spec, n = layout.spec, layout.sections
     what = (("touch" if gap_mm == 0 else "cross") if gap_mm <= 0 else

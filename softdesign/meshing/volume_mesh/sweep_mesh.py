@@ -1,9 +1,9 @@
 """A tetrahedral mesh of the body in its parameter domain: a cross-section swept along l in layers.
 
 Parameter domain
-    (x, y, l): the unit disk of :mod:`softdesign.meshing.cross_section` (x, y
+    (x, y, l): the unit disk of :mod:`softdesign.meshing.volume_mesh.cross_section` (x, y
     in fractions of the section's radius along N, B) times l in [0, 1].  A
-    mapping to space at some q (:mod:`softdesign.meshing.sweep_body`) moves
+    mapping to space at some q (:mod:`softdesign.meshing.volume_mesh.sweep_body`) moves
     the nodes only, so every q has this mesh's connectivity.
 Layers
     The cross-section is copied at each layer ``l_j``; node ``j * P + p`` is
@@ -18,7 +18,7 @@ Prisms into tetrahedra
     sharing a face cut it alike and the mesh conforms.  A three-fold
     symmetric section orders its triangles' corners by a rule of the same
     kind that turns with its rotation (``corner_order``,
-    :mod:`softdesign.meshing.three_fold`), so that the split commutes with it.  Every tetrahedron is
+    :mod:`softdesign.meshing.volume_mesh.three_fold`), so that the split commutes with it.  Every tetrahedron is
     then ordered to positive volume in (x, y, l) (VTK's order).
 Named surfaces
     Boundary faces (those of one tetrahedron), outward: ``skin`` (the outer
@@ -39,7 +39,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import MeshError
-from softdesign.meshing.cross_section import Circle, CrossSection, cross_section, turned_gradings
+from softdesign.meshing.volume_mesh.cross_section import Circle, CrossSection, cross_section, turned_gradings
 from softdesign.types import FloatArray, IntArray
 
 #: A grid value closer than this fraction of its neighbouring step to a hole's end is dropped (no slivers).
@@ -263,8 +263,8 @@ def _lids(section: CrossSection, holes: Sequence[Hole], l: FloatArray, used: Int
 
 def swept_disk(outer_count: int, holes: Sequence[Hole], size: float, l: npt.ArrayLike) -> SweptMesh:
     """:func:`cross_section` with the holes' circles, swept through :func:`layer_grid` of ``l``; circles next
-    to a narrow gap get more nodes (:func:`~softdesign.meshing.section_gaps.resolve_circles`)."""
-    from softdesign.meshing.section_gaps import resolve_circles
+    to a narrow gap get more nodes (:func:`~softdesign.meshing.volume_mesh.section_gaps.resolve_circles`)."""
+    from softdesign.meshing.volume_mesh.section_gaps import resolve_circles
 
     # a three-fold symmetric section's orbits share their first circle's grading, turned (its nodes are those)
     circles = turned_gradings(outer_count, resolve_circles([h.circle for h in holes]), size)
