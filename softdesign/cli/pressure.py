@@ -47,10 +47,16 @@ def pressure(
     """
 
     def action() -> None:
+        from softdesign.pipeline.rod_pressure import answer_if_unchanged
+
+        _check(q, pressure_kpa)
+        quick = answer_if_unchanged(case_file, out, q, pressure_kpa)  # the build's own case and inputs: no models
+        if quick is not None:
+            _answer(quick, json_out)
+            return
         from softdesign.config import load_case
         from softdesign.pipeline.rod_pressure import check_pressure_case, pressure_from_build
 
-        _check(q, pressure_kpa)
         case = load_case(case_file)
         with errors_named_for(case_file):
             check_pressure_case(case, pressure_kpa)
@@ -62,12 +68,16 @@ def pressure(
             outcome = build_through(case_file, out, target="fit", progress=note, case=case)
             with errors_named_for(case_file):
                 document = pressure_document(outcome, q, pressure_kpa)
-        if json_out:
-            emit_json(document)
-            return
-        _print(document)
+        _answer(document, json_out)
 
     run_guarded(action)
+
+
+def _answer(document: dict, json_out: bool) -> None:
+    if json_out:
+        emit_json(document)
+        return
+    _print(document)
 
 
 def _print(document: dict) -> None:

@@ -24,7 +24,7 @@ from softdesign.config.shapes import FinalShape, InitialShape, IntermediateShape
 from softdesign.config.simulate import Simulate
 from softdesign.config.types import CaseBlock
 from softdesign.errors import ConfigError
-from softdesign.io.case_yaml import parse_case_yaml, read_case_text
+from softdesign.io.case_yaml import case_text_record, parse_case_yaml, read_case_text
 from softdesign.meshing.volume_tolerance import MAX_CAVITY_SHARE, MIN_ANGULAR_COUNT_WITH_CAVITIES
 
 
@@ -74,6 +74,7 @@ class Case(CaseBlock):
     """Estimate each section's chamber pressures for given q in the build (finite elements; off unless enabled)."""
 
     _base: Path = PrivateAttr(default_factory=Path.cwd)
+    _source: dict[str, str] | None = PrivateAttr(default=None)
 
     @model_validator(mode="after")
     def _pcc_needs_a_design(self) -> Case:
@@ -186,6 +187,12 @@ class Case(CaseBlock):
         """``path`` relative to the case file's folder, POSIX style (for outputs)."""
         return Path(os.path.relpath(path, self._base)).as_posix()
 
+    @property
+    def source(self) -> dict[str, str] | None:
+        """The case file it was read from: ``{"name": file name, "sha256": of its text}`` (None when not read from a
+        file).  ``softdesign pressure`` answers from a build without building the case's models when both match."""
+        return self._source
+
     def resolved(self) -> dict[str, Any]:
         """The case as a JSON-ready dict, defaults filled in, for the build folder.
 
@@ -205,13 +212,16 @@ def load_case(path: str | Path) -> Case:
         match the schema; the message names the file, line and field.
     """
     path = Path(path)
-    raw, root = _parse_yaml(path, read_case_text(path))
+    text = read_case_text(path)
+    raw, root = _parse_yaml(path, text)
     raw.setdefault("name", path.stem)
     try:
         case = Case.model_validate(raw)
     except ValidationError as err:
         raise ConfigError(format_errors(path, root, err, Case)) from None
-    return _resolve_paths(case, path.resolve().parent)
+    resolved = _resolve_paths(case, path.resolve().parent)
+    resolved._source = case_text_record(path, text)
+    return resolved
 
 
 def _parse_yaml(path: Path, text: str) -> tuple[dict[str, Any], yaml.Node | None]:

@@ -16,6 +16,7 @@ are kept as text, which the schema then refuses as a number.
 
 from __future__ import annotations
 
+import hashlib
 import os
 import stat
 from pathlib import Path
@@ -103,6 +104,12 @@ def file_kind(mode: int) -> str:
         (stat.S_ISSOCK, "a socket"),
     ]
     return next((name for test, name in kinds if test(mode)), "not a regular file")
+
+
+def case_text_record(path: Path, text: str) -> dict[str, str]:
+    """The case file's name and the sha256 of its text (as :func:`read_case_text` gives it): what a build records
+    to know the file again without validating it."""
+    return {"name": path.name, "sha256": hashlib.sha256(text.encode("utf-8")).hexdigest()}
 
 
 def parse_case_yaml(path: Path, text: str) -> tuple[Any, yaml.Node | None]:

@@ -56,6 +56,7 @@ def build_manifest(
     return {
         "software": software_versions(),
         "case": case.resolved(),
+        **({"case_file": case.source} if case.source is not None else {}),
         "inputs": [
             {"path": case.resolved_path(p), "sha256": h, "bytes": p.stat().st_size}
             for p, h in zip(inputs, input_hashes, strict=True)

@@ -99,3 +99,61 @@ def read_rod(case: Case, build_dir: Path, case_file: str) -> dict[str, Any]:
         raise ConfigError(f"pressure: an input file of this case changed since the build in {build_dir}: {remake} "
                           "again")
     return document
+
+
+def rod_of_unchanged_build(case_file: str | Path, out: Path | None) -> dict[str, Any] | None:
+    """The build's rod file, without building the case's models, when nothing it came from has changed.
+
+    That is when the build's manifest names this case file with the same text (``case_file``: its name and the
+    sha256 of its text), every input still has the sha256 the manifest recorded, the softdesign that built it is
+    this one, and the rod file is that build's (its ``case_sha256`` is the manifest's resolved case's).  None
+    otherwise, whatever the reason (no build, an edit, even a comment's, a file that cannot be read): the caller
+    then loads and validates the case and :func:`read_rod` says what is wrong.  Reads the case file, the manifest,
+    the inputs (to hash them) and the rod file; imports yaml only when ``out`` is None (the case's ``name``).
+    """
+    from softdesign import __version__
+    from softdesign.errors import SoftdesignError
+    from softdesign.io.case_yaml import case_text_record, parse_case_yaml, read_case_text
+    from softdesign.pipeline.store import canonical_json, sha256_file
+
+    path = Path(case_file)
+    try:
+        text = read_case_text(path)
+        build_dir = out if out is not None else Path("build") / _case_name(path, parse_case_yaml(path, text)[0])
+        manifest, document = _json_of(build_dir / "manifest.json"), _json_of(build_dir / ROD_FILE)
+        if (manifest.get("case_file") != case_text_record(path, text)
+                or manifest.get("software", {}).get("softdesign") != __version__
+                or not isinstance(document, dict) or document.get("format") != FORMAT
+                or document.get("case_sha256") != hashlib.sha256(
+                    canonical_json(manifest["case"]).encode("utf-8")).hexdigest()):
+            return None
+        base = path.resolve().parent
+        if any(sha256_file(base / item["path"]) != item["sha256"] for item in manifest["inputs"]):
+            return None
+    except (SoftdesignError, OSError, ValueError, KeyError, TypeError, AttributeError):
+        return None
+    return document
+
+
+#: The largest manifest or rod file the quick path reads (the demo's are 190 and 50 kB); a bigger one is left to
+#: the full path.
+QUICK_READ_BYTES = 64 * 2**20
+
+
+def _json_of(path: Path) -> Any:
+    """A regular file's JSON (ValueError for anything else: a folder, a FIFO, a file over QUICK_READ_BYTES)."""
+    import stat
+
+    info = path.stat()
+    if not stat.S_ISREG(info.st_mode) or info.st_size > QUICK_READ_BYTES:
+        raise ValueError(f"{path} is not a rod model's file")
+    return json.loads(path.read_text(encoding="utf-8"))
+
+
+def _case_name(path: Path, raw: Any) -> str:
+    """The case's ``name`` as :func:`softdesign.config.load_case` gives it (the file's stem by default)."""
+    name = raw.get("name", path.stem) if isinstance(raw, dict) else None
+    if not isinstance(name, str):
+        raise ValueError("no name")
+    return name
+

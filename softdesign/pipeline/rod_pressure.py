@@ -17,7 +17,7 @@ import numpy as np
 from softdesign.errors import ConfigError
 from softdesign.kinematics.rod import section_arcs, station_poses, strains
 from softdesign.pipeline.rod_evaluate import per_chamber_from_rod, single_from_rod
-from softdesign.pipeline.rod_file import read_rod
+from softdesign.pipeline.rod_file import read_rod, rod_of_unchanged_build
 
 if TYPE_CHECKING:
     from softdesign.config import Case
@@ -49,6 +49,28 @@ def pressure_from_build(case: Case, case_file: str, out: Path | None, q: float |
     rod = read_rod(case, build_dir, case_file)
     if rod["supply"] == "single":
         document = single_from_rod(rod, q, pressure_kpa)
+    else:
+        found = per_chamber_from_rod(rod, 1.0 if q is None else q)
+        if found is None:
+            return None
+        document = found
+    document["seconds"] = time.perf_counter() - start
+    return document
+
+
+def answer_if_unchanged(case_file: str | Path, out: Path | None, q: float | None,
+                        pressure_kpa: float | None) -> dict[str, Any] | None:
+    """The answer from the build's rod file when the case file and its inputs are those the build was made from
+    (:func:`~softdesign.pipeline.rod_file.rod_of_unchanged_build`), without loading the case; None otherwise, and
+    for what the rod file cannot answer alone (``--pressure`` on a per-chamber case, a q off the build's grid)."""
+    rod = rod_of_unchanged_build(case_file, out)
+    if rod is None:
+        return None
+    start = time.perf_counter()
+    if rod["supply"] == "single":
+        document = single_from_rod(rod, q, pressure_kpa)
+    elif pressure_kpa is not None:
+        return None  # the full path refuses it, naming the case's supply
     else:
         found = per_chamber_from_rod(rod, 1.0 if q is None else q)
         if found is None:

@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
 
 from softdesign.cli import app
+from softdesign.pipeline.rod_pressure import answer_if_unchanged
 from tests.cli.test_cli_validate import demo_case
 from tests.helpers.cases import case_from
 from tests.helpers.paths import REPO
@@ -69,6 +72,15 @@ def test_the_single_supply_demo_from_its_build(tmp_path: Path) -> None:
     assert abs(again["q"] - 0.5) <= SAME_TOL
     for a, b in zip(again["sections"], doc["sections"], strict=True):
         assert abs(a["kappa"] - b["kappa"]) <= SAME_TOL and abs(a["length"] - b["length"]) <= SAME_TOL
+    # unchanged case file and inputs: answered from the build alone, without the case's models (a new process)
+    assert _answers_without_the_case_models(case, out)
+    quick = answer_if_unchanged(case, out, 0.5, None)
+    assert quick is not None and {**quick, "seconds": 0} == {**doc, "seconds": 0}
+    # a comment is an edit the quick path cannot see through: the case is loaded and checked, the same answer
+    case.write_text(case.read_text() + "# a comment\n")
+    assert answer_if_unchanged(case, out, 0.5, None) is None
+    commented = runner.invoke(app, ["pressure", str(case), "--out", str(out), "--q", "0.5", "--json"])
+    assert commented.exit_code == 0 and {**json.loads(commented.stdout), "seconds": 0} == {**doc, "seconds": 0}
     # a build of other settings is not this case's: it says so and which command remakes it
     edited = case_from(tmp_path, case, {"export": {"q": [0.0, 1.0]}})
     stale = runner.invoke(app, ["pressure", str(edited), "--out", str(out), "--q", "0.5"])
@@ -88,3 +100,14 @@ def test_the_per_chamber_demo_gives_the_builds_pressures_at_a_grid_q(tmp_path: P
              for i in range(len(doc["pressures_kpa"]))]
     for mine, theirs in zip(doc["pressures_kpa"], built, strict=True):
         assert all(abs(a - b) <= SAME_TOL * max(1.0, abs(b)) for a, b in zip(mine, theirs, strict=True))
+
+
+def _answers_without_the_case_models(case: Path, out: Path) -> bool:
+    """``softdesign pressure`` in a fresh interpreter answers (exit 0) and never imports softdesign.config."""
+    code = ("import sys\nfrom softdesign.cli import main\n"
+            f"sys.argv = ['softdesign', 'pressure', {str(case)!r}, '--out', {str(out)!r}, '--q', '0.5']\n"
+            "try:\n    main()\nexcept SystemExit as e:\n    assert not e.code, e.code\n"
+            "print('config imported:', 'softdesign.config' in sys.modules)\n")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120)
+    return "config imported: False" in result.stdout
+
