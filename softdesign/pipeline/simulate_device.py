@@ -165,6 +165,30 @@ def device_mesh_of(outcome: Any, o: DeviceOptions) -> Any:
     return device
 
 
+#: The solve stops itself after this share of ``--timeout`` (between two steps), to report the largest load reached;
+#: the child is killed at the timeout itself.
+DEADLINE_SHARE = 0.8
+
+
+class _Deadline:
+    """The step listener that remembers the largest load reached and stops the solve past its deadline."""
+
+    def __init__(self, seconds: float, pressures: FloatList, told: Any) -> None:
+        self.end, self.pressures, self.told, self.t = time.perf_counter() + seconds, pressures, told, 0.0
+        self.seconds = seconds
+
+    def __call__(self, point: Any) -> None:
+        self.t = max(self.t, point.t)
+        if self.told is not None:
+            self.told(point)
+        if time.perf_counter() > self.end:
+            reached = ", ".join(f"{self.t * p:.4g}" for p in self.pressures)
+            raise SolveError(f"the whole device's solve was stopped after {self.seconds:.0f} s ({DEADLINE_SHARE:g} "
+                             f"of --timeout) at {reached} kPa (load factor {self.t:.4g}, the largest it reached); "
+                             "raise --timeout (simulate.timeout_s in a build), or coarsen the mesh (--size-mm, "
+                             "--layer-mm)")
+
+
 def solve_device_in_child(device: Any, law: Any, pressures: FloatList, o: DeviceOptions,
                           threads: tuple[Any, Any]) -> Any:
     """The worker (module-level: pickled by name): the solve and its figures
@@ -175,8 +199,9 @@ def solve_device_in_child(device: Any, law: Any, pressures: FloatList, o: Device
 
     start = time.process_time()
     settings = NewtonSettings(load_steps=o.load_steps, max_iterations=o.max_iterations)
-    with o.step_progress or contextlib.nullcontext() as on_step:
-        solve = solve_device(device, law, np.asarray(pressures, float), settings, threads[0], on_step=on_step,
+    with o.step_progress or contextlib.nullcontext() as told:
+        deadline = _Deadline(DEADLINE_SHARE * o.timeout_s, pressures, told)
+        solve = solve_device(device, law, np.asarray(pressures, float), settings, threads[0], on_step=deadline,
                              backbone=threads[1])
     return {"figures": measure_device(solve), "record": solve.path.record(), "cpu_s": time.process_time() - start}
 
