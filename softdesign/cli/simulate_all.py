@@ -46,16 +46,16 @@ class StepProgress:
     def __init__(self) -> None:
         self._bar: Any = None
 
-    def __enter__(self) -> Callable[[Any], None]:
+    def __enter__(self) -> Callable[[float, list[float]], None]:
         from softdesign.cli.progress import part_progress
 
         self._bar = part_progress("simulate --all", enabled=True)
         tick = self._bar.__enter__()
         last = [time.perf_counter()]
 
-        def told(point: Any) -> None:
+        def told(t: float, history: list[float]) -> None:
             now = time.perf_counter()
-            tick(f"load {point.t:.3f} of the pressures, {len(point.history)} iterations", now - last[0])
+            tick(f"load {t:.3f} of the pressures, {len(history)} iterations", now - last[0])
             last[0] = now
 
         return told

@@ -77,7 +77,7 @@ class DeviceFigures:
 
 def measure_device(solve: DeviceSolve) -> DeviceFigures:
     """The figures of a solved device (module docstring)."""
-    device, problem, u = solve.device, solve.problem, solve.path.end.u
+    device, problem, u = solve.device, solve.problem, solve.u
     mesh = problem.mesh
     assert isinstance(mesh, QuadraticMesh)
     corners = mesh.linear.points
@@ -106,7 +106,7 @@ def measure_device(solve: DeviceSolve) -> DeviceFigures:
 
 def _material_extremes(solve: DeviceSolve) -> tuple[Extreme, Extreme]:
     """The largest principal stretch and Cauchy stress (kPa) over the quadrature points, with section and place."""
-    problem, u = solve.problem, solve.path.end.u
+    problem, u = solve.problem, solve.u
     mesh = problem.mesh
     assert isinstance(mesh, QuadraticMesh)
     state = quadratic_state(mesh, problem.law, u)
@@ -131,7 +131,7 @@ def _thread_extremes(solve: DeviceSolve) -> tuple[Extreme | None, Extreme | None
         return None, None
     mesh = solve.problem.mesh
     assert isinstance(mesh, QuadraticMesh)
-    tension = fibres.thread_tension_mn(mesh.points + solve.path.end.u).max(axis=1)
+    tension = fibres.thread_tension_mn(mesh.points + solve.u).max(axis=1)
     out: list[Extreme | None] = []
     for part in (slice(0, solve.hoop_fibres), slice(solve.hoop_fibres, None)):
         if not len(tension[part]):

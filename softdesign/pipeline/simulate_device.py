@@ -49,8 +49,9 @@ class DeviceOptions:
     size_mm: float = 3.0
     layer_mm: float = 8.0
     angular_count: int = 12
-    load_steps: int = 2
+    load_steps: int = 8
     max_iterations: int = 12
+    max_cutbacks: int = 20
     timeout_s: float = 600.0
     #: a context manager yielding the solve's step listener (the command line's progress), or None
     step_progress: Any = None
@@ -177,10 +178,10 @@ class _Deadline:
         self.end, self.pressures, self.told, self.t = time.perf_counter() + seconds, pressures, told, 0.0
         self.seconds = seconds
 
-    def __call__(self, point: Any) -> None:
-        self.t = max(self.t, point.t)
+    def __call__(self, t: float, history: list[float]) -> None:
+        self.t = max(self.t, t)
         if self.told is not None:
-            self.told(point)
+            self.told(t, history)
         if time.perf_counter() > self.end:
             reached = ", ".join(f"{self.t * p:.4g}" for p in self.pressures)
             raise SolveError(f"the whole device's solve was stopped after {self.seconds:.0f} s ({DEADLINE_SHARE:g} "
@@ -198,12 +199,12 @@ def solve_device_in_child(device: Any, law: Any, pressures: FloatList, o: Device
     from softdesign.mechanics.newton import NewtonSettings
 
     start = time.process_time()
-    settings = NewtonSettings(load_steps=o.load_steps, max_iterations=o.max_iterations)
+    settings = NewtonSettings(load_steps=o.load_steps, max_iterations=o.max_iterations, max_cutbacks=o.max_cutbacks)
     with o.step_progress or contextlib.nullcontext() as told:
         deadline = _Deadline(DEADLINE_SHARE * o.timeout_s, pressures, told)
         solve = solve_device(device, law, np.asarray(pressures, float), settings, threads[0], on_step=deadline,
                              backbone=threads[1])
-    return {"figures": measure_device(solve), "record": solve.path.record(), "cpu_s": time.process_time() - start}
+    return {"figures": measure_device(solve), "record": solve.record, "cpu_s": time.process_time() - start}
 
 
 def run_device(case_file: Path, out: Path | None, o: DeviceOptions, progress: Any) -> dict[str, Any]:
