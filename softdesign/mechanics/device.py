@@ -46,9 +46,8 @@ from softdesign.types import FloatArray, IntArray
 
 #: A node is on the axis when its distance from it is below this share of the section's size.
 AXIS_TOL = 1e-9
-#: The threads' rounding floor on the residual, a share of the stiffest thread's E_t A_t (:func:`roundoff_floor_mn`):
-#: five times the stall measured (2e-13).
-FIBRE_ROUNDOFF = 1e-12
+#: The threads' rounding floor on the residual over its estimate (:func:`roundoff_floor_mn`): a safety factor.
+FIBRE_ROUNDOFF = 10.0
 #: Centerline points located per batch (each batch holds an (n, E, 4) array of barycentric coordinates).
 LOCATE_BATCH = 16
 
@@ -226,17 +225,22 @@ def tip_nodes(device: DeviceMesh, i: int) -> IntArray:
 
 
 def roundoff_floor_mn(problem: PressureProblem) -> float:
-    """The residual (mN) below which a Newton iteration cannot go for the threads' rounding: ``FIBRE_ROUNDOFF`` of
-    the stiffest thread's ``E_t A_t`` (0 without threads).
+    """The residual (mN) below which a Newton iteration cannot go for the threads' rounding (0 without threads).
 
-    A thread's force is ``E_t A_t e`` with its strain e found from positions to about 1e-16 relative, so every
-    fibre carries a force noise of about 1e-13 ``E_t A_t`` (its pieces are short against the coordinates): measured
-    on a straight two-section device with a 0.3 mm, 70 GPa thread (``E_t A_t`` = 4.9e6 mN), the residual stalled at
-    1.0e-6 to 1.2e-6 mN whatever the load.  The section solves' absolute tolerance (1e-10 mN) is below that floor.
+    A thread's force is ``E_t A_t e``, its strain found from positions of size X (mm) over fibre pieces as short
+    as h: each fibre's force carries a noise of about ``eps X / h`` of ``E_t A_t``, and F fibres' noise adds up
+    as ``sqrt(F)``.  The floor is ``FIBRE_ROUNDOFF`` times that.  Measured stalls: a straight two-section device
+    near the origin with a 0.3 mm, 70 GPa thread (``E_t A_t`` = 4.9e6 mN), 1.0e-6 to 1.2e-6 mN; the demo's
+    device in the patient's coordinates, 2.7e-5 to 3.0e-5 mN.  The section solves' absolute tolerance (1e-10 mN)
+    is below either.
     """
-    if problem.fibres is None:
+    fibres = problem.fibres
+    if fibres is None:
         return 0.0
-    return FIBRE_ROUNDOFF * float(problem.fibres.axial_stiffness_mn.max())
+    size = float(np.abs(problem.mesh.points).max())
+    reach = np.abs(fibres.directions).sum(axis=2).max()  # 1 / h: the largest |dx/dX| a unit position error makes
+    noise = np.finfo(float).eps * size * float(reach) * np.sqrt(len(fibres.faces))
+    return FIBRE_ROUNDOFF * noise * float(fibres.axial_stiffness_mn.max())
 
 
 @dataclass(frozen=True)
