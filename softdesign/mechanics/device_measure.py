@@ -87,8 +87,8 @@ def measure_device(solve: DeviceSolve) -> DeviceFigures:
         base = base_nodes(device, i)
         frame = rotation_between(corners[base], corners[base] + u[base]) @ part.base_frame
         frames.append(frame)
-        steps = np.linalg.norm(np.diff(part.samples, axis=0), axis=1)
-        fractions = np.concatenate([[0.0], np.cumsum(steps)]) / steps.sum()
+        along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(part.samples, axis=0), axis=1))])
+        fractions = along / along[-1]  # exactly 1 at the tip (a pairwise sum may differ from the cumulative one)
         kappa, phi, length, miss, _ = arc_of((line - line[0]) @ frame, fractions)
         arcs.append(SectionArc(kappa, phi, length, miss))
     last = len(device.parts) - 1
