@@ -20,6 +20,7 @@ from softdesign.cli.common import (
     note,
     run_guarded,
 )
+from softdesign.cli.simulate_all import AllOpt, PressureOpt, QOpt, run_all
 from softdesign.errors import ConfigError
 
 SectionOpt = Annotated[int, typer.Option(
@@ -110,6 +111,9 @@ def simulate(
     figure: FigureOpt = None,
     force: ReplaceFigureOpt = False,
     write: WriteOpt = False,
+    whole: AllOpt = False,
+    q: QOpt = None,
+    pressure: PressureOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Solve one section under chamber pressures (hyperelastic finite elements), or find the pressures for a q.
@@ -118,10 +122,17 @@ def simulate(
     reports the best arc through the deformed centerline, each chamber's length, the largest stretch and stress
     and the convergence; with --target, the pressures whose arc best matches the design at q, and with --write
     also into the build folder's actuation.csv (labelled as model estimates). A search shows its trials on a
-    terminal (each one's residual and the time) and exits 1 when it does not converge.
+    terminal (each one's residual and the time) and exits 1 when it does not converge. With --all, the whole
+    device in one solve, against the designed chain and the rod model.
     """
 
     def action() -> None:
+        if whole or q is not None or pressure is not None:
+            if not whole or pressures is not None or target is not None or write or figure is not None:
+                raise ConfigError("simulate: --q and --pressure go with --all (the whole device), and --all takes "
+                                  "neither --pressures, --target, --write nor --figure")
+            run_all(case_file, out, q, pressure, size_mm, layer_mm, timeout, as_json, note)
+            return
         from softdesign.pipeline.simulate_command import run_simulate, write_to_table
         from softdesign.pipeline.simulate_run import SimulateOptions
 

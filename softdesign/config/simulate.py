@@ -39,7 +39,8 @@ class Simulate(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
 
     enabled: Flag = False
-    """Run the simulate stage in `build` (minutes per section): false by default."""
+    """Run the finite elements in `build`: each section's pressures per q (supply: per_chamber, minutes per
+    section), or the whole device at every exported q (supply: single, minutes): false by default."""
     q: list[FiniteFloat] = Field([1.0], min_length=1, max_length=MAX_SIMULATE_Q)
     """The q values whose pressures are estimated, each in [0, 1], at least 0.001 apart (default [1])."""
     sections: list[Integer] | None = Field(None, min_length=1, max_length=MAX_LINKS)

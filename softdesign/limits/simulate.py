@@ -32,3 +32,10 @@ MIN_ANGULAR_COUNT, MAX_ANGULAR_COUNT = 8, 256
 #: The child's address space, bytes (2 GiB), and the longest time a solve may take, s.
 SIMULATE_MEMORY_BYTES = 2**31
 MAX_SIMULATE_SECONDS = 3600.0
+#: Nodes of the whole device's quadratic mesh (``simulate --all``): its factorization's fill grows about with the
+#: device's length times its cross-section's unknowns squared; measured on the demo's device at the default mesh
+#: (8,546 nodes, 25k unknowns): 5 s per factorization on the 2-core machine under load.
+MAX_DEVICE_NODES = 40_000
+#: The whole device's child's address space, bytes (6 GiB): its element matrices alone are (E * 4, 30, 30) floats,
+#: 141 MiB a copy on the demo's device at the default mesh, over the section's 2 GiB (measured: it ran out there).
+DEVICE_MEMORY_BYTES = 6 * 2**30

@@ -37,6 +37,7 @@ Ending
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -194,8 +195,12 @@ def _admissible_share(problem: PressureProblem, u: FloatArray, du: FloatArray) -
 
 
 def follow_pressures(problem: PressureProblem, pressures: FloatArray, settings: ContinuationSettings,
-                     solver: TangentSolver | None = None) -> PathResult:
-    """Follow the pressures ``t pressures`` (k,) kPa from t = 0 towards 1 in volume steps (the module's docstring)."""
+                     solver: TangentSolver | None = None,
+                     on_step: Callable[[PathPoint], None] | None = None) -> PathResult:
+    """Follow the pressures ``t pressures`` (k,) kPa from t = 0 towards 1 in volume steps (the module's docstring).
+
+    ``on_step`` is told of every converged point on the way (a progress display).
+    """
     pattern = np.asarray(pressures, float)
     if not np.any(pattern):  # no load: the rest state
         rest = PathPoint(np.zeros_like(problem.mesh.points), 1.0, float("inf"))
@@ -213,7 +218,10 @@ def follow_pressures(problem: PressureProblem, pressures: FloatArray, settings: 
             cutbacks, dw = cutbacks + 1, dw / 2
             continue
         if new.t >= 1.0 and new.slope > 0 or (new.t >= 1.0 and start.slope > 0):
-            u, history = _newton_step(problem, start.u, pattern, settings.newton, path.solver)
+            # the last step lands on t = 1 from the path's chord between the two equilibria that bracket it
+            share = (1.0 - start.t) / (new.t - start.t)
+            u, history = _newton_step(problem, start.u + share * (new.u - start.u), pattern, settings.newton,
+                                      path.solver)
             if u is not None:
                 end = PathPoint(u, 1.0, path.slope(u, 1.0), tuple(history))
                 return _ended("reached", end, [*points, end], [*works, works[-1] + dw])
@@ -221,6 +229,8 @@ def follow_pressures(problem: PressureProblem, pressures: FloatArray, settings: 
             return _limit(path, start, new, dw, points, works)
         points.append(new)
         works.append(works[-1] + dw)
+        if on_step is not None:
+            on_step(new)
         previous, start = (start, dw), new
         dw *= 1.5
     return _ended("stopped", max(points, key=lambda p: p.t), points, works)

@@ -267,7 +267,8 @@ def _predicted(problem: PressureProblem, u: FloatArray, t: float, target: float,
 
 def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: NewtonSettings,
                     start: tuple[FloatArray, FloatArray] | None = None, solver: TangentSolver | None = None,
-                    start_rate: FloatArray | None = None) -> tuple[FloatArray, SolveRecord]:
+                    start_rate: FloatArray | None = None,
+                    on_step: Callable[[float, list[float]], None] | None = None) -> tuple[FloatArray, SolveRecord]:
     """Displacement (V, 3) mm at cavity ``pressures`` (k,) kPa, reached in load steps, and the record.
 
     The load path runs from zero, or from ``start`` = (displacement (V, 3) mm, pressures (k,) kPa), an
@@ -275,6 +276,7 @@ def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: N
     ``solver`` keeps the order of its matrices from earlier solves of the same problem (a fresh one when
     None).  ``start_rate`` (k, V, 3) mm/kPa, ``du/dp`` at ``start``
     (:func:`pressure_sensitivity`), makes the first step start on the tangent rather than at ``start``.
+    ``on_step`` is told of every converged step: its load factor and Newton residuals (a progress display).
 
     Raises
     ------
@@ -309,6 +311,8 @@ def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: N
         record.load_factors.append(t)
         record.iterations.append(len(history))
         record.residuals.append(history)
+        if on_step is not None:
+            on_step(t, history)
         if len(history) <= EASY_STEP_ITERATIONS:
             dt *= 2.0  # an easy step: the next one may be twice as long
     return u, record

@@ -15,6 +15,7 @@ from softdesign.pipeline.stages import (
     actuation,
     blend,
     design,
+    device_fe,
     export,
     fabrication,
     feasibility,
@@ -30,7 +31,8 @@ from softdesign.pipeline.stages import (
 #: Every stage, in build order.
 STAGES: list[Stage] = [
     ingest.STAGE, design.STAGE, blend.STAGE, links.STAGE, kinematics.STAGE, fit.STAGE, simulate.STAGE,
-    actuation.STAGE, export.STAGE, mould.STAGE, volume_mesh.STAGE, feasibility.STAGE, fabrication.STAGE,
+    actuation.STAGE, device_fe.STAGE, export.STAGE, mould.STAGE, volume_mesh.STAGE, feasibility.STAGE,
+    fabrication.STAGE,
 ]
 
 

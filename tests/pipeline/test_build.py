@@ -20,8 +20,8 @@ from softdesign.pipeline.versions import software_versions
 from tests.helpers.paths import REPO
 
 runner = CliRunner()
-STAGES = ["ingest", "design", "blend", "links", "kinematics", "fit", "simulate", "actuation", "export", "mould",
-          "volume_mesh", "feasibility", "fabrication"]
+STAGES = ["ingest", "design", "blend", "links", "kinematics", "fit", "simulate", "actuation", "device_fe", "export",
+          "mould", "volume_mesh", "feasibility", "fabrication"]
 
 
 def snapshot(folder: Path) -> dict[str, str]:
@@ -73,15 +73,15 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "design": "skipped", "blend": "ran", "links": "ran", "kinematics": "ran",
         "fit": "ran", "simulate": "ran",
-        "actuation": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
-        "fabrication": "ran",
+        "actuation": "ran", "device_fe": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran",
+        "feasibility": "ran", "fabrication": "ran",
     }
     edit(demo_case, "export", q=[0, 0.5, 1])
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "ran",
         "fit": "skipped", "simulate": "ran",
-        "actuation": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
-        "fabrication": "ran",
+        "actuation": "ran", "device_fe": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran",
+        "feasibility": "ran", "fabrication": "ran",
     }
     # The mesh formats are read by export (and the mould's formats): kinematics, the fit and the feasibility
     # figures stay cached.
@@ -89,7 +89,8 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
         "fit": "skipped", "simulate": "skipped",
-        "actuation": "skipped", "export": "ran", "mould": "ran", "volume_mesh": "skipped", "feasibility": "skipped",
+        "actuation": "skipped", "device_fe": "skipped", "export": "ran", "mould": "ran", "volume_mesh": "skipped",
+        "feasibility": "skipped",
         "fabrication": "ran",
     }
     # A mould is read by the mould stage and by the fit (which turns the end cuts into the mould's parting
@@ -98,8 +99,8 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
         "fit": "ran", "simulate": "ran",
-        "actuation": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
-        "fabrication": "ran",
+        "actuation": "ran", "device_fe": "ran", "export": "ran", "mould": "ran", "volume_mesh": "ran",
+        "feasibility": "ran", "fabrication": "ran",
     }
     assert (out / "meshes" / "mould" / "half_a.ply").is_file()
     # New link breaks: the blend (explicit breaks may be sharp joints of the path, geometry/curve_joints.py), the
@@ -107,7 +108,7 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     edit(demo_case, "links", count=None, breaks=[0, 0.4, 1])
     assert statuses(build(demo_case, out)) == {
         "ingest": "skipped", "design": "skipped", "blend": "ran", "links": "ran", "kinematics": "ran",
-        "fit": "ran", "simulate": "ran", "actuation": "ran",
+        "fit": "ran", "simulate": "ran", "actuation": "ran", "device_fe": "ran",
         "export": "ran", "mould": "ran", "volume_mesh": "ran", "feasibility": "ran",
         "fabrication": "ran",
     }
@@ -117,7 +118,7 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
     # with it (the demo declares ecoflex-00-30).
     edit(demo_case, "material", name="dragon-skin-10")
     assert statuses(build(demo_case, out)) == {**dict.fromkeys(STAGES, "skipped"), "simulate": "ran",
-                                               "actuation": "ran", "export": "ran", "mould": "ran",
+                                               "actuation": "ran", "device_fe": "ran", "export": "ran", "mould": "ran",
                                                "volume_mesh": "ran", "feasibility": "ran", "fabrication": "ran"}
     assert statuses(build(demo_case, out, "--force")) == dict.fromkeys(STAGES, "ran")
 
@@ -138,7 +139,8 @@ def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tm
     assert ran == {
         "ingest": "skipped", "design": "skipped", "blend": "skipped", "links": "skipped", "kinematics": "skipped",
         "fit": "skipped", "simulate": "kept",
-        "actuation": "kept", "export": "kept", "mould": "kept", "volume_mesh": "kept", "feasibility": "kept",
+        "actuation": "kept", "device_fe": "kept", "export": "kept", "mould": "kept", "volume_mesh": "kept",
+        "feasibility": "kept",
         "fabrication": "kept",
     }
     outputs = {o["path"]: o for o in manifest["outputs"]}

@@ -120,6 +120,8 @@ def run_simulate_stage(case: Case, kinematics: KinematicsResult, fit: FitResult)
 
     if case.simulate is None or not case.simulate.enabled:
         return None
+    if case.actuation is not None and case.actuation.supply == "single":
+        return None  # the whole device is solved after its sizing (the device_fe stage), not per section
     material = material_of(case)
     if material.law is None:
         raise no_law_error(case, "simulate.enabled")

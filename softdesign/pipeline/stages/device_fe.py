@@ -1,0 +1,172 @@
+"""Stage: device_fe -- the single-supply device solved whole by finite elements at the exported q (off by default).
+
+With ``simulate: {enabled: true}``, ``actuation: {supply: single}`` and a
+material with a hyperelastic law, this stage, after actuation (whose sizing it
+solves):
+
+1. meshes the whole device (:func:`~softdesign.pipeline.simulate_device.device_mesh_of`:
+   every section, its chamber and thread, the backbone thread), its size checked
+   against :data:`~softdesign.limits.simulate.MAX_DEVICE_NODES` before any solve;
+2. at every exported q above 0, solves it at ``P = q P*`` in a child process with
+   ``simulate.timeout_s`` (:mod:`softdesign.mechanics.device`); a solve that stops
+   fails the build with the largest load it reached (exit 1);
+3. keeps each solve's figures (:func:`~softdesign.pipeline.device_figures.device_payload`:
+   the deformed centerline against the designed chain and the rod model, each
+   section's arc, the largest stress, stretch and thread tension) in
+   ``simulate/device.json`` and the manifest; the times go to the run log.
+
+The verdict then carries "FE: within X mm at P*" beside the rod model's line; a
+stress over the material's tensile strength or a thread over its limit is a reason.
+``supply: per_chamber`` keeps the simulate stage's per-section pressure search.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from types import SimpleNamespace
+from typing import TYPE_CHECKING, Any
+
+from softdesign.errors import ConfigError, MeshError, SolveError
+from softdesign.pipeline.notices import Judgement
+from softdesign.pipeline.stage import Stage
+from softdesign.pipeline.store import Staging
+
+if TYPE_CHECKING:
+    from softdesign.config import Case
+
+VERSION = 1
+SUMMARY = "simulate/device.json"
+
+
+def wanted(case: Case) -> bool:
+    """Whether the build solves the whole device: simulate enabled on a single-supply device."""
+    return bool(case.simulate is not None and case.simulate.enabled and case.actuation is not None
+                and case.actuation.supply == "single")
+
+
+def run_device_stage(case: Case, results: dict[str, Any]) -> dict[str, Any] | None:
+    """Every exported q's whole-device solve (None unless :func:`wanted`)."""
+    import time
+
+    from softdesign.limits.simulate import DEVICE_MEMORY_BYTES, MAX_PRESSURE_KPA
+    from softdesign.pipeline.child import run_in_child
+    from softdesign.pipeline.device_figures import LEAVES_OUT, device_payload
+    from softdesign.pipeline.simulate_device import (
+        DeviceOptions,
+        device_mesh_of,
+        device_pressures,
+        device_threads,
+        solve_device_in_child,
+    )
+    from softdesign.pipeline.simulate_run import no_law_error
+    from softdesign.pipeline.stages.volume_sweep import material_of
+
+    if not wanted(case):
+        return None
+    material = material_of(case)
+    if material.law is None:
+        raise no_law_error(case, "simulate.enabled")
+    s = case.simulate
+    assert s is not None
+    outcome = SimpleNamespace(case=case, results=results)
+    top = float(results["actuation"].summary["design_pressure_kpa"])
+    if top > MAX_PRESSURE_KPA:
+        raise ConfigError(f"simulate.enabled: the design pressure P* {top:.1f} kPa is above the finite elements' "
+                          f"bound {MAX_PRESSURE_KPA:g} kPa (softdesign/limits/simulate.py); use a stiffer thread or a "
+                          "thinner material.min_wall_mm, which lower P*, or leave simulate off")
+    base = DeviceOptions(None, None, s.size_mm, s.layer_mm, s.angular_count, timeout_s=s.timeout_s)
+    device = device_mesh_of(outcome, base)
+    solves, times = [], []
+    for q in [q for q in case.export.q_values() if q > 0.0]:
+        options = DeviceOptions(q, None, s.size_mm, s.layer_mm, s.angular_count, timeout_s=s.timeout_s)
+        loads = device_pressures(outcome, options)
+        start = time.perf_counter()
+        try:
+            answer = run_in_child(solve_device_in_child, (device, material.law, loads[1], options,
+                                                          device_threads(case)), s.timeout_s,
+                                  f"simulate: the whole device at q = {q:g} ({len(device.whole.points)} nodes)",
+                                  "raise simulate.size_mm or simulate.layer_mm, or raise simulate.timeout_s",
+                                  DEVICE_MEMORY_BYTES)
+        except MeshError as err:  # the child's failures, a stopped solve among them
+            raise SolveError(str(err)) from err
+        seconds = {"mesh_s": 0.0, "solve_s": time.perf_counter() - start, "solve_cpu_s": answer["cpu_s"]}
+        figures = device_payload(outcome, options, device, material, loads, answer, seconds)
+        times.append(f"q = {q:g}: {seconds['solve_s']:.1f} s wall, {answer['cpu_s']:.1f} s CPU")
+        del figures["seconds"]  # the same build gives the same bytes: times go to the run log
+        solves.append(figures)
+    return {"solves": solves, "leaves_out": list(LEAVES_OUT), "design_pressure_kpa": top, "times": times}
+
+
+def fe_line(summary: dict[str, Any]) -> str | None:
+    """The verdict's line from the largest exported q's solve: "FE: within X mm at P*" and its limits."""
+    if not summary or not summary["solves"]:
+        return None
+    top = max(summary["solves"], key=lambda s: s["q"])
+    at = "P*" if abs(top["q"] - 1.0) < 1e-12 else f"{top['q']:g} P*"
+    thread = top["thread"]
+    share = f", thread at {100 * thread['fraction_of_limit']:.1f} % of its limit" if thread and thread[
+        "fraction_of_limit"] is not None else ""
+    strength = top["max_stress_kpa"]["tensile_strength_kpa"]
+    stress = f" of {strength:.0f} kPa" if strength else ""
+    return (f"FE: within {top['versus_design']['max_mm']:.3g} mm of the designed chain at {at} "
+            f"({top['pressure_kpa']:.1f} kPa; the whole device in finite elements, the rod model "
+            f"{top['versus_rod_model']['max_mm']:.3g} mm from it), largest stress {top['max_stress_kpa']['value']:.0f} "
+            f"kPa{stress}, stretch {top['max_stretch']['value']:.3f}{share}")
+
+
+def device_judgement(summary: dict[str, Any] | None) -> Judgement | None:
+    """A margin (:func:`fe_line`), or a reason per limit the FE's figures cross (each names the key to change)."""
+    line = fe_line(summary or {})
+    if line is None or summary is None:
+        return None
+    reasons = []
+    for solve in summary["solves"]:
+        stress, thread = solve["max_stress_kpa"], solve["thread"]
+        if stress["tensile_strength_kpa"] and stress["value"] > stress["tensile_strength_kpa"]:
+            reasons.append(f"FE at q = {solve['q']:g}: stress {stress['value']:.0f} kPa in section "
+                           f"{stress['section']} > the tensile strength {stress['tensile_strength_kpa']:.0f} kPa; "
+                           "use a stronger material (material.name)")
+        if thread and thread["fraction_of_limit"] is not None and thread["fraction_of_limit"] > 1.0:
+            reasons.append(f"FE at q = {solve['q']:g}: hoop thread {thread['value']:.3g} N > its limit "
+                           f"{thread['limit_n']:.3g} N; use a finer actuation.reinforcement.pitch_mm or a stronger "
+                           "thread")
+    return Judgement(judged=False, reasons=tuple(reasons), margins=() if reasons else (line,))
+
+
+def write_device(result: dict[str, Any] | None, staging: Staging) -> None:
+    """``simulate/device.json`` without the times (nothing when the stage is off)."""
+    if result is not None:
+        staging.write_json(SUMMARY, {k: v for k, v in result.items() if k != "times"})
+
+
+def load_device(build_dir: Path) -> dict[str, Any] | None:
+    """The kept figures, or None when the build solved no device."""
+    path = Path(build_dir) / SUMMARY
+    return json.loads(path.read_text(encoding="utf-8")) if path.is_file() else None
+
+
+def describe_device(result: dict[str, Any] | None) -> list[str]:
+    """One line per solve (:func:`~softdesign.pipeline.device_figures.device_lines`' first ones)."""
+    if result is None:
+        return []
+    from softdesign.pipeline.device_figures import versus_line
+
+    return [f"q={s['q']:g} ({s['pressure_kpa']:.1f} kPa): " + versus_line("designed chain", s["versus_design"])
+            + "; " + versus_line("rod model", s["versus_rod_model"]) for s in result["solves"]]
+
+
+STAGE = Stage(
+    name="device_fe",
+    version=VERSION,
+    reads=("simulate", "actuation", "material", "export.q", "export.frames"),
+    upstream=("kinematics", "fit", "design", "actuation"),
+    compute=run_device_stage,
+    write=write_device,
+    load=lambda build_dir, results: load_device(build_dir),
+    describe=describe_device,
+    metrics=lambda result: {} if result is None else {"solves": [
+        {k: v for k, v in s.items() if k not in ("centerline", "convergence")} for s in result["solves"]]},
+    log=lambda result: [] if result is None else list(result["times"]),
+    judge=device_judgement,
+)

@@ -1,0 +1,49 @@
+"""`softdesign simulate CASE --all`: bad options and cases refused with exit 2 and the option or key named, before
+the build (or, for the mesh's size, before the solve)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from softdesign.cli import app
+from tests.helpers.paths import DEMO, REPO
+
+runner = CliRunner()
+ACTUATOR = REPO / "configs" / "actuator.yaml"
+PER_CHAMBER = REPO / "configs" / "actuator-per-chamber.yaml"
+
+
+def test_help_names_the_whole_device_options() -> None:
+    result = runner.invoke(app, ["simulate", "--help"])
+    assert result.exit_code == 0
+    for option in ("--all", "--q", "--pressure"):
+        assert option in result.output
+
+
+@pytest.mark.parametrize(("case", "args", "message"), [
+    (ACTUATOR, ["--all", "--q", "1.5"], "--q: got 1.5"),
+    (ACTUATOR, ["--all", "--pressure", "2000"], "--pressure: got 2000, expected a number in [0, 1000]"),
+    (ACTUATOR, ["--all", "--q", "1", "--pressure", "100"], "not both"),
+    (ACTUATOR, ["--q", "1"], "--q and --pressure go with --all"),
+    (ACTUATOR, ["--all", "--pressures", "1,2,3"], "--all takes neither --pressures"),
+    (ACTUATOR, ["--all", "--timeout", "0"], "--timeout: got 0"),
+    (PER_CHAMBER, ["--all", "--pressure", "100"], "one supply pressure is for actuation.supply: single"),
+    (DEMO, ["--all"], "the case has no actuation chambers"),
+])
+def test_bad_options_exit_2_before_the_build(case: Path, args: list[str], message: str, tmp_path: Path) -> None:
+    result = runner.invoke(app, ["simulate", str(case), "--out", str(tmp_path / "build"), *args])
+    assert result.exit_code == 2, result.output
+    assert message in result.output
+    assert not (tmp_path / "build").exists()
+
+
+@pytest.mark.slow
+def test_a_mesh_over_the_bound_is_refused_before_the_solve(tmp_path: Path) -> None:
+    # about 10 s: the build through actuation; the estimate refuses before meshing
+    result = runner.invoke(app, ["simulate", str(ACTUATOR), "--out", str(tmp_path / "build"), "--all",
+                                 "--size-mm", "0.2", "--layer-mm", "0.2"])
+    assert result.exit_code == 2, result.output
+    assert "MAX_DEVICE_NODES" in result.output and "raise --size-mm or --layer-mm" in result.output
