@@ -67,6 +67,20 @@ class SimulateOptions:
     thread: Any = None
 
 
+def thread_of(case: Any) -> Any:
+    """The case's hoop thread as the finite elements take it (:class:`~softdesign.mechanics.reinforcement.HoopThread`:
+    ``actuation.reinforcement``'s pitch, its thread's diameter and modulus), or None: no chambers, or
+    ``reinforcement.kind: none`` (bare chambers, which balloon)."""
+    actuation = getattr(case, "actuation", None)
+    if actuation is None or actuation.reinforcement.kind != "hoop":
+        return None
+    from softdesign.materials.threads import thread_presets
+    from softdesign.mechanics.reinforcement import HoopThread
+
+    thread = thread_presets()[actuation.reinforcement.thread.name]
+    return HoopThread(actuation.reinforcement.pitch_mm, thread.diameter_mm, thread.modulus_gpa * 1.0e6)
+
+
 def no_law_error(case: Any, where: str) -> ConfigError:
     """The refusal of a simulate whose case has no hyperelastic law, naming the key to change and the presets to use.
 
