@@ -44,7 +44,8 @@ def run_simulate(case_file: Path, out: Path | None, o: SimulateOptions, progress
     if material.law is None:
         raise no_law_error(outcome.case, str(case_file))
     section = section_mesh_of(outcome.case, outcome.results["kinematics"], outcome.results["fit"], o.section,
-                              o.size_mm, o.angular_count, o.layer_mm)
+                              o.size_mm, o.angular_count, o.layer_mm,
+                              None if o.feed_pressures_kpa is None else len(o.feed_pressures_kpa))
     check_node_count(section, o.section + 1, "raise --size-mm or --layer-mm")
     target = None
     if o.target_q is not None:
