@@ -1,5 +1,6 @@
-"""Benchmark of `softdesign simulate` (issue 33): one section of the sample case and of the aorta, against 60 s;
-the whole single-supply demo device at P* (issue 42, ``--all --q 1``) against 300 s.
+"""Benchmark of `softdesign simulate` (issues 33, 42): one reinforced section of the sample case and of the aorta:
+the forward solve against 30 s, the inverse against 60 s; the whole single-supply demo device at P* (issue 42,
+``--all --q 1``) against 300 s.
 
 Cases: configs/actuator-per-chamber.yaml (the sample vessel with seed 003's chambers) and
 the VMTK aorta (path 0 of ../shared/data/vmtk-aorta, when present) with
@@ -13,10 +14,16 @@ the console script, as a user runs it, timed wall clock from start to exit:
   q = 1), default mesh, stopped by ``--timeout`` a little past the target so a
   slow search counts as missed without running for its default ten minutes.
 
-Each line gives the section mesh's nodes, the pressures, the remaining arc
-error (the inverse), the largest principal stress against the tensile
-strength, the command's wall time and the verdict against :data:`TARGET_S`.
-Exit 1 when a target is missed (its lines say which).
+Both cases take the default ``actuation.reinforcement`` (a kevlar hoop thread
+round each chamber), which every pipeline solve now models.  Each line gives
+the section mesh's nodes, the pressures, the remaining arc error (the
+inverse), the largest principal stress against the tensile strength, the
+command's wall time and the verdict against its target
+(:data:`FORWARD_TARGET_S`, :data:`INVERSE_TARGET_S`).  Exit 1 when a target is
+missed (its lines say which).  Issue 42 asks for the single-supply demo's
+section at P*; ``simulate`` does not mesh ``supply: single``'s sized chambers
+yet, so the forward line is the per-chamber demo's section at
+:data:`FORWARD_KPA`.
 
 Usage: ``python pipelines/bench_simulate.py``; ``make bench`` runs it after the
 build benchmark (pipelines/bench.py).
@@ -34,12 +41,14 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 AORTA_DIR = REPO.parent / "shared" / "data" / "vmtk-aorta"
-#: Issue 33: `simulate` on a demo section and an aorta section in at most this long each on 2 cores, s.
-TARGET_S = 60.0
+#: Issue 42: one reinforced section's forward solve in at most this long on 2 cores, s.
+FORWARD_TARGET_S = 30.0
+#: Issues 33 and 42: an inverse per section in at most this long on 2 cores, s.
+INVERSE_TARGET_S = 60.0
 #: The forward solve's pressures, kPa (chamber 1 only: the section bends away from it).
 FORWARD_KPA = "20,0,0"
 #: The inverse's --timeout: past the target, so a miss is measured as one, but bounded, s.
-INVERSE_TIMEOUT_S = 2.0 * TARGET_S
+INVERSE_TIMEOUT_S = 2.0 * INVERSE_TARGET_S
 SECTION = 1  # numbered from 1 at the base, as --section takes it
 #: Issue 42: the whole demo device (configs/actuator.yaml, single supply) at P* in at most this long on 2 cores, s.
 DEVICE_TARGET_S = 300.0
@@ -75,10 +84,11 @@ def run(args: list[str]) -> tuple[float, dict | None, str]:
     return seconds, json.loads(done.stdout), ""  # exit 1 with figures: a search that did not converge
 
 
-def line(label: str, mode: str, seconds: float, payload: dict | None, error: str) -> tuple[str, bool]:
-    """One row: the figures and the verdict (a failed run misses the target)."""
-    ok = payload is not None and seconds <= TARGET_S
-    verdict = f"target <= {TARGET_S:g} s: {'met' if ok else 'MISSED'}"
+def line(label: str, mode: str, target_s: float, seconds: float, payload: dict | None, error: str
+         ) -> tuple[str, bool]:
+    """One row: the figures and the verdict against ``target_s`` (a failed run misses the target)."""
+    ok = payload is not None and seconds <= target_s
+    verdict = f"target <= {target_s:g} s: {'met' if ok else 'MISSED'}"
     if payload is None:
         return f"{label:<28} {mode:<18} {seconds:7.1f} s  failed: {error[:160]}  {verdict}", ok
     strength = payload["tensile_strength_kpa"]
@@ -109,15 +119,17 @@ def main() -> int:
     from softdesign.pipeline.api import build_through
 
     missed = False
-    print(f"softdesign simulate, section {SECTION}, default mesh (--size-mm 3 --layer-mm 8), wall s of the command:")
+    print(f"softdesign simulate, section {SECTION}, default mesh (--size-mm 3 --layer-mm 8), the case's hoop thread, "
+          "wall s of the command:")
     with tempfile.TemporaryDirectory(prefix="softdesign-bench-simulate-") as scratch:
         for k, (label, case) in enumerate(case_files(Path(scratch))):
             out = Path(scratch) / f"build-{k}"
             build_through(case, out, "actuation")  # untimed: the command finds it cached
             common = [str(case), "--out", str(out), "--section", str(SECTION)]
-            for mode, extra in ((f"--pressures {FORWARD_KPA}", ["--pressures", FORWARD_KPA]),
-                                ("--target 1", ["--target", "1", "--timeout", f"{INVERSE_TIMEOUT_S:g}"])):
-                text, ok = line(label, mode, *run(common + extra))
+            for mode, target_s, extra in (
+                    (f"--pressures {FORWARD_KPA}", FORWARD_TARGET_S, ["--pressures", FORWARD_KPA]),
+                    ("--target 1", INVERSE_TARGET_S, ["--target", "1", "--timeout", f"{INVERSE_TIMEOUT_S:g}"])):
+                text, ok = line(label, mode, target_s, *run(common + extra))
                 missed |= not ok
                 print(text, flush=True)
         device, out = REPO / "configs" / "actuator.yaml", Path(scratch) / "build-device"

@@ -28,6 +28,9 @@ SectionOpt = Annotated[int, typer.Option(
     "simulate.sections number them).")]
 PressuresOpt = Annotated[str | None, typer.Option(
     "--pressures", help="Chamber pressures P1,P2,P3 in kPa (chambers 1, 2, 3 of the section, as actuation.csv).")]
+FeedPressuresOpt = Annotated[str | None, typer.Option(
+    "--feed-pressures", help="With --pressures: the feeds of distal chambers that cross the section, meshed as "
+    "cavities with these pressures in kPa (one per feed, comma-separated); without it they are meshed solid.")]
 TargetOpt = Annotated[float | None, typer.Option(
     "--target", help="Find the pressures whose section best matches the designed arc at this q.")]
 SizeOpt = Annotated[float, typer.Option("--size-mm", help="Element size in the cross-section, mm.")]
@@ -55,6 +58,12 @@ def pressures_from_text(text: str) -> tuple[float, ...]:
     return tuple(finite_number(p, f"--pressures value {k + 1}", PRESSURES_FIX) for k, p in enumerate(parts))
 
 
+def feed_pressures_from_text(text: str) -> tuple[float, ...]:
+    """``--feed-pressures`` as one or more finite numbers (ConfigError naming the bad one)."""
+    fix = "give one pressure in kPa per feed crossing the section, separated by commas, e.g. --feed-pressures 20,0,0"
+    return tuple(finite_number(p, f"--feed-pressures value {k + 1}", fix) for k, p in enumerate(text.split(",")))
+
+
 def _check_figure_path(figure: Path | None, force: bool) -> None:
     """Refuse a ``--figure`` that is not a .png in an existing folder, or that writing would damage (an existing
     file without ``force``, anything but a regular file, a file in a build folder: as every ``--output``), before
@@ -73,6 +82,8 @@ def _print(payload: dict[str, Any]) -> None:
     typer.echo(f"section {payload['section']}: {payload['mesh']['nodes']} nodes, {payload['mesh']['tets']} tets, "
                f"{payload['material']['name']} ({payload['material']['law']}), {payload['seconds']:.1f} s")
     typer.echo("pressures kPa: " + ", ".join(f"{p:.3f}" for p in payload["pressures_kpa"]))
+    if "feed_pressures_kpa" in payload:
+        typer.echo("feed pressures kPa: " + ", ".join(f"{p:.3f}" for p in payload["feed_pressures_kpa"]))
     typer.echo(f"best arc: kappa {arc['kappa_per_mm']:.6g} 1/mm, phi {math.degrees(arc['phi_rad']):.2f} deg, "
                f"L {arc['length_mm']:.4f} mm (misfit max {arc['misfit_max_mm']:.4f} mm)")
     # the cavity between its end walls, not actuation.csv's length_mm (the line at the chambers' distance over the
@@ -101,6 +112,7 @@ def simulate(
     case_file: CaseArg,
     section: SectionOpt = 1,
     pressures: PressuresOpt = None,
+    feed_pressures: FeedPressuresOpt = None,
     target: TargetOpt = None,
     out: OutOpt = None,
     size_mm: SizeOpt = 3.0,
@@ -141,10 +153,11 @@ def simulate(
             raise ConfigError(f"simulate --section: got {section}; sections are numbered from 1 at the base, as "
                               "actuation.csv numbers them")
         values = None if pressures is None else pressures_from_text(pressures)
+        feeds = None if feed_pressures is None else feed_pressures_from_text(feed_pressures)
         shown = target is not None and not as_json and sys.stderr.isatty()
         options = SimulateOptions(section - 1, values, target, size_mm, layer_mm, max_pressure_kpa=max_pressure,
                                   timeout_s=timeout, time_limit_s=time_limit,
-                                  trial_progress=TrialProgress() if shown else None)
+                                  trial_progress=TrialProgress() if shown else None, feed_pressures_kpa=feeds)
         result = (write_to_table if write else run_simulate)(case_file, out, options, note)
         if figure is not None:
             from softdesign.io.atomic import write_bytes_atomically

@@ -55,7 +55,9 @@ def backbone_fibres(mesh: QuadraticMesh, chains: list[IntArray], thread: HoopThr
     directions[:, :, 0] = -1.0 / length[:, None]
     directions[:, :, 1] = 1.0 / length[:, None]
     count = len(a)
-    return FibreMembrane(faces, directions, np.repeat(length[:, None] / q, q, axis=1),
+    unit = (mesh.points[b] - mesh.points[a]) / length[:, None]
+    reference = np.repeat(unit[:, None, :], q, axis=1)  # A = sum_b D_b X_b: the unit fibre at rest
+    return FibreMembrane(faces, directions, reference, np.repeat(length[:, None] / q, q, axis=1),
                          np.full(count, thread.axial_stiffness_mn), np.full(count, thread.axial_stiffness_mn),
                          np.full(count, thread.buckling_strain(matrix_modulus_kpa)))
 
@@ -65,5 +67,5 @@ def joined(first: FibreMembrane | None, second: FibreMembrane) -> FibreMembrane:
     if first is None:
         return second
     return FibreMembrane(*(np.concatenate([getattr(first, k), getattr(second, k)])
-                           for k in ("faces", "directions", "weights", "stiffness", "axial_stiffness_mn",
+                           for k in ("faces", "directions", "reference", "weights", "stiffness", "axial_stiffness_mn",
                                      "buckling_strain")))

@@ -160,7 +160,7 @@ def _residual(problem: PressureProblem, u: FloatArray, cavity_pressures: FloatAr
     mesh, law, positions = problem.mesh, problem.law, problem.mesh.points + u
     f_extra, K_extra = np.zeros(mesh.dof_count), sp.csr_matrix((mesh.dof_count, mesh.dof_count))
     if problem.fibres is not None:
-        f_fibre, K_fibre = problem.fibres.force_and_tangent(positions, tangent)
+        f_fibre, K_fibre = problem.fibres.force_and_tangent_at(u, tangent)
         f_extra, K_extra = f_extra + f_fibre, K_extra if K_fibre is None else K_extra + K_fibre
     if problem.springs is not None:
         f_extra, K_extra = f_extra + problem.springs @ u.ravel(), K_extra + problem.springs

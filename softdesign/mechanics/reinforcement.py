@@ -48,6 +48,19 @@ Derivatives
     ``W'' = k / 4``, or ``-k e_b / 2`` and 0 when buckled),
     ``f_b = sum_q w 2 W' a D_b`` and ``K_bc = sum_q w D_b D_c [4 W'' a (x) a + 2 W' I]``:
     the exact Hessian but at the buckling kink (the tests check it against finite differences).
+Strain from the displacement
+    The strain is computed from the displacement ``u``, never from the
+    positions: with ``A = sum_b D_b X_b`` (the unit reference fibre, kept)
+    and ``w = sum_b D_b u_b``, ``e = A . w + |w|^2 / 2`` (the same Green
+    strain, ``a = A + w``).  From the positions, ``|a|^2 - 1`` cancels two
+    numbers near 1 that are each sums of terms of the size of the coordinates
+    over the element (26 mm over 1 mm on the demo's section): a strain
+    round-off of 1e-13 at rest, which a thread of ``k`` ~ 1e7 mN/mm turns
+    into spurious forces of 8e-6 mN.  Newton could not go below them, and at
+    a small load step (10 kPa / 128 on the demo's section, a pressure load of
+    0.78 mN) the step's tolerance (1e-8 of the load) was 1000 times smaller:
+    every step failed near 3e-6 mN.  From ``w`` the round-off is relative to
+    the strain itself and the residual falls to the silicone's floor.
 """
 
 from __future__ import annotations
@@ -116,6 +129,7 @@ class FibreMembrane:
     ----------
     faces : (F, 6) int, the 6-node faces carrying fibres
     directions : (F, Q, 6) float, ``D_b``: the fibre vector ``a = sum_b D_b x_b`` at each point
+    reference : (F, Q, 3) float, ``A = sum_b D_b X_b``: the unit fibre at rest
     weights : (F, Q) float, mm^2: quadrature weight times the reference area's Jacobian
     stiffness : (F,) float, mN/mm: ``k`` of each face
     axial_stiffness_mn : (F,) float, mN: ``E_t A_t`` (for the thread's tension)
@@ -124,40 +138,44 @@ class FibreMembrane:
 
     faces: IntArray
     directions: FloatArray
+    reference: FloatArray
     weights: FloatArray
     stiffness: FloatArray
     axial_stiffness_mn: FloatArray
     buckling_strain: FloatArray
 
-    def fibre_invariants(self, positions: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """The fibre vectors ``a`` (F, Q, 3) and ``I4 = |a|^2`` (F, Q) at deformed ``positions`` (N, 3) mm."""
-        a = np.einsum("fqb,fbi->fqi", self.directions, positions[self.faces])
-        return a, np.einsum("fqi,fqi->fq", a, a)
+    def fibre_vectors(self, displacement: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """The deformed fibre vectors ``a`` (F, Q, 3) and the Green strains ``e`` (F, Q) along them under the nodes'
+        ``displacement`` (N, 3) mm (from the displacement: the module's docstring)."""
+        w = np.einsum("fqb,fbi->fqi", self.directions, displacement[self.faces])
+        e = np.einsum("fqi,fqi->fq", self.reference, w) + 0.5 * np.einsum("fqi,fqi->fq", w, w)
+        return self.reference + w, e
 
-    def strains(self, positions: FloatArray) -> FloatArray:
-        """The thread's Green strain ``e = (I4 - 1) / 2`` (F, Q) at each point."""
-        return 0.5 * (self.fibre_invariants(positions)[1] - 1.0)
+    def strains_at(self, displacement: FloatArray) -> FloatArray:
+        """The thread's Green strain ``e = (I4 - 1) / 2`` (F, Q) at each point under ``displacement`` (N, 3) mm."""
+        return self.fibre_vectors(displacement)[1]
 
-    def energy(self, positions: FloatArray) -> float:
-        """The stored energy, mN mm."""
-        e, e_b = self.strains(positions), self.buckling_strain[:, None]
+    def energy_at(self, displacement: FloatArray) -> float:
+        """The stored energy, mN mm, under ``displacement`` (N, 3) mm."""
+        e, e_b = self.strains_at(displacement), self.buckling_strain[:, None]
         per_area = np.where(e >= -e_b, 0.5 * e**2, 0.5 * e_b**2 - e_b * (e + e_b)) * self.stiffness[:, None]
         return float(np.sum(self.weights * per_area))
 
-    def force_and_tangent(self, positions: FloatArray, want_tangent: bool
-                          ) -> tuple[FloatArray, sp.csr_matrix | None]:
-        """Internal forces (3N,) mN of the fibres and, if asked, their derivative (3N, 3N) mN/mm."""
-        a, i4 = self.fibre_invariants(positions)
-        e, e_b = 0.5 * (i4 - 1.0), self.buckling_strain[:, None]
+    def force_and_tangent_at(self, displacement: FloatArray, want_tangent: bool
+                             ) -> tuple[FloatArray, sp.csr_matrix | None]:
+        """Internal forces (3N,) mN of the fibres under ``displacement`` (N, 3) mm and, if asked, their derivative
+        (3N, 3N) mN/mm."""
+        a, e = self.fibre_vectors(displacement)
+        e_b = self.buckling_strain[:, None]
         w = self.weights * self.stiffness[:, None]
-        elastic = e >= -e_b
         first = 0.5 * np.maximum(e, -e_b) * w  # dW/dI4 times the weight
         forces = np.einsum("fq,fqi,fqb->fbi", 2.0 * first, a, self.directions)
         dofs = quadratic_face_dofs(self.faces)
-        n = positions.size
+        n = displacement.size
         f = summed(dofs, forces.reshape(len(self.faces), 18), n)
         if not want_tangent:
             return f, None
+        elastic = e >= -e_b
         second = np.where(elastic, 0.25, 0.0) * w
         inner = (4.0 * second[..., None, None] * np.einsum("fqi,fqk->fqik", a, a)
                  + 2.0 * first[..., None, None] * np.eye(3)[None, None])
@@ -166,9 +184,11 @@ class FibreMembrane:
         cols = np.broadcast_to(dofs[:, None, :], blocks.shape).ravel()
         return f, sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(n, n))
 
-    def thread_tension_mn(self, positions: FloatArray) -> FloatArray:
-        """The thread's force (F, Q) mN at each point, ``E_t A_t e`` (tension > 0; at least ``-E_t A_t e_b``)."""
-        return self.axial_stiffness_mn[:, None] * np.maximum(self.strains(positions), -self.buckling_strain[:, None])
+    def thread_tension_at(self, displacement: FloatArray) -> FloatArray:
+        """The thread's force (F, Q) mN at each point under ``displacement`` (N, 3) mm, ``E_t A_t e`` (tension > 0;
+        at least ``-E_t A_t e_b``)."""
+        return self.axial_stiffness_mn[:, None] * np.maximum(self.strains_at(displacement),
+                                                             -self.buckling_strain[:, None])
 
 
 def _surface_tangents(points: FloatArray, faces: IntArray) -> tuple[FloatArray, FloatArray]:
@@ -207,8 +227,13 @@ def hoop_membrane(points: FloatArray, faces: IntArray, axes: FloatArray, radii_m
     rhs = np.stack([np.einsum("fqi,fqi->fq", u, a0) for u in (x_xi, x_eta)], axis=-1)
     coeff = np.linalg.solve(g, rhs[..., None])[..., 0]  # (F, Q, 2)
     directions = coeff[..., :1] * _DXI[None] + coeff[..., 1:] * _DETA[None]
+    reference = np.einsum("fqb,fbi->fqi", directions, np.asarray(points, float)[faces])
+    length = np.linalg.norm(reference, axis=2)  # 1 within the metric solve's round-off (1e-13): made unit
+    length = np.where(length > 0.0, length, 1.0)  # caps' zero fibres (dropped below)
+    directions, reference = directions / length[..., None], reference / length[..., None]
     keep = side
     count = int(keep.sum())
-    return FibreMembrane(np.asarray(faces, np.int64)[keep], directions[keep], (TRI_WEIGHTS[None] * area)[keep],
+    return FibreMembrane(np.asarray(faces, np.int64)[keep], directions[keep], reference[keep],
+                         (TRI_WEIGHTS[None] * area)[keep],
                          np.full(count, thread.stiffness_mn_per_mm), np.full(count, thread.axial_stiffness_mn),
                          np.full(count, thread.buckling_strain(matrix_modulus_kpa)))

@@ -9,6 +9,7 @@ the simulate stage (the options and their bounds, the section's mesh, the child'
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +24,7 @@ from softdesign.pipeline.simulate_run import (
     payload,
     section_mesh_of,
     solve_in_child,
+    thread_of,
 )
 
 
@@ -36,11 +38,14 @@ def run_simulate(case_file: Path, out: Path | None, o: SimulateOptions, progress
     check_options(o)
     start = time.perf_counter()
     outcome = build_through(case_file, out, "actuation", progress=progress)
+    if o.thread is None:  # the chambers as the case reinforces them (actuation.reinforcement)
+        o = replace(o, thread=thread_of(outcome.case))
     material = material_of(outcome.case)
     if material.law is None:
         raise no_law_error(outcome.case, str(case_file))
     section = section_mesh_of(outcome.case, outcome.results["kinematics"], outcome.results["fit"], o.section,
-                              o.size_mm, o.angular_count, o.layer_mm)
+                              o.size_mm, o.angular_count, o.layer_mm,
+                              None if o.feed_pressures_kpa is None else len(o.feed_pressures_kpa))
     check_node_count(section, o.section + 1, "raise --size-mm or --layer-mm")
     target = None
     if o.target_q is not None:

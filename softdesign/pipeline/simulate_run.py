@@ -65,6 +65,22 @@ class SimulateOptions:
     trial_progress: Any = None
     #: the chambers' hoop thread (:class:`softdesign.mechanics.reinforcement.HoopThread`), or None: unreinforced
     thread: Any = None
+    #: the pressures of the feeds that cross the section (meshed as cavities), kPa; None: the feeds meshed solid
+    feed_pressures_kpa: tuple[float, ...] | None = None
+
+
+def thread_of(case: Any) -> Any:
+    """The case's hoop thread as the finite elements take it (:class:`~softdesign.mechanics.reinforcement.HoopThread`:
+    ``actuation.reinforcement``'s pitch, its thread's diameter and modulus), or None: no chambers, or
+    ``reinforcement.kind: none`` (bare chambers, which balloon)."""
+    actuation = getattr(case, "actuation", None)
+    if actuation is None or actuation.reinforcement.kind != "hoop":
+        return None
+    from softdesign.materials.threads import thread_presets
+    from softdesign.mechanics.reinforcement import HoopThread
+
+    thread = thread_presets()[actuation.reinforcement.thread.name]
+    return HoopThread(actuation.reinforcement.pitch_mm, thread.diameter_mm, thread.modulus_gpa * 1.0e6)
 
 
 def no_law_error(case: Any, where: str) -> ConfigError:
@@ -93,6 +109,11 @@ def check_options(o: SimulateOptions) -> None:
         raise ConfigError("simulate: give either --pressures P1,P2,P3 (kPa) or --target q, not both or neither")
     for k, p in enumerate(o.pressures_kpa or ()):
         bound(f"--pressures value {k + 1}", p, 0.0, MAX_PRESSURE_KPA)
+    for k, p in enumerate(o.feed_pressures_kpa or ()):
+        bound(f"--feed-pressures value {k + 1}", p, 0.0, MAX_PRESSURE_KPA)
+    if o.feed_pressures_kpa is not None and o.target_q is not None:
+        raise ConfigError("simulate --feed-pressures: goes with --pressures (a forward solve); --target searches the "
+                          "chambers' pressures with the feeds meshed solid")
     if o.target_q is not None:
         bound("--target", o.target_q, 0.0, 1.0)
     bound("--size-mm", o.size_mm, MIN_SIZE_MM, 100.0)
@@ -119,7 +140,8 @@ def solve_in_child(section: Any, law: Any, o: SimulateOptions, target: tuple[flo
 
     newton = NewtonSettings(load_steps=o.load_steps, max_iterations=o.max_iterations)
     if target is None:
-        result = simulate_section(section, law, np.array(o.pressures_kpa, float), newton, o.thread)
+        feeds = None if o.feed_pressures_kpa is None else np.array(o.feed_pressures_kpa, float)
+        result = simulate_section(section, law, np.array(o.pressures_kpa, float), newton, o.thread, feeds)
         return {"result": result, "inverse": None}
     settings = InverseSettings(o.max_pressure_kpa, 0.1 * o.max_pressure_kpa, 0.25 * o.max_pressure_kpa,
                                tolerance_mm=1e-3, max_iterations=o.max_solves, time_limit_s=o.time_limit_s)
@@ -135,8 +157,12 @@ def inverses_in_child(section: Any, law: Any, o: SimulateOptions,
 
 
 def section_mesh_of(case: Any, kinematics: Any, fit: Any, section: int, size_mm: float, angular_count: int,
-                    layer_mm: float) -> Any:
-    """Section ``section``'s (0 at the base) mesh at q = 0 (ConfigError without chambers or for a bad index)."""
+                    layer_mm: float, feed_count: int | None = None) -> Any:
+    """Section ``section``'s (0 at the base) mesh at q = 0 (ConfigError without chambers or for a bad index).
+
+    ``feed_count``: the feeds that cross the section are meshed as cavities, and there must be that many
+    (``--feed-pressures``' values; ConfigError naming the count, before the mesh); None: meshed solid.
+    """
     from softdesign.mechanics.layout_section import layout_section_mesh
     from softdesign.pipeline.body_spec import body_spec
     from softdesign.pipeline.stages.actuation import actuation_layout, unsized_single
@@ -148,8 +174,13 @@ def section_mesh_of(case: Any, kinematics: Any, fit: Any, section: int, size_mm:
     if not 0 <= section < layout.sections:
         raise ConfigError(f"simulate --section: got {section + 1}, the body has sections 1 to {layout.sections} "
                           "(numbered from 1 at the base)")
+    if feed_count is not None and feed_count != len(layout.feeds_through(section)):
+        raise ConfigError(f"simulate --feed-pressures: got {feed_count} values, section {section + 1} has "
+                          f"{len(layout.feeds_through(section))} feeds of distal chambers crossing it; give one "
+                          "pressure (kPa) per feed, in the order of actuation.csv's distal chambers")
     curve0 = kinematics.chain.shape.curve_at(0.0)
-    return layout_section_mesh(curve0, fit.field, body_spec(case), layout, section, size_mm, angular_count, layer_mm)
+    return layout_section_mesh(curve0, fit.field, body_spec(case), layout, section, size_mm, angular_count, layer_mm,
+                               feeds=feed_count is not None)
 
 
 def check_node_count(section: Any, index: int, fix: str) -> None:
@@ -186,6 +217,7 @@ def payload(o: SimulateOptions, section: Any, material: Any, answer: dict[str, A
                  "quadratic_nodes": quadratic_node_count(section), "size_mm": o.size_mm,
                  "layer_mm": o.layer_mm, "angular_count": o.angular_count},
         "pressures_kpa": [round(float(p), 6) for p in r.pressures_kpa],
+        **({} if o.feed_pressures_kpa is None else {"feed_pressures_kpa": [float(p) for p in o.feed_pressures_kpa]}),
         "arc": {"kappa_per_mm": r.kappa, "phi_rad": r.phi, "length_mm": r.length,
                 "misfit_max_mm": r.arc_max_mm, "misfit_rms_mm": r.arc_rms_mm},
         "chamber_lengths_mm": [float(v) for v in r.chamber_lengths],
@@ -197,7 +229,8 @@ def payload(o: SimulateOptions, section: Any, material: Any, answer: dict[str, A
                         for t, n, h in zip(r.record.load_factors, r.record.iterations, r.record.residuals,
                                            strict=True)],
         "deformed_centerline_mm": np.round(r.centerline, 6).tolist(),
-        "leaves_out": list(LEAVES_OUT if o.thread is None else LEAVES_OUT[1:]),
+        "leaves_out": [("the body's slanted end cuts" if item.startswith("the feed lines") and o.feed_pressures_kpa
+                        is not None else item) for item in (LEAVES_OUT if o.thread is None else LEAVES_OUT[1:])],
         "seconds": round(seconds, 2),
     }
     if target is not None and inverse is not None:

@@ -15,7 +15,7 @@ runner = CliRunner()
 def test_help_names_the_options() -> None:
     result = runner.invoke(app, ["simulate", "--help"])
     assert result.exit_code == 0
-    for option in ("--section", "--pressures", "--target", "--json", "--timeout", "--time-limit"):
+    for option in ("--section", "--pressures", "--feed-pressures", "--target", "--json", "--timeout", "--time-limit"):
         assert option in result.output
 
 
@@ -34,6 +34,11 @@ def test_help_names_the_options() -> None:
     (["--pressures", "10,0,0", "--section", "0"], "numbered from 1 at the base"),
     (["--target", "1", "--time-limit", "700"], "not below --timeout 600 s"),
     (["--target", "1", "--time-limit", "0"], "--time-limit: got 0"),
+    (["--pressures", "0,0,0", "--feed-pressures", "20,x"], "--feed-pressures value 2: 'x' is not a number"),
+    (["--pressures", "0,0,0", "--feed-pressures", "20,-5"], "--feed-pressures value 2: got -5"),
+    (["--pressures", "0,0,0", "--feed-pressures", "2000"], "expected a number in [0, 1000]"),
+    (["--pressures", "0,0,0", "--feed-pressures", "nan"], "--feed-pressures value 1"),
+    (["--target", "1", "--feed-pressures", "20"], "goes with --pressures"),
 ])
 def test_bad_options_exit_2_before_any_work(args: list[str], message: str, tmp_path) -> None:
     result = runner.invoke(app, ["simulate", str(DEMO), "--out", str(tmp_path / "build"), *args])
@@ -53,3 +58,15 @@ def test_the_figure_draws_a_payload(tmp_path) -> None:
                "target": {"q": 1.0, "kappa_per_mm": 0.02, "phi_rad": -1.5, "length_mm": 20.0}}
     png = simulate_figure_png(payload)
     assert png.startswith(b"\x89PNG") and png == simulate_figure_png(payload)  # same figures, same bytes
+
+
+def test_feed_pressures_must_be_one_per_feed_crossing_the_section(tmp_path) -> None:
+    """Refused (exit 2) before the mesh and the solve: the per-chamber demo's base section is crossed by the feeds
+    of its three distal sections' chambers."""
+    from tests.helpers.paths import REPO
+
+    case = REPO / "configs" / "actuator-per-chamber.yaml"
+    result = runner.invoke(app, ["simulate", str(case), "--out", str(tmp_path / "build"), "--pressures", "0,0,0",
+                                 "--feed-pressures", "20"])
+    assert result.exit_code == 2, result.output
+    assert "got 1 values, section 1 has 9 feeds" in result.output

@@ -100,3 +100,21 @@ def test_an_unreinforced_pressurised_feed_bends_its_section_away_from_it_by_less
     away = layout.feeds_through(0)[0].angle + np.pi
     assert abs(np.angle(np.exp(1j * (result.phi - away)))) < np.deg2rad(1.0)
     assert 0 < result.kappa < 0.5 * _beam_curvature(section, layout, 1.0)
+
+
+@pytest.mark.slow
+def test_a_reinforced_pressurised_feed_bends_its_section_more_than_a_bare_one() -> None:
+    """With the hoop thread on the feed's wall (wound as the chambers'), the feed no longer swells, so its side
+    wall no longer cancels most of its cap's pull: the section bends away from the feed by most of P A_f d_f / (E I)
+    (issue 41's rod model's figure, written out here from the mesh's own cross-section).  Measured: 6.38e-6 against
+    8.82e-6 1/mm at 1 kPa (72 %; bare: 21 %), and the solve reaches its load (no false limit).  The remaining 28 %
+    is not explained yet (the feed stops at the chambers' end, not at the section's tip; the thread lies 72 degrees
+    from the feed's axis at this pitch): the issue's "about" is not met within 10 %."""
+    from tests.mechanics.test_reinforced_section import THREAD
+
+    section, layout = _section()
+    result = simulate_section(section, LAW, np.zeros(3), NewtonSettings(load_steps=1), THREAD, np.array([1.0, 0, 0]))
+    away = layout.feeds_through(0)[0].angle + np.pi
+    assert abs(np.angle(np.exp(1j * (result.phi - away)))) < np.deg2rad(1.0)
+    beam = _beam_curvature(section, layout, 1.0)
+    assert 0.5 * beam < result.kappa < beam  # bare: 0.21 beam (the test above); above beam: more than a stopped swell

@@ -42,17 +42,18 @@ if TYPE_CHECKING:
     from softdesign.pipeline.stages.fit import FitResult
     from softdesign.pipeline.stages.kinematics import KinematicsResult
 
-VERSION = 2  # 2: the section meshes three-fold symmetric (equal chambers at equal pressure do not bend)
+VERSION = 3  # 2: the section meshes three-fold symmetric; 3: the case's hoop thread (reinforcement) in the model
 SUMMARY = "simulate/summary.json"
 
 
 def _options(case: Case, section: int) -> Any:
-    from softdesign.pipeline.simulate_run import SimulateOptions
+    from softdesign.pipeline.simulate_run import SimulateOptions, thread_of
 
     s = case.simulate
     assert s is not None  # only called when enabled
     return SimulateOptions(section, None, s.q[0], s.size_mm, s.layer_mm, s.angular_count,
-                           max_pressure_kpa=s.max_pressure_kpa, max_solves=s.max_solves, timeout_s=s.timeout_s)
+                           max_pressure_kpa=s.max_pressure_kpa, max_solves=s.max_solves, timeout_s=s.timeout_s,
+                           thread=thread_of(case))
 
 
 def _sections(case: Case, count: int) -> list[int]:
@@ -115,7 +116,7 @@ def run_simulate_stage(case: Case, kinematics: KinematicsResult, fit: FitResult)
     """Every requested section's pressures at every requested q; None unless ``simulate.enabled``."""
     from dataclasses import replace
 
-    from softdesign.pipeline.simulate_run import LEAVES_OUT, no_law_error, payload
+    from softdesign.pipeline.simulate_run import LEAVES_OUT, no_law_error, payload, thread_of
     from softdesign.pipeline.stages.volume_sweep import material_of
 
     if case.simulate is None or not case.simulate.enabled:
@@ -131,7 +132,8 @@ def run_simulate_stage(case: Case, kinematics: KinematicsResult, fit: FitResult)
             figures = payload(replace(_options(case, index), target_q=q), mesh, material, answer, target, 0.0)
             del figures["seconds"]  # the same build gives the same bytes: times go to the manifest's timing
             solves.append({**figures, "section": index + 1, "q": q, "source": source_label(figures)})
-    return SimulateResult({"solves": solves, "leaves_out": list(LEAVES_OUT), "settings": case.simulate.model_dump(),
+    leaves_out = list(LEAVES_OUT if thread_of(case) is None else LEAVES_OUT[1:])  # the thread is in the model
+    return SimulateResult({"solves": solves, "leaves_out": leaves_out, "settings": case.simulate.model_dump(),
                            "numbering": "sections from 1 at the base and chambers from 1, as in actuation.csv"})
 
 
