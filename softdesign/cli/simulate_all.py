@@ -23,8 +23,9 @@ def run_all(case_file: Path, out: Path | None, q: float | None, pressure: float 
             layer_mm: float, timeout: float, as_json: bool, progress: Callable[[str], None]) -> dict[str, Any]:
     """The whole-device solve with the command's options; its payload (printed unless ``as_json``)."""
     from softdesign.cli.common import emit_json
+    from softdesign.pipeline.device_command import run_device
     from softdesign.pipeline.device_figures import device_lines
-    from softdesign.pipeline.simulate_device import DeviceOptions, run_device
+    from softdesign.pipeline.simulate_device import DeviceOptions
 
     shown = not as_json and sys.stderr.isatty()
     options = DeviceOptions(q, pressure, size_mm, layer_mm, timeout_s=timeout,

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -21,8 +21,20 @@ from softdesign.pipeline.rod_file import read_rod, rod_of_unchanged_build
 
 if TYPE_CHECKING:
     from softdesign.config import Case
-    from softdesign.pipeline.api import BuildOutcome
     from softdesign.pipeline.rod_device import RodSetup
+
+
+
+class Built(Protocol):
+    """What the per-chamber answer reads of a run: its case and each stage's result (a
+    :class:`~softdesign.pipeline.api.BuildOutcome`, or the device stage's own; not imported, so that stages can
+    call this module without an import running up to the API)."""
+
+    @property
+    def case(self) -> Case: ...
+
+    @property
+    def results(self) -> dict[str, Any]: ...
 
 
 def check_pressure_case(case: Case, pressure_kpa: float | None) -> None:
@@ -80,7 +92,7 @@ def answer_if_unchanged(case_file: str | Path, out: Path | None, q: float | None
     return document
 
 
-def pressure_document(outcome: BuildOutcome, q: float | None, pressure_kpa: float | None) -> dict[str, Any]:
+def pressure_document(outcome: Built, q: float | None, pressure_kpa: float | None) -> dict[str, Any]:
     """The per-chamber rod model at a ``q`` off the build's grid, from the stages through fit: JSON-ready (see
     ``softdesign pressure --help``; a single supply is always answered from its rod file)."""
     from softdesign.pipeline.rod_device import rod_setup
@@ -96,7 +108,7 @@ def pressure_document(outcome: BuildOutcome, q: float | None, pressure_kpa: floa
     return document
 
 
-def _per_chamber(outcome: BuildOutcome, setup: RodSetup, q: float) -> dict[str, Any]:
+def _per_chamber(outcome: Built, setup: RodSetup, q: float) -> dict[str, Any]:
     from softdesign.pipeline.rod_device import (
         layout_body,
         layout_stations,

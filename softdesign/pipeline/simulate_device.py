@@ -19,14 +19,12 @@ import contextlib
 import math
 import time
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from softdesign.errors import ConfigError, MeshError, SolveError
+from softdesign.errors import ConfigError, SolveError
 from softdesign.limits.simulate import (
-    DEVICE_MEMORY_BYTES,
     MAX_ANGULAR_COUNT,
     MAX_DEVICE_NODES,
     MAX_LOAD_STEPS,
@@ -205,35 +203,3 @@ def solve_device_in_child(device: Any, law: Any, pressures: FloatList, o: Device
         solve = solve_device(device, law, np.asarray(pressures, float), settings, threads[0], on_step=deadline,
                              backbone=threads[1])
     return {"figures": measure_device(solve), "record": solve.record, "cpu_s": time.process_time() - start}
-
-
-def run_device(case_file: Path, out: Path | None, o: DeviceOptions, progress: Any) -> dict[str, Any]:
-    """Build through actuation, mesh the device, solve it in a child process; the figures as a dict."""
-    from softdesign.config import load_case
-    from softdesign.pipeline.api import build_through
-    from softdesign.pipeline.child import run_in_child
-    from softdesign.pipeline.device_figures import device_payload
-    from softdesign.pipeline.simulate_run import no_law_error
-    from softdesign.pipeline.stages.volume_sweep import material_of
-
-    check_device_options(o)
-    start = time.perf_counter()
-    case = load_case(case_file)
-    check_device_case(case, o)
-    outcome = build_through(case_file, out, "actuation", progress=progress, case=case)
-    material = material_of(outcome.case)
-    if material.law is None:
-        raise no_law_error(outcome.case, str(case_file))
-    q, pressures, top = device_pressures(outcome, o)
-    device = device_mesh_of(outcome, o)
-    meshed = time.perf_counter()
-    what = f"the finite-element solve of the whole device ({len(device.whole.points)} nodes)"
-    fix = "raise --size-mm or --layer-mm, lower the pressure, or raise --timeout"
-    try:
-        answer = run_in_child(solve_device_in_child, (device, material.law, pressures, o,
-                                                      device_threads(outcome.case)), o.timeout_s, what, fix,
-                              DEVICE_MEMORY_BYTES)
-    except MeshError as err:  # the child's failures, a stopped solve among them
-        raise SolveError(str(err)) from err
-    times = {"mesh_s": meshed - start, "solve_s": time.perf_counter() - meshed, "solve_cpu_s": answer["cpu_s"]}
-    return device_payload(outcome, o, device, material, (q, pressures, top), answer, times)
