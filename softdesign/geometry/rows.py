@@ -60,3 +60,61 @@ def distinct_rows(values: npt.ArrayLike) -> DistinctRows:
     inverse[order] = np.cumsum(starts) - 1
     start_at = np.flatnonzero(starts)
     return DistinctRows(ordered[start_at], order[start_at], inverse, np.diff(np.append(start_at, n)))
+
+
+#: Odd 64-bit multipliers that mix each column's bits into a row's hash (any odd constants would do: a hash only
+#: brings equal rows together, and a collision is detected and handled, see :func:`rows_in_first_order`).
+_MIXERS = (0x9E3779B97F4A7C15, 0xC2B2AE3D27D4EB4F, 0x165667B19E3779F9, 0x27D4EB2F165667C5)
+
+
+def rows_in_first_order(values: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """Groups of equal rows of ``values`` (n, k), numbered in the order of their first occurrence.
+
+    Returns ``first`` (m,) int, the input index of each group's first row, increasing, and ``inverse`` (n,)
+    int, each row's group (``values[first][inverse]`` is ``values``): what trimesh's
+    ``grouping.unique_rows(..., keep_order=True)`` gives for integer rows, and, whatever the method, the only
+    numbering in first-occurrence order.  Rows are equal as in :func:`distinct_rows` (``-0.0 == 0.0``; NaN never).
+
+    The rows are hashed to one 64-bit key each and sorted by it (one stable sort of (n,) keys, not k); every
+    row is then compared with the first of its key's run, so a hash collision or a NaN is seen, and those
+    inputs are grouped by :func:`distinct_rows` instead: the same groups either way.
+    """
+    array = np.asarray(values)
+    if array.ndim != 2:
+        raise ValueError(f"rows_in_first_order expects an (n, k) array, got shape {array.shape}")
+    n = len(array)
+    if n == 0:
+        return np.zeros(0, np.intp), np.zeros(0, np.intp)
+    if array.dtype.kind == "f":
+        array = array + 0.0  # -0.0 becomes 0.0: equal values, equal bits
+    found = _hashed_groups(array) if array.dtype.itemsize <= 8 and array.shape[1] <= len(_MIXERS) else None
+    if found is None:
+        distinct = distinct_rows(array)
+        found = distinct.first, distinct.inverse
+    first, inverse = found
+    order = np.argsort(first, kind="stable")
+    rank = np.empty(len(first), np.intp)
+    rank[order] = np.arange(len(first))
+    return first[order], rank[inverse]
+
+
+def _hashed_groups(array: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """(first index, group) of each run of equal rows after a stable sort by hash; None on a collision or NaN."""
+    bits = np.ascontiguousarray(array).view(f"u{array.dtype.itemsize}").astype(np.uint64)
+    key = np.zeros(len(array), np.uint64)
+    for column, mixer in zip(bits.T, _MIXERS, strict=False):
+        key ^= column * np.uint64(mixer)
+        key = (key << np.uint64(29)) | (key >> np.uint64(35))  # rotate, so that columns do not cancel by position
+    order = np.argsort(key, kind="stable")
+    ordered_key = key[order]
+    starts = np.empty(len(array), bool)
+    starts[0] = True
+    np.not_equal(ordered_key[1:], ordered_key[:-1], out=starts[1:])
+    ordered = array[order]
+    same = ~starts[1:]  # each row of a run against the one before it: equality is transitive
+    if not np.array_equal(ordered[1:][same], ordered[:-1][same]):  # a collision, or a NaN (never equal)
+        return None
+    group = np.cumsum(starts) - 1
+    inverse = np.empty(len(array), np.intp)
+    inverse[order] = group
+    return order[starts], inverse
