@@ -126,7 +126,7 @@ def _merged_as_trimesh_merges(vertices: np.ndarray, faces: np.ndarray, digits: i
 
     Vertices are one when their coordinates times 10^digits round to the same integers; each merged vertex is
     the first of its group, in the order of first occurrence among the vertices that faces use (what trimesh
-    keeps): the same arrays, bit for bit (tests/io/test_formats.py compares them).
+    keeps): the same arrays, bit for bit (tests/io/test_stl_merge.py compares them).
     """
     from softdesign.geometry.rows import rows_in_first_order
 
