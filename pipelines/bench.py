@@ -345,6 +345,7 @@ def run_worker(case_file: Path, out_dir: Path, profile_dir: Path | None, jobs: i
         "input": {"triangles": surface["faces"], "vertices": surface["vertices"]},
         "output": {"meshes": len(meshes), "triangles": sum(o["faces"] for o in meshes)},
         "floor": floor,
+        "load": os.getloadavg(),  # at the build's end: the figures' context (wall times swell with it)
     }
 
 
@@ -566,8 +567,9 @@ def stage_table(result: dict[str, Any]) -> list[str]:
     floor = result["floor"]
     floors = {"ingest": floor["read_s"], "export": floor["write_s"], "total": floor["read_s"] + floor["write_s"]}
     i, o = result["input"], result["output"]
+    load = ", ".join(f"{v:.2f}" for v in result.get("load", ()))
     lines = [
-        f"{result['label']}",
+        f"{result['label']}" + (f" (load average {load} at its end)" if load else ""),
         f"  input {i['triangles']:,} triangles ({i['vertices']:,} vertices); writes {o['meshes']} STL meshes, "
         f"{o['triangles']:,} triangles; imports before the clock {result['import_s']:.2f} s, "
         f"RSS after imports {result['baseline_mib']:.0f} MiB; --jobs {result['jobs']}, largest worker's peak "
@@ -712,7 +714,7 @@ def profile_lines(profile_dir: Path, rows: int = PROFILE_ROWS) -> list[str]:
 
 
 def _short(file: str) -> str:
-    return file.split("site-packages/")[-1].split("/work/main/")[-1]
+    return file.split("site-packages/")[-1].removeprefix(f"{REPO}/")
 
 
 # ---------------------------------------------------------------- driver

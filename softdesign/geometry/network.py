@@ -15,6 +15,7 @@ import numpy as np
 
 from softdesign.errors import InputDataError
 from softdesign.geometry.inlet import widest_end_flip
+from softdesign.geometry.rows import distinct_rows
 from softdesign.types import FloatArray, Points
 
 #: VMTK's cell arrays that identify tracts of a branch-split network.
@@ -171,7 +172,7 @@ def _check_points(points: Points, where: str) -> None:
             f"{where}: {bad.size} point(s) have NaN or infinite coordinates (first at position {bad[0]}); "
             "re-export the centerline"
         )
-    distinct = len(np.unique(points, axis=0))
+    distinct = len(distinct_rows(points).rows)
     if distinct < MIN_PATH_POINTS:
         raise InputDataError(
             f"{where}: expected at least {MIN_PATH_POINTS} distinct points, got {distinct}; "

@@ -38,6 +38,10 @@ PLAUSIBLE_RADIUS_MM = (0.3, 20.0)
 PLAUSIBLE_LENGTH_MM = (5.0, 2000.0)
 #: Nearest distances by measuring every pair up to this many (a (n, V) float64 array of 32 MB), a KD-tree beyond.
 BRUTE_FORCE_PAIRS = 4_000_000
+#: Points measured together by the direct method: on the sample case (352 points, 8,455 vertices) blocks of 16
+#: took 6 ms of CPU, of 64 22 ms, all at once 48 ms (a block's table stays in the processor's cache, and its
+#: product is too small for BLAS to spread over threads).
+NEAREST_BLOCK = 16
 
 
 def surrounds(points: Points, radius: FloatArray | None, vertices: Points) -> bool:
@@ -75,11 +79,17 @@ def nearest_distances(points: Points, vertices: Points) -> FloatArray:
         # nearest distances do not depend on how the tree is split
         tree = cKDTree(vertices, balanced_tree=False, compact_nodes=False)
         return np.asarray(tree.query(points)[0], dtype=float)
-    # |p - v|^2 = |p|^2 - 2 p.v + |v|^2, relative to the vertices' centre so that the rounding stays small
+    # |p - v|^2 = |p|^2 + min over v of (|v|^2 - 2 p.v), relative to the vertices' centre so that the rounding
+    # stays small; NEAREST_BLOCK points at a time, so that each block's table stays in the processor's cache
     centre = vertices.mean(axis=0)
     p, v = points - centre, vertices - centre
-    squared = np.einsum("ij,ij->i", p, p)[:, None] - 2.0 * (p @ v.T) + np.einsum("ij,ij->i", v, v)[None, :]
-    nearest: FloatArray = np.sqrt(np.maximum(squared.min(axis=1), 0.0))
+    v_squared = np.einsum("ij,ij->i", v, v)
+    least = np.empty(len(p))
+    for start in range(0, len(p), NEAREST_BLOCK):
+        block = p[start:start + NEAREST_BLOCK] @ (-2.0 * v.T)
+        block += v_squared
+        least[start:start + NEAREST_BLOCK] = block.min(axis=1)
+    nearest: FloatArray = np.sqrt(np.maximum(least + np.einsum("ij,ij->i", p, p), 0.0))
     return nearest
 
 

@@ -1,4 +1,4 @@
-"""A binary STL's corners with numpy alone, for ``softdesign validate`` (no trimesh import, about 0.3 s of CPU).
+"""A binary STL's corners with numpy alone, for ``softdesign validate`` (no trimesh import; about 0.01 s of CPU).
 
 A binary STL is an 84-byte header (80 bytes of text, a uint32 triangle count)
 and 50 bytes per triangle: a float32 normal, three float32 corners and a
@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from softdesign.geometry.rows import distinct_rows
 from softdesign.io.input_checks import STL_HEADER_BYTES, STL_RECORD_BYTES, check_input_file
 from softdesign.types import FloatArray
 
@@ -39,5 +40,5 @@ def binary_stl_corners(path: Path) -> tuple[FloatArray, int] | None:
             return None
         records = np.fromfile(handle, dtype=_RECORD, count=count)
     corners = records["corners"].reshape(-1, 3).astype(np.float64) + 0.0  # + 0.0 turns -0.0 into 0.0
-    distinct: FloatArray = np.unique(corners, axis=0) if len(corners) else corners
+    distinct: FloatArray = distinct_rows(corners).rows if len(corners) else corners
     return distinct, count

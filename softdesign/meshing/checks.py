@@ -20,6 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import MeshError
+from softdesign.geometry.rows import rows_in_first_order
 from softdesign.meshing.topology import corner_planes, mesh_topology
 from softdesign.meshing.volume_tolerance import MIN_ANGULAR_COUNT, VOLUME_RTOL
 from softdesign.types import FloatArray
@@ -106,15 +107,16 @@ def written_defects(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> tuple[int,
     faces = np.asarray(faces, np.int64).reshape(-1, 3)
     if not faces.size:
         return 0, 0
-    inverse = np.unique(rounded, axis=0, return_inverse=True)[1].reshape(-1)
+    inverse = rows_in_first_order(rounded)[1]  # coincident vertices as one (np.unique's groups, faster)
     merged = inverse[faces]
     corners = rounded[faces]
     doubled = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
     zero = int(np.sum(doubled == 0.0))
     edges = np.sort(np.concatenate([merged[:, [0, 1]], merged[:, [1, 2]], merged[:, [2, 0]]]), axis=1)
     edges = edges[edges[:, 0] != edges[:, 1]]  # a folded face's point-edge is no edge
-    counts = np.unique(edges, axis=0, return_counts=True)[1]
-    return zero, int(np.sum(counts > 2))
+    keys = np.sort(edges[:, 0] * np.int64(len(rounded)) + edges[:, 1])  # one integer per edge (< V^2 < 2^63)
+    runs = np.diff(np.flatnonzero(np.diff(keys, prepend=-1, append=-1)))  # faces sharing each edge
+    return zero, int(np.sum(runs > 2))
 
 
 def inspect_mesh(

@@ -1,0 +1,67 @@
+"""The binary STL reader merges vertices exactly as trimesh's merge_vertices did: the same arrays, bit for bit."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+
+from softdesign.geometry.rows import rows_in_first_order
+from softdesign.io.formats import _merge_digits, _merged_as_trimesh_merges, read_mesh
+from softdesign.meshing.checks import written_defects
+from tests.helpers.paths import REPO
+
+
+def _trimesh_merged(vertices: np.ndarray, faces: np.ndarray, digits: int) -> tuple[np.ndarray, np.ndarray]:
+    mesh = trimesh.Trimesh(vertices, faces, process=False)
+    mesh.merge_vertices(digits_vertex=digits)
+    return np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces, np.int64)
+
+
+def _assert_same(found: tuple[np.ndarray, np.ndarray], expected: tuple[np.ndarray, np.ndarray]) -> None:
+    for mine, theirs in zip(found, expected, strict=True):
+        assert mine.dtype == theirs.dtype and mine.shape == theirs.shape
+        assert mine.tobytes() == theirs.tobytes()
+
+
+@pytest.mark.parametrize("scale_to_mm", [1.0, 1000.0])
+def test_near_duplicates_unused_vertices_and_negative_zero_merge_as_trimesh_merges(scale_to_mm):
+    rng = np.random.default_rng(3)
+    base = rng.normal(size=(300, 3)) * 20.0
+    base[:5] = 0.0
+    base[5:10] = -0.0
+    jitter = rng.choice([0.0, 1e-12, 4e-9, 3e-8], size=(900, 1)) * rng.choice([-1.0, 1.0], size=(900, 3))
+    vertices = base[rng.integers(0, 300, size=900)] + jitter / scale_to_mm
+    faces = rng.integers(0, 850, size=(400, 3))  # vertices 850-899 unused: dropped as trimesh drops them
+    digits = _merge_digits(scale_to_mm)
+    _assert_same(_merged_as_trimesh_merges(vertices, faces, digits), _trimesh_merged(vertices, faces, digits))
+
+
+def test_the_demo_surface_reads_as_trimesh_merged_it():
+    path = REPO / "data" / "demo" / "surface.stl"
+    loaded = trimesh.exchange.stl.load_stl_binary(path.open("rb"))
+    expected = _trimesh_merged(np.asarray(loaded["vertices"], np.float64), loaded["faces"], _merge_digits(1.0))
+    _assert_same(read_mesh(path), expected)
+
+
+def test_groups_in_first_order_are_trimesh_s_and_survive_a_hash_collision(monkeypatch):
+    rng = np.random.default_rng(5)
+    rows = rng.integers(-4, 4, size=(2000, 3))
+    first, inverse = trimesh.grouping.unique_rows(rows, keep_order=True)
+    found = rows_in_first_order(rows)
+    np.testing.assert_array_equal(found[0], first)
+    np.testing.assert_array_equal(found[1], inverse)
+    from softdesign.geometry import rows as module
+
+    monkeypatch.setattr(module, "_MIXERS", (0, 0, 0, 0))  # every row one hash: the check falls back to sorting
+    collided = rows_in_first_order(rows)
+    np.testing.assert_array_equal(collided[0], first)
+    np.testing.assert_array_equal(collided[1], inverse)
+
+
+def test_written_defects_count_coincident_vertices_as_one():
+    # two triangles sharing an edge through distinct but float32-equal vertices, and a third on the same edge
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 0], [1 + 1e-9, 0, 0], [0, -1, 0], [0, 0, 1]], float)
+    faces = np.array([[0, 1, 2], [3, 5, 4], [0, 6, 1]])
+    assert written_defects(vertices, faces) == (0, 1)  # edge 0-1 shared by three faces once merged
+    assert written_defects(vertices[:3], faces[:1]) == (0, 0)
