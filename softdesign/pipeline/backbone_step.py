@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softdesign.fitting.metrics import closest_surface_points
+from softdesign.fitting.closest import closest_surface_points
 from softdesign.fitting.selection import NetworkContext, SelectionSettings, other_branch_mask
 from softdesign.fitting.wall_fit import WallFit
 from softdesign.geometry.backbone import (

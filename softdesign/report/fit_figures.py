@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import InputDataError
-from softdesign.fitting.metrics import closest_surface_points
+from softdesign.fitting.closest import closest_surface_points
 from softdesign.fitting.projection import PolarPoints
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.selection import REASONS

@@ -31,7 +31,8 @@ import pytest
 from softdesign.config import Resample
 from softdesign.errors import FitError
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
-from softdesign.fitting.metrics import closest_surface_points, holdout_rms, summarize_distances
+from softdesign.fitting.closest import closest_surface_points
+from softdesign.fitting.metrics import holdout_rms, summarize_distances
 from softdesign.fitting.projection import project_points
 from softdesign.fitting.radius_field import RadiusField, check_self_folding
 from softdesign.fitting.selection import NetworkContext, inscribed_profile, select_wall_points

@@ -6,21 +6,18 @@ import numpy as np
 import pytest
 
 from softdesign.errors import ConfigError
-from softdesign.fitting import metrics
+from softdesign.fitting import closest
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface, fold_solver
+from softdesign.fitting.closest import CLOSEST_TOL_MM, closest_surface_points, frame_twist_table, surface_points
 from softdesign.fitting.metrics import (
-    CLOSEST_TOL_MM,
     HoldoutSettings,
     choose_knot_spacing,
-    closest_surface_points,
     fold_labels,
-    frame_twist_table,
     holdout_rms,
     holdout_sample,
     measure_distances,
     measure_fit,
     summarize_distances,
-    surface_points,
 )
 from softdesign.fitting.projection import project_points
 from tests.helpers.analytic import Arc, FrenetHelix, Helix, Line, grid_parameters, tube_points
@@ -219,7 +216,7 @@ def test_distances_are_the_same_bits_in_blocks_on_worker_processes(monkeypatch):
     curve, noisy = _noisy_tube(sigma=0.2)
     spline = fit_radius_surface(noisy, curve.length, FitSettings()).whole
     whole = measure_distances(curve, spline, noisy, np.random.default_rng(0))
-    monkeypatch.setattr(metrics, "CLOSEST_CHUNK", 500)
+    monkeypatch.setattr(closest, "CLOSEST_CHUNK", 500)
     mapper, blocks = two_worker_mapper()
     split = measure_distances(curve, spline, noisy, np.random.default_rng(0), mapper=mapper)
     assert blocks == [5]
