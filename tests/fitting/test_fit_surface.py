@@ -10,14 +10,13 @@ from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import (
     FitSettings,
     RadiusSpline,
-    design_and_gram,
-    design_matrix,
     fit_radius_surface,
     intervals_per_link,
     split_at_breaks,
 )
 from softdesign.fitting.metrics import measure_fit
 from softdesign.fitting.projection import project_points
+from softdesign.fitting.surface_system import design_and_gram, design_matrix
 from tests.helpers.analytic import Arc, Helix, Line, grid_parameters, tube_points
 
 #: Shapes inside the spline space come back to rounding plus the projection's 1e-10 mm Newton tolerance.
