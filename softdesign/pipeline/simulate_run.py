@@ -209,10 +209,10 @@ def payload(o: SimulateOptions, section: Any, material: Any, answer: dict[str, A
                      "c2_kpa": material.law.c2, "c3_kpa": material.law.c3, "bulk_kpa": material.law.bulk_kpa,
                      "source": material.law.source},
         "formulation": ("quadratic (10-node) tetrahedra, mean dilatation per element (near-incompressible), "
-                        "follower pressure on 6-node faces, volume continuation"
-                        + ("" if o.thread is None else
-                           f", hoop thread on the chamber walls (pitch {o.thread.pitch_mm:g} mm, diameter "
-                           f"{o.thread.diameter_mm:g} mm, modulus {o.thread.modulus_kpa:g} kPa)")),
+                        "follower pressure on 6-node faces"
+                        + (", volume continuation" if o.thread is None else
+                           f", load steps, hoop thread on the chamber walls (pitch {o.thread.pitch_mm:g} mm, "
+                           f"diameter {o.thread.diameter_mm:g} mm, modulus {o.thread.modulus_kpa:g} kPa)")),
         "mesh": {"nodes": len(section.points), "tets": len(section.tets),
                  "quadratic_nodes": quadratic_node_count(section), "size_mm": o.size_mm,
                  "layer_mm": o.layer_mm, "angular_count": o.angular_count},
