@@ -56,18 +56,8 @@ def pressure_from_build(case: Case, case_file: str, out: Path | None, q: float |
                         pressure_kpa: float | None) -> dict[str, Any] | None:
     """The answer from the build's rod file (ConfigError when there is none, or it is not this case's); None for a
     per-chamber q off the build's grid (the caller then runs the stages through fit)."""
-    start = time.perf_counter()
     build_dir = out if out is not None else Path("build") / case.name
-    rod = read_rod(case, build_dir, case_file)
-    if rod["supply"] == "single":
-        document = single_from_rod(rod, q, pressure_kpa)
-    else:
-        found = per_chamber_from_rod(rod, 1.0 if q is None else q)
-        if found is None:
-            return None
-        document = found
-    document["seconds"] = time.perf_counter() - start
-    return document
+    return _answer_from_rod(read_rod(case, build_dir, case_file), q, pressure_kpa)
 
 
 def answer_if_unchanged(case_file: str | Path, out: Path | None, q: float | None,
@@ -76,13 +66,17 @@ def answer_if_unchanged(case_file: str | Path, out: Path | None, q: float | None
     (:func:`~softdesign.pipeline.rod_file.rod_of_unchanged_build`), without loading the case; None otherwise, and
     for what the rod file cannot answer alone (``--pressure`` on a per-chamber case, a q off the build's grid)."""
     rod = rod_of_unchanged_build(case_file, out)
-    if rod is None:
-        return None
+    return None if rod is None else _answer_from_rod(rod, q, pressure_kpa)
+
+
+def _answer_from_rod(rod: dict[str, Any], q: float | None, pressure_kpa: float | None) -> dict[str, Any] | None:
+    """The rod file's answer, ``seconds`` the model's time; None for what it cannot answer alone: ``--pressure``
+    on a per-chamber case (the full path refuses it, naming the case's supply) or a q off the build's grid."""
     start = time.perf_counter()
     if rod["supply"] == "single":
         document = single_from_rod(rod, q, pressure_kpa)
     elif pressure_kpa is not None:
-        return None  # the full path refuses it, naming the case's supply
+        return None
     else:
         found = per_chamber_from_rod(rod, 1.0 if q is None else q)
         if found is None:
