@@ -57,9 +57,9 @@ from softdesign.meshing.mould.checks import (
     shared_volume,
 )
 from softdesign.meshing.mould.frame import PartingFrame, parting_frame
-from softdesign.meshing.mould.make import Mould, MouldMesh, checks_passed
+from softdesign.meshing.mould.make import Mould, checks_passed, meshes_in_world
 from softdesign.meshing.mould.parts import MouldParts, MouldRefused, MouldSpec, _cylinder, build_mould
-from softdesign.meshing.solids import checked, cut_body, manifold_from_mesh, welded_as_written
+from softdesign.meshing.solids import checked, cut_body, manifold_from_mesh
 from softdesign.meshing.tessellate import Region, Sweep, TubeMesh, TubeSections, sweep_from_sections, tessellate
 from softdesign.meshing.volume import BodySpec
 from softdesign.types import FloatArray
@@ -203,15 +203,7 @@ def make_actuated_mould(sections: TubeSections, body_spec: BodySpec, spec: Mould
     figures["core"] = _core_note(frame, layout, cores)
     figures["thread"] = _thread_note(thread_mm, hole_mm, frame.straight)
     named = [("half_a", half_a), ("half_b", half_b), ("core_plate", plate), *cores]
-    to_world = frame.world_from_frame()
-    meshes = []
-    for part_name, part in named:
-        mesh = part.transform(to_world).to_mesh64()
-        faces = np.asarray(mesh.tri_verts, np.int64)
-        vertices, faces, _ = welded_as_written(np.asarray(mesh.vert_properties, float)[:, :3], faces,
-                                               np.zeros(len(faces), np.int8))  # as STL keeps it (issue 43)
-        meshes.append(MouldMesh(part_name, vertices, faces.copy()))
-    return Mould(tuple(meshes), figures)
+    return Mould(meshes_in_world(named, frame), figures)
 
 
 def _thread_note(thread_mm: float | None, hole_mm: float, straight: bool) -> dict[str, Any] | None:

@@ -150,8 +150,13 @@ def make_mould(sections: TubeSections, body_spec: BodySpec, spec: MouldSpec,
                  "(the base cap stretches over it)") if frame.straight else
                 ("the chamber is not straight at q = 0: a rigid core cannot be drawn out; cast it in a dissolvable "
                  "or wax material (lost core) and melt or dissolve it out through the port")}
-    to_world = frame.world_from_frame()
     named = [("half_a", parts.half_a), ("half_b", parts.half_b)] + ([("core", parts.core)] if parts.core else [])
+    return Mould(meshes_in_world(named, frame), figures)
+
+
+def meshes_in_world(named: list[tuple[str, Any]], frame: PartingFrame) -> tuple[MouldMesh, ...]:
+    """The named solids (manifold3d) moved from the parting frame to the case's, welded as STL keeps them."""
+    to_world = frame.world_from_frame()
     meshes = []
     for part_name, part in named:
         mesh = part.transform(to_world).to_mesh64()
@@ -159,7 +164,7 @@ def make_mould(sections: TubeSections, body_spec: BodySpec, spec: MouldSpec,
         vertices, faces, _ = welded_as_written(np.asarray(mesh.vert_properties, float)[:, :3], faces,
                                                np.zeros(len(faces), np.int8))  # as STL keeps it (issue 43)
         meshes.append(MouldMesh(part_name, vertices, faces.copy()))
-    return Mould(tuple(meshes), figures)
+    return tuple(meshes)
 
 
 def checks_passed(figures: dict[str, Any], frame: PartingFrame) -> None:
