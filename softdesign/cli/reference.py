@@ -20,6 +20,8 @@ from typing import Any
 from pydantic import BaseModel
 from pydantic.fields import FieldInfo
 
+from softdesign.config.field_docs import attach_field_docs
+
 #: Bounds pydantic keeps in a field's metadata, and how the page writes them.
 BOUNDS = (("gt", ">"), ("ge", ">="), ("lt", "<"), ("le", "<="), ("min_length", "length >="),
           ("max_length", "length <="))
@@ -36,7 +38,7 @@ def case_keys(model: type[BaseModel], prefix: str = "") -> Iterator[tuple[str, F
 
 def missing_descriptions(model: type[BaseModel]) -> list[str]:
     """The dotted keys whose field has no description (the test of the reference fails on any)."""
-    return [key for key, field, _ in case_keys(model) if not (field.description or "").strip()]
+    return [key for key, field, _ in case_keys(attach_field_docs(model)) if not (field.description or "").strip()]
 
 
 def case_reference_markdown(model: type[BaseModel]) -> str:
@@ -45,7 +47,7 @@ def case_reference_markdown(model: type[BaseModel]) -> str:
              "Generated from the pydantic models that validate it (`python pipelines/docs.py`); do not edit.",
              "Every key is optional unless marked required; sizes in mm, angles in degrees only where the key says "
              "so. Editors can complete and check case files with the JSON Schema of `softdesign schema`.", ""]
-    for key, field, nested in case_keys(model):
+    for key, field, nested in case_keys(attach_field_docs(model)):
         depth = key.count(".")
         heading = "##" if depth == 0 else "###"
         lines.append(f"{heading} `{key}`")

@@ -22,8 +22,9 @@ DIALECT = "https://json-schema.org/draft/2020-12/schema"
 def case_schema() -> dict[str, Any]:
     """The case file's JSON Schema, made from the same pydantic models that validate it (so it cannot drift)."""
     from softdesign.config import Case
+    from softdesign.config.field_docs import attach_field_docs
 
-    schema = Case.model_json_schema()
+    schema = attach_field_docs(Case).model_json_schema()
     schema["title"] = "softdesign case file"
     return {"$schema": DIALECT, **schema}
 

@@ -72,7 +72,7 @@ SIZED_BY_SINGLE = ("chambers_per_section", "distance_mm", "diameter_mm", "first_
 class ThreadChoice(BaseModel):
     """A thread of softdesign/data/threads.yaml, by name."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+    model_config = ConfigDict(extra="forbid", frozen=True)
 
     name: str = "kevlar-69"
     """The thread's name in softdesign/data/threads.yaml (``softdesign materials`` lists them)."""
@@ -90,7 +90,7 @@ class ThreadChoice(BaseModel):
 class Reinforcement(BaseModel):
     """What stops a chamber's radial growth: a thread wound round it (``hoop``), or nothing (``none``)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+    model_config = ConfigDict(extra="forbid", frozen=True)
 
     kind: Literal["hoop", "none"] = "hoop"
     """hoop: a thread wound round each chamber core before casting; none: bare chambers (no rod-model bend)."""
@@ -105,7 +105,7 @@ class Reinforcement(BaseModel):
 class Actuation(BaseModel):
     """The chambers in the body: their supply, reinforcement and backbone, and Zou et al.'s per-chamber sizes."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+    model_config = ConfigDict(extra="forbid", frozen=True)
 
     supply: Literal["single", "per_chamber"] = "per_chamber"
     """single: one pressure, one sized chamber per section; per_chamber: Zou et al.'s three chambers, a feed each."""

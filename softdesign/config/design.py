@@ -16,7 +16,7 @@ from softdesign.limits.design import MAX_DESIGN_LINKS
 class Design(BaseModel):
     """Sections of constant curvature composed from the base frame, within these bounds of the q = 1 centerline."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+    model_config = ConfigDict(extra="forbid", frozen=True)
 
     tolerance_mm: FiniteFloat = Field(1.0, gt=0.0, le=100.0)
     """Largest true distance between the composed chain and the q = 1 centerline, both ways, the tip included, mm."""

@@ -21,7 +21,7 @@ MAX_TAPER_MM = 100.0
 class LocalMaxRadius(BaseModel):
     """The body held at most ``radius_mm`` from ``from_mm`` to ``to_mm`` along the path, tapering over ``taper_mm``."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+    model_config = ConfigDict(extra="forbid", frozen=True)
 
     from_mm: FiniteFloat = Field(ge=0.0, le=MAX_INITIAL_LENGTH_MM)
     """Start of the stretch, mm of the q = 1 centerline from the inlet."""

@@ -37,7 +37,7 @@ def _printable(value: str) -> str:
 class CustomLaw(BaseModel):
     """A hyperelastic law: Yeoh coefficients in kPa (neo-Hookean: c2 = c3 = 0, mu = 2 c1)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+    model_config = ConfigDict(extra="forbid", frozen=True)
 
     kind: Literal["neo-hookean", "yeoh"]
     """neo-hookean or yeoh."""
@@ -58,7 +58,7 @@ class CustomLaw(BaseModel):
 class CustomMaterial(BaseModel):
     """A material given in full in the case file, with its source."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+    model_config = ConfigDict(extra="forbid", frozen=True)
 
     name: str = Field(min_length=1, max_length=80)
     """Your material's name, as the report names it."""

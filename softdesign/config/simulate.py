@@ -36,7 +36,7 @@ Q_RESOLUTION = 1e-3
 class Simulate(BaseModel):
     """Chamber pressures per section and q from a finite-element inverse (the simulate stage): off unless enabled."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+    model_config = ConfigDict(extra="forbid", frozen=True)
 
     enabled: Flag = False
     """Run the finite elements in `build`: each section's pressures per q (supply: per_chamber, minutes per

@@ -40,6 +40,10 @@ def q_in_range(values: list[float]) -> list[float]:
 
 
 class CaseBlock(BaseModel):
-    """A block of the case file: unknown keys refused, frozen, each key's docstring its description."""
+    """A block of the case file: unknown keys refused, frozen, each key's docstring its description.
 
-    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+    The docstrings become descriptions where they are read (the schema, the reference page), by
+    :func:`softdesign.config.field_docs.attach_field_docs`, not at every start-up.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
