@@ -29,9 +29,16 @@ from typing import Any
 import numpy as np
 
 from softdesign.fitting.bspline_surface import RadiusSpline
+from softdesign.fitting.closest import SearchStart, closest_with_part
 from softdesign.fitting.end_prior import SEEN_GAP_RAD, largest_gap
 from softdesign.fitting.mapping import Mapper, serial_map
-from softdesign.fitting.metrics import FitMetrics, measure_distances, summarize_distances
+from softdesign.fitting.metrics import (
+    DISTANCE_SAMPLE_MAX,
+    FitMetrics,
+    measure_distances,
+    summarize_distances,
+    with_exact_max,
+)
 from softdesign.fitting.projection import PolarPoints
 from softdesign.fitting.selection import REASONS, WallSelection
 from softdesign.types import FloatArray, FramedCurve
@@ -97,6 +104,7 @@ def measure_coverage(
     held_ends: dict[str, Any],
     mapper: Mapper = serial_map,
     spans_mm: tuple[tuple[float, float], ...] = (),
+    known: tuple[np.ndarray, FloatArray] | None = None,
 ) -> WallCoverage:
     """True distances of the own wall to the fitted surface, the coverage, the unseen stretches and the flags.
 
@@ -113,18 +121,24 @@ def measure_coverage(
     mapper : runs the distance blocks
     spans_mm : stretches (from, to), mm from the inlet, where local caps hold the body thinner on purpose: the
         all-wall figures are given outside them too, and the p95 flag judges those
+    known : sorted indices into ``polar`` (m,) of fitted points already measured against ``surface`` (all of
+        them, or a seeded uniform sample: the kept-point figures'), and their distances (m,) mm, which are used,
+        not searched again (:func:`_own_wall_distances`); None: the own wall is measured afresh
     """
     own = own_wall(polar, selection)
     nan = float("nan")
     measured, outside = FitMetrics(nan, nan, nan, nan, 0), None
     if own.any():
-        found = measure_distances(curve, surface, polar.subset(own), np.random.default_rng(ALL_WALL_SEED),
-                                  mapper=mapper)
-        measured = found.metrics
+        if known is None:
+            found = measure_distances(curve, surface, polar.subset(own), np.random.default_rng(ALL_WALL_SEED),
+                                      mapper=mapper)
+            measured, sample, distance = found.metrics, np.flatnonzero(own)[found.sample], found.distance
+        else:
+            measured, sample, distance = _own_wall_distances(curve, surface, polar, own, fitted, known, mapper)
         if spans_mm:  # local caps hold the body off the wall on purpose there: judged outside them
-            s = polar.l[np.flatnonzero(own)[found.sample]] * curve.length
+            s = polar.l[sample] * curve.length
             away = ~np.any([(s >= lo) & (s <= hi) for lo, hi in spans_mm], axis=0)
-            outside = summarize_distances(found.distance[away]) if away.any() else FitMetrics(nan, nan, nan, nan, 0)
+            outside = summarize_distances(distance[away]) if away.any() else FitMetrics(nan, nan, nan, nan, 0)
     judged = measured if outside is None else outside
     kept = polar.subset(fitted)
     radius = float(np.median(reference[1] if reference is not None else kept.rho)) if len(kept) else float("nan")
@@ -146,6 +160,50 @@ def measure_coverage(
             f"the radius {radius:.3f} mm (max {judged.max_mm:.3f} mm): the kept-point figures do not describe it")
     return WallCoverage(measured, int(own.sum()), int(len(fitted)), radius, tuple(stretches), tuple(flags),
                         tuple(warnings), outside, tuple(spans_mm))
+
+
+def _own_wall_distances(
+    curve: FramedCurve, surface: RadiusSpline, polar: PolarPoints, own: np.ndarray, fitted: np.ndarray,
+    known: tuple[np.ndarray, FloatArray], mapper: Mapper,
+) -> tuple[FitMetrics, np.ndarray, FloatArray]:
+    """The all-wall figures from the fitted points' known distances and the searches of the other own points.
+
+    Up to ``DISTANCE_SAMPLE_MAX`` own points, every one is measured (a known distance is the same search's
+    result: the same number); above it, a stratified sample: the known points (a uniform sample of the fitted
+    ones at rate r) and a seeded uniform draw at the same rate r of the own points the fit did not use, so every
+    own point has the same chance r; the max is over every own point, as :func:`measure_distances` makes it.
+
+    Returns
+    -------
+    metrics, the measured own points (sorted indices into ``polar``) and their distances, mm.
+    """
+    own_index = np.flatnonzero(own)
+    order = np.argsort(known[0], kind="stable")  # the fit's points run along the path, not in input order
+    known_index, known_distance = known[0][order], known[1][order]
+    if len(own_index) <= DISTANCE_SAMPLE_MAX:
+        sample = own_index
+    else:
+        unfitted = own.copy()
+        unfitted[fitted] = False
+        rate = len(known_index) / max(len(fitted), 1)
+        candidates = np.flatnonzero(unfitted)
+        drawn = np.random.default_rng(ALL_WALL_SEED).choice(candidates, size=round(rate * len(candidates)),
+                                                            replace=False)
+        chosen = np.zeros(len(own), bool)
+        chosen[drawn] = True
+        chosen[known_index[own[known_index]]] = True
+        sample = np.flatnonzero(chosen)
+    at = np.minimum(np.searchsorted(known_index, sample), max(len(known_index) - 1, 0))
+    hit = known_index[at] == sample if len(known_index) else np.zeros(len(sample), bool)
+    distance = np.empty(len(sample))
+    distance[hit] = known_distance[at[hit]]
+    if not hit.all():
+        rest = polar.subset(sample[~hit])
+        distance[~hit] = closest_with_part(curve, surface, rest.points, SearchStart(rest.l, rest.angle), mapper)[0]
+    own_points = polar.subset(own_index)
+    metrics = with_exact_max(curve, surface, own_points, np.searchsorted(own_index, sample),
+                             summarize_distances(distance))
+    return metrics, sample, distance
 
 
 def unseen_stretches(

@@ -163,17 +163,28 @@ def measure_distances(
     measured = polar.subset(sample)
     distance, l, angle, part = closest_with_part(curve, spline, measured.points,
                                                  SearchStart(measured.l, measured.angle), mapper)
-    metrics = summarize_distances(distance)
-    if len(sample) < len(polar):
-        rest = np.setdiff1d(np.arange(len(polar)), sample, assume_unique=True)
-        bound = np.abs(polar.rho[rest] - spline.evaluate(polar.l[rest], polar.angle[rest]))
-        # a foot clamped at an end is not in p's normal plane: the radial residual bounds nothing there
-        doubtful = rest[(bound >= metrics.max_mm - BOUND_SLACK_MM) | (polar.end_side[rest] != 0)]
-        largest = metrics.max_mm
-        if doubtful.size:
-            largest = max(largest, float(closest_surface_points(curve, spline, polar.subset(doubtful))[0].max()))
-        metrics = replace(metrics, max_mm=largest, total=len(polar))
+    metrics = with_exact_max(curve, spline, polar, sample, summarize_distances(distance))
     return MeasuredDistances(metrics, sample, distance, l, angle, part)
+
+
+def with_exact_max(
+    curve: FramedCurve, spline: RadiusSpline, polar: PolarPoints, sample: np.ndarray, metrics: FitMetrics
+) -> FitMetrics:
+    """``metrics`` of the points ``sample`` (sorted indices into ``polar``) with the max over every point of ``polar``.
+
+    Only the points whose radial residual (an upper bound of the true distance, see the module notes) reaches
+    the sample's largest distance, or whose foot is clamped at an end, are measured; ``total`` counts them all.
+    """
+    if len(sample) == len(polar):
+        return metrics
+    rest = np.setdiff1d(np.arange(len(polar)), sample, assume_unique=True)
+    bound = np.abs(polar.rho[rest] - spline.evaluate(polar.l[rest], polar.angle[rest]))
+    # a foot clamped at an end is not in p's normal plane: the radial residual bounds nothing there
+    doubtful = rest[(bound >= metrics.max_mm - BOUND_SLACK_MM) | (polar.end_side[rest] != 0)]
+    largest = metrics.max_mm
+    if doubtful.size:
+        largest = max(largest, float(closest_surface_points(curve, spline, polar.subset(doubtful))[0].max()))
+    return replace(metrics, max_mm=largest, total=len(polar))
 
 
 def fold_labels(count: int, folds: int, rng: np.random.Generator) -> np.ndarray:
