@@ -16,7 +16,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import FitError, FoldError
-from softdesign.fitting.bspline_surface import FitSettings, SurfaceFit, fit_radius_surface
+from softdesign.fitting.bspline_surface import FitSettings, SurfaceFit, fit_radius_surface, intervals_per_link
 from softdesign.fitting.coverage import WallCoverage, measure_coverage
 from softdesign.fitting.end_checks import end_radii, negative_radius_cause
 from softdesign.fitting.end_hold import negative_end
@@ -41,6 +41,8 @@ from softdesign.fitting.radius_field import (
     fold_margin,
 )
 from softdesign.fitting.selection import NetworkContext, SelectionSettings, WallSelection, select_wall_points
+from softdesign.fitting.thinning import even_subset
+from softdesign.limits.fit import MAX_FIT_POINTS
 from softdesign.types import FloatArray, FramedCurve
 
 #: The steps of :func:`fit_wall`, told to ``WallFitOptions.progress`` as each ends.
@@ -65,6 +67,8 @@ class WallFitOptions:
     local_caps : the fitted rho held at most a radius over stretches of the path only
         (:mod:`softdesign.fitting.local_cap`)
     progress : told the name of each of :data:`FIT_STEPS` as it ends (None: nobody)
+    fit_points : the most kept points the spline is fitted to (an even subset above it; every figure of the
+        fit is still measured on the kept points)
     mapper : runs independent pieces (the hold-out's folds, the projection's and the metrics' blocks of
         points), perhaps on other processes; the same figures for any
     """
@@ -80,6 +84,7 @@ class WallFitOptions:
     local_caps: tuple[LocalCap, ...] = ()
     mapper: Mapper = serial_map
     progress: Callable[[str], None] | None = None
+    fit_points: int = MAX_FIT_POINTS
 
 
 @dataclass(frozen=True)
@@ -126,14 +131,21 @@ class WallFit:
 
 def _fit_kept(curve: FramedCurve, kept: PolarPoints, options: WallFitOptions,
               reference: tuple[FloatArray, FloatArray] | None, rng: np.random.Generator):
-    """The end prior, the knot spacing (``auto``), the surface fitted to ``kept``, held at ``max_radius_mm``."""
+    """The end prior, the knot spacing (``auto``), the surface fitted to ``kept``, held at ``max_radius_mm``.
+
+    Above ``options.fit_points`` points the surface is fitted to an even subset of them
+    (:func:`~softdesign.fitting.thinning.even_subset`); the prior and the spacing's hold-out see them all.
+    """
     settings, scores = options.fit, dict[float, float]()
     prior = end_prior(kept, curve.length, settings.knot_spacing_mm, settings.angular_intervals, reference)
     settings = replace(settings, prior=prior)
     if options.auto_spacing:
         spacing, scores = choose_knot_spacing(curve, kept, settings, rng, options.holdout)
         settings = replace(settings, knot_spacing_mm=spacing)
-    surface = surface_capped_locally(fit_radius_surface(kept, curve.length, settings), options.local_caps,
+    fitted = kept if len(kept) <= options.fit_points else kept.subset(
+        even_subset(kept, sum(intervals_per_link(curve.length, settings)), settings.angular_intervals,
+                    options.fit_points))
+    surface = surface_capped_locally(fit_radius_surface(fitted, curve.length, settings), options.local_caps,
                                      curve.length, settings.breaks)
     if options.max_radius_mm is not None:  # every figure after is of the body built
         cap = options.max_radius_mm
