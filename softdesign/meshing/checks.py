@@ -93,7 +93,7 @@ def _mean_squared_edge(p0: FloatArray, p1: FloatArray, p2: FloatArray) -> float:
     return float(np.mean(edge_sq))
 
 
-def written_defects(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> tuple[int, int]:
+def written_defects(vertices: npt.ArrayLike, faces: npt.ArrayLike, watertight: bool = False) -> tuple[int, int]:
     """(zero-area faces, non-manifold edges: shared by more than two faces) of the mesh as written in float32 and
     read with coincident vertices merged (see the module notes); both 0 for a 2-manifold whose vertices stay
     apart in float32 (an open surface's boundary edges are no concern here: watertight says that).
@@ -102,16 +102,21 @@ def written_defects(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> tuple[int,
     ----------
     vertices : (V, 3) float, mm
     faces : (F, 3) int
+    watertight : the faces as given are known to use every edge exactly twice
+        (:func:`~softdesign.meshing.topology.mesh_topology`'s ``watertight``): when float32 merges no vertices,
+        no edge can then be in more than two faces, and the edges are not counted again
     """
     rounded = np.asarray(vertices, np.float32).astype(np.float64)
     faces = np.asarray(faces, np.int64).reshape(-1, 3)
     if not faces.size:
         return 0, 0
-    inverse = rows_in_first_order(rounded)[1]  # coincident vertices as one (np.unique's groups, faster)
-    merged = inverse[faces]
+    first, inverse = rows_in_first_order(rounded)  # coincident vertices as one (np.unique's groups, faster)
     corners = rounded[faces]
     doubled = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
     zero = int(np.sum(doubled == 0.0))
+    if watertight and len(first) == len(rounded):  # nothing merged: the edges are the faces' own, each in two
+        return zero, 0
+    merged = inverse[faces]
     edges = np.sort(np.concatenate([merged[:, [0, 1]], merged[:, [1, 2]], merged[:, [2, 0]]]), axis=1)
     edges = edges[edges[:, 0] != edges[:, 1]]  # a folded face's point-edge is no edge
     keys = np.sort(edges[:, 0] * np.int64(len(rounded)) + edges[:, 1])  # one integer per edge (< V^2 < 2^63)
@@ -138,7 +143,7 @@ def inspect_mesh(
     corners = corner_planes(np.asarray(vertices, float), np.asarray(faces, np.int64))
     degenerate = topology.face_areas <= DEGENERATE_AREA_FRACTION * _mean_squared_edge(*corners)
     rel = None if volume_expected is None else topology.volume / volume_expected - 1.0
-    zero_area, nonmanifold = written_defects(vertices, faces)
+    zero_area, nonmanifold = written_defects(vertices, faces, watertight=topology.watertight)
     return MeshReport(
         vertices=topology.vertices,
         faces=topology.faces,
