@@ -206,6 +206,13 @@ def _trimesh_encoder(file_type: str) -> Encoder:
     return encode
 
 
+def _stl_bytes(vertices: np.ndarray, faces: np.ndarray, regions: np.ndarray | None) -> bytes:
+    """Binary STL, trimesh's bytes (:mod:`softdesign.io.stl_bytes`); STL carries no regions."""
+    from softdesign.io.stl_bytes import binary_stl_bytes
+
+    return binary_stl_bytes(vertices, faces)
+
+
 #: mm per metre: glTF's coordinates are metres.
 MM_PER_M = 1000.0
 
@@ -250,7 +257,7 @@ def _vtp_bytes(vertices: np.ndarray, faces: np.ndarray, regions: np.ndarray | No
 FORMATS: dict[str, MeshFormat] = {
     f.name: f
     for f in (
-        MeshFormat("stl", "binary STL (float32 corners, no shared vertices)", _read_trimesh, _trimesh_encoder("stl")),
+        MeshFormat("stl", "binary STL (float32 corners, no shared vertices)", _read_trimesh, _stl_bytes),
         MeshFormat("ply", "binary PLY with a region label per face", _read_trimesh, _trimesh_encoder("ply"), True),
         MeshFormat("obj", "Wavefront OBJ (text)", _read_trimesh, _trimesh_encoder("obj")),
         MeshFormat("glb", "binary glTF 2.0 in metres, for viewers", _read_glb, _glb_bytes, unit="m"),
