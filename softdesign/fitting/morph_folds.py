@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from softdesign.fitting.mapping import Mapper, serial_map
 from softdesign.fitting.radius_field import FoldReport, RadiusField, fold_margin
 from softdesign.types import FramedCurve
 
@@ -55,7 +56,8 @@ class MorphFold:
                 f"meshes at export q near it will fail; {fix}")
 
 
-def fold_over_morph(shape_at: Callable[[float], FramedCurve], field: RadiusField, q_grid: np.ndarray) -> MorphFold:
+def fold_over_morph(shape_at: Callable[[float], FramedCurve], field: RadiusField, q_grid: np.ndarray,
+                    mapper: Mapper = serial_map) -> MorphFold:
     """The largest ``rho(q) * kappa_n(q)`` over ``q_grid`` (increasing, in [0, 1]), refined around the worst.
 
     Parameters
@@ -63,9 +65,10 @@ def fold_over_morph(shape_at: Callable[[float], FramedCurve], field: RadiusField
     shape_at : q -> the framed centerline c(q, .)
     field : the fitted radius field
     q_grid : (k,) the q values searched first
+    mapper : runs the grid's q values (each its own), perhaps on other processes; the same figures for any
     """
     q_grid = np.asarray(q_grid, float)
-    reports = [fold_margin(shape_at(float(q)), field, float(q)) for q in q_grid]
+    reports = mapper(lambda q: fold_margin(shape_at(float(q)), field, float(q)), q_grid.tolist())
     best = int(np.argmax([r.max_rho_kappa for r in reports]))
     q, report = float(q_grid[best]), reports[best]
     if 0 < best < len(q_grid) - 1:

@@ -36,3 +36,16 @@ def test_a_body_folding_between_the_grid_q_is_found_and_warned_about():
     assert "blend: intrinsic" in warning
     on_intrinsic = found.warning("intrinsic")
     assert on_intrinsic is not None and "blend:" not in on_intrinsic and "fit.local_max_radius" in on_intrinsic
+
+
+def test_the_grid_on_two_worker_processes_gives_the_same_fold():
+    from softdesign.pipeline.parallel import jobs_for_build, map_items
+
+    def shape(q: float) -> Arc:
+        kappa = max(4.0 * q * (1.0 - q), 1e-3) / 4.0
+        return Arc(1.0 / kappa, 10.0 * kappa)
+
+    field = _round_field(lambda l: np.full_like(l, RHO))
+    with jobs_for_build(2):
+        forked = fold_over_morph(shape, field, GRID, map_items)
+    assert forked == fold_over_morph(shape, field, GRID)
