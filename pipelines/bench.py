@@ -563,7 +563,7 @@ def ratio_text(value: float, floor: float | None) -> str:
 
 
 def stage_table(result: dict[str, Any]) -> list[str]:
-    """Per stage: wall s, CPU s, peak RSS MiB, I/O floor s and build/floor."""
+    """Per stage: wall s, CPU s, its share of the build's wall time, peak RSS MiB, I/O floor s and build/floor."""
     floor = result["floor"]
     floors = {"ingest": floor["read_s"], "export": floor["write_s"], "total": floor["read_s"] + floor["write_s"]}
     i, o = result["input"], result["output"]
@@ -575,19 +575,20 @@ def stage_table(result: dict[str, Any]) -> list[str]:
         f"RSS after imports {result['baseline_mib']:.0f} MiB; --jobs {result['jobs']}, largest worker's peak "
         f"{result['worker_peak_mib']:.0f} MiB (pages shared with the build's; the whole is at most "
         f"{result['total']['peak_mib'] + result['jobs'] * result['worker_peak_mib']:.0f} MiB)",
-        f"  {'stage':<11}{'wall s':>9}{'cpu s':>9}{'peak MiB':>10}{'floor s':>9}{'build/floor':>13}"
+        f"  {'stage':<11}{'wall s':>9}{'cpu s':>9}{'share':>7}{'peak MiB':>10}{'floor s':>9}{'build/floor':>13}"
         f"{'wall/whole floor':>18}",
     ]
     rows = [(name, result["stages"][name]) for name in STAGE_NAMES] + [("total", result["total"])]
     for name, row in rows:
         f = floors.get(name)
         floor_text = "-" if f is None else f"{f:.3f}"
+        share = 100.0 * row["wall_s"] / result["total"]["wall_s"] if result["total"]["wall_s"] > 0 else 0.0
         lines.append(
-            f"  {name:<11}{row['wall_s']:>9.2f}{row['cpu_s']:>9.2f}{row['peak_mib']:>10.0f}"
+            f"  {name:<11}{row['wall_s']:>9.2f}{row['cpu_s']:>9.2f}{share:>6.0f}%{row['peak_mib']:>10.0f}"
             f"{floor_text:>9}{ratio_text(row['wall_s'], f):>13}{ratio_text(row['wall_s'], floors['total']):>18}"
         )
-    lines.append("  (build/floor: against the stage's own I/O floor; wall/whole floor: against the build's, read + "
-                 "writes, so the stages' shares add up to the total's ratio)")
+    lines.append("  (share: of the build's wall time; build/floor: against the stage's own I/O floor; wall/whole "
+                 "floor: against the build's, read + writes, so the stages' shares add up to the total's ratio)")
     return lines
 
 

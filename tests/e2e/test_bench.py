@@ -57,6 +57,8 @@ def test_stage_table_has_every_stage_the_total_and_the_ratio_to_the_floor(bench)
     # every stage against the whole build's floor (0.5 s read + 0.25 s writes)
     assert rows["ingest"][-1] == f"{1.0 / 0.75:.1f}x" and rows["export"][-1] == f"{0.5 / 0.75:.1f}x"
     assert "shares add up to the total's ratio" in lines[-1]
+    # each stage's share of the build's wall time (issue 46)
+    assert rows["ingest"][3] == f"{100 * 1.0 / result['total']['wall_s']:.0f}%" and rows["total"][3] == "100%"
     assert "--jobs 2, largest worker's peak 200 MiB" in lines[1] and "at most 710 MiB" in lines[1]  # 310 + 2 x 200
 
 
