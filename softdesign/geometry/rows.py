@@ -105,7 +105,9 @@ def _hashed_groups(array: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     for column, mixer in zip(bits.T, _MIXERS, strict=False):
         key ^= column * np.uint64(mixer)
         key = (key << np.uint64(29)) | (key >> np.uint64(35))  # rotate, so that columns do not cancel by position
-    order = np.argsort(key, kind="stable")
+    # not a stable sort (a third of its time on 3M keys): a run's rows come in any order, and its first is its
+    # smallest index, which the stable sort put first; the same groups, numbered by key as before
+    order = np.argsort(key)
     ordered_key = key[order]
     starts = np.empty(len(array), bool)
     starts[0] = True
@@ -117,4 +119,4 @@ def _hashed_groups(array: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     group = np.cumsum(starts) - 1
     inverse = np.empty(len(array), np.intp)
     inverse[order] = group
-    return order[starts], inverse
+    return np.minimum.reduceat(order, np.flatnonzero(starts)), inverse
