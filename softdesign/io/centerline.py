@@ -28,7 +28,7 @@ from softdesign.io.centerline_segments import (
     read_line_cells,
 )
 from softdesign.io.input_checks import check_input_file, check_npy_header
-from softdesign.io.vtk_polydata import polydata_arrays, read_polydata
+from softdesign.io.vtk_polydata import polydata_arrays, read_polydata, simple_vtp
 
 RADIUS_KEY = "MaximumInscribedSphereRadius"
 
@@ -84,9 +84,13 @@ def read_centerline_network(path: str | Path, scale_to_mm: float = 1.0) -> Cente
 def _read_vtk_lines(path: Path) -> tuple[list[Polyline], tuple[str, ...]]:
     if is_unstructured_grid(path):
         return _joined(read_line_cells(path), path)
-    poly = read_polydata(path)
-    points, point_arrays, cell_arrays = polydata_arrays(poly)
-    cells = _line_cells(poly)
+    simple = simple_vtp(path)  # a VMTK .vtp without importing vtk (validate's start-up), else vtk's reader
+    if simple is not None:
+        points, point_arrays, cell_arrays, cells = simple.points, simple.point_arrays, simple.cell_arrays, simple.lines
+    else:
+        poly = read_polydata(path)
+        points, point_arrays, cell_arrays = polydata_arrays(poly)
+        cells = _line_cells(poly)
     if all_two_point(cells):
         return _joined(LineCells("VTK PolyData", points, cells, point_arrays, cell_arrays), path)
     radius_all = point_arrays.get(RADIUS_KEY)

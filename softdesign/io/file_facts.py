@@ -70,15 +70,19 @@ def file_facts(path: Path) -> FileFacts:
 
 def _vtk_facts(path: Path) -> FileFacts:
     from softdesign.io.centerline_segments import is_unstructured_grid, read_line_cells
-    from softdesign.io.vtk_polydata import polydata_arrays, read_polydata
+    from softdesign.io.vtk_polydata import polydata_arrays, read_polydata, simple_vtp
 
     if is_unstructured_grid(path):
         grid = read_line_cells(path)
         return FileFacts(grid.kind, len(grid.points), {"lines": len(grid.cells), "other cells": grid.other_cells},
                          tuple(grid.point_arrays), tuple(grid.cell_arrays))
+    kind = "VTK XML PolyData" if path.suffix.lower() == ".vtp" else "legacy VTK PolyData"
+    simple = simple_vtp(path)  # without importing vtk where it can
+    if simple is not None:
+        return FileFacts(kind, len(simple.points), simple.cell_counts, tuple(simple.point_arrays),
+                         tuple(simple.cell_arrays))
     poly = read_polydata(path)
     _, point_arrays, cell_arrays = polydata_arrays(poly)
-    kind = "VTK XML PolyData" if path.suffix.lower() == ".vtp" else "legacy VTK PolyData"
     cells = {"lines": poly.GetNumberOfLines(), "polygons": poly.GetNumberOfPolys(),
              "triangle strips": poly.GetNumberOfStrips(), "vertices": poly.GetNumberOfVerts()}
     return FileFacts(kind, int(poly.GetNumberOfPoints()), cells, tuple(point_arrays), tuple(cell_arrays))

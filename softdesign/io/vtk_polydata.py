@@ -8,12 +8,15 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from softdesign.errors import InputDataError
 from softdesign.io.vtk_header_bounds import check_cell_indices, check_vtk_header
+
+if TYPE_CHECKING:
+    from softdesign.io.vtp_xml import PolyDataArrays
 
 
 def read_polydata(path: Path):
@@ -47,6 +50,17 @@ def read_polydata(path: Path):
         raise InputDataError(f"{path}: cannot read it as VTK PolyData ({detail}); re-export it from VMTK or ParaView")
     check_cell_indices(poly, path)
     return poly
+
+
+def simple_vtp(path: Path) -> PolyDataArrays | None:
+    """A .vtp's arrays read without vtk (:mod:`softdesign.io.vtp_xml`), after the same header check as
+    :func:`read_polydata`; None for another suffix, a missing file or a layout vtk must read (then call it)."""
+    from softdesign.io.vtp_xml import read_simple_vtp
+
+    if path.suffix.lower() != ".vtp" or not path.is_file():
+        return None
+    check_vtk_header(path)
+    return read_simple_vtp(path)
 
 
 def _silence_vtk_log() -> None:
