@@ -47,7 +47,7 @@ from softdesign.types import FloatArray
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 9  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
+VERSION = 10  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
 # 3: points fitted in path order; distances sampled above 200k points (max still over all)
 # 4: end prior and end radii (issue 20); true distances on the regularized backbone's stretches (``backbone``)
 # 5: each end's cut plane in the end frame (``end_cut``, issue 20)
@@ -55,6 +55,8 @@ VERSION = 9  # 2: flat-cap points and too-small rho excluded; hold-out sampled a
 # 7: the fit against all of the path's own wall, its coverage and flags (``all_wall``, ``coverage``, issue 29)
 # 8: the coverage warnings in an engineer's words (issue 44)
 # 9: fit.local_max_radius, and the all-wall figures outside its stretches (issue 43)
+# 10: above 200k kept points the spline is fitted to an even subset, and the all-wall figures are sampled by
+#     stratum from the kept points' distances (issue 46); fewer points fit and measure as before
 #: Seed of the hold-out folds: the same case always gets the same folds.
 HOLDOUT_SEED = 4
 #: A failed fit is blamed on the centerline when the smoothed one strays from the input by this fraction of the
