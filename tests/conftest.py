@@ -8,11 +8,13 @@ worker process per core, each taking whole test files.  So that a test stays rig
   a subprocess that runs ``softdesign`` gets ``--out`` under ``tmp_path``.  The one exception is the browser
   test's screenshots (build/test-artifacts/browser/, names of their own, one file writes them).
 * A build several tests only read is built once: a ``scope="module"`` fixture (the file's tests all run in the
-  same worker) or, when several files read it, a ``scope="session"`` fixture here (built once per worker).  A
-  test that changes such a build copies it first (see ``out`` below: a copy of ``prior_build``).
-  ``functools.cache`` on a module-level builder does the same for in-memory results (meshes, solves).
-* No fixed ports, no lock files, no environment changes outside ``monkeypatch``; a child process gets its own
-  ``env=`` copy.
+  same worker) or, when several files read it, once for the whole run in the folder the workers share
+  (tests/helpers/shared_builds.py: the README's commands and the demo build made by the first, under a lock the
+  others wait on).  A test that changes such a build copies it first (see ``out`` below: a copy of
+  ``prior_build``; ``demo_build_copy``).  ``functools.cache`` on a module-level builder does the same for
+  in-memory results (meshes, solves).
+* No fixed ports, no lock files but shared_builds' own, no environment changes outside ``monkeypatch``; a child
+  process gets its own ``env=`` copy.
 * Mark a test ``@pytest.mark.slow`` when it takes about a second or more (``make test-fast`` leaves them out); a
   study that takes minutes does not belong in the suite: record its expensive end in a reference under tests/
   and re-derive it with a make target, as the refinement study does (tests/helpers/refinement_study.py,
@@ -28,6 +30,7 @@ import pytest
 
 from tests.helpers.attacks import BUILD_TIMEOUT_S, demo_case, run_limited
 from tests.helpers.paths import AORTA_DIR
+from tests.helpers.shared_builds import made_once, shared_root
 
 
 @pytest.fixture(scope="session")
@@ -38,13 +41,17 @@ def aorta_dir() -> Path:
     return AORTA_DIR
 
 
-@pytest.fixture(scope="session")
-def prior_build(tmp_path_factory) -> Path:
-    """The coarse demo built once (in a child under the memory budget): the build an attack must leave as it was."""
-    folder = tmp_path_factory.mktemp("prior")
+def _build_prior(folder: Path) -> None:
+    folder.mkdir()
     result = run_limited("build", str(demo_case(folder)), "--out", str(folder / "build"), timeout=BUILD_TIMEOUT_S)
     assert result.returncode == 0, result.stderr
-    return folder / "build"
+
+
+@pytest.fixture(scope="session")
+def prior_build(tmp_path_factory) -> Path:
+    """The coarse demo built once per run, for every worker (in a child under the memory budget): the build an
+    attack must leave as it was.  Only read: each attack works on its copy (``out``)."""
+    return made_once(shared_root(tmp_path_factory), "prior", _build_prior) / "build"
 
 
 @pytest.fixture
