@@ -15,7 +15,7 @@ CLUSTER_STAMP := $(CLUSTER_VENV)/.installed-stamp
 CLUSTER_CONSTRAINTS := requirements/cluster.txt
 CLUSTER_PACKAGES = $$($(PYTHON) -c 'import tomllib; print(" ".join(tomllib.load(open("pyproject.toml", "rb"))["project"]["optional-dependencies"]["cluster"]))')
 
-.PHONY: demo test test-fast lint lock lock-cluster bench study install clean bytecode
+.PHONY: demo test test-fast lint lock lock-cluster bench study study-property install clean bytecode
 
 install: $(STAMP) $(CLUSTER_STAMP)
 
@@ -102,6 +102,11 @@ test-fast: bytecode $(CLUSTER_STAMP)
 # and says to run this when they no longer match the record.
 study: $(STAMP)
 	$(BIN)/python pipelines/study.py
+
+# `make study-property`: the incremental-build property (tests/pipeline/test_incremental_property.py) with 20 drawn
+# examples beside its written ones (about 2 minutes); `make test` draws 5.
+study-property: bytecode
+	SOFTDESIGN_PROPERTY_EXAMPLES=20 $(BIN)/python -m pytest -n 0 tests/pipeline/test_incremental_property.py
 
 # ruff (style, imports, bugbear, pyupgrade, numpy rules) and mypy, both
 # configured in pyproject.toml; both run, and either failing fails the target.

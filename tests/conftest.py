@@ -18,7 +18,7 @@ worker process per core, each taking whole test files.  So that a test stays rig
 * Mark a test ``@pytest.mark.slow`` when it takes about a second or more (``make test-fast`` leaves them out); a
   study that takes minutes does not belong in the suite: record its expensive end in a reference under tests/
   and re-derive it with a make target, as the refinement study does (tests/helpers/refinement_study.py,
-  ``make study``).
+  ``make study``), or run its short form and keep the long one for a target (``make study-property``).
 """
 
 from __future__ import annotations
