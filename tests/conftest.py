@@ -1,7 +1,8 @@
 """Shared fixtures: the real VMTK data beside the checkout, the attack tests' prior build (helpers: tests/helpers/).
 
-How the suite runs: ``make test`` is ``pytest -n auto --dist loadfile --durations=15`` (pytest-xdist): one
-worker process per core, each taking whole test files.  So that a test stays right and fast there:
+How the suite runs: ``make test`` is ``pytest -n auto --dist loadfile --no-loadscope-reorder --durations=15``
+(pytest-xdist): one worker process per core, each taking whole test files, the longest first (the order below,
+tests/helpers/schedule.py).  So that a test stays right and fast there:
 
 * Write only under ``tmp_path`` (one test) or ``tmp_path_factory.mktemp(...)`` (a shared fixture): each worker
   has its own base folder.  Never under the checkout (``build/``, ``data/``, ``tests/``) nor a fixed /tmp path;
@@ -30,7 +31,25 @@ import pytest
 
 from tests.helpers.attacks import BUILD_TIMEOUT_S, demo_case, run_limited
 from tests.helpers.paths import AORTA_DIR
+from tests.helpers.schedule import SecondsRecorder, known_seconds, longest_first
 from tests.helpers.shared_builds import made_once, shared_root
+
+_RECORDER = SecondsRecorder()
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Whole files, the longest first (every worker collects the same order: the controller hands files out in it)."""
+    longest_first(items, known_seconds(config))
+
+
+def pytest_runtest_logreport(report: pytest.TestReport) -> None:
+    _RECORDER.add(report)
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    """Each test's seconds into pytest's cache, by the process that saw them all (not an xdist worker)."""
+    if not hasattr(session.config, "workerinput"):
+        _RECORDER.save(session.config)
 
 
 @pytest.fixture(scope="session")
