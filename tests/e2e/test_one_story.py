@@ -24,9 +24,9 @@ from typer.testing import CliRunner
 
 from softdesign.cli import app
 from softdesign.report.writer import PAGE, REPORT_DIR
-from tests.helpers.paths import AORTA_DIR, REPO
+from tests.helpers.paths import AORTA_DIR
 from tests.helpers.robust_vessels import write_tilted_cap_vessel
-from tests.helpers.shared_builds import DEMO_BUILD, run_once, workspace
+from tests.helpers.shared_builds import ACTUATOR_BUILD, DEMO_BUILD, PER_CHAMBER_BUILD, run_once, workspace
 from tests.test_user_strings import INTERNAL
 
 pytestmark = pytest.mark.slow
@@ -36,15 +36,17 @@ runner = CliRunner()
 #: the largest tilt the body is cut at.
 ICA_RADIUS_MM, ICA_LENGTH_MM, ICA_TILT_DEG = 2.0, 40.0, 31.0
 CASES = ("demo", "designed", "actuator", "per_chamber", "aorta", "ica_tilted")
-#: The cases built by the README's commands (in its order; a child process each, as a user runs them), with the
-#: build folder each writes in the shared workspace.
+#: The cases built by the README's commands (in its order; a child process each, as a user runs them), and the
+#: per-chamber actuator (three chambers per section, feeds, a mould and a volume mesh), with the build folder each
+#: writes in the shared workspace.
 README_BUILDS: dict[str, tuple[tuple[tuple[str, ...], ...], str]] = {
     "demo": ((DEMO_BUILD,), "build/demo"),
     "designed": ((("design", "configs/demo.yaml", "--tolerance-mm", "1", "--output", "build/demo-designed.yaml",
                    "--out", "build/demo-designed"),
                   ("build", "build/demo-designed.yaml", "--out", "build/demo-designed", "--report")),
                  "build/demo-designed"),
-    "actuator": ((("build", "configs/actuator.yaml", "--report"),), "build/actuator"),
+    "actuator": ((ACTUATOR_BUILD,), "build/actuator"),
+    "per_chamber": ((PER_CHAMBER_BUILD,), "build/per-chamber"),
 }
 
 
@@ -69,7 +71,7 @@ def _build(name: str, case: Path, out: Path) -> Story:
 
 
 def _readme_build(name: str, factory: pytest.TempPathFactory) -> Story:
-    """A README case: its commands run once in the shared workspace (the last one the build with its report)."""
+    """A shared case: its commands run once in the shared workspace (the last one the build with its report)."""
     steps, build_dir = README_BUILDS[name]
     for args in steps:
         result = run_once(factory, *args)
@@ -81,8 +83,6 @@ def _readme_build(name: str, factory: pytest.TempPathFactory) -> Story:
 
 
 def _case(name: str, folder: Path) -> Path:
-    if name == "per_chamber":  # three chambers per section, feeds, a mould and a volume mesh
-        return REPO / "configs" / "actuator-per-chamber.yaml"
     if name == "aorta":
         if not AORTA_DIR.is_dir():
             pytest.skip(f"real VMTK data not found at {AORTA_DIR}")

@@ -9,9 +9,11 @@ failed attempt leaves no mark, so the next asker makes it again (and fails the s
 
 The shared workspace is the README's (tests/cli/test_readme.py): a copy of configs/ and data/ in which the
 README's commands run as a user runs them, each once per run (:func:`run_once`); tests/e2e/test_one_story.py
-reads the same runs of the commands it checks, and the report tests copy the demo's build from it
-(:func:`demo_build_copy`).  Whoever asks first runs the command; the others read its recorded exit code and
-output, and its build folder.  Tests only read these folders; a test that changes a build copies it first.
+reads the same runs of the commands it checks (and adds the per-chamber actuator's build), the report tests copy
+the demo's build from it (:func:`demo_build_copy`), and tests/cli/test_pressure_cli.py copies the actuators'
+builds with their case files (:func:`workspace_copy`).  Whoever asks first runs the command; the others read its
+recorded exit code and output, and its build folder.  Tests only read these folders; a test that changes a build
+copies it first.
 """
 
 from __future__ import annotations
@@ -41,6 +43,11 @@ COMMAND_TIMEOUT_S = 900
 DEMO_BUILD = ("build", "configs/demo.yaml", "--report")
 #: Where DEMO_BUILD puts the build, in the workspace.
 DEMO_BUILD_DIR = Path("build") / "demo"
+#: The README's single-supply device, built with its report (into build/actuator).
+ACTUATOR_BUILD = ("build", "configs/actuator.yaml", "--report")
+#: The per-chamber actuator built with its report, into a folder of its own: not the README's simulate command's
+#: build/actuator-per-chamber, which that command writes into.
+PER_CHAMBER_BUILD = ("build", "configs/actuator-per-chamber.yaml", "--out", "build/per-chamber", "--report")
 
 
 @dataclass(frozen=True)
@@ -132,14 +139,29 @@ def demo_build(factory: pytest.TempPathFactory) -> Path:
     return workspace(factory) / DEMO_BUILD_DIR
 
 
-def demo_build_copy(factory: pytest.TempPathFactory, target: Path, *, report: bool = False) -> Path:
-    """A copy of :func:`demo_build` at ``target`` for a test to change, its report left out unless ``report``."""
+def _copy_build(source: Path, target: Path, report: bool) -> Path:
     from softdesign.pipeline.layout import REPORT_DIR
-
-    source = demo_build(factory)
 
     def leave_out(folder: str, names: list[str]) -> list[str]:
         return [REPORT_DIR] if not report and Path(folder) == source and REPORT_DIR in names else []
 
     shutil.copytree(source, target, ignore=leave_out)
+    return target
+
+
+def demo_build_copy(factory: pytest.TempPathFactory, target: Path, *, report: bool = False) -> Path:
+    """A copy of :func:`demo_build` at ``target`` for a test to change, its report left out unless ``report``."""
+    return _copy_build(demo_build(factory), target, report)
+
+
+def workspace_copy(factory: pytest.TempPathFactory, target: Path, build: tuple[str, ...], build_dir: str) -> Path:
+    """``target`` made a copy of the workspace's configs/ and data/ and of the build the command ``build`` made
+    at ``build_dir`` (its report left out), in the same layout: the build's input paths (relative to it) and its
+    recorded case file hold there, so a test may run commands on it, or change it, as on a build of its own."""
+    run = run_once(factory, *build)
+    assert run.returncode == 0, f"softdesign {' '.join(build)}:\n{run.stderr[-3000:]}"
+    source = workspace(factory)
+    for name in ("configs", "data"):
+        shutil.copytree(source / name, target / name)
+    _copy_build(source / build_dir, target / build_dir, report=False)
     return target
