@@ -23,6 +23,7 @@ def _ask(root: str) -> list[str]:
     return sorted(p.name for p in made_once(Path(root), "thing", _make_slowly).iterdir())
 
 
+@pytest.mark.slow  # two interpreters started (about 3 s on a busy machine)
 def test_two_processes_asking_at_once_get_one_build(tmp_path):
     with multiprocessing.get_context("spawn").Pool(2) as pool:
         seen = pool.map(_ask, [str(tmp_path)] * 2)
