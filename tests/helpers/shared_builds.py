@@ -127,7 +127,9 @@ def run_once(factory: pytest.TempPathFactory, *args: str) -> Run:
             done = subprocess.run([*CLI, *args], cwd=folder, capture_output=True, text=True,
                                   timeout=COMMAND_TIMEOUT_S, stdin=subprocess.DEVNULL)
             run = Run(tuple(args), done.returncode, done.stdout, done.stderr, round(_child_cpu_s() - before, 2))
-            record.write_text(json.dumps(asdict(run)), encoding="utf-8")
+            partial = record.with_suffix(".partial")
+            partial.write_text(json.dumps(asdict(run)), encoding="utf-8")
+            partial.replace(record)  # whole or absent, should the run be stopped while it writes
     data = json.loads(record.read_text(encoding="utf-8"))
     return Run(tuple(data["args"]), data["returncode"], data["stdout"], data["stderr"], data["cpu_s"])
 
