@@ -15,7 +15,7 @@ CLUSTER_STAMP := $(CLUSTER_VENV)/.installed-stamp
 CLUSTER_CONSTRAINTS := requirements/cluster.txt
 CLUSTER_PACKAGES = $$($(PYTHON) -c 'import tomllib; print(" ".join(tomllib.load(open("pyproject.toml", "rb"))["project"]["optional-dependencies"]["cluster"]))')
 
-.PHONY: demo test test-fast lint lock lock-cluster bench study install clean bytecode
+.PHONY: demo test test-fast lint lock lock-cluster bench study study-property test-seconds install clean bytecode
 
 install: $(STAMP) $(CLUSTER_STAMP)
 
@@ -85,11 +85,13 @@ demo: bytecode
 	@$(BIN)/softdesign build configs/demo.yaml --report
 
 # pytest-xdist: one worker per core (-n auto; CI's machines have 2), whole files to a worker (--dist loadfile:
-# a file's module caches and module-scoped builds are made once, its tests never race each other for them),
-# and the slowest 15 tests printed at the end.  How to keep a test safe in parallel: tests/conftest.py.
+# a file's module caches and module-scoped builds are made once, its tests never race each other for them), the
+# longest files first (--no-loadscope-reorder keeps the order tests/conftest.py gives them from the seconds of the
+# last run, tests/helpers/schedule.py; xdist's own order, the most tests first, left the slow files of one or two
+# tests to the end), and the slowest 15 tests printed at the end.  How to keep a test safe in parallel: tests/conftest.py.
 # `bytecode` first: the suite starts softdesign in child processes (43 call sites, some in loops), and with
 # PYTHONDONTWRITEBYTECODE set (CI) each child compiled the modules it imports again (validate's: ~0.17 s of CPU).
-PYTEST_PARALLEL := -n auto --dist loadfile --durations=15
+PYTEST_PARALLEL := -n auto --dist loadfile --no-loadscope-reorder --durations=15
 test: bytecode $(CLUSTER_STAMP)
 	$(BIN)/python -m pytest $(PYTEST_PARALLEL)
 
@@ -97,11 +99,21 @@ test: bytecode $(CLUSTER_STAMP)
 test-fast: bytecode $(CLUSTER_STAMP)
 	$(BIN)/python -m pytest $(PYTEST_PARALLEL) -m "not slow"
 
+# `make test-seconds`: after a full `make test`, write each file's seconds from pytest's cache to
+# tests/file_seconds.json, the order a fresh clone (CI) starts the files in.  Commit it when the order moved.
+test-seconds:
+	$(BIN)/python -m tests.helpers.schedule
+
 # `make study`: re-derive the nested-refinement study's recorded finest level
 # (tests/mechanics/refinement_reference.json; about 10 minutes).  `make test` solves the two coarser levels
 # and says to run this when they no longer match the record.
 study: $(STAMP)
 	$(BIN)/python pipelines/study.py
+
+# `make study-property`: the incremental-build property (tests/pipeline/test_incremental_property.py) with 20 drawn
+# examples beside its written ones (about 2 minutes); `make test` draws 5.
+study-property: bytecode
+	SOFTDESIGN_PROPERTY_EXAMPLES=20 $(BIN)/python -m pytest -n 0 tests/pipeline/test_incremental_property.py
 
 # ruff (style, imports, bugbear, pyupgrade, numpy rules) and mypy, both
 # configured in pyproject.toml; both run, and either failing fails the target.

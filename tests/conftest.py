@@ -1,22 +1,25 @@
 """Shared fixtures: the real VMTK data beside the checkout, the attack tests' prior build (helpers: tests/helpers/).
 
-How the suite runs: ``make test`` is ``pytest -n auto --dist loadfile --durations=15`` (pytest-xdist): one
-worker process per core, each taking whole test files.  So that a test stays right and fast there:
+How the suite runs: ``make test`` is ``pytest -n auto --dist loadfile --no-loadscope-reorder --durations=15``
+(pytest-xdist): one worker process per core, each taking whole test files, the longest first (the order below,
+tests/helpers/schedule.py).  So that a test stays right and fast there:
 
 * Write only under ``tmp_path`` (one test) or ``tmp_path_factory.mktemp(...)`` (a shared fixture): each worker
   has its own base folder.  Never under the checkout (``build/``, ``data/``, ``tests/``) nor a fixed /tmp path;
   a subprocess that runs ``softdesign`` gets ``--out`` under ``tmp_path``.  The one exception is the browser
   test's screenshots (build/test-artifacts/browser/, names of their own, one file writes them).
 * A build several tests only read is built once: a ``scope="module"`` fixture (the file's tests all run in the
-  same worker) or, when several files read it, a ``scope="session"`` fixture here (built once per worker).  A
-  test that changes such a build copies it first (see ``out`` below: a copy of ``prior_build``).
-  ``functools.cache`` on a module-level builder does the same for in-memory results (meshes, solves).
-* No fixed ports, no lock files, no environment changes outside ``monkeypatch``; a child process gets its own
-  ``env=`` copy.
+  same worker) or, when several files read it, once for the whole run in the folder the workers share
+  (tests/helpers/shared_builds.py: the README's commands and the demo build made by the first, under a lock the
+  others wait on).  A test that changes such a build copies it first (see ``out`` below: a copy of
+  ``prior_build``; ``demo_build_copy``).  ``functools.cache`` on a module-level builder does the same for
+  in-memory results (meshes, solves).
+* No fixed ports, no lock files but shared_builds' own, no environment changes outside ``monkeypatch``; a child
+  process gets its own ``env=`` copy.
 * Mark a test ``@pytest.mark.slow`` when it takes about a second or more (``make test-fast`` leaves them out); a
   study that takes minutes does not belong in the suite: record its expensive end in a reference under tests/
   and re-derive it with a make target, as the refinement study does (tests/helpers/refinement_study.py,
-  ``make study``).
+  ``make study``), or run its short form and keep the long one for a target (``make study-property``).
 """
 
 from __future__ import annotations
@@ -28,6 +31,25 @@ import pytest
 
 from tests.helpers.attacks import BUILD_TIMEOUT_S, demo_case, run_limited
 from tests.helpers.paths import AORTA_DIR
+from tests.helpers.schedule import SecondsRecorder, known_seconds, longest_first
+from tests.helpers.shared_builds import made_once, shared_root
+
+_RECORDER = SecondsRecorder()
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Whole files, the longest first (every worker collects the same order: the controller hands files out in it)."""
+    longest_first(items, known_seconds(config))
+
+
+def pytest_runtest_logreport(report: pytest.TestReport) -> None:
+    _RECORDER.add(report)
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    """Each test's seconds into pytest's cache, by the process that saw them all (not an xdist worker)."""
+    if not hasattr(session.config, "workerinput"):
+        _RECORDER.save(session.config)
 
 
 @pytest.fixture(scope="session")
@@ -38,13 +60,17 @@ def aorta_dir() -> Path:
     return AORTA_DIR
 
 
-@pytest.fixture(scope="session")
-def prior_build(tmp_path_factory) -> Path:
-    """The coarse demo built once (in a child under the memory budget): the build an attack must leave as it was."""
-    folder = tmp_path_factory.mktemp("prior")
+def _build_prior(folder: Path) -> None:
+    folder.mkdir()
     result = run_limited("build", str(demo_case(folder)), "--out", str(folder / "build"), timeout=BUILD_TIMEOUT_S)
     assert result.returncode == 0, result.stderr
-    return folder / "build"
+
+
+@pytest.fixture(scope="session")
+def prior_build(tmp_path_factory) -> Path:
+    """The coarse demo built once per run, for every worker (in a child under the memory budget): the build an
+    attack must leave as it was.  Only read: each attack works on its copy (``out``)."""
+    return made_once(shared_root(tmp_path_factory), "prior", _build_prior) / "build"
 
 
 @pytest.fixture

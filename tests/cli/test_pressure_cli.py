@@ -15,6 +15,7 @@ from softdesign.pipeline.rod_pressure import answer_if_unchanged
 from tests.cli.test_cli_validate import demo_case
 from tests.helpers.cases import case_from
 from tests.helpers.paths import REPO
+from tests.helpers.shared_builds import ACTUATOR_BUILD, PER_CHAMBER_BUILD, workspace_copy
 
 runner = CliRunner()
 #: q P* against the pressure printed (both from one float), and the same model at --q and --pressure, kPa and mm.
@@ -53,10 +54,10 @@ def test_without_a_build_it_names_the_command_that_makes_one(tmp_path: Path) -> 
 
 
 @pytest.mark.slow
-def test_the_single_supply_demo_from_its_build(tmp_path: Path) -> None:
-    case = case_from(tmp_path, REPO / "configs" / "actuator.yaml", {})
-    out = tmp_path / "build"
-    assert runner.invoke(app, ["build", str(case), "--out", str(out)]).exit_code == 0
+def test_the_single_supply_demo_from_its_build(tmp_path: Path, tmp_path_factory) -> None:
+    # the README's build of configs/actuator.yaml (made once per run), copied with its case file and inputs
+    clone = workspace_copy(tmp_path_factory, tmp_path / "clone", ACTUATOR_BUILD, "build/actuator")
+    case, out = clone / "configs" / "actuator.yaml", clone / "build" / "actuator"
     summary = json.loads((out / "actuation" / "summary.json").read_text())
     half = runner.invoke(app, ["pressure", str(case), "--out", str(out), "--q", "0.5", "--json"])
     assert half.exit_code == 0, half.output
@@ -88,10 +89,10 @@ def test_the_single_supply_demo_from_its_build(tmp_path: Path) -> None:
 
 
 @pytest.mark.slow
-def test_the_per_chamber_demo_gives_the_builds_pressures_at_a_grid_q(tmp_path: Path) -> None:
-    case = case_from(tmp_path, REPO / "configs" / "actuator-per-chamber.yaml", {})
-    out = tmp_path / "build"
-    assert runner.invoke(app, ["build", str(case), "--out", str(out)]).exit_code == 0
+def test_the_per_chamber_demo_gives_the_builds_pressures_at_a_grid_q(tmp_path: Path, tmp_path_factory) -> None:
+    # configs/actuator-per-chamber.yaml's build as tests/e2e/test_one_story.py reads it (made once per run), copied
+    clone = workspace_copy(tmp_path_factory, tmp_path / "clone", PER_CHAMBER_BUILD, "build/per-chamber")
+    case, out = clone / "configs" / "actuator-per-chamber.yaml", clone / "build" / "per-chamber"
     result = runner.invoke(app, ["pressure", str(case), "--out", str(out), "--q", "0.5", "--json"])
     assert result.exit_code == 0, result.output
     doc = json.loads(result.stdout)

@@ -4,19 +4,15 @@ from __future__ import annotations
 
 import re
 import shlex
-import shutil
-import subprocess
-import sys
 
 import pytest
 
 from tests.helpers.paths import REPO
+from tests.helpers.shared_builds import DEMO_BUILD, run_once, workspace
 
 README = (REPO / "README.md").read_text(encoding="utf-8")
 #: "At most about 150 lines" (issue 34): the reference is in docs/.
 MAX_README_LINES = 150
-#: The CLI as the README's `.venv/bin/softdesign` runs it, in this test's interpreter.
-CLI = [sys.executable, "-c", "import sys; from softdesign.cli import main; sys.argv[0] = 'softdesign'; main()"]
 
 
 def readme_commands() -> list[str]:
@@ -38,18 +34,18 @@ def test_the_readme_is_short_and_opens_on_the_two_commands():
 
 
 @pytest.mark.slow
-def test_every_command_of_the_readme_runs(tmp_path):
-    shutil.copytree(REPO / "configs", tmp_path / "configs")
-    shutil.copytree(REPO / "data", tmp_path / "data")
+def test_every_command_of_the_readme_runs(tmp_path_factory):
+    # in the run's shared workspace (copies of configs/ and data/): tests/e2e/test_one_story.py and the report
+    # tests read the builds of the same commands, each run once for all of them (tests/helpers/shared_builds.py)
     commands = readme_commands()
     assert len(commands) >= 6
     # what `make demo` does first: the sample case built with its report
-    steps = [["build", "configs/demo.yaml", "--report"]] + [shlex.split(c)[1:] for c in commands]
+    steps = [list(DEMO_BUILD)] + [shlex.split(c)[1:] for c in commands]
     for args in steps:
-        done = subprocess.run([*CLI, *args], cwd=tmp_path, capture_output=True, text=True, timeout=900,
-                              stdin=subprocess.DEVNULL)
+        done = run_once(tmp_path_factory, *args)
         assert done.returncode == 0, f"softdesign {' '.join(args)}:\n{done.stderr[-3000:]}"
         assert "Traceback" not in done.stderr
-    assert (tmp_path / "build" / "demo" / "report" / "index.html").is_file()
-    assert (tmp_path / "build" / "actuator" / "actuation.csv").is_file()
-    assert (tmp_path / "build" / "demo-designed" / "design" / "summary.json").is_file()
+    folder = workspace(tmp_path_factory)
+    assert (folder / "build" / "demo" / "report" / "index.html").is_file()
+    assert (folder / "build" / "actuator" / "actuation.csv").is_file()
+    assert (folder / "build" / "demo-designed" / "design" / "summary.json").is_file()

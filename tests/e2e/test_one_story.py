@@ -4,7 +4,10 @@ On the demo, the designed demo (README's `design` command), configs/actuator.yam
 ICA-sized vessel whose outlet cap is tilted 31 degrees (above the 30 degrees ``fit.end_cut: auto`` cuts at, so
 the body's end stays square and the fit warns), the warnings each output lists are the same set, each once; the
 verdict is the same word; the terminal ends with the verdict and the build folder; the report says "No warnings"
-only when there are none.  Each case is built once (module-scoped fixture) with its report.
+only when there are none.  Each case is built once (module-scoped fixture) with its report.  The demo, the
+designed demo and the actuator are built by the README's own commands, in the run's shared workspace
+(tests/helpers/shared_builds.py): tests/cli/test_readme.py runs the same commands, and whichever asks first
+builds; the others read that run's terminal output and build folder.
 """
 
 from __future__ import annotations
@@ -21,8 +24,9 @@ from typer.testing import CliRunner
 
 from softdesign.cli import app
 from softdesign.report.writer import PAGE, REPORT_DIR
-from tests.helpers.paths import AORTA_DIR, DEMO, REPO
+from tests.helpers.paths import AORTA_DIR
 from tests.helpers.robust_vessels import write_tilted_cap_vessel
+from tests.helpers.shared_builds import ACTUATOR_BUILD, DEMO_BUILD, PER_CHAMBER_BUILD, run_once, workspace
 from tests.test_user_strings import INTERNAL
 
 pytestmark = pytest.mark.slow
@@ -32,6 +36,18 @@ runner = CliRunner()
 #: the largest tilt the body is cut at.
 ICA_RADIUS_MM, ICA_LENGTH_MM, ICA_TILT_DEG = 2.0, 40.0, 31.0
 CASES = ("demo", "designed", "actuator", "per_chamber", "aorta", "ica_tilted")
+#: The cases built by the README's commands (in its order; a child process each, as a user runs them), and the
+#: per-chamber actuator (three chambers per section, feeds, a mould and a volume mesh), with the build folder each
+#: writes in the shared workspace.
+README_BUILDS: dict[str, tuple[tuple[tuple[str, ...], ...], str]] = {
+    "demo": ((DEMO_BUILD,), "build/demo"),
+    "designed": ((("design", "configs/demo.yaml", "--tolerance-mm", "1", "--output", "build/demo-designed.yaml",
+                   "--out", "build/demo-designed"),
+                  ("build", "build/demo-designed.yaml", "--out", "build/demo-designed", "--report")),
+                 "build/demo-designed"),
+    "actuator": ((ACTUATOR_BUILD,), "build/actuator"),
+    "per_chamber": ((PER_CHAMBER_BUILD,), "build/per-chamber"),
+}
 
 
 @dataclass(frozen=True)
@@ -54,19 +70,19 @@ def _build(name: str, case: Path, out: Path) -> Story:
     return Story(name, out, result.stdout.splitlines(), result.stderr.splitlines(), manifest, page)
 
 
+def _readme_build(name: str, factory: pytest.TempPathFactory) -> Story:
+    """A shared case: its commands run once in the shared workspace (the last one the build with its report)."""
+    steps, build_dir = README_BUILDS[name]
+    for args in steps:
+        result = run_once(factory, *args)
+        assert result.returncode == 0, f"softdesign {' '.join(args)}:\n{result.stderr[-3000:]}"
+    out = workspace(factory) / build_dir
+    manifest = json.loads((out / "manifest.json").read_text(encoding="utf-8"))
+    page = (out / REPORT_DIR / PAGE).read_text(encoding="utf-8")
+    return Story(name, out, result.stdout.splitlines(), result.stderr.splitlines(), manifest, page)
+
+
 def _case(name: str, folder: Path) -> Path:
-    if name == "demo":
-        return DEMO
-    if name == "actuator":  # the single-supply device (issue 41)
-        return REPO / "configs" / "actuator.yaml"
-    if name == "per_chamber":  # three chambers per section, feeds, a mould and a volume mesh
-        return REPO / "configs" / "actuator-per-chamber.yaml"
-    if name == "designed":  # README: softdesign design configs/demo.yaml --tolerance-mm 1 --output ...
-        output = folder / "demo-designed.yaml"
-        design = runner.invoke(app, ["design", str(DEMO), "--tolerance-mm", "1", "--output", str(output),
-                                     "--out", str(folder / "design")])
-        assert design.exit_code == 0, design.output
-        return output
     if name == "aorta":
         if not AORTA_DIR.is_dir():
             pytest.skip(f"real VMTK data not found at {AORTA_DIR}")
@@ -89,7 +105,9 @@ _BUILT: dict[str, Story] = {}
 
 
 def _story(name: str, factory: pytest.TempPathFactory) -> Story:
-    if name not in _BUILT:
+    if name not in _BUILT and name in README_BUILDS:
+        _BUILT[name] = _readme_build(name, factory)
+    elif name not in _BUILT:
         folder = factory.mktemp(name)
         _BUILT[name] = _build(name, _case(name, folder), folder / "build")
     return _BUILT[name]

@@ -39,6 +39,7 @@ from softdesign.report.writer import (
 )
 from tests.helpers.cases import write_case
 from tests.helpers.paths import REPO
+from tests.helpers.shared_builds import demo_build_copy
 
 #: Builds and reports the sample case and the aorta: `make test-fast` leaves these out.
 pytestmark = pytest.mark.slow
@@ -115,8 +116,8 @@ def tree_hashes(folder: Path) -> dict[str, str]:
 
 @pytest.fixture(scope="module")
 def demo(tmp_path_factory):
-    build_dir = tmp_path_factory.mktemp("demo") / "build"
-    build_through(DEMO_CASE, build_dir)
+    """The README's demo build (made once per run, tests/helpers/shared_builds.py), copied, with this file's report."""
+    build_dir = demo_build_copy(tmp_path_factory, tmp_path_factory.mktemp("demo") / "build")
     result = write_report(build_dir, ReportOptions(pcc_d=(DEMO_PCC_D,)))
     return build_dir, result
 

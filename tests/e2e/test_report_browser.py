@@ -28,6 +28,7 @@ from softdesign.report.interactive_parts import CHAMBER_NAME, MOULD_PREFIX
 from softdesign.report.writer import PAGE, REPORT_DIR, ReportOptions, write_report
 from tests.helpers.parts_cases import hollow_tube_case
 from tests.helpers.paths import REPO
+from tests.helpers.shared_builds import demo_build
 
 pytestmark = pytest.mark.slow
 
@@ -87,10 +88,8 @@ def session(tmp_path_factory):
     """The demo's page opened, its messages and requests recorded, captured at q = 1 and after the drag to q = 0."""
     sync_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed (make install)")
     executable = chromium()
-    build_dir = tmp_path_factory.mktemp("browser") / "build"
-    build_through(REPO / "configs" / "demo.yaml", build_dir)
-    write_report(build_dir)
-    report_dir = (build_dir / REPORT_DIR).resolve()
+    # the README's demo build with its report (`make demo`'s; made once per run), only read here
+    report_dir = (demo_build(tmp_path_factory) / REPORT_DIR).resolve()
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     record: dict = {"report_dir": report_dir, "messages": [], "requests": []}
     with sync_api.sync_playwright() as playwright:

@@ -13,18 +13,16 @@ import pytest
 from typer.testing import CliRunner
 
 from softdesign.cli import app
-from softdesign.pipeline.api import build_through
 from softdesign.pipeline.layout import REPORT_DIR
 from softdesign.report.writer import LOG
-from tests.helpers.paths import REPO
+from tests.helpers.shared_builds import demo_build_copy
 
 runner = CliRunner()
 
 
 @pytest.mark.slow
-def test_identical_builds_in_other_folders_give_the_same_report_bytes(tmp_path):
-    first = tmp_path / "folder-alpha"
-    build_through(REPO / "configs" / "demo.yaml", first)
+def test_identical_builds_in_other_folders_give_the_same_report_bytes(tmp_path, tmp_path_factory):
+    first = demo_build_copy(tmp_path_factory, tmp_path / "folder-alpha")  # the README's demo build, no report
     second = tmp_path / "elsewhere" / "folder-beta"
     shutil.copytree(first, second)  # the same build, in a folder of another name and depth
     drawn = {}

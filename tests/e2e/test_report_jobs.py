@@ -6,11 +6,10 @@ import pytest
 from typer.testing import CliRunner
 
 from softdesign.cli import app
-from softdesign.pipeline.api import build_through
 from softdesign.pipeline.layout import REPORT_DIR
 from softdesign.pipeline.parallel import MAX_JOBS
 from softdesign.report.writer import LOG
-from tests.helpers.paths import REPO
+from tests.helpers.shared_builds import demo_build_copy
 
 runner = CliRunner()
 
@@ -25,9 +24,8 @@ def test_jobs_outside_the_bound_is_refused_before_any_work(tmp_path, jobs):
 
 
 @pytest.mark.slow
-def test_a_report_is_the_same_bytes_with_one_and_two_jobs(tmp_path):
-    build_dir = tmp_path / "build"
-    build_through(REPO / "configs" / "demo.yaml", build_dir)
+def test_a_report_is_the_same_bytes_with_one_and_two_jobs(tmp_path, tmp_path_factory):
+    build_dir = demo_build_copy(tmp_path_factory, tmp_path / "build")  # the README's demo build, without its report
     drawn = {}
     for jobs in ("1", "2"):
         result = runner.invoke(app, ["report", str(build_dir), "--jobs", jobs])

@@ -12,10 +12,9 @@ from typing import Any
 
 import pytest
 
-from softdesign.pipeline.api import build_through
 from softdesign.report import plotting
 from softdesign.report.writer import ReportOptions, write_report
-from tests.helpers.paths import REPO
+from tests.helpers.shared_builds import demo_build_copy
 
 pytestmark = pytest.mark.slow
 
@@ -38,8 +37,7 @@ def _overlap(a, b) -> float:
 
 @pytest.fixture(scope="module")
 def drawn_boxes(tmp_path_factory):
-    build_dir = tmp_path_factory.mktemp("layout") / "build"
-    build_through(REPO / "configs" / "demo.yaml", build_dir)
+    build_dir = demo_build_copy(tmp_path_factory, tmp_path_factory.mktemp("layout") / "build")
     boxes: dict[str, tuple[tuple[float, float], dict[str, Any]]] = {}
     real_png_bytes = plotting.png_bytes
 

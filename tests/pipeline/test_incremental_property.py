@@ -9,12 +9,18 @@ files, byte for byte, the manifest included.  Only the run log
 records how the folder was reached, and it is the one file left out.
 
 Coarse settings keep a build to about a second: the property is about caching, not resolution.
+
+Every run tries the three written examples below, which between them make every kind of edit (each of the nine
+keys, a block removed and put back), upstream and downstream of one another, then :data:`DRAWN_EXAMPLES` drawn
+ones (new orders and values each run; Hypothesis's database replays a failure first).  ``make study-property``
+draws :data:`STUDY_EXAMPLES` (the count ``make test`` drew before the suite had to fit in 15 minutes).
 """
 
 from __future__ import annotations
 
 import copy
 import json
+import os
 import shutil
 import tempfile
 from pathlib import Path
@@ -22,7 +28,7 @@ from typing import Any
 
 import pytest
 import yaml
-from hypothesis import HealthCheck, Phase, given, settings
+from hypothesis import HealthCheck, Phase, example, given, settings
 from hypothesis import strategies as st
 
 from softdesign.pipeline.api import build_through
@@ -43,6 +49,22 @@ BASE: dict[str, Any] = {
     "fit": {"knot_spacing_mm": 3.0, "angular_intervals": 12, "smoothing": 1.0e-5},
     "export": {"q": [0, 1], "formats": ["stl"], "spacing_mm": 1.0, "angular_count": 40},
 }
+
+#: Drawn examples in `make test` (each 3-5 rebuilds and a fresh build, about a second each), and in
+#: `make study-property` (which sets SOFTDESIGN_PROPERTY_EXAMPLES).
+DRAWN_EXAMPLES, STUDY_EXAMPLES = 5, 20
+#: The most drawn examples the variable may ask for (about 20 minutes).
+MAX_EXAMPLES = 200
+
+
+def drawn_examples() -> int:
+    """SOFTDESIGN_PROPERTY_EXAMPLES (1 to MAX_EXAMPLES) when set, else DRAWN_EXAMPLES."""
+    text = os.environ.get("SOFTDESIGN_PROPERTY_EXAMPLES", str(DRAWN_EXAMPLES))
+    if not (text.isdigit() and 1 <= int(text) <= MAX_EXAMPLES):
+        raise pytest.UsageError(f"SOFTDESIGN_PROPERTY_EXAMPLES must be a whole number from 1 to {MAX_EXAMPLES}, "
+                                f"got {text!r}: unset it for make test's {DRAWN_EXAMPLES}")
+    return int(text)
+
 
 #: One edit: (where, value); "material" replaces the block (None removes it), the others set one key.
 EDITS = st.one_of(
@@ -92,9 +114,14 @@ def first_build(tmp_path_factory) -> Path:
 
 
 @pytest.mark.slow
-@settings(max_examples=20, deadline=None, phases=(Phase.explicit, Phase.reuse, Phase.generate),
+@settings(max_examples=drawn_examples(), deadline=None, phases=(Phase.explicit, Phase.reuse, Phase.generate),
           suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 @given(edits=st.lists(EDITS, min_size=3, max_size=5))
+@example(edits=[("resample.spacing_mm", 1.25), ("fit.knot_spacing_mm", 4.0), ("export.formats", ["stl", "ply"])])
+@example(edits=[("export.q", [0, 0.5, 1]), ("links", {"count": 3}), ("resample.smoothing_mm", 0.1),
+                ("fit.angular_intervals", 16)])
+@example(edits=[("material", None), ("fit.smoothing", 3.0e-5), ("links", {"breaks": [0.0, 0.4, 1.0]}),
+                ("material", {"name": "dragon-skin-30"})])
 def test_rebuilds_after_any_edits_give_a_fresh_builds_bytes(first_build, edits):
     # no shrinking phase: each step is a build; a failure prints its edits as drawn
     with tempfile.TemporaryDirectory(prefix="incremental-") as scratch:
