@@ -20,8 +20,7 @@ import numpy as np
 
 from softdesign.errors import MeshError
 from softdesign.mechanics.quadratic import QuadraticMesh, midpoint_nodes
-from softdesign.mechanics.quadratic_pressure import TRI_WEIGHTS
-from softdesign.mechanics.reinforcement import FibreMembrane, HoopThread
+from softdesign.mechanics.reinforcement import FIBRE_WEIGHTS, FibreMembrane, HoopThread
 from softdesign.types import IntArray
 
 
@@ -49,7 +48,7 @@ def backbone_fibres(mesh: QuadraticMesh, chains: list[IntArray], thread: HoopThr
     length = np.linalg.norm(mesh.points[b] - mesh.points[a], axis=1)
     if np.any(length <= 0.0):
         raise MeshError("device mesh: two consecutive axis nodes coincide; the backbone thread needs distinct nodes")
-    q = len(TRI_WEIGHTS)
+    q = len(FIBRE_WEIGHTS)
     faces = np.column_stack([a, b, a, a, a, a])  # the fibres' 6 slots: a and b carry it, the rest weigh nothing
     directions = np.zeros((len(a), q, 6))
     directions[:, :, 0] = -1.0 / length[:, None]
