@@ -71,13 +71,14 @@ def test_feed_pressures_must_match_the_feeds() -> None:
 
 
 def _beam_curvature(section: SectionMesh, layout: ChamberLayout, pressure_kpa: float) -> float:
-    """P A_f d_f / (E I): feed 0's polygon area A_f (mm^2) at d_f (mm) from the axis, I (mm^4) of the material
-    about the axis normal to the feed's direction, integrated over the tets of the layer band at mid-length."""
+    """P A_f d_f / (E I): feed 0's area A_f (mm^2, its polygon's and circle's) at d_f (mm) from the axis, I (mm^4)
+    of the material about the axis normal to the feed's direction, integrated over the tets of the layer band at
+    mid-length."""
     feed = layout.feeds_through(0)[0]
     assert section.feed_faces is not None and section.face_feed is not None
     ring = np.unique(section.feed_faces[section.face_feed == 0])
     ring = ring[np.abs(section.points[ring, 2]) < 1e-9]
-    area = 0.5 * len(ring) * (0.5 * feed.diameter_mm) ** 2 * np.sin(2 * np.pi / len(ring))
+    area = np.pi * (0.5 * feed.diameter_mm) ** 2  # the mesh's polygon has the designed circle's area
     c = section.points[section.tets]
     volume = np.abs(np.einsum("ij,ij->i", np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]), c[:, 3] - c[:, 0])) / 6
     y = c @ np.array([np.cos(feed.angle), np.sin(feed.angle), 0.0])
