@@ -6,12 +6,13 @@ that cross it as cavities, capped where its chambers end) and carried from its
 base frame into the frame of the body's q = 0 centerline (the case's frame, mm).
 Its centerline is sampled every ``sample_mm`` or finer for the measures.
 
-What this leaves out (stated with every answer): a tapered chamber is meshed
-as a cylinder of its middle distance and diameter (``supply: single``'s taper
-is a few per cent along a section); the short feed from the base face into
-section 1's chamber, and the channels that join consecutive chambers in
-series, are not meshed (their walls' loads are in the end walls, which they
-cross); the body's slanted end cuts are not applied.
+A tapered chamber (``supply: single``) is meshed as designed, its distance
+and diameter following its profile layer by layer
+(:mod:`softdesign.mechanics.section_taper`).  What this leaves out (stated
+with every answer): the short feed from the base face into section 1's
+chamber, and the channels that join consecutive chambers in series, are not
+meshed (their walls' loads are in the end walls, which they cross); the
+body's slanted end cuts are not applied.
 """
 
 from __future__ import annotations

@@ -41,6 +41,7 @@ import numpy as np
 
 from softdesign.geometry.frames import FramedSpline
 from softdesign.mechanics.section import SectionMesh
+from softdesign.mechanics.section_taper import tapered_offsets
 from softdesign.meshing.chambers.carve import area_radius
 from softdesign.meshing.chambers.layout import ChamberLayout
 from softdesign.meshing.volume import BodySpec, angle_grid
@@ -134,6 +135,10 @@ def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, lay
     # angular_count corners on the surface would leave 8.8 % of the bending stiffness out at the default 12
     outer = replace(outer, xy=outer.xy * area_radius(1.0, angular_count))
     xy = section_xy(mesh.section.points, outer, inner, ref)
+    # a tapered chamber (supply: single) moved layer by layer onto its designed distance and diameter
+    circles = [h.circle for h in mesh.holes]
+    xy = xy + tapered_offsets(mesh.section.points, mesh.l, chambers, circles[:len(holes)], circles[len(holes):],
+                              ref.core, scale)
     frames = outer.frames[:, None, :, :]
     grid = outer.centers[:, None, :] + xy[..., :1] * frames[..., 0] + xy[..., 1:] * frames[..., 1]
     world = grid[mesh.node_layer, mesh.node_point]

@@ -30,8 +30,6 @@ LEAVES_OUT = (
     "contact with the vessel wall",
     "viscoelasticity (the answer is the static, long-time equilibrium)",
     "the Mullins effect (softening after the first loading)",
-    "a tapered chamber's taper (each section's chamber is meshed as a cylinder of its middle distance and "
-    "diameter)",
     "the supply line from the base face into section 1's chamber and the channels joining consecutive chambers "
     "(supply: single), and the body's slanted end cuts",
 )
