@@ -63,6 +63,7 @@ class DevicePart:
     samples : (n, 3) float, mm, points of the section's unloaded centerline, base to tip (measured)
     feed_chambers : (m,) int, the chamber (numbered over the whole device, base first) that each feed crossing
         the section feeds: the feed carries that chamber's pressure
+    notes : what the section's mesh leaves out of the design (a taper meshed as a cylinder), for the answer
     """
 
     mesh: SectionMesh
@@ -70,6 +71,7 @@ class DevicePart:
     tip_frame: FloatArray
     samples: FloatArray
     feed_chambers: IntArray = field(default_factory=lambda: np.zeros(0, np.int64))
+    notes: tuple[str, ...] = ()
 
 
 def placed_section(section: SectionMesh, origin: FloatArray, frame: FloatArray) -> SectionMesh:

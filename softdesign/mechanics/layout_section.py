@@ -94,7 +94,8 @@ def _feed_holes(layout: ChamberLayout, section: int, scale_mm: float, size_mm: f
 
 
 def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, layout: ChamberLayout, section: int,
-                        size_mm: float, angular_count: int, layer_mm: float, feeds: bool = False) -> SectionMesh:
+                        size_mm: float, angular_count: int, layer_mm: float, feeds: bool = False,
+                        taper: bool = True) -> SectionMesh:
     """Section ``section``'s mesh at q = 0 in its base frame, with its base fixed and chamber walls named.
 
     Parameters
@@ -110,11 +111,13 @@ def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, lay
     feeds : mesh the feeds of distal chambers that cross the section as cavities (``feed_faces``: their walls
         and a cap where the section's chambers end, which carries the pull of the feed's pressure on the
         distal part), not solid
+    taper : mesh a tapered chamber as designed (:mod:`softdesign.mechanics.section_taper`); False: as a cylinder
+        of its middle distance and diameter
 
     Raises
     ------
     MeshError
-        As the swept mesher: a chamber that does not fit, a fold.
+        As the swept mesher: a chamber that does not fit, a fold; TaperError: a taper the mesh cannot follow.
     """
     l0, l1 = layout.breaks[section], layout.breaks[section + 1]
     layers = section_layers(curve0, l0, l1, layer_mm)
@@ -137,8 +140,9 @@ def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, lay
     xy = section_xy(mesh.section.points, outer, inner, ref)
     # a tapered chamber (supply: single) moved layer by layer onto its designed distance and diameter
     circles = [h.circle for h in mesh.holes]
-    xy = xy + tapered_offsets(mesh.section.points, mesh.l, chambers, circles[:len(holes)], circles[len(holes):],
-                              ref.core, scale)
+    if taper:
+        xy = xy + tapered_offsets(mesh.section.points, mesh.l, chambers, circles[:len(holes)], circles[len(holes):],
+                                  ref.core, scale)
     frames = outer.frames[:, None, :, :]
     grid = outer.centers[:, None, :] + xy[..., :1] * frames[..., 0] + xy[..., 1:] * frames[..., 1]
     world = grid[mesh.node_layer, mesh.node_point]

@@ -17,8 +17,9 @@ at every layer.  ``reach`` stays inside the rigid core and off every other hole,
 and the thread's fibres elsewhere do not move.
 
 Assumptions: the taper is gentle (its change over a section, |d - d0| + |D/D0 - 1| r, is small against the
-blend's width ``reach - r``; :func:`tapered_offsets` refuses one that would fold an element), and the chamber's
-axis stays straight between layers (the layers are its profile's piecewise-linear samples).
+blend's width ``reach - r``; :func:`tapered_offsets` refuses one that would fold an element, and the whole device
+then meshes that chamber as a cylinder of its middle values and says so), and the chamber's axis stays straight
+between layers (the layers are its profile's piecewise-linear samples).
 """
 
 from __future__ import annotations
@@ -39,6 +40,11 @@ BLEND_MARGIN = 0.1
 #: The largest move of the blend over its width: beyond it an element could fold (the map's Jacobian is
 #: 1 - move / width at worst); a taper of a few per cent moves a tenth of this.
 MAX_BLEND_STRAIN = 0.5
+
+
+class TaperError(MeshError):
+    """A chamber's taper is more than the blend can take without folding an element (the caller may mesh it as a
+    cylinder of its middle values and say so)."""
 
 
 def _reach(circle: Circle, others: Sequence[Circle], core: float) -> float:
@@ -69,7 +75,7 @@ def tapered_offsets(points: FloatArray, layer_l: FloatArray, chambers: Sequence[
 
     Raises
     ------
-    MeshError
+    TaperError
         A chamber's circle leaves no room to blend, or its taper would move nodes by more than
         MAX_BLEND_STRAIN of the blend's width (a fold).
     """
@@ -86,10 +92,9 @@ def tapered_offsets(points: FloatArray, layer_l: FloatArray, chambers: Sequence[
         move = float(np.max(np.linalg.norm(shift, axis=1) + np.abs(growth) * radius * scale_mm))
         width = (reach - radius) * scale_mm
         if not width > 0 or move > MAX_BLEND_STRAIN * width:
-            raise MeshError(f"section mesh: section {chamber.section + 1}'s chamber {chamber.index + 1} tapers by "
-                            f"{move:.3g} mm, more than {MAX_BLEND_STRAIN:g} of the {max(width, 0.0):.3g} mm "
-                            "between its circle and the next hole or the core's rim: moving the cylinder's nodes "
-                            "would fold the mesh; this is a bug in the layout's sizing, please report the case")
+            raise TaperError(f"section {chamber.section + 1}'s chamber {chamber.index + 1} tapers by {move:.3g} mm, "
+                             f"more than {MAX_BLEND_STRAIN:g} of the {max(width, 0.0):.3g} mm between its circle and "
+                             "the next hole or the rigid core's rim: moving the cylinder's nodes would fold the mesh")
         local = points - np.asarray(circle.center, float)
         weight = np.clip((reach - np.linalg.norm(local, axis=1)) / (reach - radius), 0.0, 1.0)  # (P,)
         offsets += weight[None, :, None] * (shift[:, None, :] + growth[:, None, None] * scale_mm * local[None])

@@ -148,7 +148,7 @@ def device_payload(outcome: Any, o: Any, device: Any, material: Any, loads: tupl
         "convergence": [{"load_factor": t, "iterations": n, "residuals_mN": h}
                         for t, n, h in zip(record.load_factors, record.iterations, record.residuals, strict=True)],
         "seconds": {k: round(v, 2) for k, v in times.items()},
-        "leaves_out": list(LEAVES_OUT),
+        "leaves_out": list(LEAVES_OUT) + [note for part in device.parts for note in part.notes],
     }
 
 

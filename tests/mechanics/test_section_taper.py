@@ -9,13 +9,13 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from softdesign.errors import MeshError
 from softdesign.geometry.blend import blend_shapes
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
 from softdesign.geometry.frames import FramedSpline
 from softdesign.geometry.initial import straight_initial_shape
 from softdesign.mechanics.layout_section import layout_section_mesh
 from softdesign.mechanics.section import SectionMesh, check_section
+from softdesign.mechanics.section_taper import TaperError
 from softdesign.meshing.chambers.layout import ActuationSpec, ChamberLayout, plan_layout
 from softdesign.meshing.volume import BodySpec
 from tests.fitting.test_fit_strain import _constant_field
@@ -79,5 +79,17 @@ def test_an_untapered_chamber_does_not_move() -> None:
 
 
 def test_a_taper_the_blend_cannot_take_is_refused() -> None:
-    with pytest.raises(MeshError, match="would fold the mesh"):
+    with pytest.raises(TaperError, match="would fold the mesh"):
         _mesh((3.6, 1.4), DIAMETER_ENDS)
+
+
+def test_the_device_meshes_a_taper_it_cannot_follow_as_a_cylinder_and_says_so() -> None:
+    from softdesign.mechanics.device_layout import device_parts
+
+    layout, curve0 = _layout((3.6, 1.4), DIAMETER_ENDS)
+    field = _constant_field(RADIUS_MM, RADIUS_MM)
+    (part,) = device_parts(curve0, field, BodySpec(), layout, 3.0, 12, 4.0)
+    assert len(part.notes) == 1 and "meshed as a cylinder of its middle distance and diameter" in part.notes[0]
+    cylinder = layout_section_mesh(curve0, field, BodySpec(), layout, 0, size_mm=3.0, angular_count=12,
+                                   layer_mm=4.0, taper=False)
+    np.testing.assert_allclose(part.mesh.points, cylinder.points, rtol=0, atol=EXACT_TOL)  # the base frame is I
