@@ -41,7 +41,7 @@ import numpy as np
 
 from softdesign.geometry.frames import FramedSpline
 from softdesign.mechanics.section import SectionMesh
-from softdesign.mechanics.section_taper import tapered_offsets
+from softdesign.mechanics.section_taper import check_taper, tapered_offsets
 from softdesign.meshing.chambers.carve import area_radius
 from softdesign.meshing.chambers.layout import ChamberLayout
 from softdesign.meshing.volume import BodySpec, angle_grid
@@ -141,8 +141,10 @@ def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, lay
     # a tapered chamber (supply: single) moved layer by layer onto its designed distance and diameter
     circles = [h.circle for h in mesh.holes]
     if taper:
-        xy = xy + tapered_offsets(mesh.section.points, mesh.l, chambers, circles[:len(holes)], circles[len(holes):],
-                                  ref.core, scale)
+        moved = xy + tapered_offsets(mesh.section.points, mesh.l, chambers, circles[:len(holes)],
+                                     circles[len(holes):], scale)
+        check_taper(mesh.section.triangles, xy, moved, chambers)
+        xy = moved
     frames = outer.frames[:, None, :, :]
     grid = outer.centers[:, None, :] + xy[..., :1] * frames[..., 0] + xy[..., 1:] * frames[..., 1]
     world = grid[mesh.node_layer, mesh.node_point]

@@ -10,15 +10,17 @@ nodes move, in each layer's (N, B) plane (mm), by
     x' = x + w(x) [(d(l) - d0) e + (D(l) / D0 - 1) (x - c0)]
 
 where c0 = d0 e is the chamber's reference centre (its middle distance d0 along its direction e), D0 its middle
-diameter, and w a weight that is 1 on and inside the chamber's circle and falls linearly to 0 at ``reach`` from
-its centre.  On the circle the map is the similarity that takes the reference circle onto the designed one, so
-the chamber's polygon (area-matched, :mod:`softdesign.mechanics.layout_section`) keeps the designed circle's area
-at every layer.  ``reach`` stays inside the rigid core and off every other hole, so the skin, the other holes
-and the thread's fibres elsewhere do not move.
+diameter, and w a weight that is 1 on and inside the chamber's circle and falls linearly, along each ray from
+c0, to 0 short of the skin (or of another hole) on that ray.  On the circle the map is the similarity that
+takes the reference circle onto the designed one, so the chamber's polygon (area-matched,
+:mod:`softdesign.mechanics.layout_section`) keeps the designed circle's area at every layer.  The skin and the
+other holes do not move; the material between is compressed on the side the chamber moves to, as the design's
+own wall is thinner there.  The weight's reach is measured per ray in the reference disk, so a chamber that
+moves towards the axis compresses the wide material on that side, not the thin wall to the skin.
 
-Assumptions: the taper is gentle (its change over a section, |d - d0| + |D/D0 - 1| r, is small against the
-blend's width ``reach - r``; :func:`tapered_offsets` refuses one that would fold an element, and the whole device
-then meshes that chamber as a cylinder of its middle values and says so), and the chamber's axis stays straight
+Assumptions: the moved mesh is checked, not assumed: every layer's triangles must keep MIN_AREA_RATIO of their
+area (:func:`check_taper`); a taper that would crush or fold one is refused (TaperError), and the whole device
+then meshes that chamber as a cylinder of its middle values and says so.  The chamber's axis is straight
 between layers (the layers are its profile's piecewise-linear samples).
 """
 
@@ -32,14 +34,13 @@ import numpy as np
 from softdesign.errors import MeshError
 from softdesign.meshing.chambers.layout import Chamber
 from softdesign.meshing.volume_mesh.cross_section import Circle
-from softdesign.types import FloatArray
+from softdesign.types import FloatArray, IntArray
 
-#: The blend keeps this share of the room between a chamber's circle and the nearest other circle or the core's
-#: rim clear (its weight reaches 0 before them).
+#: The blend's weight reaches 0 this share of the room short of the skin or another hole on each ray.
 BLEND_MARGIN = 0.1
-#: The largest move of the blend over its width: beyond it an element could fold (the map's Jacobian is
-#: 1 - move / width at worst); a taper of a few per cent moves a tenth of this.
-MAX_BLEND_STRAIN = 0.5
+#: Every triangle of a moved layer keeps at least this share of its area (or is refused): a quarter keeps the
+#: elements usable (their quality falls as the ratio); the design's wall is at least its wall_min_mm anyway.
+MIN_AREA_RATIO = 0.25
 
 
 class TaperError(MeshError):
@@ -47,20 +48,21 @@ class TaperError(MeshError):
     cylinder of its middle values and say so)."""
 
 
-def _reach(circle: Circle, others: Sequence[Circle], core: float) -> float:
-    """Where the weight of ``circle``'s blend reaches 0, reference units: short of the core's rim and of every
-    other circle by BLEND_MARGIN of the room left."""
-    centre = np.asarray(circle.center, float)
-    room = core - float(np.hypot(*centre))
+def _ray_room(local: FloatArray, centre: FloatArray, others: Sequence[Circle]) -> FloatArray:
+    """Distance (P,) reference units from ``centre`` along each point's ray (``local``: the points less the
+    centre, (P, 2)) to the unit circle (the skin), capped by the gap to every other circle."""
+    length = np.maximum(np.linalg.norm(local, axis=1), 1e-300)
+    u = local / length[:, None]
+    along = u @ centre
+    room = -along + np.sqrt(np.maximum(along * along - centre @ centre + 1.0, 0.0))  # |centre + t u| = 1
     for other in others:
         gap = float(np.hypot(*(np.asarray(other.center, float) - centre))) - other.node_radius(other.nodes)
-        room = min(room, gap)
-    radius = circle.node_radius(circle.nodes)
-    return radius + (1.0 - BLEND_MARGIN) * (room - radius)
+        room = np.minimum(room, gap)
+    return np.asarray(room, float)
 
 
 def tapered_offsets(points: FloatArray, layer_l: FloatArray, chambers: Sequence[Chamber],
-                    circles: Sequence[Circle], others: Sequence[Circle], core: float, scale_mm: float) -> FloatArray:
+                    circles: Sequence[Circle], others: Sequence[Circle], scale_mm: float) -> FloatArray:
     """The nodes' moves (n, P, 2) mm in each layer's (N, B) plane that taper ``chambers`` as designed.
 
     Parameters
@@ -70,32 +72,45 @@ def tapered_offsets(points: FloatArray, layer_l: FloatArray, chambers: Sequence[
     chambers : the section's chambers (those without a profile do not move)
     circles : each chamber's circle in the cross-section (reference units), in ``chambers``' order
     others : every other hole's circle (feeds), which the blends keep off
-    core : the rigid core's radius, reference units (inside it a point is ``scale_mm`` times its coordinates)
-    scale_mm : mm per reference unit
+    scale_mm : mm per reference unit inside the rigid core, where the chambers are
 
     Raises
     ------
     TaperError
-        A chamber's circle leaves no room to blend, or its taper would move nodes by more than
-        MAX_BLEND_STRAIN of the blend's width (a fold).
+        A chamber's circle leaves no room to blend before the skin.
     """
     points, layer_l = np.asarray(points, float), np.asarray(layer_l, float)
     offsets = np.zeros((len(layer_l), len(points), 2))
     for k, (chamber, circle) in enumerate(zip(chambers, circles, strict=True)):
         if not chamber.profile:
             continue
+        centre, radius = np.asarray(circle.center, float), circle.node_radius(circle.nodes)
+        local = points - centre
         rest = [c for j, c in enumerate(circles) if j != k] + list(others)
-        reach, radius = _reach(circle, rest, core), circle.node_radius(circle.nodes)
+        reach = radius + (1.0 - BLEND_MARGIN) * (_ray_room(local, centre, rest) - radius)  # (P,)
+        if np.any(reach <= radius):
+            raise TaperError(f"section {chamber.section + 1}'s chamber {chamber.index + 1} leaves no room to taper "
+                             "between its circle and the skin")
         direction = np.array([math.cos(chamber.angle), math.sin(chamber.angle)])
         shift = (chamber.distance_at(layer_l) - chamber.distance_mm)[:, None] * direction  # (n, 2) mm
         growth = chamber.diameter_at(layer_l) / chamber.diameter_mm - 1.0  # (n,)
-        move = float(np.max(np.linalg.norm(shift, axis=1) + np.abs(growth) * radius * scale_mm))
-        width = (reach - radius) * scale_mm
-        if not width > 0 or move > MAX_BLEND_STRAIN * width:
-            raise TaperError(f"section {chamber.section + 1}'s chamber {chamber.index + 1} tapers by {move:.3g} mm, "
-                             f"more than {MAX_BLEND_STRAIN:g} of the {max(width, 0.0):.3g} mm between its circle and "
-                             "the next hole or the rigid core's rim: moving the cylinder's nodes would fold the mesh")
-        local = points - np.asarray(circle.center, float)
         weight = np.clip((reach - np.linalg.norm(local, axis=1)) / (reach - radius), 0.0, 1.0)  # (P,)
         offsets += weight[None, :, None] * (shift[:, None, :] + growth[:, None, None] * scale_mm * local[None])
     return offsets
+
+
+def check_taper(triangles: IntArray, before: FloatArray, after: FloatArray, chambers: Sequence[Chamber]) -> None:
+    """TaperError unless every layer's triangles (T, 3) keep MIN_AREA_RATIO of their area from ``before`` to
+    ``after`` (n, P, 2) mm: the moved mesh neither folds nor crushes an element (the layers' prisms are made of
+    these triangles)."""
+    def areas(xy: FloatArray) -> FloatArray:
+        p = xy[:, triangles]  # (n, T, 3, 2)
+        u, v = p[:, :, 1] - p[:, :, 0], p[:, :, 2] - p[:, :, 0]
+        return np.asarray(0.5 * (u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]), float)
+
+    ratio = areas(after) / areas(before)
+    if ratio.min() < MIN_AREA_RATIO:
+        layer = int(np.argmin(ratio.min(axis=1)))
+        tapered = ", ".join(f"section {c.section + 1}'s chamber {c.index + 1}" for c in chambers if c.profile)
+        raise TaperError(f"the taper of {tapered} would crush an element of layer {layer} to {ratio.min():.3g} of "
+                         f"its area (at least {MIN_AREA_RATIO:g} kept)")
