@@ -95,7 +95,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from softdesign.mechanics.quadratic_pressure import quadratic_face_dofs, triangle_shapes
+from softdesign.mechanics.quadratic_pressure import triangle_shapes
 from softdesign.mechanics.tets import summed
 from softdesign.types import FloatArray, IntArray
 
@@ -152,7 +152,8 @@ class HoopThread:
 
 @dataclass(frozen=True)
 class FibreMembrane:
-    """Fibres on 6-node faces: the reinforcement's energy term of a pressure problem.
+    """Fibres on 6-node faces (or any fixed number of node slots): the reinforcement's energy term of a pressure
+    problem.
 
     Attributes
     ----------
@@ -204,9 +205,10 @@ class FibreMembrane:
         w = self.weights * self.stiffness[:, None]
         first = 0.5 * np.maximum(e, -e_b) * w  # dW/dI4 times the weight
         forces = np.einsum("fq,fqi,fqb->fbi", 2.0 * first, a, self.directions)
-        dofs = quadratic_face_dofs(self.faces)
+        width = 3 * self.faces.shape[1]  # 18 on 6-node faces; any node count per fibre assembles alike
+        dofs = (3 * self.faces[:, :, None] + np.arange(3)[None, None, :]).reshape(len(self.faces), width)
         n = displacement.size
-        f = summed(dofs, forces.reshape(len(self.faces), 18), n)
+        f = summed(dofs, forces.reshape(len(self.faces), width), n)
         if not want_tangent:
             return f, None
         if strain is not None:
@@ -216,7 +218,7 @@ class FibreMembrane:
         second = np.where(elastic, 0.25, 0.0) * w
         inner = (4.0 * second[..., None, None] * np.einsum("fqi,fqk->fqik", a, a)
                  + 2.0 * first[..., None, None] * np.eye(3)[None, None])
-        blocks = np.einsum("fqb,fqc,fqik->fbick", self.directions, self.directions, inner).reshape(-1, 18, 18)
+        blocks = np.einsum("fqb,fqc,fqik->fbick", self.directions, self.directions, inner).reshape(-1, width, width)
         rows = np.broadcast_to(dofs[:, :, None], blocks.shape).ravel()
         cols = np.broadcast_to(dofs[:, None, :], blocks.shape).ravel()
         return f, sp.csr_matrix((blocks.ravel(), (rows, cols)), shape=(n, n))
