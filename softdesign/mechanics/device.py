@@ -34,18 +34,17 @@ import numpy as np
 
 from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.errors import MeshError, SolveError
-from softdesign.mechanics.backbone import axis_chain, backbone_fibres, joined
+from softdesign.mechanics.backbone import backbone_fibres
 from softdesign.mechanics.device_ties import Ties, joint_faces, tie_joints
+from softdesign.mechanics.embedded_thread import thread_fibres
 from softdesign.mechanics.linear_solve import TangentSolver
 from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord, solve_pressures
 from softdesign.mechanics.quadratic import QuadraticMesh, shape_values
 from softdesign.mechanics.reinforcement import HoopThread
-from softdesign.mechanics.section import LEVEL_TOL_MM, SectionMesh, locate, section_problem
+from softdesign.mechanics.section import SectionMesh, locate, section_problem
 from softdesign.mechanics.tets import make_tet_mesh
 from softdesign.types import FloatArray, IntArray
 
-#: A node is on the axis when its distance from it is below this share of the section's size.
-AXIS_TOL = 1e-9
 #: The threads' rounding floor on the residual over its estimate (:func:`roundoff_floor_mn`): a safety factor.
 FIBRE_ROUNDOFF = 10.0
 #: Centerline points located per batch (each batch holds an (n, E, 4) array of barycentric coordinates).
@@ -64,6 +63,7 @@ class DevicePart:
     samples : (n, 3) float, mm, points of the section's unloaded centerline, base to tip (measured)
     feed_chambers : (m,) int, the chamber (numbered over the whole device, base first) that each feed crossing
         the section feeds: the feed carries that chamber's pressure
+    notes : what the section's mesh leaves out of the design (a taper meshed as a cylinder), for the answer
     """
 
     mesh: SectionMesh
@@ -71,6 +71,7 @@ class DevicePart:
     tip_frame: FloatArray
     samples: FloatArray
     feed_chambers: IntArray = field(default_factory=lambda: np.zeros(0, np.int64))
+    notes: tuple[str, ...] = ()
 
 
 def placed_section(section: SectionMesh, origin: FloatArray, frame: FloatArray) -> SectionMesh:
@@ -180,25 +181,10 @@ def device_problem(device: DeviceMesh, law: HyperelasticLaw, thread: HoopThread 
     if len(device.parts) > 1:
         problem = replace(problem, springs=ties.springs())
     if backbone is not None:
-        chains = [axis_chain(mesh, axis_nodes(device, i)) for i in range(len(device.parts))]
-        problem = replace(problem, fibres=joined(problem.fibres, backbone_fibres(mesh, chains, backbone,
-                                                                                  3.0 * law.mu_kpa)))
+        pools = [np.arange(device.tet_start[i], device.tet_start[i + 1]) for i in range(len(device.parts))]
+        spine = backbone_fibres(mesh, [p.mesh.centerline for p in device.parts], pools, backbone, 3.0 * law.mu_kpa)
+        problem = replace(problem, fibres=thread_fibres([problem.fibres, spine]))
     return problem, ties, hoops
-
-
-def axis_nodes(device: DeviceMesh, i: int) -> IntArray:
-    """Section i's corner nodes (global) on its centerline, base to tip (MeshError when a layer has none)."""
-    mesh = device.parts[i].mesh
-    levels, layer = np.unique(np.round(mesh.node_l / LEVEL_TOL_MM), return_inverse=True)
-    if len(levels) != len(mesh.centerline):
-        raise MeshError(f"device mesh: section {i + 1} has {len(levels)} layers and {len(mesh.centerline)} "
-                        "centerline points; one per layer expected")
-    off = np.linalg.norm(mesh.points - mesh.centerline[layer], axis=1)
-    on_axis = np.flatnonzero(off <= AXIS_TOL * float(np.abs(mesh.points - mesh.centerline[0]).max()))
-    if len(on_axis) != len(levels):
-        raise MeshError(f"device mesh: section {i + 1} has {len(on_axis)} nodes on its axis for {len(levels)} "
-                        "layers; the backbone thread runs through one per layer")
-    return device.node_start[i] + on_axis[np.argsort(mesh.node_l[on_axis])]
 
 
 def joints_of(device: DeviceMesh) -> list[tuple[IntArray, IntArray]]:

@@ -17,7 +17,9 @@ needs 5-7 iterations a step.  The mixed method keeps each element's pressure as
 an unknown, updated by its linearization
 (:func:`~softdesign.mechanics.quadratic.linearized_pressure`), and the matrix
 takes that one; the residual is the same, so is the equilibrium it converges
-to.  Measured on the sample case's base section at 20 kPa in one chamber
+to.  The reinforcement's fibres carry their strain the same way (their tension in
+the matrix is the linearized one: :mod:`softdesign.mechanics.reinforcement`).
+Measured on the sample case's base section at 20 kPa in one chamber
 (17,757 unknowns): 35 factorizations and 103 s before, 9 and 34 s after, the
 curvature equal to 1e-16.  For linear
 tetrahedra (average nodal pressure), the volumetric part couples each node
@@ -151,16 +153,17 @@ def pressure_forces(problem: PressureProblem, positions: FloatArray, cavity_pres
 
 
 def _residual(problem: PressureProblem, u: FloatArray, cavity_pressures: FloatArray, tangent: bool,
-              element_pressure: FloatArray | None = None
+              element_pressure: FloatArray | None = None, fibre_strain: FloatArray | None = None
               ) -> tuple[FloatArray, FloatArray, Tangent | None, QuadraticState | None]:
     """Residual (3V,), the pressure load (3V,), if asked the Newton matrix, and the quadratic state, at ``u`` (V, 3).
 
-    ``element_pressure`` (quadratic elements) is the mixed method's pressure unknown the matrix carries.
+    ``element_pressure`` (quadratic elements) and ``fibre_strain`` (the fibres' points) are the mixed method's
+    unknowns the matrix carries (None: those of ``u``).
     """
     mesh, law, positions = problem.mesh, problem.law, problem.mesh.points + u
     f_extra, K_extra = np.zeros(mesh.dof_count), sp.csr_matrix((mesh.dof_count, mesh.dof_count))
     if problem.fibres is not None:
-        f_fibre, K_fibre = problem.fibres.force_and_tangent_at(u, tangent)
+        f_fibre, K_fibre = problem.fibres.force_and_tangent_at(u, tangent, fibre_strain)
         f_extra, K_extra = f_extra + f_fibre, K_extra if K_fibre is None else K_extra + K_fibre
     if problem.springs is not None:
         f_extra, K_extra = f_extra + problem.springs @ u.ravel(), K_extra + problem.springs
@@ -219,16 +222,17 @@ def _admissible(problem: PressureProblem, u: FloatArray, du: FloatArray) -> Floa
 
 
 def _newton_step(problem: PressureProblem, u: FloatArray, cavity_pressures: FloatArray, settings: NewtonSettings,
-                 solver: TangentSolver) -> tuple[FloatArray, list[float]] | tuple[None, list[float]]:
+                 solver: TangentSolver, fibre_strain: FloatArray | None = None
+                 ) -> tuple[FloatArray, list[float]] | tuple[None, list[float]]:
     """Equilibrium at ``cavity_pressures`` (k,) kPa from ``u``: the new displacement and residual history, or None
-    if it failed."""
+    if it failed.  ``fibre_strain``: the fibres' mixed strain at ``u`` (None: their strain under ``u``)."""
     free = ~problem.fixed
     history: list[float] = []
     u = u.copy()
     pressure: FloatArray | None = None  # the mixed method's element pressures (None: U'(theta) of u)
     for _ in range(settings.max_iterations):
         try:
-            R, f_p, K, state = _residual(problem, u, cavity_pressures, True, pressure)
+            R, f_p, K, state = _residual(problem, u, cavity_pressures, True, pressure, fibre_strain)
         except InvertedElementError:
             return None, history
         norm = float(np.linalg.norm(R[free]))
@@ -244,6 +248,8 @@ def _newton_step(problem: PressureProblem, u: FloatArray, cavity_pressures: Floa
         if state is not None:
             assert isinstance(problem.mesh, QuadraticMesh)
             pressure = linearized_pressure(problem.mesh, problem.law, state, new_u - u)
+        if problem.fibres is not None:
+            fibre_strain = problem.fibres.linearized_strains(u, new_u - u)
         u = new_u
     return None, history
 
@@ -293,8 +299,10 @@ def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: N
     while t < 1.0 - 1e-12:
         target = min(1.0, t + dt)
         cavity_pressures = (1.0 - target) * p0 + target * pressures
-        new_u, history = _newton_step(problem, _predicted(problem, u, t, target, previous, first_rate),
-                                       cavity_pressures, settings, solver)
+        guess = _predicted(problem, u, t, target, previous, first_rate)
+        # the fibres' mixed strain at the guess: the last equilibrium's, carried to the guess to first order
+        strain = None if problem.fibres is None else problem.fibres.linearized_strains(u, guess - u)
+        new_u, history = _newton_step(problem, guess, cavity_pressures, settings, solver, strain)
         if new_u is None:
             if record.cutbacks >= settings.max_cutbacks:
                 last = f"{history[-1]:.3g} mN" if history else "none (an element turned inside out)"

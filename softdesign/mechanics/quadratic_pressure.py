@@ -29,9 +29,9 @@ TRI_POINTS = np.array([[_A1, _A1], [1 - 2 * _A1, _A1], [_A1, 1 - 2 * _A1],
 TRI_WEIGHTS = np.array([_W1, _W1, _W1, _W2, _W2, _W2])
 
 
-def _triangle_shapes() -> tuple[FloatArray, FloatArray, FloatArray]:
-    """N (6 points, 6 nodes), dN/dxi and dN/deta at the rule's points."""
-    xi, eta = TRI_POINTS[:, 0], TRI_POINTS[:, 1]
+def triangle_shapes(points: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The 6-node triangle's N (P points, 6 nodes), dN/dxi and dN/deta at reference ``points`` (P, 2) (xi, eta)."""
+    xi, eta = points[:, 0], points[:, 1]
     L = np.stack([1 - xi - eta, xi, eta], axis=1)
     dL = np.array([[-1.0, 1.0, 0.0], [-1.0, 0.0, 1.0]])  # d L_i / d(xi, eta)
     pairs = [(0, 1), (1, 2), (2, 0)]
@@ -44,7 +44,7 @@ def _triangle_shapes() -> tuple[FloatArray, FloatArray, FloatArray]:
     return N, d[0], d[1]
 
 
-_N, _DXI, _DETA = _triangle_shapes()
+_N, _DXI, _DETA = triangle_shapes(TRI_POINTS)
 
 
 def quadratic_face_dofs(faces: IntArray) -> IntArray:

@@ -15,9 +15,10 @@ from tests.fitting.test_fit_strain import _constant_field
 
 RADIUS_MM, LENGTH_MM = 5.0, 40.0
 SPEC = ActuationSpec(distance_mm=2.5, diameter_mm=2.0, feed_diameter_mm=0.5, end_wall_mm=1.5, first_angle_deg=90.0)
-#: the chamber circles have 8 nodes: an inscribed polygon holds 1 - sin(h)/h = 10 % less than the circle,
-#: the outer one (24 nodes) 1.1 % less; the volume is compared with the polygons' to the swept mesher's accuracy
-VOLUME_RTOL = 1e-3
+#: the chamber circles have 8 nodes and the skin 24, every polygon with its circle's area (an inscribed octagon
+#: would hold 10 % less, the 24-gon 1.1 % less): on a straight body the volume is the designed pi R^2 L less the
+#: chambers' pi r^2 L_c, to rounding
+VOLUME_RTOL = 1e-9
 
 
 def _section(index: int):
@@ -33,18 +34,20 @@ def _section(index: int):
     return section, layout
 
 
-def _polygon_area(radius: float, nodes: int) -> float:
-    return 0.5 * nodes * radius**2 * np.sin(2 * np.pi / nodes)
-
-
 def test_section_volume_frame_and_chambers() -> None:
     section, layout = _section(1)
     mesh = check_section(section)
     chambers = layout.section_chambers(1)
     half = LENGTH_MM / 2
     chamber_length = (chambers[0].l_end - chambers[0].l_start) * LENGTH_MM
-    expected = _polygon_area(RADIUS_MM, 24) * half - 3 * _polygon_area(1.0, 8) * chamber_length
+    radius = 0.5 * SPEC.diameter_mm
+    expected = np.pi * RADIUS_MM**2 * half - 3 * np.pi * radius**2 * chamber_length
     np.testing.assert_allclose(mesh.volumes.sum(), expected, rtol=VOLUME_RTOL)
+    # each chamber's closed cavity (walls and end caps) holds the designed cylinder's volume
+    for k in range(len(chambers)):
+        corners = section.points[section.wall_faces[section.face_chamber == k]]
+        inside = np.einsum("ij,ij->i", corners[:, 0], np.cross(corners[:, 1], corners[:, 2])).sum() / 6
+        np.testing.assert_allclose(inside, np.pi * radius**2 * chamber_length, rtol=VOLUME_RTOL)
     # in the section's base frame: the base at z = 0, the centerline along +z, the tip at the section's length
     np.testing.assert_allclose(section.points[section.base, 2], 0.0, atol=1e-9)
     np.testing.assert_allclose(section.centerline[:, :2], 0.0, atol=1e-9)

@@ -111,3 +111,32 @@ def test_a_tiny_strain_far_from_the_origin_is_computed_to_its_own_precision() ->
     stretch = 1e-9
     e = fibres.strains_at(mesh.points * np.array([stretch, stretch, 0.0]))
     np.testing.assert_allclose(e, stretch + stretch**2 / 2, rtol=1e-6, atol=0)  # the pitch's 1e-13 and round-off
+
+
+def test_the_linearized_strain_is_the_strains_first_order() -> None:
+    # e(u + s) - linearized(u, s) is the strain's second-order term |D s|^2 / 2: it falls as the step's square
+    mesh, fibres = _wall()
+    rng = np.random.default_rng(5)
+    u = 0.02 * rng.standard_normal(mesh.points.shape)
+    step = rng.standard_normal(mesh.points.shape)
+    misses = [np.abs(fibres.strains_at(u + h * step) - fibres.linearized_strains(u, h * step)).max()
+              for h in (1e-2, 1e-3)]
+    assert misses[0] > 0.0
+    assert 80.0 < misses[0] / misses[1] < 120.0  # 100 for a second-order remainder
+
+
+def test_the_mixed_tangent_takes_the_carried_tension_and_the_same_forces() -> None:
+    mesh, fibres = _wall()
+    x = 0.02 * np.random.default_rng(7).standard_normal(mesh.points.shape)
+    own = fibres.strains_at(x)
+    f, K = fibres.force_and_tangent_at(x, want_tangent=True)
+    f_same, K_same = fibres.force_and_tangent_at(x, want_tangent=True, strain=own)
+    f_mixed, K_mixed = fibres.force_and_tangent_at(x, want_tangent=True, strain=own + 1e-3)
+    assert K is not None and K_same is not None and K_mixed is not None
+    np.testing.assert_array_equal(f_same, f)
+    np.testing.assert_array_equal(f_mixed, f)  # the residual is always the displacement's
+    np.testing.assert_allclose(K_same.toarray(), K.toarray(), rtol=0, atol=1e-9)
+    # a tension larger by k 1e-3 on every stretched point adds its geometric part 2 W' I: positive, symmetric
+    extra = (K_mixed - K).toarray()
+    np.testing.assert_allclose(extra, extra.T, atol=1e-9)
+    assert np.trace(extra) > 0.0

@@ -35,7 +35,7 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:
     from softdesign.config import Case
 
-VERSION = 1
+VERSION = 2  # 2: area-matched polygons, the backbone thread embedded in the elements
 SUMMARY = "simulate/device.json"
 
 

@@ -42,7 +42,8 @@ if TYPE_CHECKING:
     from softdesign.pipeline.stages.fit import FitResult
     from softdesign.pipeline.stages.kinematics import KinematicsResult
 
-VERSION = 3  # 2: the section meshes three-fold symmetric; 3: the case's hoop thread (reinforcement) in the model
+VERSION = 4  # 2: the section meshes three-fold symmetric; 3: the case's hoop thread (reinforcement) in the model;
+# 4: the section mesh's polygons (chambers, feeds, skin) have their circles' areas
 SUMMARY = "simulate/summary.json"
 
 
