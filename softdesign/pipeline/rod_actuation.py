@@ -180,6 +180,7 @@ def _single(case: Case, kinematics: KinematicsResult, fit: FitResult, design: De
                                     [min(s["chambers"][0]["diameter_mm"].values()) for s in sections], lost=True,
                                     strand_mm=STRAND_FRACTION * narrowest)
     warnings += _core_notes(summary["cores"])
+    warnings += _end_notes(float(summary["design_pressure_kpa"]), setup.modulus_kpa)
     warnings += [_slant_note(c) for c in summary["channels"]
                  if c["width_mm"] < MIN_CHANNEL_WIDTH_FRACTION * c["diameter_mm"]]
     document = rod_document(case, single.device.body, single.problem.stations.chamber, rod_extra(single))
@@ -197,6 +198,31 @@ def channel_figures(single: SingleDesign) -> list[dict[str, Any]]:
                     "diameter_mm": course.diameter_mm, "length_mm": course.between[1] - course.between[0],
                     "slant_max_rad": slant, "width_mm": course.diameter_mm * float(np.cos(slant))})
     return out
+
+
+#: A cavity in an incompressible neo-Hookean solid grows without bound at this pressure over the shear modulus
+#: (5 / 2: the spherical cavity in an infinite solid); a chamber's end carries no thread.
+END_LIMIT_MU = 2.5
+
+
+def _end_notes(pressure_kpa: float, modulus_kpa: float) -> list[str]:
+    """A warning when P* passes what a chamber's unreinforced end can hold.
+
+    Model: the end is taken as a cavity in an incompressible neo-Hookean solid of shear modulus ``E / 3``, which
+    has no equilibrium above ``END_LIMIT_MU`` mu (an upper bound: a finite body and a cylinder's corner give way
+    sooner).  The whole-device finite elements (``softdesign simulate --all``) of the sample single-supply case
+    stop at 2.2 mu and of the VMTK aorta at 1.8 mu, near those ends.  P* scales with E, so a stiffer silicone does
+    not help: the ends must be reinforced or the design ask less pressure.
+    """
+    mu = modulus_kpa / 3.0
+    if pressure_kpa <= END_LIMIT_MU * mu:
+        return []
+    return [f"P* {pressure_kpa:.1f} kPa is {pressure_kpa / mu:.1f} times the silicone's shear modulus "
+            f"({mu:.1f} kPa): a chamber's end carries no thread, and a cavity in this rubber has no equilibrium "
+            f"past {END_LIMIT_MU:g} times it, so the ends are likely to balloon before P* (a stiffer silicone "
+            "raises P* alike); check with `softdesign simulate CASE --all`, which reports the largest pressure "
+            "it reaches, and reinforce the chambers' ends or ask less curvature per pressure (larger chambers "
+            "further from the axis)"]
 
 
 def _slant_note(channel: dict[str, Any]) -> str:

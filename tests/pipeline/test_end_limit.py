@@ -1,0 +1,27 @@
+"""The single-supply design's warning when P* passes what a chamber's unreinforced end holds
+(:func:`softdesign.pipeline.rod_actuation._end_notes`): a cavity in an incompressible neo-Hookean solid has no
+equilibrium past 5 mu / 2."""
+
+from __future__ import annotations
+
+import pytest
+
+from softdesign.pipeline.rod_actuation import END_LIMIT_MU, _end_notes
+
+#: Ecoflex 00-30's E = 3 mu, mu = 39.4 kPa (the material file's law).
+YOUNG_KPA = 3 * 39.4
+
+
+def test_the_cavity_limit_is_five_halves_of_mu() -> None:
+    assert END_LIMIT_MU == pytest.approx(2.5)
+
+
+def test_a_pressure_the_ends_hold_gives_no_warning() -> None:
+    assert _end_notes(2.4 * 39.4, YOUNG_KPA) == []
+    assert _end_notes(2.5 * 39.4, YOUNG_KPA) == []
+
+
+def test_the_sample_devices_pressure_is_named_with_its_ratio_and_the_check() -> None:
+    (note,) = _end_notes(446.6, YOUNG_KPA)
+    assert "11.3 times the silicone's shear modulus (39.4 kPa)" in note
+    assert "softdesign simulate CASE --all" in note
