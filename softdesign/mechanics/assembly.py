@@ -36,7 +36,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from softdesign.continuum.laws import HyperelasticLaw, isochoric_stress, isochoric_tangent
-from softdesign.mechanics.tets import TetMesh, deformation_gradients, summed
+from softdesign.mechanics.tets import TetMesh, deformation_gradients, node_dofs, summed
 from softdesign.types import FloatArray, IntArray
 
 
@@ -68,7 +68,7 @@ class VolumetricState:
 
 def element_dofs(tets: IntArray) -> IntArray:
     """Global unknowns (E, 12) of each element, node-major: ``3 node + component``."""
-    return (3 * tets[:, :, None] + np.arange(3)[None, None, :]).reshape(len(tets), 12)
+    return node_dofs(tets)
 
 
 def volumetric_state(mesh: TetMesh, law: HyperelasticLaw, displacement: FloatArray) -> VolumetricState:

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from softdesign.mechanics.tets import summed
+from softdesign.mechanics.tets import node_dofs, summed
 from softdesign.types import FloatArray, IntArray
 
 
@@ -33,7 +33,7 @@ def _cross_matrices(v: FloatArray) -> FloatArray:
 
 def face_dofs(faces: IntArray) -> IntArray:
     """Global unknowns (F, 9) of each triangle, node-major."""
-    return (3 * faces[:, :, None] + np.arange(3)[None, None, :]).reshape(len(faces), 9)
+    return node_dofs(faces)
 
 
 def pressure_load(

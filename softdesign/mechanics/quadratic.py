@@ -39,7 +39,7 @@ import scipy.sparse as sp
 
 from softdesign.continuum.laws import HyperelasticLaw, isochoric_stress, isochoric_tangent
 from softdesign.mechanics.assembly import InvertedElementError
-from softdesign.mechanics.tets import TetMesh, summed
+from softdesign.mechanics.tets import TetMesh, node_dofs, summed
 from softdesign.types import FloatArray, IntArray
 
 #: The six edges of a tetrahedron (local corners), in the order of the midpoint nodes 4..9.
@@ -187,7 +187,7 @@ def quadratic_state(mesh: QuadraticMesh, law: HyperelasticLaw, displacement: Flo
 
 def cell_dofs(cells: IntArray) -> IntArray:
     """Global unknowns (E, 30) of each element, node-major."""
-    return (3 * cells[:, :, None] + np.arange(3)[None, None, :]).reshape(len(cells), 30)
+    return node_dofs(cells)
 
 
 def _volume_gradient(mesh: QuadraticMesh, state: QuadraticState) -> FloatArray:

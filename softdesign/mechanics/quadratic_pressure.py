@@ -18,7 +18,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from softdesign.mechanics.pressure import _cross_matrices
-from softdesign.mechanics.tets import summed
+from softdesign.mechanics.tets import node_dofs, summed
 from softdesign.types import FloatArray, IntArray
 
 _A1, _B1 = 0.445948490915965, 0.091576213509771
@@ -49,7 +49,7 @@ _N, _DXI, _DETA = triangle_shapes(TRI_POINTS)
 
 def quadratic_face_dofs(faces: IntArray) -> IntArray:
     """Global unknowns (F, 18) of each 6-node face, node-major."""
-    return (3 * faces[:, :, None] + np.arange(3)[None, None, :]).reshape(len(faces), 18)
+    return node_dofs(faces)
 
 
 def quadratic_pressure_load(positions: FloatArray, faces: IntArray, face_pressure: FloatArray, want_tangent: bool

@@ -98,7 +98,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from softdesign.mechanics.quadratic_pressure import triangle_shapes
-from softdesign.mechanics.tets import summed
+from softdesign.mechanics.tets import node_dofs, summed
 from softdesign.types import FloatArray, IntArray
 
 #: A wall face whose normal is within this angle of the chamber's axis is a cap: no thread on it, rad.
@@ -207,8 +207,8 @@ class FibreMembrane:
         w = self.weights * self.stiffness[:, None]
         first = 0.5 * np.maximum(e, -e_b) * w  # dW/dI4 times the weight
         forces = np.einsum("fq,fqi,fqb->fbi", 2.0 * first, a, self.directions)
-        width = 3 * self.faces.shape[1]  # 18 on 6-node faces; any node count per fibre assembles alike
-        dofs = (3 * self.faces[:, :, None] + np.arange(3)[None, None, :]).reshape(len(self.faces), width)
+        dofs = node_dofs(self.faces)  # 18 on 6-node faces; any node count per fibre assembles alike
+        width = dofs.shape[1]
         n = displacement.size
         f = summed(dofs, forces.reshape(len(self.faces), width), n)
         if not want_tangent:

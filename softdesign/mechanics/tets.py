@@ -43,6 +43,12 @@ class TetMesh:
         return 3 * len(self.points)
 
 
+def node_dofs(nodes: IntArray) -> IntArray:
+    """Global unknowns (K, 3 n) of each row of ``nodes`` (K, n) (an element's, a face's, a fibre's), node-major:
+    ``3 node + component``."""
+    return (3 * nodes[:, :, None] + np.arange(3)[None, None, :]).reshape(len(nodes), 3 * nodes.shape[1])
+
+
 def summed(index: IntArray, values: FloatArray, length: int) -> FloatArray:
     """``out[i] = sum of values[index == i]`` (length,): the scatter-add of an assembly."""
     return np.asarray(np.bincount(index.ravel(), values.ravel(), minlength=length), dtype=np.float64)
