@@ -60,6 +60,9 @@ RIM_SECTORS = 8
 MAX_FLATNESS_FRACTION = 0.05
 #: A plane tilted more than this to the end tangent is a wall facet, not an end, degrees.
 MAX_TILT_DEG = 60.0
+#: A face whose edges' cross product is no longer than this is degenerate, its normal zero (trimesh's
+#: ``util.TOL_ZERO``, 100 float64 resolutions).
+TRIMESH_TOL_ZERO = 1e-13
 #: The rim past the body's square end that the build warns about, mm (a tenth of a 2.5 mm vessel's radius).
 RIM_GAP_TOLERANCE_MM = 0.25
 
@@ -218,12 +221,11 @@ def _flat_regions(vertices: Points, faces: IntArray, edges: EdgeTable, near: np.
 
     Only the regions holding a face of ``near`` (bool per face), in the order of their smallest face id.
     """
-    import trimesh
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
     pairs = edges.face_pairs()
-    pairs = pairs[trimesh.geometry.vector_angle(_face_normals(vertices, faces)[pairs]) < np.radians(FLAT_ANGLE_DEG)]
+    pairs = pairs[_pair_angles(_face_normals(vertices, faces), pairs) < np.radians(FLAT_ANGLE_DEG)]
     count = len(faces)
     graph = coo_matrix((np.ones(len(pairs), np.int8), (pairs[:, 0], pairs[:, 1])), shape=(count, count))
     labels = connected_components(graph, directed=False)[1]  # numbered in the order of their smallest face id
@@ -238,13 +240,42 @@ def _flat_regions(vertices: Points, faces: IntArray, edges: EdgeTable, near: np.
 
 
 def _face_normals(vertices: Points, faces: IntArray) -> FloatArray:
-    """(F, 3) unit normals as trimesh's ``face_normals`` makes them (zero for a degenerate face)."""
-    import trimesh
+    """(3, F) unit normals, x, y and z rows, as trimesh's ``face_normals`` makes them (zero for a degenerate face).
 
-    unit, valid = trimesh.triangles.normals(vertices[faces])
-    normals = np.zeros((len(faces), 3))
-    normals[valid] = unit
+    trimesh's arithmetic on coordinate rows (:func:`~softdesign.meshing.topology.corner_planes`' layout): the
+    cross product of p1 - p0 and p2 - p1 with ``np.cross``'s products in its order, its length from the squares
+    added x + y, then + z, as trimesh's ``np.dot`` with ones adds them, zero below trimesh's ``TOL_ZERO``
+    (1e-13), and the reciprocal length multiplied in: the same numbers, bit for bit
+    (tests/geometry/test_end_planes.py compares them), in about a third of its time on 1M faces, which
+    gathered (F, 3, 3) corners and strode across their coordinates.
+    """
+    from softdesign.meshing.topology import corner_planes
+
+    p0, p1, p2 = corner_planes(vertices, faces)
+    u, v = p1 - p0, p2 - p1
+    normals = np.empty_like(u)
+    for i, (j, k) in enumerate(((1, 2), (2, 0), (0, 1))):
+        np.multiply(u[j], v[k], out=normals[i])
+        normals[i] -= u[k] * v[j]
+    squares = normals * normals
+    length = squares[0] + squares[1]
+    length += squares[2]
+    np.sqrt(length, out=length)
+    valid = length > TRIMESH_TOL_ZERO
+    scale = np.zeros_like(length)
+    np.divide(1.0, length, out=scale, where=valid)
+    normals *= scale
     return normals
+
+
+def _pair_angles(normals: FloatArray, pairs: IntArray) -> FloatArray:
+    """(P,) angle between the unit normals (3, F) of each face pair (P, 2), rad: trimesh's ``vector_angle``
+    (the dot product clipped to [-1, 1], its arccos) on coordinate rows."""
+    a, b = np.take(normals, pairs[:, 0], axis=1), np.take(normals, pairs[:, 1], axis=1)
+    dots = a[0] * b[0]
+    dots += a[1] * b[1]
+    dots += a[2] * b[2]
+    return np.abs(np.arccos(np.clip(dots, -1.0, 1.0, out=dots)))
 
 
 def _region_rim(faces: IntArray, facet: IntArray, n_vertices: int) -> IntArray:

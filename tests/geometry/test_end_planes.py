@@ -173,3 +173,29 @@ def test_the_edge_table_pairs_faces_and_finds_boundary_edges_as_trimesh_does():
     assert {tuple(sorted(p)) for p in table.face_pairs().tolist()} == {tuple(p) for p in mesh.face_adjacency.tolist()}
     once = mesh.edges_sorted[trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1)]
     assert sorted(map(tuple, table.single_edges().tolist())) == sorted(map(tuple, once.tolist()))
+
+
+def test_the_face_normals_and_pair_angles_are_trimeshs_bit_for_bit(aorta_dir):
+    import trimesh
+
+    from softdesign.geometry.edges import EdgeTable
+    from softdesign.geometry.end_planes import _face_normals, _pair_angles
+
+    # the VMTK aorta as read, and a lumpy sphere with a degenerate face, one whose cross product is just above
+    # trimesh's zero (1e-13) and one just below it
+    rng = np.random.default_rng(5)
+    sphere = trimesh.creation.icosphere(subdivisions=4, radius=RADIUS)
+    vertices = np.concatenate([sphere.vertices * rng.uniform(0.9, 1.1, (len(sphere.vertices), 1)),
+                               [[0.0, 0.0, 0.0], [1e-6, 0.0, 0.0], [0.0, 2e-7, 0.0], [0.0, 5e-8, 0.0]]])
+    n = len(sphere.vertices)
+    faces = np.concatenate([sphere.faces, [[0, 1, 0], [n, n + 1, n + 2], [n, n + 1, n + 3]]])
+    for v, f in (read_surface(aorta_dir / "aorta-surface.stl", 1.0), (vertices, faces)):
+        v, f = np.asarray(v, float), np.asarray(f, np.int64)
+        unit, valid = trimesh.triangles.normals(v[f])
+        expected = np.zeros((len(f), 3))
+        expected[valid] = unit
+        normals = _face_normals(v, f)
+        assert np.array_equal(normals.T, expected)
+        pairs = EdgeTable.of(f, len(v)).face_pairs()
+        assert np.array_equal(_pair_angles(normals, pairs), trimesh.geometry.vector_angle(expected[pairs]))
+    assert not valid[-1] and valid[-2] and not valid[-3]  # the test has faces on both sides of the zero
