@@ -20,7 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import MeshError
-from softdesign.geometry.rows import rows_in_first_order
+from softdesign.geometry.rows import rows_all_distinct, rows_in_first_order
 from softdesign.meshing.topology import corner_planes, mesh_topology
 from softdesign.meshing.volume_tolerance import MIN_ANGULAR_COUNT, VOLUME_RTOL
 from softdesign.types import FloatArray
@@ -110,18 +110,30 @@ def written_defects(vertices: npt.ArrayLike, faces: npt.ArrayLike, watertight: b
     faces = np.asarray(faces, np.int64).reshape(-1, 3)
     if not faces.size:
         return 0, 0
-    first, inverse = rows_in_first_order(rounded)  # coincident vertices as one (np.unique's groups, faster)
-    corners = rounded[faces]
-    doubled = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
-    zero = int(np.sum(doubled == 0.0))
-    if watertight and len(first) == len(rounded):  # nothing merged: the edges are the faces' own, each in two
+    zero = _zero_area_faces(rounded, faces)
+    if watertight and rows_all_distinct(rounded):  # nothing merged: the edges are the faces' own, each in two
         return zero, 0
+    first, inverse = rows_in_first_order(rounded)  # coincident vertices as one (np.unique's groups, faster)
     merged = inverse[faces]
     edges = np.sort(np.concatenate([merged[:, [0, 1]], merged[:, [1, 2]], merged[:, [2, 0]]]), axis=1)
     edges = edges[edges[:, 0] != edges[:, 1]]  # a folded face's point-edge is no edge
     keys = np.sort(edges[:, 0] * np.int64(len(rounded)) + edges[:, 1])  # one integer per edge (< V^2 < 2^63)
     runs = np.diff(np.flatnonzero(np.diff(keys, prepend=-1, append=-1)))  # faces sharing each edge
     return zero, int(np.sum(runs > 2))
+
+
+def _zero_area_faces(vertices: FloatArray, faces: npt.NDArray[np.int64]) -> int:
+    """How many faces have a zero cross product (p1 - p0) x (p2 - p0): every square of it zero, which is when its
+    length (``np.linalg.norm``, a sum of the squares) is zero; coordinate rows, ``np.cross``'s products."""
+    p0, p1, p2 = corner_planes(vertices, faces)
+    u, v = p1 - p0, p2 - p0
+    zero = np.ones(faces.shape[0], bool)
+    for j, k in ((1, 2), (2, 0), (0, 1)):
+        component = u[j] * v[k]
+        component -= u[k] * v[j]
+        component *= component
+        zero &= component == 0.0
+    return int(np.count_nonzero(zero))
 
 
 def inspect_mesh(

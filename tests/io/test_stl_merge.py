@@ -65,3 +65,25 @@ def test_written_defects_count_coincident_vertices_as_one():
     faces = np.array([[0, 1, 2], [3, 5, 4], [0, 6, 1]])
     assert written_defects(vertices, faces) == (0, 1)  # edge 0-1 shared by three faces once merged
     assert written_defects(vertices[:3], faces[:1]) == (0, 0)
+
+
+def test_rows_all_distinct_says_what_the_groups_say_and_survives_a_hash_collision(monkeypatch):
+    from softdesign.geometry import rows as module
+    from softdesign.geometry.rows import rows_all_distinct
+
+    rng = np.random.default_rng(6)
+    distinct = rng.permutation(np.array(np.meshgrid(*[np.arange(-6, 6)] * 3)).reshape(3, -1).T).astype(float)
+    cases = {
+        "distinct": (distinct, True),
+        "one repeated": (np.vstack([distinct, distinct[17:18]]), False),
+        "-0.0 against 0.0": (np.array([[0.0, 1.0, 2.0], [-0.0, 1.0, 2.0]]), False),
+        "NaN rows never equal": (np.array([[np.nan, 1.0, 2.0], [np.nan, 1.0, 2.0]]), True),
+        "float32": (distinct.astype(np.float32), True),
+        "one row": (distinct[:1], True),
+    }
+    for name, (rows, expected) in cases.items():
+        assert rows_all_distinct(rows) is expected, name
+        assert (len(rows_in_first_order(rows)[0]) == len(rows)) is expected, name
+    monkeypatch.setattr(module, "_MIXERS", (0, 0, 0, 0))  # every row one hash: settled by the groups
+    for name, (rows, expected) in cases.items():
+        assert rows_all_distinct(rows) is expected, name
