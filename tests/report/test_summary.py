@@ -95,3 +95,23 @@ def test_a_large_vessel_is_clustered_first_then_decimated_within_the_tolerance(m
     assert display_mesh.max_distance_to_mesh(vertices, coarse_v, coarse_f) > 0.2
     _, kept, error = display_mesh.decimated_surface(vertices, faces, target=2000, tolerance_mm=0.2)
     assert len(kept) <= 2000 and error <= 0.2
+
+
+def test_the_largest_display_error_measured_by_bound_is_the_largest_over_every_point():
+    from softdesign.meshing.compare import squared_distances
+
+    # a lumpy sphere's 40962 vertices (over EXACT_POINTS: measured by bound), a few of them pushed off the surface,
+    # against its decimations to a few hundred and a few thousand faces, and against a mesh with a degenerate face
+    rng = np.random.default_rng(8)
+    sphere = trimesh.creation.icosphere(subdivisions=6, radius=10.0)
+    vertices = np.asarray(sphere.vertices) * rng.uniform(0.98, 1.02, (len(sphere.vertices), 1))
+    vertices[rng.choice(len(vertices), 5, replace=False)] *= 1.3
+    faces = np.asarray(sphere.faces)
+    assert len(vertices) > display_mesh.EXACT_POINTS
+    for target in (300, 3000):
+        shown_v, shown_f = display_mesh._quadric_decimation(vertices, faces, target)
+        shown_f = np.concatenate([shown_f, [[0, 0, 1]]])  # a sliver: its bound is a vertex's distance
+        every = float(np.sqrt(squared_distances(vertices, shown_v, shown_f).max()))
+        assert display_mesh.max_distance_to_mesh(vertices, shown_v, shown_f) == every
+        bounds = display_mesh.distance_bounds(vertices, shown_v, shown_f)
+        assert np.all(bounds ** 2 >= squared_distances(vertices, shown_v, shown_f))
