@@ -107,7 +107,8 @@ class EndPlane:
 
 
 def end_planes(
-    vertices: Points, faces: IntArray, ends: Points, tangents: Points, inscribed_mm: FloatArray
+    vertices: Points, faces: IntArray, ends: Points, tangents: Points, inscribed_mm: FloatArray,
+    table: EdgeTable | None = None,
 ) -> tuple[EndPlane | None, EndPlane | None]:
     """The plane at the path's inlet and at its outlet, or None where no flat cap or open loop is found.
 
@@ -117,10 +118,11 @@ def end_planes(
     ends : (2, 3) mm, the path's first and last points (the body's ends)
     tangents : (2, 3) unit tangents of the path at those points, in the path's direction
     inscribed_mm : (2,) inscribed-sphere radius at each end, mm
+    table : the faces' edge table on ``len(vertices)`` vertices, when the caller has it (else made here)
     """
     vertices, faces = np.asarray(vertices, float), np.asarray(faces, np.int64)
     ends, inscribed_mm = np.asarray(ends, float), np.asarray(inscribed_mm, float)
-    edges = EdgeTable.of(faces, len(vertices))
+    edges = table if table is not None and table.n_vertices == len(vertices) else EdgeTable.of(faces, len(vertices))
     rims = [("open_end", loop) for loop in _boundary_loops(edges)]
     # a cap's faces lie within its rim, whose centre is within END_SEARCH_RADII inscribed radii of the end
     reach = (END_SEARCH_RADII + 1.0 / np.cos(np.radians(MAX_TILT_DEG))) * inscribed_mm

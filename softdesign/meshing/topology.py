@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from softdesign.geometry.edges import edge_keys, run_starts
+from softdesign.geometry.edges import EdgeTable, edge_keys, run_starts
 from softdesign.types import FloatArray, IntArray
 
 
@@ -229,11 +229,20 @@ def drop_unused_vertices(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> tuple
     return np.asarray(vertices, float)[used], compact.reshape(-1, 3)
 
 
-def describe_surface(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> SurfaceInfo:
-    """Topology summary of a surface that may be open or non-manifold (vertices (V, 3) mm, faces (F, 3))."""
+def describe_surface(vertices: npt.ArrayLike, faces: npt.ArrayLike, table: EdgeTable | None = None) -> SurfaceInfo:
+    """Topology summary of a surface that may be open or non-manifold (vertices (V, 3) mm, faces (F, 3)).
+
+    ``table``: the faces' :class:`~softdesign.geometry.edges.EdgeTable` on V vertices, when the caller has it
+    (the ingest's end planes use the same one): its groups are :func:`edge_uses`' edges and counts, not sorted again.
+    """
     vertices = np.asarray(vertices, float)
     faces = np.asarray(faces, np.int64)
-    edges, uses = edge_uses(faces, max(len(vertices), int(faces.max(initial=-1)) + 1))
+    count = max(len(vertices), int(faces.max(initial=-1)) + 1)
+    if table is not None and table.n_vertices == count and len(table.keys) == faces.size and faces.size:
+        key = table.keys[table.starts]
+        edges, uses = np.column_stack([key // count, key % count]), table.uses
+    else:
+        edges, uses = edge_uses(faces, count)
     boundary = edges[uses == 1]
     loops = 0
     if len(boundary):

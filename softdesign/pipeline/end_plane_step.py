@@ -15,6 +15,7 @@ import numpy as np
 
 from softdesign.errors import ConfigError, GeometryError
 from softdesign.geometry.curves import smooth_curve_from_polyline
+from softdesign.geometry.edges import EdgeTable
 from softdesign.geometry.end_planes import end_planes
 from softdesign.geometry.inlet import end_radii
 from softdesign.geometry.network import SelectedPath
@@ -27,10 +28,11 @@ if TYPE_CHECKING:  # only annotations: the report loads stage results without th
 
 
 def end_plane_summary(
-    case: Case, path: SelectedPath, vertices: FloatArray, faces: np.ndarray
+    case: Case, path: SelectedPath, vertices: FloatArray, faces: np.ndarray, table: EdgeTable | None = None
 ) -> dict[str, dict[str, Any] | None] | None:
     """Per end ("inlet", "outlet"): the plane found there (``EndPlane.as_dict``) or None; None when not measured.
 
+    ``table``: the surface's edge table, when the caller has it (:func:`~softdesign.geometry.end_planes.end_planes`).
     Not measured: no surface, no inscribed radii, a spacing the runner refuses after ingest, or a path the
     blend stage will refuse (it says why).
     """
@@ -44,5 +46,5 @@ def end_plane_summary(
         return None
     l = np.array([0.0, 1.0])
     inscribed = np.array(end_radii(path.points, path.radius))
-    inlet, outlet = end_planes(vertices, faces, curve.points(l), curve.tangents(l), inscribed)
+    inlet, outlet = end_planes(vertices, faces, curve.points(l), curve.tangents(l), inscribed, table)
     return {"inlet": None if inlet is None else inlet.as_dict(), "outlet": None if outlet is None else outlet.as_dict()}

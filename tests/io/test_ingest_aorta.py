@@ -78,3 +78,20 @@ def test_capped_and_open_surfaces_both_read(aorta_dir):
     assert not opened.capped and opened.boundary_loops == 3  # inlet and two iliac outlets
     as_vtp = describe_surface(*read_surface(aorta_dir / "aorta-surface.vtp"))
     assert as_vtp.capped and as_vtp.faces == 12932
+
+
+def test_the_description_from_the_end_planes_edge_table_is_the_one_sorted_afresh(aorta_dir):
+    import trimesh
+
+    from softdesign.geometry.edges import EdgeTable
+
+    # the open aorta (boundary loops), and an open tube with a face repeated (a non-manifold edge)
+    tube = trimesh.creation.cylinder(radius=3.0, height=4.0, sections=24)
+    side = np.asarray(tube.faces)[np.abs(np.abs(tube.triangles_center[:, 2]) - 2.0) > 1e-9]
+    for vertices, faces in (read_surface(aorta_dir / "aorta-surface-open-ends.stl"),
+                            (np.asarray(tube.vertices), np.concatenate([side, side[:1]]))):
+        table = EdgeTable.of(np.asarray(faces, np.int64), len(vertices))
+        with_table, afresh = describe_surface(vertices, faces, table), describe_surface(vertices, faces)
+        assert with_table.as_dict() == afresh.as_dict()
+        assert afresh.boundary_loops >= 2
+    assert afresh.nonmanifold_edges == 2  # the repeated face's two edges in the wall (its rim edge: two faces now)

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from softdesign.geometry.edges import EdgeTable
 from softdesign.geometry.network import CenterlineNetwork, Orientation, SelectedPath, all_paths, select_path
 from softdesign.geometry.plausibility import check_surface_surrounds, check_vessel_scale
 from softdesign.io.centerline import read_centerline_network
@@ -103,13 +104,13 @@ def run_ingest(case: Case) -> IngestResult:
     notes = list(network.notes) + list(path.notes)
     if extracted is not None:
         notes += [*extracted.notes, continuation_note(extracted, case.units)]
-    vertices, faces, info = _final_surface(case, path, scale)
+    vertices, faces, info, edges = _final_surface(case, path, scale)
     step("surface")
     inlet_rule = path.notes[-1]
     path, backbone = regularized_path(case, path, vertices, others)
     notes += [n for n in path.notes if n not in notes]
     step("backbone")
-    ends = end_plane_summary(case, path, vertices, faces)
+    ends = end_plane_summary(case, path, vertices, faces, edges)
     step("end planes")
     initial_path = None
     if case.initial.kind == "file" and case.initial.centerline is not None:
@@ -152,13 +153,17 @@ def _one_path(file: Path, index: int, scale: float, orientation: Orientation) ->
     return select_path(read_centerline_network(file, scale), index, orientation)
 
 
-def _final_surface(case: Case, path: SelectedPath, scale: float) -> tuple[FloatArray, np.ndarray, SurfaceInfo | None]:
+def _final_surface(case: Case, path: SelectedPath, scale: float
+                   ) -> tuple[FloatArray, np.ndarray, SurfaceInfo | None, EdgeTable | None]:
+    """The final surface (mm), its description and its edge table (one sort of its edges, which the end planes
+    read too)."""
     if case.final.surface is None:
-        return np.zeros((0, 3)), np.zeros((0, 3), np.int64), None
+        return np.zeros((0, 3)), np.zeros((0, 3), np.int64), None, None
     surface_scale = UNIT_SCALE_TO_MM[case.final.surface_units] if case.final.surface_units else scale
     vertices, faces = read_surface(case.final.surface, surface_scale)
     check_surface_surrounds(path.points, path.radius, vertices, str(case.final.surface))
-    return vertices, faces, describe_surface(vertices, faces)
+    edges = EdgeTable.of(np.asarray(faces, np.int64), len(vertices))
+    return vertices, faces, describe_surface(vertices, faces, edges), edges
 
 
 def _summary(case: Case, network: CenterlineNetwork, every: list[SelectedPath], path: SelectedPath,
