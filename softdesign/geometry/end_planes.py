@@ -244,16 +244,15 @@ def _flat_regions(vertices: Points, faces: IntArray, edges: EdgeTable, near: np.
 def _face_normals(vertices: Points, faces: IntArray) -> FloatArray:
     """(3, F) unit normals, x, y and z rows, as trimesh's ``face_normals`` makes them (zero for a degenerate face).
 
-    trimesh's arithmetic on coordinate rows (:func:`~softdesign.meshing.topology.corner_planes`' layout): the
+    trimesh's arithmetic on coordinate rows (each corner's x, y and z as contiguous (F,) rows): the
     cross product of p1 - p0 and p2 - p1 with ``np.cross``'s products in its order, its length from the squares
     added x + y, then + z, as trimesh's ``np.dot`` with ones adds them, zero below trimesh's ``TOL_ZERO``
     (1e-13), and the reciprocal length multiplied in: the same numbers, bit for bit
     (tests/geometry/test_end_planes.py compares them), in about a third of its time on 1M faces, which
     gathered (F, 3, 3) corners and strode across their coordinates.
     """
-    from softdesign.meshing.topology import corner_planes
-
-    p0, p1, p2 = corner_planes(vertices, faces)
+    corners = np.take(np.ascontiguousarray(vertices.T), np.ascontiguousarray(faces.T), axis=1)  # (3, 3, F)
+    p0, p1, p2 = corners[:, 0], corners[:, 1], corners[:, 2]
     u, v = p1 - p0, p2 - p1
     normals = np.empty_like(u)
     for i, (j, k) in enumerate(((1, 2), (2, 0), (0, 1))):
