@@ -189,10 +189,15 @@ def frame_twist_table(curve: FramedCurve) -> tuple[FloatArray, FloatArray]:
 
 
 def _curve_part(curve: FramedCurve, twist, l: FloatArray) -> CurvePart:
-    """c, c', the frames and their l derivative (from c', c'' and the twist table) at l."""
-    frames = curve.frames(l)
+    """c, c', the frames and their l derivative (from c', c'' and the twist table) at l.
+
+    A curve with ``frames_and_derivative`` (:class:`~softdesign.geometry.frames.FramedSpline`) evaluates c' once
+    for its frames' tangents and for c' itself: the same numbers as ``frames`` and ``derivative``.
+    """
+    both = getattr(curve, "frames_and_derivative", None)
+    frames, d1 = both(l) if both is not None else (curve.frames(l), curve.derivative(l, 1))
     normal, binormal, tangent = frames[:, :, 0], frames[:, :, 1], frames[:, :, 2]
-    d1, d2 = curve.derivative(l, 1), curve.derivative(l, 2)
+    d2 = curve.derivative(l, 2)
     speed = np.linalg.norm(d1, axis=1)
     tangent_change = (d2 - np.einsum("ni,ni->n", d2, tangent)[:, None] * tangent) / speed[:, None]
     w = np.interp(l, *twist)[:, None]

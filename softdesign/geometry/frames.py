@@ -204,11 +204,24 @@ class FramedSpline:
             return np.concatenate([self._rmf_frames(l[lo : lo + FRAME_CHUNK]) for lo in range(0, len(l), FRAME_CHUNK)])
         return self._rmf_frames(l)
 
-    def _rmf_frames(self, l: FloatArray) -> Frames:
-        # one double-reflection step from the dense sample at or before l
+    def frames_and_derivative(self, l: npt.ArrayLike) -> tuple[Frames, Points]:
+        """:meth:`frames` and :meth:`derivative` (order 1) at l, c' evaluated once for both (the frames' unit
+        tangents are c' / |c'|): the same numbers as the two calls, one spline evaluation fewer."""
+        l = checked_l(l)
+        d1 = self.curve.derivative(l)
+        if self.mode == "frenet":
+            return frenet_frames(self.curve, l, self.label), d1
+        tangents = d1 / np.linalg.norm(d1, axis=1, keepdims=True)  # SmoothCurve.tangents' operations
+        if len(l) > FRAME_CHUNK:
+            return np.concatenate([self._rmf_frames(l[lo : lo + FRAME_CHUNK], tangents[lo : lo + FRAME_CHUNK])
+                                   for lo in range(0, len(l), FRAME_CHUNK)]), d1
+        return self._rmf_frames(l, tangents), d1
+
+    def _rmf_frames(self, l: FloatArray, tangents: Points | None = None) -> Frames:
+        # one double-reflection step from the dense sample at or before l (``tangents``: the unit tangents at l)
         start = np.clip(np.searchsorted(self.dense_l, l, side="right") - 1, 0, len(self.dense_l) - 2)
         dense_tangents, dense_derivatives = self.dense_jets
-        tangents = self.curve.tangents(l)
+        tangents = self.curve.tangents(l) if tangents is None else tangents
         chords = taylor_sum([d[start] for d in dense_derivatives], l - self.dense_l[start])
         rotations = reflection_rotations_between(chords, dense_tangents[start], tangents)
         return _orthonormal_with_tangent(rotations @ self.dense_frames[start], tangents)

@@ -166,3 +166,13 @@ def test_unknown_mode_and_frenet_on_a_line_in_the_pure_function():
         framed_curve(line, mode="tnb")
     with pytest.raises(GeometryError, match=r"l in \[0.0000, 1.0000\]"):
         frenet_frames(line, np.linspace(0, 1, 5))
+
+
+@pytest.mark.parametrize("mode", ["rmf", "frenet"])
+def test_frames_and_derivative_are_frames_and_derivative_bit_for_bit(helix_curve, mode):
+    from softdesign.geometry.frames import FRAME_CHUNK
+
+    framed = framed_curve(helix_curve, mode)
+    l = np.random.default_rng(9).uniform(0.0, 1.0, FRAME_CHUNK + 1000)  # more than one chunk of frames
+    frames, d1 = framed.frames_and_derivative(l)
+    assert np.array_equal(frames, framed.frames(l)) and np.array_equal(d1, framed.derivative(l, 1))
