@@ -132,6 +132,9 @@ def _merged_as_trimesh_merges(vertices: np.ndarray, faces: np.ndarray, digits: i
 
     referenced = np.zeros(len(vertices), bool)
     referenced[faces] = True
+    if referenced.all():  # every corner is a face's (a binary STL's): the vertices as they are, no gather
+        first, inverse_used = rows_in_first_order((vertices * 10.0**digits).round().astype(np.int64))
+        return vertices[first], inverse_used[faces]
     used = np.flatnonzero(referenced)
     first, inverse_used = rows_in_first_order((vertices[used] * 10.0**digits).round().astype(np.int64))
     inverse = np.zeros(len(vertices), np.int64)
@@ -161,7 +164,9 @@ def _load_stl(path: Path) -> object:
 
 def _refuse_non_finite(path: Path, vertices: np.ndarray) -> None:
     """InputDataError naming how many vertices have a NaN or infinite coordinate (the first one too)."""
-    bad = ~np.all(np.isfinite(vertices), axis=1) if len(vertices) else np.zeros(0, bool)
+    if np.isfinite(vertices).all():  # the common case, without a row-wise pass
+        return
+    bad = ~np.all(np.isfinite(vertices), axis=1)
     if bad.any():
         raise InputDataError(f"{path}: {int(bad.sum())} of its {len(vertices)} vertices have NaN or infinite "
                              f"coordinates (the first: vertex {int(np.argmax(bad))} as stored); expected finite "
