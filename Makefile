@@ -104,11 +104,13 @@ test-fast: bytecode $(CLUSTER_STAMP)
 test-seconds:
 	$(BIN)/python -m tests.helpers.schedule
 
-# `make study`: re-derive the nested-refinement study's recorded finest level
-# (tests/mechanics/refinement_reference.json; about 10 minutes).  `make test` solves the two coarser levels
-# and says to run this when they no longer match the record.
+# `make study`: re-derive the nested-refinement studies' recorded finest levels
+# (tests/mechanics/refinement_reference*.json: bare and with the sample case's hoop thread, about 12 minutes of
+# CPU each); `make study STUDY=thread` re-derives one (STUDY=thread-six: the thread's six-point rule, not read by
+# the tests, much longer).  `make test` solves the two coarser levels and says to run this when they no longer
+# match the record.
 study: $(STAMP)
-	$(BIN)/python pipelines/study.py
+	$(BIN)/python pipelines/study.py $(if $(STUDY),--study $(STUDY))
 
 # `make study-property`: the incremental-build property (tests/pipeline/test_incremental_property.py) with 20 drawn
 # examples beside its written ones (about 2 minutes); `make test` draws 5.

@@ -1,11 +1,13 @@
-"""``make study``: re-derive the recorded nested-refinement study (tests/mechanics/refinement_reference.json).
+"""``make study``: re-derive the recorded nested-refinement studies (tests/mechanics/refinement_reference*.json).
 
-Solves the study's section (tests/helpers/refinement_study.py) at its three levels, the finest about 9 minutes
-on 2 cores, and writes every level's curvature, direction error and mesh size with how and when they were made.
-``make test`` solves levels 0 and 1 afresh, checks them against this file and takes level 2 from it; run this
-after a change to the mesher, the refinement or the solver moves them (the test says so), then commit the file.
+Solves each study's section (tests/helpers/refinement_study.py: bare and with the sample case's hoop thread,
+or, when asked, with that thread under the six-point rule) at its three levels, the finest about 12 minutes of
+CPU each, and writes every level's curvature, direction error, mesh size, Newton iterations and CPU time with how
+and when they were made.  ``make test`` solves levels 0 and 1 afresh, checks them against these files and takes level 2
+from them; run this after a change to the mesher, the refinement, the thread or the solver moves them (the tests
+say so), then commit the files.
 
-Usage: ``python pipelines/study.py [--out FILE]``.
+Usage: ``python pipelines/study.py [--study NAME ...] [--out FILE]`` (``--out`` with one study only).
 """
 
 from __future__ import annotations
@@ -15,39 +17,70 @@ import datetime
 import json
 import platform
 import sys
-import time
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
+
+import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO))  # the tests' helpers: the study is defined once, beside its test
+sys.path.insert(0, str(REPO))  # the tests' helpers: each study is defined once, beside its test
 
-from tests.helpers.refinement_study import LEVELS, REFERENCE, coarse_section, solve_level  # noqa: E402
+from tests.helpers.refinement_study import (  # noqa: E402
+    LEVELS,
+    RECORDED,
+    STUDIES,
+    STUDY_KPA,
+    Study,
+    coarse_section,
+    observed_order,
+    solve_level,
+)
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=REFERENCE, help=f"where to write (default: {REFERENCE})")
-    args = parser.parse_args(argv)
+def run_study(study: Study, out: Path) -> None:
+    """Solve ``study`` at every level, print each, and write its record to ``out`` (whole, or not at all)."""
     coarse = coarse_section()
-    levels = []
+    levels: list[dict[str, Any]] = []
     for level in range(LEVELS):
-        start = time.process_time()
-        row = solve_level(coarse, level)
-        row["cpu_s"] = round(time.process_time() - start, 1)
+        row = solve_level(coarse, level, study)
         levels.append(row)
-        print(f"level {level}: kappa {row['kappa_per_mm']:.6e} 1/mm, direction off by "
-              f"{row['phi_error_rad']:.3e} rad, {row['tets']} tets, {row['cpu_s']} s CPU", flush=True)
+        print(f"{study.name} level {level}: kappa {row['kappa_per_mm']:.6e} 1/mm, direction off by "
+              f"{row['phi_error_rad']:.3e} rad, {row['tets']} tets, {row['iterations']} Newton iterations, "
+              f"{row['cpu_s']} s CPU", flush=True)
+    kappas = np.array([row["kappa_per_mm"] for row in levels])
+    order, extrapolated = observed_order(kappas)
+    print(f"{study.name}: changes {100 * (kappas[1] / kappas[0] - 1):+.2f} %, "
+          f"{100 * (kappas[2] / kappas[1] - 1):+.2f} %; order {order:.2f}; Richardson {extrapolated:.6e} 1/mm")
+    thread = study.thread()
     document = {
         "made_by": "make study (python pipelines/study.py): tests/helpers/refinement_study.py at every level",
         "made_on": datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d"),
         "python": f"{platform.python_implementation()} {platform.python_version()} on {platform.machine()}",
+        "study": study.name,
+        "pressure_kpa": STUDY_KPA,
+        "thread": None if thread is None else {"pitch_mm": thread.pitch_mm, "diameter_mm": thread.diameter_mm,
+                                               "modulus_kpa": thread.modulus_kpa, "rule": study.rule},
         "levels": levels,
     }
-    tmp = args.out.with_suffix(".json.tmp")
+    tmp = out.with_suffix(".json.tmp")
     tmp.write_text(json.dumps(document, indent=2) + "\n", encoding="utf-8")
-    tmp.replace(args.out)
-    print(f"wrote {args.out}")
+    tmp.replace(out)
+    print(f"wrote {out}", flush=True)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--study", action="append", choices=sorted(STUDIES),
+                        help=f"a study to re-derive (repeat for more; default: {', '.join(RECORDED)}: the tests' "
+                             "records)")
+    parser.add_argument("--out", type=Path, help="where to write (one study only; default: its recorded file)")
+    args = parser.parse_args(argv)
+    names = args.study or list(RECORDED)
+    if args.out is not None and len(names) != 1:
+        parser.error(f"--out names one file: give one --study, got {len(names)}")
+    for name in names:
+        run_study(STUDIES[name], args.out or STUDIES[name].reference)
     return 0
 
 

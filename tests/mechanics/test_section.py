@@ -14,7 +14,6 @@ from softdesign.errors import MeshError
 from softdesign.mechanics.inverse import InverseSettings, find_pressures
 from softdesign.mechanics.newton import NewtonSettings
 from softdesign.mechanics.section import SectionMesh, SectionResult, check_section, simulate_section
-from softdesign.types import FloatArray
 from tests.helpers import refinement_study as study
 from tests.helpers.fe_meshes import three_chamber_section
 
@@ -127,13 +126,6 @@ ORDER_BAND = (2.0 / 3.0, 3.0)
 REPRODUCE_RTOL = 1e-6
 
 
-def _observed_order(kappas: FloatArray) -> tuple[float, float]:
-    """Observed order p = log2((k_h - k_h/2) / (k_h/2 - k_h/4)) and the Richardson extrapolation, 1/mm."""
-    first, second = np.diff(kappas)
-    order = float(np.log2(first / second))
-    return order, float(kappas[2] + second / (2.0**order - 1.0))
-
-
 @pytest.mark.slow
 def test_curvature_converges_at_the_expected_order_under_nested_refinement() -> None:
     # Levels 0 and 1 (648 and 5,184 tets, about 15 s) are solved here; level 2 (41,472 tets, 61,188 quadratic
@@ -155,7 +147,7 @@ def test_curvature_converges_at_the_expected_order_under_nested_refinement() -> 
     phi_errors = np.array([fresh[0]["phi_error_rad"], fresh[1]["phi_error_rad"], recorded[2]["phi_error_rad"]])
     first, second = np.diff(kappas)
     assert first * second > 0 and abs(second) < abs(first)
-    order, extrapolated = _observed_order(kappas)
+    order, extrapolated = study.observed_order(kappas)
     assert ORDER_BAND[0] < order < ORDER_BAND[1]
     assert abs(kappas[2] - extrapolated) < abs(kappas[2] - kappas[1])
     assert phi_errors[0] > phi_errors[1] > phi_errors[2]  # the direction converges to the side opposite

@@ -1,0 +1,71 @@
+"""The reinforced section's curvature under nested refinement (issue 42's known answer "with reinforcement,
+curvature changes less than 2 % under one nested refinement"): the studies of tests/helpers/refinement_study.py
+with the sample case's hoop thread, their finest level recorded by ``make study``."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+
+from tests.helpers import refinement_study as study
+
+#: Levels 0 and 1 solved afresh against the recorded ones: Newton stops at a relative residual of 1e-8, so a
+#: re-solve on other BLAS or METIS builds moves the curvature by far less than this, while any change to the mesh,
+#: the refinement, the thread or the solver moves it by more (level 1 differs from level 0 by 3 %).
+REPRODUCE_RTOL = 1e-6
+
+
+def _fresh_and_recorded(which: study.Study) -> tuple[np.ndarray, np.ndarray, list[dict[str, Any]]]:
+    """Curvatures (3,) 1/mm and direction errors (3,) rad of ``which``'s levels 0, 1 (solved here) and 2
+    (recorded), and the record's levels; fails, saying to run ``make study``, when levels 0 and 1 moved."""
+    recorded = study.load_reference(which.reference)["levels"]
+    coarse = study.coarse_section()
+    fresh = [study.solve_level(coarse, level, which) for level in (0, 1)]
+    for mine, theirs in zip(fresh, recorded[:2], strict=True):
+        assert (mine["tets"], mine["linear_nodes"]) == (theirs["tets"], theirs["linear_nodes"]), "run `make study`"
+        np.testing.assert_allclose([mine["kappa_per_mm"], mine["phi_error_rad"]],
+                                   [theirs["kappa_per_mm"], theirs["phi_error_rad"]], rtol=REPRODUCE_RTOL,
+                                   err_msg=f"{which.name}: levels 0 and 1 moved: the recorded level 2 is stale, "
+                                           f"run `make study STUDY={which.name}`")
+    assert recorded[2]["tets"] == 64 * fresh[0]["tets"]  # two red refinements of the same coarse mesh
+    rows = [*fresh, recorded[2]]
+    return (np.array([r["kappa_per_mm"] for r in rows]), np.array([r["phi_error_rad"] for r in rows]), recorded)
+
+
+@pytest.mark.slow
+def test_the_threaded_sections_curvature_falls_under_refinement_with_the_one_point_rule() -> None:
+    # about 25 s.  Recorded (1/mm): 6.00422e-4, 5.81280e-4, 5.62964e-4: -3.19 % and -3.15 % per refinement,
+    # observed order 0.06 (no asymptotic range yet, so no Richardson value is claimed).  Bare, the same section
+    # converges from below (+2.9 %, +1.3 %, order 1.12); with the thread it bends less at every level.  Not the
+    # one-point rule's doing: the six-point rule gives 6.2039e-4 -> 5.9776e-4 (-3.65 %, 43 Newton iterations at
+    # level 1 against 6).  The octagonal chambers' doing (the next test).  So the first refinement of this
+    # default-like mesh (12 nodes round the skin, octagonal chambers, 8.5 mm layers: the simulate command's 3 mm /
+    # 8 mm default gives the same polygons) is not within the issue's 2 %.
+    kappas, phi_errors, _ = _fresh_and_recorded(study.THREADED)
+    changes = kappas[1:] / kappas[:-1] - 1
+    assert np.all(changes < 0)  # stiffer at every refinement (bare: softer)
+    assert phi_errors.max() < np.deg2rad(0.5)  # the bend stays opposite chamber 0 (the helix's twist is small)
+
+
+#: The issue's bound: with reinforcement, one nested refinement changes the curvature by less than this.
+REFINEMENT_RTOL = 0.02
+
+
+@pytest.mark.slow
+def test_with_round_chambers_one_refinement_moves_the_threaded_curvature_by_less_than_two_percent() -> None:
+    # about 60 s of CPU (10,800 and 74,796 unknowns).  The same section, thread and load as the recorded study,
+    # but 32 wall nodes round each chamber (a polygon 0.6 % short of the circle's area; the octagon's 10 %) in
+    # place of 8: measured 7.05754e-4 -> 6.93188e-4 1/mm, -1.78 %.  The change under one refinement falls with the
+    # chamber's polygon (8 nodes -3.19 %, 16 -2.36 %, 32 -1.78 %), grows when the lattice or the layers alone are
+    # finer (2 mm across -4.74 %, 4.25 mm layers -4.06 %, both with octagons), and a near-hoop winding of the same
+    # stiffness (pitch 0.05 mm) gives -3.04 % on octagons: what converges slowly is, most likely, the stiff thread
+    # on a polygon, whose corners it pulls in as a cable (a line load that finer elements resolve ever more
+    # sharply), not the helix, the rule or the element size.  Red refinement keeps the coarse polygon, so only the
+    # coarse mesh's chamber nodes help.
+    coarse = study.coarse_section(study.ROUND_CHAMBER_NODES)
+    rows = [study.solve_level(coarse, level, study.THREADED) for level in (0, 1)]
+    kappas = np.array([r["kappa_per_mm"] for r in rows])
+    assert abs(kappas[1] / kappas[0] - 1) < REFINEMENT_RTOL
+    assert max(r["phi_error_rad"] for r in rows) < np.deg2rad(0.5)
