@@ -64,5 +64,5 @@ def test_a_device_that_stops_short_is_not_feasible_and_says_where() -> None:
     (reason,) = judgement.reasons
     assert reason.startswith("FE: pressure does not reach the shape: the whole device in finite elements finds no "
                              "equilibrium past 85.2 kPa (10.0 % of P* 852.5 kPa), bent to q = 0.1")
-    assert "largest stretch 2.15 in section 5" in reason and "actuation.reinforcement" in reason
+    assert "largest stretch 2.15 in section 5" in reason and "material.min_wall_mm" in reason
     assert describe_device(summary)[0].startswith("q=0.5 (426.2 kPa): stopped at 85.2 kPa (q = 0.1), there against")

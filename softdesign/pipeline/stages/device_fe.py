@@ -130,9 +130,9 @@ def stop_reason(solve: dict[str, Any]) -> str:
     stretch = solve["max_stretch"]
     return (f"FE: pressure does not reach the shape: the whole device in finite elements finds no equilibrium past "
             f"{at}, bent to q = {held['q']:.3g} (the designed chain within {solve['versus_design']['max_mm']:.3g} "
-            f"mm there; largest stretch {stretch['value']:.2f} in section {stretch['section']}); a chamber's end "
-            "balloons before the design pressure: ask less curvature per pressure (a softer or thinner body, "
-            "larger chambers) or reinforce the chambers' ends (actuation.reinforcement)")
+            f"mm there; largest stretch {stretch['value']:.2f} in section {stretch['section']}): the design asks "
+            "more pressure than the body holds (a chamber's end carries no thread); ask less curvature per "
+            "pressure (larger chambers further from the axis, a thinner material.min_wall_mm) and check again")
 
 
 def device_judgement(summary: dict[str, Any] | None) -> Judgement | None:
