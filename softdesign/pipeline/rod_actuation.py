@@ -222,8 +222,8 @@ def _end_notes(pressure_kpa: float, modulus_kpa: float, what: str = "P*") -> lis
             f"({mu:.1f} kPa): a chamber's end carries no thread, and a cavity in this rubber has no equilibrium "
             f"past {END_LIMIT_MU:g} times it, so the ends are likely to balloon before it (a stiffer silicone "
             "raises the pressure alike); check with `softdesign simulate CASE --all`, which reports the largest "
-            "pressure it reaches, and reinforce the chambers' ends or ask less curvature per pressure (larger "
-            "chambers further from the axis)"]
+            "pressure it reaches, and ask less curvature per pressure (larger chambers further from the axis, a "
+            "thinner material.min_wall_mm)"]
 
 
 def table_end_notes(rows: list[dict[str, Any]], modulus_kpa: float | None) -> list[str]:
