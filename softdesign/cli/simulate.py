@@ -143,7 +143,10 @@ def simulate(
             if not whole or pressures is not None or target is not None or write or figure is not None:
                 raise ConfigError("simulate: --q and --pressure go with --all (the whole device), and --all takes "
                                   "neither --pressures, --target, --write nor --figure")
-            run_all(case_file, out, q, pressure, size_mm, layer_mm, timeout, as_json, note)
+            payload = run_all(case_file, out, q, pressure, size_mm, layer_mm, timeout, as_json, note)
+            if payload["reached"] is not None:  # the figures are printed; the solve did not reach its load
+                note(f"simulate --all: {payload['reached']['stopped_because']}")
+                raise typer.Exit(code=1)
             return
         from softdesign.pipeline.simulate_command import run_simulate, write_to_table
         from softdesign.pipeline.simulate_run import SimulateOptions

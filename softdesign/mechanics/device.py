@@ -38,7 +38,7 @@ from softdesign.mechanics.backbone import backbone_fibres
 from softdesign.mechanics.device_ties import Ties, joint_faces, tie_joints
 from softdesign.mechanics.embedded_thread import thread_fibres
 from softdesign.mechanics.linear_solve import TangentSolver
-from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord, solve_pressures
+from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord, SolveStopped, solve_pressures
 from softdesign.mechanics.quadratic import QuadraticMesh, shape_values
 from softdesign.mechanics.reinforcement import HoopThread
 from softdesign.mechanics.section import SectionMesh, locate, section_problem
@@ -269,26 +269,30 @@ class DeviceSolve:
     pressures_kpa: FloatArray  #: (k + m,) the chambers' pressures, then the feeds'
     u: FloatArray  #: (N, 3) mm, every node's displacement
     record: SolveRecord  #: the load steps, their iterations and residuals
+    load_factor: float = 1.0  #: the share of the asked pressures reached (below 1: the solve stopped there)
+    stopped_because: str = ""  #: why it stopped short ("" when it reached the pressures)
 
 
 def solve_device(device: DeviceMesh, law: HyperelasticLaw, pressures: FloatArray, settings: NewtonSettings,
                  thread: HoopThread | None = None, feed_pressures: FloatArray | None = None,
                  on_step: Callable[[float, list[float]], None] | None = None,
-                 backbone: HoopThread | None = None) -> DeviceSolve:
+                 backbone: HoopThread | None = None, keep_stop: bool = False) -> DeviceSolve:
     """The device at chamber ``pressures`` (k,) kPa (feeds at ``feed_pressures`` (m,); None: their chambers').
 
     The pressures grow in load steps (:func:`~softdesign.mechanics.newton.solve_pressures`, ``settings``'
     steps and halvings), not in the cavities' volume (:mod:`~softdesign.mechanics.continuation`): a reinforced
     chamber's volume barely grows with its pressure, and a volume step asked for 8.5 kPa on the demo's device
     landed at 67-176 kPa.  ``on_step`` is told of every converged step (load factor, residuals); ``backbone``:
-    the thread along the axis (``backbone: inextensible``), None: none.
+    the thread along the axis (``backbone: inextensible``), None: none.  ``keep_stop``: a solve that stops short
+    returns its last equilibrium (``load_factor`` below 1, its pressures, ``stopped_because``) instead of
+    raising, so that its figures at the largest load it held can be reported.
 
     Raises
     ------
     MeshError
         A section's named sets are wrong, a centerline sample lies outside the material, or a joint does not meet.
     SolveError
-        A step failed after every halving: the message gives the largest pressures reached.
+        A step failed after every halving (and not ``keep_stop``): the message gives the largest pressures reached.
     """
     pressures = np.asarray(pressures, float)
     if pressures.shape != (device.chamber_count,):
@@ -300,17 +304,14 @@ def solve_device(device: DeviceMesh, law: HyperelasticLaw, pressures: FloatArray
     located = locate_samples(device)
     every = np.concatenate([pressures, feeds])
     settings = replace(settings, atol=max(settings.atol, roundoff_floor_mn(problem)))
-    reached = [0.0]
-
-    def told(t: float, history: list[float]) -> None:
-        reached[0] = t
-        if on_step is not None:
-            on_step(t, history)
-
     try:
-        u, record = solve_pressures(problem, every, settings, solver=TangentSolver(), on_step=told)
-    except SolveError as err:
-        at = ", ".join(f"{reached[0] * p:.4g}" for p in every)
-        raise SolveError(f"the whole device: the solve stopped at {at} kPa (load factor {reached[0]:.4g}, the "
-                         f"largest it reached): {err}") from err
+        u, record = solve_pressures(problem, every, settings, solver=TangentSolver(), on_step=on_step)
+    except SolveStopped as err:
+        at = ", ".join(f"{err.load_factor * p:.4g}" for p in every)
+        message = f"the whole device: the solve stopped at {at} kPa (load factor {err.load_factor:.4g}, the " \
+                  f"largest it reached): {err}"
+        if not keep_stop or err.load_factor <= 0.0:
+            raise SolveError(message) from err
+        return DeviceSolve(device, problem, ties, hoops, located, err.load_factor * every, err.displacement,
+                           err.record, err.load_factor, message)
     return DeviceSolve(device, problem, ties, hoops, located, every, u, record)

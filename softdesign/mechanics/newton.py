@@ -271,6 +271,17 @@ def _predicted(problem: PressureProblem, u: FloatArray, t: float, target: float,
     return guess
 
 
+class SolveStopped(SolveError):
+    """A load step failed after every halving: the message, and the last equilibrium reached (kept for a caller
+    that reports the largest load a device holds: its figures there)."""
+
+    def __init__(self, message: str, displacement: FloatArray, load_factor: float, record: SolveRecord) -> None:
+        super().__init__(message)
+        self.displacement = displacement  #: (V, 3) mm, the last converged step's
+        self.load_factor = load_factor  #: that step's share of the pressures (0: none converged)
+        self.record = record  #: the converged steps
+
+
 def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: NewtonSettings,
                     start: tuple[FloatArray, FloatArray] | None = None, solver: TangentSolver | None = None,
                     start_rate: FloatArray | None = None,
@@ -286,8 +297,9 @@ def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: N
 
     Raises
     ------
-    SolveError
-        A step did not converge after every allowed halving (its index, load factor and last residual).
+    SolveStopped
+        A step did not converge after every allowed halving (its index, load factor and last residual; the last
+        equilibrium reached).
     """
     pressures = np.asarray(pressures, float)
     u, p0 = (np.zeros_like(problem.mesh.points), np.zeros_like(pressures)) if start is None else start
@@ -306,11 +318,11 @@ def solve_pressures(problem: PressureProblem, pressures: FloatArray, settings: N
         if new_u is None:
             if record.cutbacks >= settings.max_cutbacks:
                 last = f"{history[-1]:.3g} mN" if history else "none (an element turned inside out)"
-                raise SolveError(
+                raise SolveStopped(
                     f"the solve did not converge at load step {step + 1} (load factor {target:.4g} towards the "
                     f"pressures {', '.join(f'{p:g}' for p in pressures)} kPa) after {record.cutbacks} step halvings; "
                     f"last residual {last}; lower the pressures (a chamber that balloons past its largest "
-                    "pressure has no equilibrium beyond it) or take more load steps")
+                    "pressure has no equilibrium beyond it) or take more load steps", u, t, record)
             record.cutbacks += 1
             dt = (target - t) / 2.0  # half the step tried (dt may have run past the end)
             continue

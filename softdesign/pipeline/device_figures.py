@@ -117,18 +117,27 @@ def _thread(outcome: Any, extreme: Any, pressures: list[float], top: float | Non
 
 def device_payload(outcome: Any, o: Any, device: Any, material: Any, loads: tuple[float, list[float], float | None],
                    answer: dict[str, Any], times: dict[str, float]) -> dict[str, Any]:
-    """The JSON-ready figures of a whole-device solve (``simulate --all --json``)."""
+    """The JSON-ready figures of a whole-device solve (``simulate --all --json``).
+
+    A solve that stopped short (``answer["load_factor"]`` below 1) is measured at the largest load it held:
+    ``reached`` says where (load factor, q, pressures) and why, and the figures compare the design and the rod
+    model at that q; ``reached`` is None when the asked load was reached.
+    """
     from softdesign.pipeline.simulate_run import quadratic_node_count
 
     q, pressures, top = loads
     figures, record = answer["figures"], answer["record"]
-    line, tip, designed = designed_shape(outcome, q)
-    rod, rod_arcs = _rod(outcome, q, pressures)
+    t = float(answer.get("load_factor", 1.0))
+    held_q, held = t * q, [t * p for p in pressures]  # where the figures are: the asked load, or the largest held
+    line, tip, designed = designed_shape(outcome, held_q)
+    rod, rod_arcs = _rod(outcome, held_q, held)
     sections = [{"section": i + 1, "kappa": a.kappa, "phi": a.phi, "length": a.length, "misfit_max_mm": a.misfit_max_mm,
                  "designed": designed[i], "rod_model": rod_arcs[i]} for i, a in enumerate(figures.arcs)]
     return {
         "supply": outcome.case.actuation.supply, "q": q,
         "pressure_kpa": pressures[0] if top else None, "design_pressure_kpa": top, "pressures_kpa": pressures,
+        "reached": None if t >= 1.0 else {"load_factor": t, "q": held_q, "pressure_kpa": held[0] if top else None,
+                                          "pressures_kpa": held, "stopped_because": answer["stopped_because"]},
         "mesh": {"sections": len(device.parts), "nodes": len(device.whole.points), "tets": len(device.whole.tets),
                  "quadratic_nodes": quadratic_node_count(device.whole), "size_mm": o.size_mm,
                  "layer_mm": o.layer_mm, "angular_count": o.angular_count},
@@ -158,8 +167,15 @@ def device_lines(payload: dict[str, Any]) -> list[str]:
     load = (f"P = {payload['pressure_kpa']:.4g} kPa (q = {payload['q']:.4g} of P* {payload['design_pressure_kpa']:.4g})"
             if payload["design_pressure_kpa"] else f"the rod model's pressures at q = {payload['q']:g}")
     lines = [f"whole device: {m['sections']} sections, {m['quadratic_nodes']} nodes, {m['tets']} tets, "
-             f"{payload['material']['name']}, {load}",
-             versus_line("designed chain", d)]
+             f"{payload['material']['name']}, {load}"]
+    held = payload.get("reached")
+    if held is not None:
+        at = (f"{held['pressure_kpa']:.4g} kPa" if held["pressure_kpa"] is not None
+              else f"{held['load_factor']:.4g} of the pressures")
+        lines.append(f"NOT REACHED: no equilibrium was found past {at} (load factor {held['load_factor']:.4g}, "
+                     f"q = {held['q']:.4g}); the figures below are there, against the design and the rod model at "
+                     "that q")
+    lines.append(versus_line("designed chain", d))
     if r is not None:
         lines.append(versus_line("rod model", r))
     for s in payload["sections"]:

@@ -205,24 +205,36 @@ def channel_figures(single: SingleDesign) -> list[dict[str, Any]]:
 END_LIMIT_MU = 2.5
 
 
-def _end_notes(pressure_kpa: float, modulus_kpa: float) -> list[str]:
-    """A warning when P* passes what a chamber's unreinforced end can hold.
+def _end_notes(pressure_kpa: float, modulus_kpa: float, what: str = "P*") -> list[str]:
+    """A warning when ``what`` (P*, or the per-chamber table's highest pressure) passes what a chamber's end holds.
 
     Model: the end is taken as a cavity in an incompressible neo-Hookean solid of shear modulus ``E / 3``, which
     has no equilibrium above ``END_LIMIT_MU`` mu (an upper bound: a finite body and a cylinder's corner give way
     sooner).  The whole-device finite elements (``softdesign simulate --all``) of the sample single-supply case
-    stop at 2.2 mu and of the VMTK aorta at 1.8 mu, near those ends.  P* scales with E, so a stiffer silicone does
-    not help: the ends must be reinforced or the design ask less pressure.
+    stop at 2.2 mu and of the VMTK aorta at 1.8 mu, with the largest stretches where a chamber's threaded wall
+    meets its end.  The pressure scales with E, so a stiffer silicone does not help: the design must ask less
+    pressure (or the ends be held otherwise).
     """
     mu = modulus_kpa / 3.0
     if pressure_kpa <= END_LIMIT_MU * mu:
         return []
-    return [f"P* {pressure_kpa:.1f} kPa is {pressure_kpa / mu:.1f} times the silicone's shear modulus "
+    return [f"{what} {pressure_kpa:.1f} kPa is {pressure_kpa / mu:.1f} times the silicone's shear modulus "
             f"({mu:.1f} kPa): a chamber's end carries no thread, and a cavity in this rubber has no equilibrium "
-            f"past {END_LIMIT_MU:g} times it, so the ends are likely to balloon before P* (a stiffer silicone "
-            "raises P* alike); check with `softdesign simulate CASE --all`, which reports the largest pressure "
-            "it reaches, and reinforce the chambers' ends or ask less curvature per pressure (larger chambers "
-            "further from the axis)"]
+            f"past {END_LIMIT_MU:g} times it, so the ends are likely to balloon before it (a stiffer silicone "
+            "raises the pressure alike); check with `softdesign simulate CASE --all`, which reports the largest "
+            "pressure it reaches, and ask less curvature per pressure (larger chambers further from the axis, a "
+            "thinner material.min_wall_mm)"]
+
+
+def table_end_notes(rows: list[dict[str, Any]], modulus_kpa: float | None) -> list[str]:
+    """``supply: per_chamber``'s end-limit warning (:func:`_end_notes`) on the table's highest pressure."""
+    pressured = [r for r in rows if r.get("pressure_kpa") is not None]
+    if modulus_kpa is None or not pressured:
+        return []
+    top = max(pressured, key=lambda r: r["pressure_kpa"])
+    return _end_notes(float(top["pressure_kpa"]), modulus_kpa,
+                      f"the table's highest pressure (section {top['section']}, chamber {top['chamber']}, "
+                      f"q = {top['q']:g})")
 
 
 def _slant_note(channel: dict[str, Any]) -> str:

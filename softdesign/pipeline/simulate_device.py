@@ -191,7 +191,8 @@ class _Deadline:
 def solve_device_in_child(device: Any, law: Any, pressures: FloatList, o: DeviceOptions,
                           threads: tuple[Any, Any]) -> Any:
     """The worker (module-level: pickled by name): the solve and its figures
-    (:class:`~softdesign.mechanics.device_measure.DeviceFigures`, the path's record, seconds)."""
+    (:class:`~softdesign.mechanics.device_measure.DeviceFigures`, the path's record, seconds); a solve that stops
+    short gives them at the largest load it held (``load_factor`` below 1, ``stopped_because``)."""
     from softdesign.mechanics.device import solve_device
     from softdesign.mechanics.device_measure import measure_device
     from softdesign.mechanics.newton import NewtonSettings
@@ -201,5 +202,6 @@ def solve_device_in_child(device: Any, law: Any, pressures: FloatList, o: Device
     with o.step_progress or contextlib.nullcontext() as told:
         deadline = _Deadline(DEADLINE_SHARE * o.timeout_s, pressures, told)
         solve = solve_device(device, law, np.asarray(pressures, float), settings, threads[0], on_step=deadline,
-                             backbone=threads[1])
-    return {"figures": measure_device(solve), "record": solve.record, "cpu_s": time.process_time() - start}
+                             backbone=threads[1], keep_stop=True)
+    return {"figures": measure_device(solve), "record": solve.record, "cpu_s": time.process_time() - start,
+            "load_factor": solve.load_factor, "stopped_because": solve.stopped_because}

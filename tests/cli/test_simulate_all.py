@@ -47,3 +47,16 @@ def test_a_mesh_over_the_bound_is_refused_before_the_solve(tmp_path: Path) -> No
                                  "--size-mm", "0.2", "--layer-mm", "0.2"])
     assert result.exit_code == 2, result.output
     assert "MAX_DEVICE_NODES" in result.output and "raise --size-mm or --layer-mm" in result.output
+
+
+def test_a_solve_that_stops_short_prints_its_figures_and_exits_1(monkeypatch: pytest.MonkeyPatch) -> None:
+    # the command's side only (the solve's own stop: tests/mechanics/test_device.py): a payload that did not reach
+    # its load is printed as any other, then the stop is said and the exit code is 1
+    payload = {"reached": {"stopped_because": "the whole device: the solve stopped at 86.9 kPa (load factor 0.1947)"},
+               "leaves_out": ["contact with the vessel wall"]}
+    monkeypatch.setattr("softdesign.pipeline.device_command.run_device", lambda *args: payload)
+    monkeypatch.setattr("softdesign.pipeline.device_figures.device_lines", lambda p: ["NOT REACHED: figures"])
+    result = runner.invoke(app, ["simulate", str(ACTUATOR), "--all", "--q", "1"])
+    assert result.exit_code == 1, result.output
+    assert "NOT REACHED: figures" in result.output
+    assert "simulate --all: the whole device: the solve stopped at 86.9 kPa (load factor 0.1947)" in result.output

@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from softdesign.continuum.laws import HyperelasticLaw
+from softdesign.errors import SolveError
 from softdesign.geometry.blend import blend_shapes
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
 from softdesign.geometry.initial import straight_initial_shape
@@ -110,3 +111,20 @@ def test_one_section_with_a_backbone_agrees_with_the_rod_model() -> None:
     print(f"FE {figures.arcs[0].kappa:.5g}, rod model {expected:.5g} 1/mm")
     assert abs(figures.arcs[0].kappa / expected - 1.0) < ROD_RTOL
     assert figures.backbone is not None and figures.thread is not None
+
+
+@pytest.mark.slow
+def test_a_device_that_stops_keeps_its_last_equilibrium_and_says_where() -> None:
+    # about 20-40 s of CPU.  A bare chamber (no thread) in a 1.5 mm skin balloons near mu (Rivlin's thick tube:
+    # about 0.9-1.3 mu for these radii), far below 5 mu: the solve must stop short and say where.
+    device = straight_device(1)
+    asked = np.array([5.0 * MU])
+    settings = NewtonSettings(load_steps=4, max_cutbacks=6)
+    with pytest.raises(SolveError, match=r"the whole device: the solve stopped at [0-9.]+ kPa \(load factor"):
+        solve_device(device, LAW, asked, settings)
+    held = solve_device(device, LAW, asked, settings, keep_stop=True)
+    assert 0.0 < held.load_factor < 1.0 and held.record.load_factors[-1] == held.load_factor
+    assert held.pressures_kpa[0] == pytest.approx(held.load_factor * asked[0], rel=1e-12)
+    assert f"load factor {held.load_factor:.4g}" in held.stopped_because
+    figures = measure_device(held)  # measured where it stopped: bent away from its chamber, the tip moved
+    assert figures.arcs[0].kappa > 0.0 and np.linalg.norm(figures.tip_frame[:3, 3] - [0, 0, SECTION_MM]) > 0.0

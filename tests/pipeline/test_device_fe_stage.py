@@ -8,15 +8,17 @@ from pathlib import Path
 import pytest
 
 from softdesign.config import load_case
-from softdesign.pipeline.stages.device_fe import device_judgement, fe_line, wanted
+from softdesign.pipeline.stages.device_fe import describe_device, device_judgement, fe_line, wanted
 from tests.helpers.cases import case_from
 from tests.helpers.paths import REPO
 
 
 def _solve(q: float, stress: float, thread: float) -> dict:
-    return {"q": q, "pressure_kpa": 852.5 * q, "versus_design": {"max_mm": 0.42}, "versus_rod_model": {"max_mm": 0.3},
+    return {"q": q, "pressure_kpa": 852.5 * q, "design_pressure_kpa": 852.5, "reached": None,
+            "versus_design": {"max_mm": 0.42, "tip_mm": 0.5, "tip_angle_rad": 0.01},
+            "versus_rod_model": {"max_mm": 0.3, "tip_mm": 0.4, "tip_angle_rad": 0.01},
             "max_stress_kpa": {"value": stress, "section": 2, "tensile_strength_kpa": 1379.0},
-            "max_stretch": {"value": 1.31}, "thread": {"value": 0.2 * thread, "limit_n": 0.2,
+            "max_stretch": {"value": 1.31, "section": 3}, "thread": {"value": 0.2 * thread, "limit_n": 0.2,
                                                        "fraction_of_limit": thread}}
 
 
@@ -49,3 +51,18 @@ def test_no_solves_no_judgement() -> None:
 ])
 def test_it_runs_for_a_single_supply_device_with_simulate_on(changes: dict, expected: bool, tmp_path: Path) -> None:
     assert wanted(load_case(case_from(tmp_path, REPO / "configs" / "actuator.yaml", changes))) is expected
+
+
+def test_a_device_that_stops_short_is_not_feasible_and_says_where() -> None:
+    stopped = {**_solve(0.5, 200.0, 0.004), "max_stretch": {"value": 2.15, "section": 5},
+               "reached": {"load_factor": 0.2, "q": 0.1, "pressure_kpa": 85.25, "pressures_kpa": [85.25],
+                           "stopped_because": "the whole device: the solve stopped at 85.25 kPa"}}
+    summary = {"solves": [stopped]}
+    assert fe_line(summary) is None  # no "within X mm at P*" for a load the device does not reach
+    judgement = device_judgement(summary)
+    assert judgement is not None and not judgement.margins
+    (reason,) = judgement.reasons
+    assert reason.startswith("FE: pressure does not reach the shape: the whole device in finite elements finds no "
+                             "equilibrium past 85.2 kPa (10.0 % of P* 852.5 kPa), bent to q = 0.1")
+    assert "largest stretch 2.15 in section 5" in reason and "material.min_wall_mm" in reason
+    assert describe_device(summary)[0].startswith("q=0.5 (426.2 kPa): stopped at 85.2 kPa (q = 0.1), there against")

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from softdesign.pipeline.rod_actuation import END_LIMIT_MU, _end_notes
+from softdesign.pipeline.rod_actuation import END_LIMIT_MU, _end_notes, table_end_notes
 
 #: Ecoflex 00-30's E = 3 mu, mu = 39.4 kPa (the material file's law).
 YOUNG_KPA = 3 * 39.4
@@ -25,3 +25,12 @@ def test_the_sample_devices_pressure_is_named_with_its_ratio_and_the_check() -> 
     (note,) = _end_notes(446.6, YOUNG_KPA)
     assert "11.3 times the silicone's shear modulus (39.4 kPa)" in note
     assert "softdesign simulate CASE --all" in note
+
+
+def test_the_per_chamber_tables_highest_pressure_is_named_with_its_place() -> None:
+    rows = [{"q": q, "section": 2, "chamber": c, "pressure_kpa": p}
+            for q, c, p in ((0.5, 1, 90.0), (1.0, 1, 180.0), (1.0, 3, 1090.0), (0.0, 2, None))]
+    (note,) = table_end_notes(rows, YOUNG_KPA)
+    assert note.startswith("the table's highest pressure (section 2, chamber 3, q = 1) 1090.0 kPa is 27.7 times")
+    assert table_end_notes(rows[:1], YOUNG_KPA) == []  # 90 kPa: 2.3 mu, under the limit
+    assert table_end_notes(rows, None) == []  # no rod model (no material): no pressures to judge

@@ -44,7 +44,7 @@ from softdesign.pipeline.body_spec import body_spec
 from softdesign.pipeline.bounds import export_workers
 from softdesign.pipeline.item_progress import item_counter
 from softdesign.pipeline.parallel import map_items
-from softdesign.pipeline.rod_actuation import describe_rod, device_line, rod_figures
+from softdesign.pipeline.rod_actuation import describe_rod, device_line, rod_figures, table_end_notes
 from softdesign.pipeline.rod_file import ROD_FILE
 from softdesign.pipeline.rod_free import body_curve_at
 from softdesign.pipeline.simulate_estimates import ESTIMATE_COLUMNS, SimulateResult, estimate_cells
@@ -58,9 +58,10 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:
     from softdesign.config import Case
 
-VERSION = 6  # 2: one reason per cause (a kind of wall, a bound of extension); 3: the simulate stage's pressures;
+VERSION = 7  # 2: one reason per cause (a kind of wall, a bound of extension); 3: the simulate stage's pressures;
 #            4: angles in (-180, 180] degrees; 5: the rod model (supply, pressure_kpa); 6: series channels,
-#            the rod file (actuation/rod.json)
+#            the rod file (actuation/rod.json); 7: the chambers' end-limit warnings (P* and the per-chamber
+#            table's highest pressure)
 SUMMARY = "actuation/summary.json"
 TABLE = "actuation.csv"
 #: The dense q grid's size (q = 0, 0.05, ..., 1).
@@ -353,6 +354,8 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult, simu
     _check_sweep(case, fit, layout)
     rows = rod.rows if rod.rows is not None else _per_chamber_rows(kinematics, layout, grid)
     filled = rod.fill(rows)
+    # per_chamber: the pressures are the table's (single: P*, in rod.warnings)
+    table_warnings = table_end_notes(rows, rod.summary.get("body_modulus_kpa")) if rod.rows is None else []
     _add_estimates(rows, simulated)
     qs = [q for q, _ in grid]
     walls = (rod.walls if rod.walls is not None else ring_walls(layout)) + _skin(kinematics, fit, layout, qs,
@@ -380,7 +383,7 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult, simu
         "material": limits,
         "feasible": None if limits is None else not reasons,
         "reasons": reasons if limits is not None else ["no material: in the case file: figures only, not judged"],
-        "warnings": warnings + rod.warnings,
+        "warnings": warnings + rod.warnings + table_warnings,
         "method": "lengths: Zou et al. on each section's best arc at q (backbone started on the section's base "
                   "frame), or with supply: single the rod model's chamber axis at q P*; pressure_kpa: the rod model "
                   "(softdesign/kinematics/rod.py); extension: the chamber's axis on the body at q over q = 0; walls "

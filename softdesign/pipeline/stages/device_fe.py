@@ -8,15 +8,18 @@ solves):
    every section, its chamber and thread, the backbone thread), its size checked
    against :data:`~softdesign.limits.simulate.MAX_DEVICE_NODES` before any solve;
 2. at every exported q above 0, solves it at ``P = q P*`` in a child process with
-   ``simulate.timeout_s`` (:mod:`softdesign.mechanics.device`); a solve that stops
-   fails the build with the largest load it reached (exit 1);
+   ``simulate.timeout_s`` (:mod:`softdesign.mechanics.device`); a solve that finds no
+   equilibrium past some load keeps its figures at the largest load it held, the
+   larger q are not solved, and the verdict says that pressure does not reach the
+   shape (a reason); a solve past its time fails the build (exit 1);
 3. keeps each solve's figures (:func:`~softdesign.pipeline.device_figures.device_payload`:
    the deformed centerline against the designed chain and the rod model, each
    section's arc, the largest stress, stretch and thread tension) in
    ``simulate/device.json`` and the manifest; the times go to the run log.
 
 The verdict then carries "FE: within X mm at P*" beside the rod model's line; a
-stress over the material's tensile strength or a thread over its limit is a reason.
+stress over the material's tensile strength, a thread over its limit, or a load the
+device does not reach is a reason.
 ``supply: per_chamber`` keeps the simulate stage's per-section pressure search.
 """
 
@@ -35,7 +38,7 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:
     from softdesign.config import Case
 
-VERSION = 2  # 2: area-matched polygons, the backbone thread embedded in the elements
+VERSION = 3  # 2: area-matched polygons, the backbone thread embedded in the elements; 3: a stop is kept, judged
 SUMMARY = "simulate/device.json"
 
 
@@ -95,12 +98,16 @@ def run_device_stage(case: Case, results: dict[str, Any]) -> dict[str, Any] | No
         times.append(f"q = {q:g}: {seconds['solve_s']:.1f} s wall, {answer['cpu_s']:.1f} s CPU")
         del figures["seconds"]  # the same build gives the same bytes: times go to the run log
         solves.append(figures)
+        if figures["reached"] is not None:  # a larger q asks more of a device that already stopped
+            times.append(f"q above {q:g} not solved: the solve at q = {q:g} stopped")
+            break
     return {"solves": solves, "leaves_out": list(LEAVES_OUT), "design_pressure_kpa": top, "times": times}
 
 
 def fe_line(summary: dict[str, Any]) -> str | None:
-    """The verdict's line from the largest exported q's solve: "FE: within X mm at P*" and its limits."""
-    if not summary or not summary["solves"]:
+    """The verdict's line from the largest exported q's solve: "FE: within X mm at P*" and its limits (None when
+    no solve reached its load: :func:`stop_reason` says so)."""
+    if not summary or not summary["solves"] or any(s["reached"] is not None for s in summary["solves"]):
         return None
     top = max(summary["solves"], key=lambda s: s["q"])
     at = "P*" if abs(top["q"] - 1.0) < 1e-12 else f"{top['q']:g} P*"
@@ -115,12 +122,27 @@ def fe_line(summary: dict[str, Any]) -> str | None:
             f"kPa{stress}, stretch {top['max_stretch']['value']:.3f}{share}")
 
 
+def stop_reason(solve: dict[str, Any]) -> str:
+    """The verdict's reason when the whole device found no equilibrium at its q: where it stopped, against P*."""
+    held, top = solve["reached"], solve["design_pressure_kpa"]
+    at = (f"{held['pressure_kpa']:.1f} kPa ({100 * held['pressure_kpa'] / top:.1f} % of P* {top:.1f} kPa)" if top
+          else f"{100 * held['load_factor']:.1f} % of the rod model's pressures at q = {solve['q']:g}")
+    stretch = solve["max_stretch"]
+    return (f"FE: pressure does not reach the shape: the whole device in finite elements finds no equilibrium past "
+            f"{at}, bent to q = {held['q']:.3g} (the designed chain within {solve['versus_design']['max_mm']:.3g} "
+            f"mm there; largest stretch {stretch['value']:.2f} in section {stretch['section']}): the design asks "
+            "more pressure than the body holds (a chamber's end carries no thread); ask less curvature per "
+            "pressure (larger chambers further from the axis, a thinner material.min_wall_mm) and check again")
+
+
 def device_judgement(summary: dict[str, Any] | None) -> Judgement | None:
-    """A margin (:func:`fe_line`), or a reason per limit the FE's figures cross (each names the key to change)."""
-    line = fe_line(summary or {})
-    if line is None or summary is None:
+    """A margin (:func:`fe_line`), or a reason per limit the FE's figures cross (each names the key to change),
+    and one when the device stopped short of its load (:func:`stop_reason`)."""
+    if not summary or not summary["solves"]:
         return None
-    reasons = []
+    stopped = [stop_reason(s) for s in summary["solves"] if s["reached"] is not None]
+    line = fe_line(summary)
+    reasons = list(stopped)
     for solve in summary["solves"]:
         stress, thread = solve["max_stress_kpa"], solve["thread"]
         if stress["tensile_strength_kpa"] and stress["value"] > stress["tensile_strength_kpa"]:
@@ -131,7 +153,7 @@ def device_judgement(summary: dict[str, Any] | None) -> Judgement | None:
             reasons.append(f"FE at q = {solve['q']:g}: hoop thread {thread['value']:.3g} N > its limit "
                            f"{thread['limit_n']:.3g} N; use a finer actuation.reinforcement.pitch_mm or a stronger "
                            "thread")
-    return Judgement(judged=False, reasons=tuple(reasons), margins=() if reasons else (line,))
+    return Judgement(judged=False, reasons=tuple(reasons), margins=() if reasons or line is None else (line,))
 
 
 def write_device(result: dict[str, Any] | None, staging: Staging) -> None:
@@ -152,7 +174,10 @@ def describe_device(result: dict[str, Any] | None) -> list[str]:
         return []
     from softdesign.pipeline.device_figures import versus_line
 
-    return [f"q={s['q']:g} ({s['pressure_kpa']:.1f} kPa): " + versus_line("designed chain", s["versus_design"])
+    return [f"q={s['q']:g} ({s['pressure_kpa']:.1f} kPa): "
+            + ("" if s["reached"] is None else f"stopped at {s['reached']['pressure_kpa']:.1f} kPa (q = "
+               f"{s['reached']['q']:.3g}), there ")
+            + versus_line("designed chain", s["versus_design"])
             + "; " + versus_line("rod model", s["versus_rod_model"]) for s in result["solves"]]
 
 
