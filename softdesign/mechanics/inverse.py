@@ -75,6 +75,9 @@ TRIAL_CUTBACKS = 2
 #: that further trials barely lower.  Near a reachable target Gauss-Newton lowers it by far more per step.
 STALL_FTOL = 1e-2
 STALL_XTOL = 1e-6
+#: Newton iterations a trial's load step may take (the Newton settings' own bound when lower): the converging steps
+#: of the demo's and the aorta's searches took 5-7; a step that has not converged by then is far from it.
+TRIAL_ITERATIONS = 8
 #: Halvings of the linear start towards rest when it has no equilibrium (past what the chambers hold).
 START_HALVINGS = 3
 
@@ -146,9 +149,11 @@ class _Evaluations:
                  settings: InverseSettings, on_trial: TrialListener | None, thread: HoopThread | None):
         self.prepared = prepare_section(section, law, thread)
         self.target, self.tolerance_mm = target, settings.tolerance_mm
-        # one load step from the neighbour's tangent; from rest (no neighbour), the caller's steps
-        self.newton, self.trial_newton = newton, replace(newton, load_steps=1,
-                                                         max_cutbacks=min(newton.max_cutbacks, TRIAL_CUTBACKS))
+        # one load step from the neighbour's tangent; from rest (no neighbour), the caller's steps; either way at
+        # most TRIAL_CUTBACKS halvings (a start beyond what the chambers hold took 84 factorizations with six)
+        self.newton = replace(newton, max_cutbacks=min(newton.max_cutbacks, TRIAL_CUTBACKS),
+                              max_iterations=min(newton.max_iterations, TRIAL_ITERATIONS))
+        self.trial_newton = replace(self.newton, load_steps=1)
         self.time_limit_s, self.on_trial, self.started = settings.time_limit_s, on_trial, time.perf_counter()
         self.trials = 0
         self.states: dict[bytes, tuple[FloatArray, SectionResult]] = {}
