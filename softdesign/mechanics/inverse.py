@@ -13,24 +13,44 @@ Objective
     either counts the same.
 Method
     A bounded trust-region least-squares search (scipy's ``least_squares``, TRF)
-    from ``start`` pressures within [0, max_pressure_kpa], ``x_scale`` the
-    step size ``max_step_kpa``.  Each evaluation solves the section, continuing
-    from the last equilibrium; its Jacobian ``de/dp`` is the equilibrium's exact
-    sensitivity ``du/dp`` (:func:`~softdesign.mechanics.newton.pressure_sensitivity`)
-    carried through the arc fit by central differences along it.  A trial whose
-    solve does not converge (beyond what the chambers hold) counts as a very
-    large error, so the trust region shrinks back (the start's must converge).  At most
-    ``max_iterations`` evaluations; the result keeps the remaining error, says
-    whether it is below ``tolerance_mm``, and gives the Jacobian's singular
-    values: an unreinforced chamber balloons rather than lengthens, so the
-    common pressure moves L little and the pressures are least determined along (1, 1, 1).
+    within [0, max_pressure_kpa], ``x_scale`` the step size ``max_step_kpa``.
+    It starts from ``start_kpa`` in every chamber or, when that is None, from the
+    linear answer: the rest shape's sensitivity (one factorization) gives the
+    bounded linear least-squares pressures (scipy's ``lsq_linear``), so the first
+    trial lies near the answer whenever the section is near linear there.  Its
+    Jacobian ``de/dp`` is the equilibrium's exact sensitivity ``du/dp``
+    (:func:`~softdesign.mechanics.newton.pressure_sensitivity`) carried through
+    the arc fit by central differences along it.  Each trial is one forward
+    solve, continued from the converged equilibrium nearest in pressure whose
+    ``du/dp`` is known and started on that tangent (the predictor
+    ``u + du/dp (p - p_near)``), in one load step (a hyperelastic solid's
+    equilibrium does not depend on the path: the answer is the forward solve's
+    from rest, to Newton's tolerance); a step that fails is halved, at most
+    ``TRIAL_CUTBACKS`` times.  A trial whose solve does not converge (beyond
+    what the chambers hold, or too far from its neighbour) counts as a very
+    large error, so the trust region shrinks back (the start's must converge).
+    At most ``max_iterations`` evaluations; the result keeps the remaining
+    error, says whether it is below ``tolerance_mm``, and gives the Jacobian's
+    singular values: an unreinforced chamber balloons rather than lengthens, so
+    the common pressure moves L little and the pressures are least determined
+    along (1, 1, 1).
+Cost
+    A factorization of the Newton matrix is most of it (about 1.1 s CPU on the
+    per-chamber demo's section 1 at the default mesh, 3.3-5 s of wall time at a
+    load of 8).  Measured there: a solve from rest to 20 kPa in one step takes 5
+    factorizations; continued from it to (22, 2, 0) kPa on the tangent, 3 (4
+    without the tangent: its start overstretches the thread, residual 2e4 mN,
+    yet Newton then converges faster); the Jacobian at an equilibrium, 1.  Before
+    (a start at a tenth of the bound, two load steps of 5-7 iterations a trial,
+    six halvings for a trial without equilibrium): on the VMTK aorta's section 1
+    at q = 1, three trials in 378 s wall (182 s CPU, load 8), one of them 266 s.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -45,6 +65,21 @@ from softdesign.types import FloatArray
 FAILED_TRIAL_MM = 1e6
 #: Central-difference step of the arc fit along the sensitivity, as a share of the section's length, 1.
 ARC_STEP_SHARE = 1e-4
+#: Step halvings a trial's solve may take (the Newton settings' own bound when lower).  A trial past what the
+#: chambers hold has no equilibrium, and each halving tries again with up to ``max_iterations`` factorizations:
+#: with six, one such trial took 266 s on the aorta's section; the search's trust region shrinks back instead.
+TRIAL_CUTBACKS = 2
+#: The search stops, not converged, when an accepted step lowers the squared error by less than this share of it
+#: (scipy's ``ftol``), or moves the pressures by less than ``STALL_XTOL`` of their size: a target the section cannot
+#: reach (beyond what the chambers hold, or shorter than the section: pressure only lengthens it) leaves an error
+#: that further trials barely lower.  Near a reachable target Gauss-Newton lowers it by far more per step.
+STALL_FTOL = 1e-2
+STALL_XTOL = 1e-6
+#: Newton iterations a trial's load step may take (the Newton settings' own bound when lower): the converging steps
+#: of the demo's and the aorta's searches took 5-7; a step that has not converged by then is far from it.
+TRIAL_ITERATIONS = 8
+#: Halvings of the linear start towards rest when it has no equilibrium (past what the chambers hold).
+START_HALVINGS = 3
 
 
 @dataclass(frozen=True)
@@ -52,7 +87,7 @@ class InverseSettings:
     """Bounds and stopping rules of the pressure search (kPa, mm)."""
 
     max_pressure_kpa: float
-    start_kpa: float
+    start_kpa: float | None  #: every chamber's pressure at the start; None: the linear answer (module docstring)
     max_step_kpa: float
     tolerance_mm: float = 1e-4
     max_iterations: int = 12
@@ -108,28 +143,41 @@ TrialListener = Callable[[int, FloatArray, float, float], None]
 
 
 class _Evaluations:
-    """Forward solves by pressures, each continued from the last equilibrium, kept for the Jacobian at that point."""
+    """Forward solves by pressures, each continued from the nearest equilibrium, kept for the Jacobian there."""
 
     def __init__(self, section: SectionMesh, law: HyperelasticLaw, target: FloatArray, newton: NewtonSettings,
                  settings: InverseSettings, on_trial: TrialListener | None, thread: HoopThread | None):
         self.prepared = prepare_section(section, law, thread)
-        self.target, self.newton, self.tolerance_mm = target, newton, settings.tolerance_mm
+        self.target, self.tolerance_mm = target, settings.tolerance_mm
+        # one load step from the neighbour's tangent; from rest (no neighbour), the caller's steps; either way at
+        # most TRIAL_CUTBACKS halvings (a start beyond what the chambers hold took 84 factorizations with six)
+        self.newton = replace(newton, max_cutbacks=min(newton.max_cutbacks, TRIAL_CUTBACKS),
+                              max_iterations=min(newton.max_iterations, TRIAL_ITERATIONS))
+        self.trial_newton = replace(self.newton, load_steps=1)
         self.time_limit_s, self.on_trial, self.started = settings.time_limit_s, on_trial, time.perf_counter()
         self.trials = 0
         self.states: dict[bytes, tuple[FloatArray, SectionResult]] = {}
-        self.last: tuple[FloatArray, FloatArray] | None = None
         self.rates: dict[bytes, FloatArray] = {}  # du/dp (k, V, 3) where the Jacobian was taken
+        self.jacobians: dict[bytes, FloatArray] = {}
         self.solves = 0
         self.failed: list[str] = []
 
+    def _nearest(self, p: FloatArray) -> tuple[tuple[FloatArray, FloatArray], FloatArray] | None:
+        """The converged equilibrium (u, its pressures) nearest ``p`` among those whose du/dp is known, and du/dp."""
+        if not self.rates:
+            return None
+        key = min(self.rates, key=lambda k: float(np.linalg.norm(np.frombuffer(k) - p)))
+        return (self.states[key][0], np.frombuffer(key).copy()), self.rates[key]
+
     def state(self, p: FloatArray) -> tuple[FloatArray, SectionResult]:
-        key = np.asarray(p, float).tobytes()
+        p = np.asarray(p, float)
+        key = p.tobytes()
         if key not in self.states:
-            rate = None if self.last is None else self.rates.get(self.last[1].tobytes())
-            u, record = solve_pressures(self.prepared.problem, p, self.newton, start=self.last,
-                                        solver=self.prepared.solver, start_rate=rate)
+            near = self._nearest(p)
+            start, rate = (None, None) if near is None else near
+            u, record = solve_pressures(self.prepared.problem, p, self.newton if near is None else self.trial_newton,
+                                        start=start, solver=self.prepared.solver, start_rate=rate)
             self.solves += 1
-            self.last = (u, np.array(p, float))
             self.states[key] = (u, measure_section(self.prepared, u, p, record))
         return self.states[key]
 
@@ -141,7 +189,7 @@ class _Evaluations:
         try:
             error = self.error(p)
         except SolveError as err:
-            if self.last is None:
+            if not self.states:
                 raise
             # a trial beyond what the solve reaches: a large error makes the trust region shrink
             self.failed.append(str(err))
@@ -164,13 +212,40 @@ class _Evaluations:
         return np.frombuffer(key).copy()
 
     def jacobian(self, p: FloatArray) -> FloatArray:
-        u, result = self.state(p)
-        prepared = self.prepared
-        du = pressure_sensitivity(prepared.problem, u, p, prepared.solver)
-        self.rates[np.asarray(p, float).tobytes()] = du
-        d_centerline = np.stack([prepared.centerline_motion(d) for d in du])
-        jacobian = _arc_jacobian(result.centerline, prepared.fractions, d_centerline)
-        return np.diag([0.5 * self.target[2], 0.5 * self.target[2], 1.0]) @ jacobian
+        """``de/dp`` (3, k) mm/kPa at the equilibrium of ``p`` (kept: one factorization per point)."""
+        key = np.asarray(p, float).tobytes()
+        if key not in self.jacobians:
+            u, result = self.state(p)
+            prepared = self.prepared
+            du = pressure_sensitivity(prepared.problem, u, p, prepared.solver)
+            self.rates[key] = du
+            d_centerline = np.stack([prepared.centerline_motion(d) for d in du])
+            jacobian = _arc_jacobian(result.centerline, prepared.fractions, d_centerline)
+            self.jacobians[key] = np.diag([0.5 * self.target[2], 0.5 * self.target[2], 1.0]) @ jacobian
+        return self.jacobians[key]
+
+    def linear_start(self, max_pressure_kpa: float) -> FloatArray:
+        """The bounded linear least-squares pressures (k,) kPa from the rest shape: ``min |e0 + J0 p|`` on
+        [0, max_pressure_kpa], with ``J0`` the sensitivity at rest (its du/dp then predicts the first trial)."""
+        from scipy.optimize import lsq_linear
+
+        rest = np.zeros(self.prepared.section.chamber_count)
+        found = lsq_linear(self.jacobian(rest), -self.error(rest), bounds=(0.0, max_pressure_kpa))
+        return np.asarray(found.x, float)
+
+
+def _converged_start(runs: _Evaluations, linear: FloatArray) -> FloatArray:
+    """The linear answer, or its half, quarter, ... (at most ``START_HALVINGS`` times) when the section has no
+    equilibrium there: the search starts from a converged trial (SolveError when none converges)."""
+    for _ in range(START_HALVINGS):
+        try:
+            runs.state(linear)
+            return linear
+        except SolveError as err:
+            runs.failed.append(str(err))
+            linear = 0.5 * linear
+    runs.state(linear)
+    return linear
 
 
 def _reach(runs: _Evaluations, kappa: float, converged: bool) -> str:
@@ -199,10 +274,11 @@ def find_pressures(section: SectionMesh, law: HyperelasticLaw, target: tuple[flo
     from scipy.optimize import least_squares
 
     runs = _Evaluations(section, law, arc_vector(*target), newton, settings, on_trial, thread)
-    start = np.full(section.chamber_count, settings.start_kpa)
+    start = (_converged_start(runs, runs.linear_start(settings.max_pressure_kpa)) if settings.start_kpa is None
+             else np.full(section.chamber_count, settings.start_kpa))
     try:
         found = least_squares(runs.error_or_stop, start, jac=runs.jacobian, bounds=(0.0, settings.max_pressure_kpa),
-                              method="trf", x_scale=settings.max_step_kpa, xtol=1e-10, ftol=1e-12, gtol=1e-12,
+                              method="trf", x_scale=settings.max_step_kpa, xtol=STALL_XTOL, ftol=STALL_FTOL, gtol=1e-12,
                               max_nfev=settings.max_iterations)
         p, message = np.asarray(found.x, float), str(found.message)
     except _Reached as reached:
