@@ -206,6 +206,7 @@ def test_stages_rerun_on_cached_results_give_a_fresh_builds_bytes(demo_case, tmp
     assert again == listed
 
 
+@pytest.mark.slow
 def test_manifest_records_inputs_case_metrics_and_outputs(demo_case, tmp_path):
     out = tmp_path / "build"
     build(demo_case, out)
