@@ -9,6 +9,7 @@ and closes each step.
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +35,7 @@ from softdesign.meshing.checks import inspect_mesh
 from softdesign.meshing.compare import compare_meshes
 from softdesign.meshing.tessellate import Region
 from tests.helpers.paths import REPO
+from tests.helpers.shared_builds import demo_build_copy
 
 app = typer.Typer(add_completion=False)
 app.command()(pose)
@@ -231,12 +233,15 @@ def test_crossing_steps_stay_one_watertight_body(chain, offset_mm):
 # --- the sample case ----------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def demo(tmp_path_factory):
-    out = tmp_path_factory.mktemp("pose") / "build"
-    result = runner.invoke(app, ["build", str(DEMO), "--out", str(out)])
-    assert result.exit_code == 0, result.output
+    """The sample case's build: a copy of the README's demo build (made once per run for every file that reads it,
+    tests/helpers/shared_builds.py; the pose tests write into their build folder), loaded.  Its case file lies in
+    the shared workspace's configs/, as configs/demo.yaml does in the checkout, so every stage is reused as built."""
+    out = demo_build_copy(tmp_path_factory, tmp_path_factory.mktemp("pose") / "build")
     from softdesign.pipeline.api import build_through
 
-    return build_through(DEMO, out)
+    outcome = build_through(DEMO, out)
+    assert all(run.status == "skipped" for run in outcome.runs), [(r.name, r.status) for r in outcome.runs]
+    return outcome
 
 
 def _run_pose(demo, q: str, output: Path, *extra: str):
@@ -366,9 +371,19 @@ def hollow_case(tmp_path_factory) -> Path:
     return path
 
 
+@pytest.fixture(scope="module")
+def hollow_build(hollow_case, tmp_path_factory) -> Path:
+    """``hollow_case`` built once for the two tests that pose it: each poses a copy (pose builds, cached, into the
+    folder it is given, so the copy's stages are all reused and only the pose is made)."""
+    out = tmp_path_factory.mktemp("hollow-build") / "build"
+    result = runner.invoke(app, ["build", str(hollow_case), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    return out
+
+
 @pytest.mark.slow
-def test_hollow_pose_with_equal_q_is_the_builds_hollow_mesh(hollow_case, tmp_path):
-    out = tmp_path / "build"
+def test_hollow_pose_with_equal_q_is_the_builds_hollow_mesh(hollow_case, hollow_build, tmp_path):
+    out = shutil.copytree(hollow_build, tmp_path / "build")
     args = ["pose", str(hollow_case), "--q", "1", "--output", str(tmp_path / "p.stl"), "--out", str(out)]
     result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
@@ -381,8 +396,8 @@ def test_hollow_pose_with_equal_q_is_the_builds_hollow_mesh(hollow_case, tmp_pat
 
 
 @pytest.mark.slow
-def test_hollow_pose_with_mixed_q_is_one_ported_body_with_its_walls_reported(hollow_case, tmp_path):
-    out = tmp_path / "build"
+def test_hollow_pose_with_mixed_q_is_one_ported_body_with_its_walls_reported(hollow_case, hollow_build, tmp_path):
+    out = shutil.copytree(hollow_build, tmp_path / "build")
     args = [
         "pose", str(hollow_case), "--q", "0,1,0,1", "--output", str(tmp_path / "p.ply"), "--out", str(out), "--json"
     ]
