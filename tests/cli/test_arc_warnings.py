@@ -13,6 +13,7 @@ import json
 import re
 
 import numpy as np
+import pytest
 from typer.testing import CliRunner
 
 from softdesign.cli import app
@@ -47,6 +48,7 @@ def test_the_demo_build_names_every_link_one_arc_misses_and_its_figure(tmp_path)
     assert "q = 1 its centerline" not in result.stdout
 
 
+@pytest.mark.slow
 def test_the_designed_demo_builds_without_a_warning_and_with_the_designs_figures(tmp_path):
     output = tmp_path / "designed.yaml"
     design = runner.invoke(app, ["design", str(DEMO), "--tolerance-mm", str(ARC_TOLERANCE_MM), "--out",

@@ -15,6 +15,7 @@ from softdesign.cli import app
 from softdesign.config import load_case
 from softdesign.kinematics import pcc
 from tests.helpers.paths import REPO
+from tests.helpers.shared_builds import DEMO_BUILD, DESIGN_DEMO, DESIGNED_BUILD, run_once, workspace
 
 runner = CliRunner()
 DEMO = REPO / "configs" / "demo.yaml"
@@ -36,6 +37,7 @@ def design_json(case: Path, build: Path, output: Path, *args: str) -> tuple[int,
     return result.exit_code, json.loads(result.stdout) if result.stdout.strip() else {}, result.stderr
 
 
+@pytest.mark.slow
 def test_demo_design_meets_the_tolerance_and_its_case_file_differs_only_in_the_links(tmp_path):
     build, output = tmp_path / "build", tmp_path / "designed.yaml"
     code, doc, err = design_json(DEMO, build, output, "--tolerance-mm", "1", "--d", "3")
@@ -66,6 +68,7 @@ def test_demo_design_meets_the_tolerance_and_its_case_file_differs_only_in_the_l
     assert written["breaks"] == doc["breaks"]
 
 
+@pytest.mark.slow
 def test_demo_counts_never_fall_as_the_tolerance_tightens(tmp_path):
     counts = []
     for tolerance in ("2", "1", "0.5"):
@@ -145,17 +148,25 @@ def test_aorta_design_keeps_every_link_within_the_tolerance(tmp_path, aorta_dir)
 
 
 @pytest.mark.slow
-def test_the_designed_demo_case_builds(tmp_path):
-    output = tmp_path / "designed.yaml"
-    code, doc, err = design_json(DEMO, tmp_path / "build", output, "--tolerance-mm", "1")
-    assert code == 0, err
-    result = runner.invoke(app, ["build", str(output), "--out", str(tmp_path / "built")])
-    assert result.exit_code == 0, result.output
-    manifest = json.loads((tmp_path / "built" / "manifest.json").read_text())
-    assert manifest["metrics"]["links"]["breaks"] == doc["breaks"]
+def test_the_designed_demo_case_builds(tmp_path_factory):
+    # the README's design at 1 mm and the build of the case file it writes, run once for the whole test run in the
+    # shared workspace (tests/helpers/shared_builds.py; tests/cli/test_readme.py and tests/e2e/test_one_story.py
+    # read the same runs): the build's links are the design's breaks, and its meshes are watertight.  Asked for in
+    # the README's order: its first command (`make demo`'s build) makes the build/ folder the design writes into
+    for args in (DEMO_BUILD, DESIGN_DEMO, DESIGNED_BUILD):
+        done = run_once(tmp_path_factory, *args)
+        assert done.returncode == 0, f"softdesign {' '.join(args)}:\n{done.stderr[-3000:]}"
+    folder = workspace(tmp_path_factory)
+    designed = load_case(folder / DESIGN_DEMO[DESIGN_DEMO.index("--output") + 1])
+    built = folder / DESIGNED_BUILD[DESIGNED_BUILD.index("--out") + 1]
+    design = json.loads((built / "design" / "summary.json").read_text())  # what `design --json` prints
+    manifest = json.loads((built / "manifest.json").read_text())
+    assert designed.blend == "pcc" and manifest["metrics"]["links"]["breaks"] == design["breaks"]
+    np.testing.assert_allclose(design["breaks"], designed.links.breaks, rtol=0, atol=BREAKS_TOL)
     assert all(o["watertight"] for o in manifest["outputs"] if o["path"].startswith("meshes/"))
 
 
+@pytest.mark.slow
 def test_frenet_frames_give_the_same_design_as_rmf(tmp_path):
     # a PCC chain continues without twist: the design measures phi in rmf frames whatever frames: says
     case = yaml.safe_load(DEMO.read_text())

@@ -60,6 +60,7 @@ def test_the_figure_draws_a_payload(tmp_path) -> None:
     assert png.startswith(b"\x89PNG") and png == simulate_figure_png(payload)  # same figures, same bytes
 
 
+@pytest.mark.slow
 def test_feed_pressures_must_be_one_per_feed_crossing_the_section(tmp_path) -> None:
     """Refused (exit 2) before the mesh and the solve: the per-chamber demo's base section is crossed by the feeds
     of its three distal sections' chambers."""

@@ -33,13 +33,29 @@ def aorta_case(folder, aorta_dir, surface: str, **export) -> tuple:
     return json.loads((out / "manifest.json").read_text()), result.output
 
 
+@pytest.fixture(scope="module")
+def aorta_builds(tmp_path_factory, aorta_dir):
+    """:func:`aorta_case` with each (surface, export) built once for the file: the plain aorta-surface.stl build is
+    read by both tests (its fit targets; the solid the offset and hollow variants are compared with)."""
+    folder = tmp_path_factory.mktemp("aorta")
+    built: dict[tuple, tuple] = {}
+
+    def build(surface: str, **export) -> tuple:
+        key = (surface, tuple(sorted(export.items())))
+        if key not in built:
+            built[key] = aorta_case(folder, aorta_dir, surface, **export)
+        return built[key]
+
+    return build
+
+
 def meshes(manifest: dict) -> list[dict]:
     return [o for o in manifest["outputs"] if o["path"].startswith("meshes/")]
 
 
 @pytest.mark.parametrize("surface", ["aorta-surface.stl", "aorta-surface-open-ends.stl"])
-def test_aorta_builds_end_to_end_within_the_fit_targets(tmp_path, aorta_dir, surface):
-    manifest, output = aorta_case(tmp_path, aorta_dir, surface)
+def test_aorta_builds_end_to_end_within_the_fit_targets(aorta_builds, surface):
+    manifest, output = aorta_builds(surface)
     fit = manifest["metrics"]["fit"]
     # issue 4's targets on path 0 with default settings
     assert fit["rms_mm"] <= 0.05 and fit["p99_mm"] <= 0.15 and fit["holdout_rms_mm"] <= 0.06
@@ -58,12 +74,12 @@ def test_aorta_builds_end_to_end_within_the_fit_targets(tmp_path, aorta_dir, sur
     assert abs(volumes[0] - volumes[2]) / volumes[2] < 0.02
 
 
-def test_aorta_offset_and_hollow_variants_are_valid_solids(tmp_path, aorta_dir):
-    shrunk, _ = aorta_case(tmp_path, aorta_dir, "aorta-surface.stl", offset_mm=-0.5)
-    solid, _ = aorta_case(tmp_path, aorta_dir, "aorta-surface.stl")
+def test_aorta_offset_and_hollow_variants_are_valid_solids(aorta_builds):
+    shrunk, _ = aorta_builds("aorta-surface.stl", offset_mm=-0.5)
+    solid, _ = aorta_builds("aorta-surface.stl")
     for small, full in zip(meshes(shrunk), meshes(solid), strict=True):
         assert small["watertight"] and small["volume_mm3"] < full["volume_mm3"]
-    hollow, _ = aorta_case(tmp_path, aorta_dir, "aorta-surface.stl", wall_mm=0.8, port_mm=2.0)
+    hollow, _ = aorta_builds("aorta-surface.stl", wall_mm=0.8, port_mm=2.0)
     export = hollow["metrics"]["export"]
     assert export["spec"] == {"offset_mm": 0.0, "wall_mm": 0.8, "port_mm": 2.0}
     for ported, full in zip(meshes(hollow), meshes(solid), strict=True):

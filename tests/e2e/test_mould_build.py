@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import shutil
 from pathlib import Path
 
 import pytest
@@ -74,10 +75,19 @@ def test_mould_keys_are_bounded(tmp_path, mould, message):
     assert result.exit_code == 2 and message in result.output, result.output
 
 
+@pytest.fixture(scope="module")
+def hollow_mould(tmp_path_factory) -> tuple[str, Path]:
+    """`softdesign mould` on the demo built hollow (1 mm wall, 1.5 mm port, 8 mm margin), run once for the two tests
+    that read it: its terminal output and its build folder (only read; a test that writes into it copies it)."""
+    folder = tmp_path_factory.mktemp("hollow-mould")
+    out = folder / "build"
+    text = run("mould", str(demo_case(folder, wall_mm=1.0, port_mm=1.5, mould={"margin_mm": 8})), "--out", str(out))
+    return text, out
+
+
 @pytest.mark.slow
-def test_demo_hollow_mould_is_written_listed_and_checked(tmp_path):
-    out = tmp_path / "build"
-    text = run("mould", str(demo_case(tmp_path, wall_mm=1.0, port_mm=1.5, mould={"margin_mm": 8})), "--out", str(out))
+def test_demo_hollow_mould_is_written_listed_and_checked(hollow_mould, tmp_path):
+    text, out = hollow_mould
     assert "[mould] ran" in text and "core: removable" in text
     manifest = json.loads((out / "manifest.json").read_text())
     listed = {o["path"]: o for o in manifest["outputs"] if o["path"].startswith("meshes/mould/")}
@@ -95,7 +105,9 @@ def test_demo_hollow_mould_is_written_listed_and_checked(tmp_path):
     assert block["core"]["process"] == "removable"
     png = mould_figure_png(out)
     assert png is not None and png.startswith(b"\x89PNG") and png == mould_figure_png(out)  # same bytes each time
-    # the report's fabrication section shows it, with the parts' checks in its caption
+    # the report's fabrication section shows it, with the parts' checks in its caption (in a copy: the report is
+    # written into the build folder, which the next test reads as the mould command left it)
+    out = shutil.copytree(out, tmp_path / "build")
     report = write_report(out)
     page = report.page.read_text()
     assert 'id="fabrication"' in page and 'src="mould.png"' in page and "core: removable" in page.lower()
@@ -128,12 +140,11 @@ def test_a_mould_changes_only_the_cuts_it_must_and_adds_its_parts(tmp_path):
 
 
 @pytest.mark.slow
-def test_demo_hollow_mould_casts_the_cut_body(tmp_path):
+def test_demo_hollow_mould_casts_the_cut_body(hollow_mould):
     # the default fit.end_cut (auto) cuts the demo's tilted caps: the mould is built around that cut body, its
     # checks pass, the cast equals the export's q = 0 volume expected from the surface integral plus the cuts'
     # wedges, and no mould part enters the exported q = 0 solid (a square-ended body would: ~1.6 mm3 per part)
-    out = tmp_path / "build"
-    run("mould", str(demo_case(tmp_path, wall_mm=1.0, port_mm=1.5, mould={"margin_mm": 8})), "--out", str(out))
+    _, out = hollow_mould
     cuts = json.loads((out / "fit" / "summary.json").read_text())["end_cut"]
     assert all(c["applied"] for c in cuts.values())
     block = json.loads((out / "manifest.json").read_text())["metrics"]["mould"]

@@ -26,7 +26,15 @@ from softdesign.cli import app
 from softdesign.report.writer import PAGE, REPORT_DIR
 from tests.helpers.paths import AORTA_DIR
 from tests.helpers.robust_vessels import write_tilted_cap_vessel
-from tests.helpers.shared_builds import ACTUATOR_BUILD, DEMO_BUILD, PER_CHAMBER_BUILD, run_once, workspace
+from tests.helpers.shared_builds import (
+    ACTUATOR_BUILD,
+    DEMO_BUILD,
+    DESIGN_DEMO,
+    DESIGNED_BUILD,
+    PER_CHAMBER_BUILD,
+    run_once,
+    workspace,
+)
 from tests.test_user_strings import INTERNAL
 
 pytestmark = pytest.mark.slow
@@ -41,10 +49,7 @@ CASES = ("demo", "designed", "actuator", "per_chamber", "aorta", "ica_tilted")
 #: writes in the shared workspace.
 README_BUILDS: dict[str, tuple[tuple[tuple[str, ...], ...], str]] = {
     "demo": ((DEMO_BUILD,), "build/demo"),
-    "designed": ((("design", "configs/demo.yaml", "--tolerance-mm", "1", "--output", "build/demo-designed.yaml",
-                   "--out", "build/demo-designed"),
-                  ("build", "build/demo-designed.yaml", "--out", "build/demo-designed", "--report")),
-                 "build/demo-designed"),
+    "designed": ((DESIGN_DEMO, DESIGNED_BUILD), "build/demo-designed"),
     "actuator": ((ACTUATOR_BUILD,), "build/actuator"),
     "per_chamber": ((PER_CHAMBER_BUILD,), "build/per-chamber"),
 }

@@ -26,9 +26,8 @@ from softdesign.pipeline.api import build_through
 from softdesign.report.interactive import DIV_ID, FRAMES
 from softdesign.report.interactive_parts import CHAMBER_NAME, MOULD_PREFIX
 from softdesign.report.writer import PAGE, REPORT_DIR, ReportOptions, write_report
-from tests.helpers.parts_cases import hollow_tube_case
 from tests.helpers.paths import REPO
-from tests.helpers.shared_builds import demo_build
+from tests.helpers.shared_builds import demo_build, hollow_tube_build
 
 pytestmark = pytest.mark.slow
 
@@ -127,7 +126,7 @@ def session(tmp_path_factory):
         record["q0"] = capture(page, "demo_q0")
         record["names"] = trace_names(page)
         record["play"] = play_then_pause(browser, (report_dir / PAGE).as_uri())
-        record["hollow"] = hollow_page(page, tmp_path_factory.mktemp("browser-hollow"))
+        record["hollow"] = hollow_page(page, tmp_path_factory.mktemp("browser-hollow"), tmp_path_factory)
         browser.close()
     return record
 
@@ -169,10 +168,10 @@ def play_then_pause(browser, url: str) -> dict[str, object]:
     return {"before": before, "paused": paused, "later": later, "frames": frames, "messages": messages}
 
 
-def hollow_page(page, folder: Path) -> dict[str, object]:
-    """The page of a hollow tube with a mould: its traces, then with the chamber's legend entry clicked."""
-    build_dir = folder / "build"
-    build_through(hollow_tube_case(folder), build_dir)
+def hollow_page(page, folder: Path, factory: pytest.TempPathFactory) -> dict[str, object]:
+    """The page of a hollow tube with a mould: its traces, then with the chamber's legend entry clicked.  The build
+    is a copy of the run's shared one (tests/helpers/shared_builds.py), the report written into the copy."""
+    build_dir = shutil.copytree(hollow_tube_build(factory), folder / "build")
     write_report(build_dir, ReportOptions(gif_frames=3))
     page.goto((build_dir / REPORT_DIR / PAGE).resolve().as_uri())
     page.wait_for_function(f"document.getElementById('{DIV_ID}')?._fullLayout?.sliders !== undefined",

@@ -18,12 +18,12 @@ from pathlib import Path
 import pytest
 
 from softdesign.cohort import existing_inputs
-from tests.e2e.test_cohort import make, needs_make, temporary_cohort
+from tests.e2e.test_cohort import needs_make, temporary_cohort
 from tests.helpers.paths import REPO
+from tests.helpers.sample_cohort import SAMPLE_CASES, sample_cohort
 
 SNAKEFILE = REPO / "pipelines" / "Snakefile"
 SLURM_PROFILE = REPO / "profiles" / "slurm"
-SAMPLE_CASES = tuple(sorted(p.stem for p in (REPO / "configs" / "cohort").glob("*.yaml")))
 #: Summary columns that differ between two runs of the same builds (wall time, where the log is).
 RUN_COLUMNS = ("seconds", "log")
 
@@ -92,12 +92,13 @@ def test_existing_inputs_leave_a_missing_file_and_a_bad_case_to_the_build(tmp_pa
 
 @pytest.mark.slow
 @needs_make
-def test_snakemake_builds_the_sample_cohort_as_make_cohort_does(tmp_path):
-    cases = temporary_cohort(tmp_path, names=SAMPLE_CASES)
-    broken = (cases / "meander.yaml").read_text().replace("knot_spacing_mm", "knot_spacng_mm")
-    (cases / "broken.yaml").write_text(broken)
-    by_make, by_snakemake = tmp_path / "make", tmp_path / "snakemake"
-    assert make("-j2", "cohort", cohort_dir=cases, build=by_make).returncode != 0  # the broken case
+def test_snakemake_builds_the_sample_cohort_as_make_cohort_does(tmp_path, tmp_path_factory):
+    # the sample cases and the broken one, built by `make -j2 cohort` once per run (tests/helpers/sample_cohort.py,
+    # read by tests/e2e/test_golden.py too): their case files are the ones Snakemake builds here, into a folder of
+    # its own
+    cohort = sample_cohort(tmp_path_factory)
+    cases, by_make, by_snakemake = cohort.cases, cohort.build, tmp_path / "snakemake"
+    assert cohort.returncode != 0, cohort.output  # the broken case
     done = snakemake("--cores", "2", "--keep-going", cohort_dir=cases, build=by_snakemake, cwd=tmp_path)
     assert done.returncode != 0, "the broken case must fail the run"
 

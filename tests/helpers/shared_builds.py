@@ -9,9 +9,12 @@ failed attempt leaves no mark, so the next asker makes it again (and fails the s
 
 The shared workspace is the README's (tests/cli/test_readme.py): a copy of configs/ and data/ in which the
 README's commands run as a user runs them, each once per run (:func:`run_once`); tests/e2e/test_one_story.py
-reads the same runs of the commands it checks (and adds the per-chamber actuator's build), the report tests copy
-the demo's build from it (:func:`demo_build_copy`), and tests/cli/test_pressure_cli.py copies the actuators'
-builds with their case files (:func:`workspace_copy`).  Whoever asks first runs the command; the others read its
+reads the same runs of the commands it checks (and adds the per-chamber actuator's build), as does
+tests/cli/test_design_cli.py the designed demo's; the report tests and the pose tests copy the demo's build from
+it (:func:`demo_build_copy`), and tests/cli/test_pressure_cli.py and tests/cli/test_simulate_all.py copy the
+actuators' builds with their case files (:func:`workspace_copy`).  Outside the workspace: the hollow tube with a
+mould (:func:`hollow_tube_build`; the report's parts tests and the browser test) and the sample cohort
+(tests/helpers/sample_cohort.py).  Whoever asks first runs the command; the others read its
 recorded exit code and output, and its build folder.  Tests only read these folders; a test that changes a build
 copies it first.
 """
@@ -43,6 +46,12 @@ COMMAND_TIMEOUT_S = 900
 DEMO_BUILD = ("build", "configs/demo.yaml", "--report")
 #: Where DEMO_BUILD puts the build, in the workspace.
 DEMO_BUILD_DIR = Path("build") / "demo"
+#: The README's second block: the demo designed at 1 mm (the case file build/demo-designed.yaml), then that case
+#: built with its report (into build/demo-designed); asked for after DEMO_BUILD (whose build/demo makes the build/
+#: folder the design writes its case file into: a first run of the design alone is refused) and before the build.
+DESIGN_DEMO = ("design", "configs/demo.yaml", "--tolerance-mm", "1", "--output", "build/demo-designed.yaml",
+               "--out", "build/demo-designed")
+DESIGNED_BUILD = ("build", "build/demo-designed.yaml", "--out", "build/demo-designed", "--report")
 #: The README's single-supply device, built with its report (into build/actuator).
 ACTUATOR_BUILD = ("build", "configs/actuator.yaml", "--report")
 #: The per-chamber actuator built with its report, into a folder of its own: not the README's simulate command's
@@ -154,6 +163,20 @@ def _copy_build(source: Path, target: Path, report: bool) -> Path:
 def demo_build_copy(factory: pytest.TempPathFactory, target: Path, *, report: bool = False) -> Path:
     """A copy of :func:`demo_build` at ``target`` for a test to change, its report left out unless ``report``."""
     return _copy_build(demo_build(factory), target, report)
+
+
+def _build_hollow_tube(folder: Path) -> None:
+    from softdesign.pipeline.api import build_through
+    from tests.helpers.parts_cases import hollow_tube_case
+
+    folder.mkdir()
+    build_through(hollow_tube_case(folder), folder / "build")
+
+
+def hollow_tube_build(factory: pytest.TempPathFactory) -> Path:
+    """tests/helpers/parts_cases.py's hollow tube with a mould, built (no report) once per run: read by the report's
+    parts tests and copied by the browser test, which writes its report into the copy."""
+    return made_once(shared_root(factory), "hollow-tube", _build_hollow_tube) / "build"
 
 
 def workspace_copy(factory: pytest.TempPathFactory, target: Path, build: tuple[str, ...], build_dir: str) -> Path:

@@ -91,6 +91,7 @@ def helix_target() -> ChainTarget:
     return chain_target(resampled)
 
 
+@pytest.mark.slow
 def test_a_smaller_tolerance_never_gives_fewer_sections():
     target = helix_target()
     counts = []

@@ -126,6 +126,7 @@ def _middle_strain(fibre: HoopThread | None, pull_kpa: float) -> float:
 COMPOSITE_RTOL = 2e-3
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("share", [1.0, 4.0])
 def test_a_bar_with_an_embedded_fibre_stretches_as_the_composite(share: float) -> None:
     # Rule of mixtures: the bar's E A (3 mu, 16 mm^2) and the fibre's E_t A_t = share E A in parallel, at the

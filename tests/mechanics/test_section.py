@@ -97,9 +97,12 @@ def test_a_section_without_a_chamber_wall_is_refused() -> None:
 @pytest.mark.slow
 def test_an_unreachable_arc_is_reported_not_converged() -> None:
     # a 1 rad bend: far beyond what these unreinforced chambers give before they balloon (at 30 kPa, 0.12 rad);
-    # the trials the solve cannot reach count as huge errors and the search steps back from them
+    # the trials the solve cannot reach count as huge errors and the search steps back from them.  Six trials, not
+    # eight (42 -> 29 s of CPU): measured, trials 2 and 3 find no equilibrium, the search steps back to 4 and 5,
+    # which converge, and trial 6 fails again, so the search still ends on a failed trial and must return the best
+    # converged one (the 7th and 8th only repeated that: one converged, one failed)
     settings = InverseSettings(max_pressure_kpa=400.0, start_kpa=5.0, max_step_kpa=100.0, tolerance_mm=1e-3,
-                               max_iterations=8)
+                               max_iterations=6)
     found = find_pressures(_section(), LAW, (0.05, -np.pi / 2, 20.0), settings,
                            NewtonSettings(load_steps=1, max_iterations=12, max_cutbacks=1))
     assert not found.converged

@@ -9,6 +9,7 @@ and closes each step.
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -231,6 +232,8 @@ def test_crossing_steps_stay_one_watertight_body(chain, offset_mm):
 # --- the sample case ----------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def demo(tmp_path_factory):
+    # its own build, not a copy of the README's demo build: make test-fast runs the quick tests below without the
+    # README's commands, and that build (with its report, in a child) cost it 51 s at load 7 against about 4 s here
     out = tmp_path_factory.mktemp("pose") / "build"
     result = runner.invoke(app, ["build", str(DEMO), "--out", str(out)])
     assert result.exit_code == 0, result.output
@@ -366,9 +369,19 @@ def hollow_case(tmp_path_factory) -> Path:
     return path
 
 
+@pytest.fixture(scope="module")
+def hollow_build(hollow_case, tmp_path_factory) -> Path:
+    """``hollow_case`` built once for the two tests that pose it: each poses a copy (pose builds, cached, into the
+    folder it is given, so the copy's stages are all reused and only the pose is made)."""
+    out = tmp_path_factory.mktemp("hollow-build") / "build"
+    result = runner.invoke(app, ["build", str(hollow_case), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    return out
+
+
 @pytest.mark.slow
-def test_hollow_pose_with_equal_q_is_the_builds_hollow_mesh(hollow_case, tmp_path):
-    out = tmp_path / "build"
+def test_hollow_pose_with_equal_q_is_the_builds_hollow_mesh(hollow_case, hollow_build, tmp_path):
+    out = shutil.copytree(hollow_build, tmp_path / "build")
     args = ["pose", str(hollow_case), "--q", "1", "--output", str(tmp_path / "p.stl"), "--out", str(out)]
     result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
@@ -381,8 +394,8 @@ def test_hollow_pose_with_equal_q_is_the_builds_hollow_mesh(hollow_case, tmp_pat
 
 
 @pytest.mark.slow
-def test_hollow_pose_with_mixed_q_is_one_ported_body_with_its_walls_reported(hollow_case, tmp_path):
-    out = tmp_path / "build"
+def test_hollow_pose_with_mixed_q_is_one_ported_body_with_its_walls_reported(hollow_case, hollow_build, tmp_path):
+    out = shutil.copytree(hollow_build, tmp_path / "build")
     args = [
         "pose", str(hollow_case), "--q", "0,1,0,1", "--output", str(tmp_path / "p.ply"), "--out", str(out), "--json"
     ]

@@ -54,7 +54,9 @@ def _keys(faces):
 
 # five sections at the defaults (diameter 0.8, feed 0.4: the widest the layout's 0.2 mm walls allow there);
 # six and eight at the widest chambers the layout's walls allow at d = 2 mm
-@pytest.mark.parametrize(("sections", "diameter", "feed"), [(5, 0.8, 0.4), (6, 0.6, 0.3), (8, 0.4, 0.2)])
+@pytest.mark.parametrize(("sections", "diameter", "feed"), [(5, 0.8, 0.4),
+                                                              pytest.param(6, 0.6, 0.3, marks=pytest.mark.slow),
+                                                              pytest.param(8, 0.4, 0.2, marks=pytest.mark.slow)])
 def test_many_sections_mesh_with_every_cavity_closed(sections, diameter, feed):
     shape, field, length = _body(sections)
     layout = _layout(shape, sections, diameter, feed)

@@ -38,22 +38,45 @@ def statuses(output: str) -> dict[str, str]:
     return dict(re.findall(r"^\[([a-z_]+)\] (ran|skipped|kept|stale)", output, flags=re.MULTILINE))
 
 
-@pytest.fixture
-def demo_case(tmp_path) -> Path:
+def write_demo_case(folder: Path) -> Path:
     """A copy of configs/demo.yaml pointing at the committed sample data, coarse enough to be quick."""
     case = yaml.safe_load((REPO / "configs" / "demo.yaml").read_text())
     for key in ("centerline", "surface"):
         case["final"][key] = str((REPO / "configs" / case["final"][key]).resolve())
     case["export"] = {"q": [0, 1], "angular_count": 48, "spacing_mm": 1.0}
-    path = tmp_path / "demo.yaml"
+    path = folder / "demo.yaml"
     path.write_text(yaml.safe_dump(case, sort_keys=False))
     return path
+
+
+@pytest.fixture
+def demo_case(tmp_path) -> Path:
+    """:func:`write_demo_case` in the test's folder."""
+    return write_demo_case(tmp_path)
 
 
 def build(case: Path, out: Path, *extra: str) -> str:
     result = runner.invoke(app, ["build", str(case), "--out", str(out), *extra])
     assert result.exit_code == 0, result.output
     return result.output
+
+
+@pytest.fixture(scope="module")
+def demo_built(tmp_path_factory) -> tuple[str, Path]:
+    """The ``demo_case`` file's text and its build, made once for the file (a fresh build: every stage ran)."""
+    folder = tmp_path_factory.mktemp("demo-built")
+    case = write_demo_case(folder)
+    build(case, folder / "build")
+    return case.read_text(), folder / "build"
+
+
+def built(demo_built: tuple[str, Path], case: Path, out: Path) -> None:
+    """``out`` as ``build(case, out)`` leaves it, for a test whose ``case`` is still ``demo_case``'s: a copy of
+    ``demo_built``'s build.  ``case`` names its inputs relative to itself and lies as deep as the module's case,
+    so the stage keys are the same and a next build reuses what did not change, as on a build of its own."""
+    text, source = demo_built
+    assert case.read_text() == text and len(case.parts) == len((source.parent / case.name).parts)
+    shutil.copytree(source, out)
 
 
 def edit(case: Path, section: str, **values) -> None:
@@ -124,9 +147,9 @@ def test_cache_skips_what_did_not_change_and_force_redoes_all(demo_case, tmp_pat
 
 
 @pytest.mark.slow
-def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tmp_path):
+def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, demo_built, tmp_path):
     out = tmp_path / "build"
-    build(demo_case, out)
+    built(demo_built, demo_case, out)
     meshes = {"meshes/q_0.000.stl", "meshes/q_1.000.stl"}
 
     def run_fit() -> tuple[dict[str, str], dict]:
@@ -164,17 +187,17 @@ def test_a_single_stage_run_says_whether_later_outputs_still_match(demo_case, tm
 
 
 @pytest.mark.slow
-def test_a_stale_output_is_not_reused_because_it_exists(demo_case, tmp_path):
+def test_a_stale_output_is_not_reused_because_it_exists(demo_case, demo_built, tmp_path):
     out = tmp_path / "build"
-    build(demo_case, out)
+    built(demo_built, demo_case, out)
     (out / "fit" / "surface.npz").write_bytes(b"tampered")
     assert statuses(build(demo_case, out))["fit"] == "ran"
 
 
 @pytest.mark.slow
-def test_same_inputs_give_the_same_bytes(demo_case, tmp_path):
+def test_same_inputs_give_the_same_bytes(demo_case, demo_built, tmp_path):
     first, second = tmp_path / "a", tmp_path / "b"
-    build(demo_case, first)
+    built(demo_built, demo_case, first)  # a build made in another folder; the second is forced here
     build(demo_case, second, "--force")
     one, two = snapshot(first), snapshot(second)
     assert one.keys() == two.keys()
@@ -189,13 +212,13 @@ def test_same_inputs_give_the_same_bytes(demo_case, tmp_path):
 
 
 @pytest.mark.slow
-def test_stages_rerun_on_cached_results_give_a_fresh_builds_bytes(demo_case, tmp_path):
+def test_stages_rerun_on_cached_results_give_a_fresh_builds_bytes(demo_case, demo_built, tmp_path):
     # the shape rebuilt from blend/curves.npz and the one the blend made equal each other to 1e-14 mm only, until
     # the blend handed on the rebuilt one: the stages after a cached blend wrote other bytes than a fresh build
     fresh, cached = tmp_path / "fresh", tmp_path / "cached"
-    build(demo_case, fresh)
+    built(demo_built, demo_case, fresh)
     plain = demo_case.read_text()
-    build(demo_case, cached)
+    built(demo_built, demo_case, cached)
     edit(demo_case, "links", count=3)  # links and everything after re-run on the loaded ingest and blend
     build(demo_case, cached)
     demo_case.write_text(plain)
@@ -206,9 +229,10 @@ def test_stages_rerun_on_cached_results_give_a_fresh_builds_bytes(demo_case, tmp
     assert again == listed
 
 
-def test_manifest_records_inputs_case_metrics_and_outputs(demo_case, tmp_path):
+@pytest.mark.slow
+def test_manifest_records_inputs_case_metrics_and_outputs(demo_case, demo_built, tmp_path):
     out = tmp_path / "build"
-    build(demo_case, out)
+    built(demo_built, demo_case, out)
     manifest = json.loads((out / "manifest.json").read_text())
     assert [i["path"].rsplit("/", 1)[-1] for i in manifest["inputs"]] == ["centerline.vtp", "surface.stl"]
     assert all(len(i["sha256"]) == 64 for i in manifest["inputs"])
@@ -230,9 +254,9 @@ def test_manifest_records_inputs_case_metrics_and_outputs(demo_case, tmp_path):
 
 
 @pytest.mark.slow
-def test_a_failed_run_leaves_the_previous_build_untouched(demo_case, tmp_path, monkeypatch):
+def test_a_failed_run_leaves_the_previous_build_untouched(demo_case, demo_built, tmp_path, monkeypatch):
     out = tmp_path / "build"
-    build(demo_case, out)
+    built(demo_built, demo_case, out)
     before = snapshot(out)
     edit(demo_case, "fit", smoothing=3.0e-5)
     from softdesign.pipeline.stages import export as export_stage
@@ -272,9 +296,9 @@ app()
 
 
 @pytest.mark.slow
-def test_a_build_killed_mid_export_leaves_the_previous_build_unchanged(demo_case, tmp_path):
+def test_a_build_killed_mid_export_leaves_the_previous_build_unchanged(demo_case, demo_built, tmp_path):
     out = tmp_path / "build"
-    build(demo_case, out)
+    built(demo_built, demo_case, out)
     before = snapshot(out)
     edit(demo_case, "export", angular_count=56)
     killed = subprocess.run(

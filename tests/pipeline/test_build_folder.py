@@ -52,6 +52,28 @@ def built(case: Path, out: Path) -> Result:
     return result
 
 
+@pytest.fixture(scope="module")
+def demo_built(tmp_path_factory) -> tuple[Path, Path]:
+    """``write_demo``'s case and its build, made once for the file: the tests that start from a finished build of
+    the coarse demo copy it (:func:`copy_of_demo`) rather than build it again."""
+    base = tmp_path_factory.mktemp("demo-built")
+    case = write_demo(base)
+    built(case, base / "build")
+    return case, base / "build"
+
+
+def copy_of_demo(demo_built: tuple[Path, Path], folder: Path, out: Path) -> Path:
+    """``write_demo(folder)`` with ``demo_built``'s build copied to ``out``: as if built there.  The case file names
+    its inputs relative to itself, and ``folder`` (a test's ``tmp_path``) lies as deep as the module's folder, so
+    the stage keys match and a next build reuses what did not change, as on a build of its own."""
+    case, build = demo_built
+    assert len(folder.parts) == len(case.parent.parts), (folder, case)
+    mine = write_demo(folder)
+    assert mine.read_text() == case.read_text()
+    shutil.copytree(build, out)
+    return mine
+
+
 def assert_refused(result: Result, *needles: str) -> None:
     """Exit 2, a message with every needle, no traceback."""
     assert result.exit_code == 2, result.output
@@ -138,11 +160,11 @@ def exchange_works(folder: Path) -> bool:
 
 
 @pytest.fixture(scope="module")
-def old_and_new(tmp_path_factory) -> tuple[Path, Path, Path]:
+def old_and_new(tmp_path_factory, demo_built) -> tuple[Path, Path, Path]:
     """A build of the demo case, the case file edited (the export changes), and the build the edit gives from it."""
     base = tmp_path_factory.mktemp("transaction")
     old = base / "old"
-    built(write_demo(base), old)
+    copy_of_demo(demo_built, base, old)
     case = write_demo(base, angular_count=56)
     new = base / "new"
     shutil.copytree(old, new)
@@ -150,6 +172,7 @@ def old_and_new(tmp_path_factory) -> tuple[Path, Path, Path]:
     return case, old, new
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("point", list(KILL_POINTS))
 def test_a_build_killed_during_its_commit_leaves_the_old_folder_or_the_new_one(point, old_and_new, tmp_path):
     (call, number, when, fallback), state = KILL_POINTS[point]
@@ -193,6 +216,7 @@ def test_the_next_run_restores_a_folder_set_aside_by_an_interrupted_swap(old_and
     assert leftovers(tmp_path, "build") == []
 
 
+@pytest.mark.slow
 def test_the_folder_holds_what_its_manifest_lists_and_kept_files_are_linked(tmp_path):
     out = tmp_path / "build"
     built(write_demo(tmp_path, q=[0, 0.25, 1]), out)
@@ -250,6 +274,7 @@ def fill_the_disk(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(pathlib.Path, "write_bytes", full)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "fault, needles",
     [
@@ -259,9 +284,10 @@ def fill_the_disk(monkeypatch: pytest.MonkeyPatch) -> None:
     ],
     ids=["read-only-parent", "read-only-parent-two-renames", "disk-full"],
 )
-def test_a_commit_that_fails_part_way_leaves_the_old_folder_as_it_was(fault, needles, tmp_path, monkeypatch):
+def test_a_commit_that_fails_part_way_leaves_the_old_folder_as_it_was(fault, needles, demo_built, tmp_path,
+                                                                     monkeypatch):
     out = tmp_path / "build"
-    built(write_demo(tmp_path), out)
+    copy_of_demo(demo_built, tmp_path, out)
     before = snapshot(out)
     case = write_demo(tmp_path, angular_count=56)
     fault(monkeypatch)
@@ -298,9 +324,10 @@ app()
 """
 
 
-def test_a_second_build_into_a_folder_being_built_is_refused_naming_the_first(tmp_path):
+@pytest.mark.slow
+def test_a_second_build_into_a_folder_being_built_is_refused_naming_the_first(demo_built, tmp_path):
     out = tmp_path / "build"
-    built(write_demo(tmp_path), out)
+    copy_of_demo(demo_built, tmp_path, out)
     before = snapshot(out)
     case = write_demo(tmp_path, angular_count=56)
     first = subprocess.Popen(
@@ -339,16 +366,16 @@ def test_out_must_be_a_softdesign_build_an_empty_folder_or_new(tmp_path):
     assert_exactly_as_listed(empty)
 
 
-def test_a_build_folder_holding_files_of_its_user_is_not_replaced(tmp_path):
-    case = write_demo(tmp_path)
+def test_a_build_folder_holding_files_of_its_user_is_not_replaced(demo_built, tmp_path):
     out = tmp_path / "build"
-    built(case, out)
+    case = copy_of_demo(demo_built, tmp_path, out)
     (out / "notes.txt").write_text("what I saw in the q = 1 mesh")
     before = snapshot(out)
     assert_refused(run("build", case, "--out", out), str(out), "notes.txt", "move them out")
     assert snapshot(out) == before
 
 
+@pytest.mark.slow
 def test_out_may_not_hold_the_input_files(tmp_path):
     data = tmp_path / "data" / "demo"
     shutil.copytree(REPO / "data" / "demo", data)

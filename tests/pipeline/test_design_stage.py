@@ -158,6 +158,7 @@ def test_a_build_warns_when_its_design_misses_the_tolerance(tmp_path):
     assert "design.max_links 2" in result.stderr and "raise design.max_links" in result.stderr
 
 
+@pytest.mark.slow
 def test_the_design_is_cached_like_any_stage_and_redone_when_its_block_changes(tmp_path):
     case = designed_case(tmp_path, DEMO, {"design": {"tolerance_mm": 2.0}})
     first = build_through(case, tmp_path / "build", target="design")

@@ -73,6 +73,7 @@ def test_a_vessel_decimated_past_the_tolerance_keeps_more_triangles_until_within
     assert len(coarse) <= 500 < len(kept) and error <= tolerance
 
 
+@pytest.mark.slow
 def test_a_large_vessel_is_clustered_first_then_decimated_within_the_tolerance(monkeypatch):
     sphere = trimesh.creation.icosphere(subdivisions=6, radius=10.0)  # 81920 faces: over 8 x the target
     vertices, faces = np.asarray(sphere.vertices), np.asarray(sphere.faces)
