@@ -278,7 +278,7 @@ class SolveStopped(SolveError):
     def __init__(self, message: str, displacement: FloatArray, load_factor: float, record: SolveRecord) -> None:
         super().__init__(message)
         self.displacement = displacement  #: (V, 3) mm, the last converged step's
-        self.load_factor = load_factor  #: that step's share of the pressures (0: none converged)
+        self.load_factor = load_factor  #: that step's share of the way from the start's pressures (0: none converged)
         self.record = record  #: the converged steps
 
 
