@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from softdesign.types import IntArray
+from softdesign.types import FloatArray, IntArray
 
 
 def edge_keys(faces: IntArray, n_vertices: int) -> IntArray:
@@ -71,3 +71,13 @@ class EdgeTable:
         twice = self.starts[self.uses == 2]
         pairs = self.order[np.column_stack((twice, twice + 1))] // 3
         return pairs[pairs[:, 0] != pairs[:, 1]]
+
+
+def corner_planes(vertices: FloatArray, faces: IntArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The first, second and third corner of every face as (3, F) arrays, mm: x, y and z each contiguous.
+
+    Per-face geometry on whole coordinate rows runs on contiguous memory, where (F, 3, 3) corners
+    made every operation stride across the other coordinates; the numbers are the same.
+    """
+    corners = np.take(np.ascontiguousarray(vertices.T), np.ascontiguousarray(faces.T), axis=1)  # (3, 3, F)
+    return corners[:, 0], corners[:, 1], corners[:, 2]

@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from softdesign.geometry.edges import EdgeTable, run_starts
+from softdesign.geometry.edges import EdgeTable, corner_planes, run_starts
 from softdesign.geometry.end_cut import MAX_CUT_TILT_DEG
 from softdesign.types import FloatArray, IntArray, Points
 
@@ -251,8 +251,7 @@ def _face_normals(vertices: Points, faces: IntArray) -> FloatArray:
     (tests/geometry/test_end_planes.py compares them), in about a third of its time on 1M faces, which
     gathered (F, 3, 3) corners and strode across their coordinates.
     """
-    corners = np.take(np.ascontiguousarray(vertices.T), np.ascontiguousarray(faces.T), axis=1)  # (3, 3, F)
-    p0, p1, p2 = corners[:, 0], corners[:, 1], corners[:, 2]
+    p0, p1, p2 = corner_planes(vertices, faces)
     u, v = p1 - p0, p2 - p1
     normals = np.empty_like(u)
     for i, (j, k) in enumerate(((1, 2), (2, 0), (0, 1))):

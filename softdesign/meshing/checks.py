@@ -20,8 +20,9 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import MeshError
+from softdesign.geometry.edges import corner_planes
 from softdesign.geometry.rows import rows_all_distinct, rows_in_first_order
-from softdesign.meshing.topology import corner_planes, mesh_topology
+from softdesign.meshing.topology import mesh_topology
 from softdesign.meshing.volume_tolerance import MIN_ANGULAR_COUNT, VOLUME_RTOL
 from softdesign.types import FloatArray
 

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from softdesign.geometry.edges import EdgeTable, edge_keys, run_starts
+from softdesign.geometry.edges import EdgeTable, corner_planes, edge_keys, run_starts
 from softdesign.types import FloatArray, IntArray
 
 
@@ -160,16 +160,6 @@ def mesh_topology(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> MeshTopology
 def face_areas(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> FloatArray:
     """Area of each face, (F,) float, mm^2."""
     return 0.5 * _double_areas(*corner_planes(np.asarray(vertices, float), np.asarray(faces, np.int64)))
-
-
-def corner_planes(vertices: FloatArray, faces: IntArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """The first, second and third corner of every face as (3, F) arrays, mm: x, y and z each contiguous.
-
-    Per-face geometry on whole coordinate rows runs on contiguous memory, where (F, 3, 3) corners
-    made every operation stride across the other coordinates; the numbers are the same.
-    """
-    corners = np.take(np.ascontiguousarray(vertices.T), np.ascontiguousarray(faces.T), axis=1)  # (3, 3, F)
-    return corners[:, 0], corners[:, 1], corners[:, 2]
 
 
 def surface_area(vertices: npt.ArrayLike, faces: npt.ArrayLike) -> float:

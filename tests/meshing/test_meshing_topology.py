@@ -159,8 +159,8 @@ def _row_cross(u, v):
 
 def test_volume_area_and_edge_scale_keep_the_bits_of_the_row_wise_formulas():
     """On (3, F) coordinate rows, the figures are those of (F, 3, 3) corners and np.einsum, to the last bit."""
+    from softdesign.geometry.edges import corner_planes
     from softdesign.meshing.checks import _mean_squared_edge
-    from softdesign.meshing.topology import corner_planes
 
     rng = np.random.default_rng(11)
     vertices, faces = joined(*[cube(rng.uniform(0.5, 3.0), rng.normal(0.0, 40.0, 3)) for _ in range(40)])
