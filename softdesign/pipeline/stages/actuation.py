@@ -354,8 +354,9 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult, simu
     _check_sweep(case, fit, layout)
     rows = rod.rows if rod.rows is not None else _per_chamber_rows(kinematics, layout, grid)
     filled = rod.fill(rows)
-    # per_chamber: the pressures are the table's (single: P*, in rod.warnings)
-    table_warnings = table_end_notes(rows, rod.summary.get("body_modulus_kpa")) if rod.rows is None else []
+    # per_chamber: the pressures are the table's (single: P*, warned of in rod.warnings)
+    table_warnings = (table_end_notes(rows, rod.summary.get("body_modulus_kpa"))
+                      if rod.summary.get("supply") == "per_chamber" else [])
     _add_estimates(rows, simulated)
     qs = [q for q, _ in grid]
     walls = (rod.walls if rod.walls is not None else ring_walls(layout)) + _skin(kinematics, fit, layout, qs,
