@@ -25,7 +25,7 @@ from typing import Any, cast
 import numpy as np
 
 from softdesign.config import Case
-from softdesign.fitting.radius_field import RadiusField, fold_margin
+from softdesign.fitting.radius_field import RadiusField, known_fold_margin
 from softdesign.fitting.strain import skin_metric
 from softdesign.geometry.blend import BlendedShape
 from softdesign.meshing.body.skin_stretch import (
@@ -170,7 +170,7 @@ def _at_q(body: _Body, q: float, case: Case) -> dict[str, Any]:
         "stretch_max": skin.maximum.value,
         "stretch_min": skin.minimum.value,
         "wall_min_mm": None,
-        "rho_kappa_max": fold_margin(cast(FramedCurve, body.shape.curve_at(q)), body.field, q).max_rho_kappa,
+        "rho_kappa_max": known_fold_margin(cast(FramedCurve, body.shape.curve_at(q)), body.field, q).max_rho_kappa,
         "where": {"stretch_max": _where(skin.maximum), "stretch_min": _where(skin.minimum)},
         "per_link": [{"stretch_max": hi, "stretch_min": lo} for hi, lo in skin.per_link],
         "grid": {"spacing_mm": skin.grid.spacing_mm, "angles": skin.grid.angles, "points": skin.grid.points,

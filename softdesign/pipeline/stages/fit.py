@@ -122,7 +122,9 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
                                           mould=case.export.mould is not None,
                                           parting_local=_parting_local(chain) if case.export.mould else None)}
     # the fitted body itself at every q of the morph's search, not only at q = 1 (issue 29)
-    morph = fold_over_morph(chain.shape.curve_at, field, np.linspace(0.0, 1.0, MORPH_Q_SAMPLES), map_items)
+    # its reports around the export q's curves (kinematics built them) are kept for the feasibility's per-q figures
+    morph = fold_over_morph(chain.shape.curve_at, field, np.linspace(0.0, 1.0, MORPH_Q_SAMPLES), map_items,
+                            built=chain.shape.built_curve)
     summary["morph_fold"] = morph.as_dict()
     warning = morph.warning(chain.shape.mode)
     if warning is not None:
