@@ -236,7 +236,7 @@ def _holdout(
     curve: FramedCurve, polar: PolarPoints, settings: FitSettings, labels: np.ndarray,
     start: SearchStart | None = None, mapper: Mapper = serial_map,
 ) -> HoldoutReport:
-    solve = fold_solver(polar, curve.length, settings, labels)
+    solve = fold_solver(polar, curve.length, settings, labels, mapper)  # each fold's rows assembled by mapper too
 
     def held_out(k: int) -> FloatArray:  # fold k's fit and its distances: on one process, after the assembly
         test = labels == k

@@ -145,6 +145,27 @@ def test_fold_solves_equal_fresh_fits_on_the_other_folds():
         np.testing.assert_allclose(spline.coefficients, fresh.coefficients, rtol=0, atol=1e-10)
 
 
+def test_each_folds_rows_assembled_apart_on_workers_give_the_same_solves_to_the_bit():
+    from softdesign.fitting.surface_system import design_matrix
+    from softdesign.pipeline.parallel import jobs_for_build, map_items
+
+    curve, noisy = _noisy_tube()
+    labels = fold_labels(len(noisy), 4, np.random.default_rng(3))
+    with jobs_for_build(2):
+        forked = fold_solver(noisy, curve.length, FitSettings(), labels, map_items)
+    here = fold_solver(noisy, curve.length, FitSettings(), labels)
+    # the assembly it replaced: one design matrix of every point, each fold's rows taken from it
+    knots = forked(0).knots
+    design = design_matrix(knots, FitSettings().angular_intervals, noisy.l, noisy.angle)
+    rows = np.flatnonzero(labels == 1)
+    alone = design_matrix(knots, FitSettings().angular_intervals, noisy.l[rows], noisy.angle[rows])
+    for mine, theirs in zip((alone.data, alone.indices, alone.indptr), (design[rows].data, design[rows].indices,
+                                                                         design[rows].indptr), strict=True):
+        np.testing.assert_array_equal(mine, theirs)
+    for k in range(4):
+        np.testing.assert_array_equal(forked(k).coefficients, here(k).coefficients)
+
+
 def test_folds_are_balanced_and_reproducible_from_the_seed():
     a = fold_labels(103, 5, np.random.default_rng(7))
     b = fold_labels(103, 5, np.random.default_rng(7))
