@@ -211,7 +211,8 @@ def _own_wall_distances(
         # the own wall is the fitted points and the sample theirs: with_exact_max would bound and search the same
         # points left out of the same sample as the kept-point figures did, so their max is this one
         return replace(summary, max_mm=known_max, total=len(own_index)), sample, distance
-    metrics = with_exact_max(curve, surface, polar.subset(own_index), np.searchsorted(own_index, sample), summary)
+    metrics = with_exact_max(curve, surface, polar.subset(own_index), np.searchsorted(own_index, sample), summary,
+                             mapper)
     return metrics, sample, distance
 
 

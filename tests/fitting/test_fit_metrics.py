@@ -134,6 +134,21 @@ def test_distances_of_a_large_input_come_from_a_sample_and_the_max_from_every_po
     np.testing.assert_array_equal(again.sample, sampled.sample)
 
 
+def test_the_exact_max_with_its_bounds_on_workers_is_the_same(monkeypatch):
+    from softdesign.fitting import metrics as fm
+    from softdesign.pipeline.parallel import jobs_for_build, map_items
+
+    curve, noisy = _noisy_tube()
+    spline = fit_radius_surface(noisy, curve.length, FitSettings()).whole
+    sample = np.sort(np.random.default_rng(2).choice(len(noisy), size=400, replace=False))
+    first = fm.summarize_distances(np.zeros(400))  # a sample's max of 0: every other point's bound is doubtful
+    here = fm.with_exact_max(curve, spline, noisy, sample, first)
+    monkeypatch.setattr(fm, "PROJECT_BLOCK", 300)  # the other 2000 points in 7 blocks
+    with jobs_for_build(2):
+        forked = fm.with_exact_max(curve, spline, noisy, sample, first, map_items)
+    assert forked == here and here.max_mm == fm.closest_surface_points(curve, spline, noisy)[0].max()  # every point's
+
+
 def test_fold_solves_equal_fresh_fits_on_the_other_folds():
     curve, noisy = _noisy_tube()
     labels = fold_labels(len(noisy), 4, np.random.default_rng(3))
