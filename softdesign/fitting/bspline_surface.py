@@ -36,6 +36,7 @@ import scipy.sparse.linalg as spla
 from softdesign.errors import ConfigError, FitError, InputFitError
 from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.end_prior import EndPrior
+from softdesign.fitting.mapping import Mapper, serial_map
 from softdesign.fitting.projection import PolarPoints
 from softdesign.fitting.surface_system import design_and_gram, design_matrix, roughness_matrix
 from softdesign.types import FloatArray, IntArray
@@ -238,20 +239,28 @@ def fit_radius_surface(polar: PolarPoints, length_mm: float, settings: FitSettin
 
 
 def fold_solver(
-    polar: PolarPoints, length_mm: float, settings: FitSettings, labels: np.ndarray
+    polar: PolarPoints, length_mm: float, settings: FitSettings, labels: np.ndarray,
+    mapper: Mapper = serial_map,
 ) -> Callable[[int], RadiusSpline]:
     """``solve(k)``: the whole-path spline fitted to the points outside fold k (``labels != k``).
 
     The same penalized least squares as :func:`fit_radius_surface` (penalty scale from each
     training set's median rho), assembled once here: fold k's normal equations are those of every
-    point minus the rows of fold k, equal to a fresh assembly up to rounding.  Each fold's solve is
-    its own (the hold-out runs it with the fold's distances, perhaps on another process): the same
-    spline whenever and wherever it is solved.
+    point minus the rows of fold k, equal to a fresh assembly up to rounding.  Each fold's rows
+    ``A_k^T A_k`` and ``A_k^T rho_k`` are assembled by ``mapper`` (perhaps on other processes; a
+    row of the design matrix is its point's own, so ``A_k`` is the whole design's rows of fold k
+    to the bit), then summed here in fold order.  Each fold's solve is its own (the hold-out runs
+    it with the fold's distances, perhaps on another process): the same spline whenever and
+    wherever it is solved.
     """
     knots = path_knots(length_mm, settings)
-    design = design_matrix(knots, settings.angular_intervals, polar.l, polar.angle)
     rows = [np.flatnonzero(labels == k) for k in range(int(labels.max()) + 1)]
-    parts = [(design[r].T @ design[r], design[r].T @ polar.rho[r]) for r in rows]
+
+    def assembled(r: np.ndarray) -> tuple[sp.csc_matrix, FloatArray]:
+        design = design_matrix(knots, settings.angular_intervals, polar.l[r], polar.angle[r])
+        return design.T @ design, design.T @ polar.rho[r]
+
+    parts = mapper(assembled, rows)
     gram, moment = sum(p[0] for p in parts), sum(p[1] for p in parts)
 
     def solve(k: int) -> RadiusSpline:

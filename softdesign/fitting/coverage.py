@@ -23,7 +23,7 @@ mouth: no wall there to match) is listed, not flagged.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -105,6 +105,7 @@ def measure_coverage(
     mapper: Mapper = serial_map,
     spans_mm: tuple[tuple[float, float], ...] = (),
     known: tuple[np.ndarray, FloatArray] | None = None,
+    known_max: float | None = None,
 ) -> WallCoverage:
     """True distances of the own wall to the fitted surface, the coverage, the unseen stretches and the flags.
 
@@ -124,6 +125,9 @@ def measure_coverage(
     known : sorted indices into ``polar`` (m,) of fitted points already measured against ``surface`` (all of
         them, or a seeded uniform sample: the kept-point figures'), and their distances (m,) mm, which are used,
         not searched again (:func:`_own_wall_distances`); None: the own wall is measured afresh
+    known_max : the largest distance of every fitted point (the kept-point figures' exact max, mm), used as the own
+        wall's when the own wall is the fitted points and ``known`` their whole sample (then the same searches);
+        None: found here
     """
     own = own_wall(polar, selection)
     nan = float("nan")
@@ -134,7 +138,8 @@ def measure_coverage(
                                       mapper=mapper)
             measured, sample, distance = found.metrics, np.flatnonzero(own)[found.sample], found.distance
         else:
-            measured, sample, distance = _own_wall_distances(curve, surface, polar, own, fitted, known, mapper)
+            measured, sample, distance = _own_wall_distances(curve, surface, polar, own, fitted, known, mapper,
+                                                             known_max)
         if spans_mm:  # local caps hold the body off the wall on purpose there: judged outside them
             s = polar.l[sample] * curve.length
             away = ~np.any([(s >= lo) & (s <= hi) for lo, hi in spans_mm], axis=0)
@@ -164,7 +169,7 @@ def measure_coverage(
 
 def _own_wall_distances(
     curve: FramedCurve, surface: RadiusSpline, polar: PolarPoints, own: np.ndarray, fitted: np.ndarray,
-    known: tuple[np.ndarray, FloatArray], mapper: Mapper,
+    known: tuple[np.ndarray, FloatArray], mapper: Mapper, known_max: float | None = None,
 ) -> tuple[FitMetrics, np.ndarray, FloatArray]:
     """The all-wall figures from the fitted points' known distances and the searches of the other own points.
 
@@ -200,9 +205,14 @@ def _own_wall_distances(
     if not hit.all():
         rest = polar.subset(sample[~hit])
         distance[~hit] = closest_with_part(curve, surface, rest.points, SearchStart(rest.l, rest.angle), mapper)[0]
-    own_points = polar.subset(own_index)
-    metrics = with_exact_max(curve, surface, own_points, np.searchsorted(own_index, sample),
-                             summarize_distances(distance))
+    summary = summarize_distances(distance)
+    if (known_max is not None and len(sample) < len(own_index) and np.array_equal(sample, known_index)
+            and np.array_equal(own_index, np.sort(fitted))):
+        # the own wall is the fitted points and the sample theirs: with_exact_max would bound and search the same
+        # points left out of the same sample as the kept-point figures did, so their max is this one
+        return replace(summary, max_mm=known_max, total=len(own_index)), sample, distance
+    metrics = with_exact_max(curve, surface, polar.subset(own_index), np.searchsorted(own_index, sample), summary,
+                             mapper)
     return metrics, sample, distance
 
 

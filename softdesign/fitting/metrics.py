@@ -23,6 +23,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from softdesign.errors import ConfigError
+from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import FitSettings, RadiusSpline, fold_solver
 from softdesign.fitting.closest import (
     CurvePart,
@@ -32,7 +33,7 @@ from softdesign.fitting.closest import (
     search_start,
 )
 from softdesign.fitting.mapping import Mapper, serial_map
-from softdesign.fitting.projection import PolarPoints
+from softdesign.fitting.projection import PROJECT_BLOCK, PolarPoints
 from softdesign.types import FloatArray, FramedCurve
 
 #: Knot spacings (mm) tried by ``knot_spacing_mm: auto``.
@@ -163,22 +164,28 @@ def measure_distances(
     measured = polar.subset(sample)
     distance, l, angle, part = closest_with_part(curve, spline, measured.points,
                                                  SearchStart(measured.l, measured.angle), mapper)
-    metrics = with_exact_max(curve, spline, polar, sample, summarize_distances(distance))
+    metrics = with_exact_max(curve, spline, polar, sample, summarize_distances(distance), mapper)
     return MeasuredDistances(metrics, sample, distance, l, angle, part)
 
 
 def with_exact_max(
-    curve: FramedCurve, spline: RadiusSpline, polar: PolarPoints, sample: np.ndarray, metrics: FitMetrics
+    curve: FramedCurve, spline: RadiusSpline, polar: PolarPoints, sample: np.ndarray, metrics: FitMetrics,
+    mapper: Mapper = serial_map,
 ) -> FitMetrics:
     """``metrics`` of the points ``sample`` (sorted indices into ``polar``) with the max over every point of ``polar``.
 
     Only the points whose radial residual (an upper bound of the true distance, see the module notes) reaches
     the sample's largest distance, or whose foot is clamped at an end, are measured; ``total`` counts them all.
+    ``mapper`` runs the residuals in blocks of ``PROJECT_BLOCK`` points (each point's own: the same numbers).
     """
     if len(sample) == len(polar):
         return metrics
     rest = np.setdiff1d(np.arange(len(polar)), sample, assume_unique=True)
-    bound = np.abs(polar.rho[rest] - spline.evaluate(polar.l[rest], polar.angle[rest]))
+    l, angle = polar.l[rest], polar.angle[rest]
+    blocks = bb.chunks(len(rest), PROJECT_BLOCK)
+    fitted = spline.evaluate(l, angle) if len(blocks) == 1 else np.concatenate(
+        mapper(lambda rows: spline.evaluate(l[rows], angle[rows]), blocks))
+    bound = np.abs(polar.rho[rest] - fitted)
     # a foot clamped at an end is not in p's normal plane: the radial residual bounds nothing there
     doubtful = rest[(bound >= metrics.max_mm - BOUND_SLACK_MM) | (polar.end_side[rest] != 0)]
     largest = metrics.max_mm
@@ -236,7 +243,7 @@ def _holdout(
     curve: FramedCurve, polar: PolarPoints, settings: FitSettings, labels: np.ndarray,
     start: SearchStart | None = None, mapper: Mapper = serial_map,
 ) -> HoldoutReport:
-    solve = fold_solver(polar, curve.length, settings, labels)
+    solve = fold_solver(polar, curve.length, settings, labels, mapper)  # each fold's rows assembled by mapper too
 
     def held_out(k: int) -> FloatArray:  # fold k's fit and its distances: on one process, after the assembly
         test = labels == k

@@ -57,7 +57,8 @@ class MorphFold:
 
 
 def fold_over_morph(shape_at: Callable[[float], FramedCurve], field: RadiusField, q_grid: np.ndarray,
-                    mapper: Mapper = serial_map) -> MorphFold:
+                    mapper: Mapper = serial_map, built: Callable[[float], FramedCurve | None] | None = None
+                    ) -> MorphFold:
     """The largest ``rho(q) * kappa_n(q)`` over ``q_grid`` (increasing, in [0, 1]), refined around the worst.
 
     Parameters
@@ -66,9 +67,16 @@ def fold_over_morph(shape_at: Callable[[float], FramedCurve], field: RadiusField
     field : the fitted radius field
     q_grid : (k,) the q values searched first
     mapper : runs the grid's q values (each its own), perhaps on other processes; the same figures for any
+    built : q -> the curve ``shape_at(q)`` returns if it is built already here, else None (then not built): the
+        grid's reports around those curves are kept on ``field`` (:meth:`RadiusField.keep_fold`), for a later
+        stage that asks for them again (the feasibility's per export q); None keeps none
     """
     q_grid = np.asarray(q_grid, float)
     reports = mapper(lambda q: fold_margin(shape_at(float(q)), field, float(q)), q_grid.tolist())
+    for q, r in zip(q_grid.tolist(), reports, strict=True):
+        curve = None if built is None else built(q)
+        if curve is not None:
+            field.keep_fold(curve, q, r)
     best = int(np.argmax([r.max_rho_kappa for r in reports]))
     q, report = float(q_grid[best]), reports[best]
     if 0 < best < len(q_grid) - 1:

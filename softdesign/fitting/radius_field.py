@@ -221,7 +221,12 @@ class RadiusField:
 
     def __getstate__(self) -> dict[str, object]:
         # pickles carry the field, not the grids cached from it
-        return {k: v for k, v in self.__dict__.items() if k not in ("_grid_cache", "_basis_cache")}
+        return {k: v for k, v in self.__dict__.items() if k not in ("_grid_cache", "_basis_cache", "_fold_cache")}
+
+    def keep_fold(self, curve: FramedCurve, q: float, report: FoldReport) -> None:
+        """Keep :func:`fold_margin`'s ``report`` of this field around ``curve`` (the very object) at q, for
+        :func:`known_fold_margin` (the fit's morph check reports the q values a later stage asks for again)."""
+        self._cache("_fold_cache")[float(q)] = (curve, report)
 
     def evaluate_pairs(self, q: float, l: npt.ArrayLike, a: npt.ArrayLike) -> FloatArray:
         """rho(q) at paired points (l_i, a_i), (n,) mm; each l in its own link."""
@@ -276,6 +281,17 @@ def fold_margin(curve: FramedCurve, field: RadiusField, q: float = 1.0) -> FoldR
         smallest.append(rho.min())
     row, column = at
     return FoldReport(best, float(l[row]), float(l[row] * curve.length), float(a[column]), float(np.min(smallest)))
+
+
+def known_fold_margin(curve: FramedCurve, field: RadiusField, q: float) -> FoldReport:
+    """:func:`fold_margin`, or the report :meth:`RadiusField.keep_fold` kept for the same curve object at q.
+
+    The same inputs give the same report: kept or computed, the same numbers.
+    """
+    kept = field.__dict__.get("_fold_cache", {}).get(float(q))
+    if kept is not None and kept[0] is curve:
+        return kept[1]
+    return fold_margin(curve, field, q)
 
 
 def check_self_folding(curve: FramedCurve, field: RadiusField, q: float = 1.0, limit: float = 1.0) -> FoldReport:

@@ -254,7 +254,8 @@ def fit_wall(
     coverage = measure_coverage(curve, surface.whole, polar, selection, kept_index, settings.knot_spacing_mm,
                                 reference, {} if prior is None else prior.ends, options.mapper,
                                 tuple(c.span_mm for c in options.local_caps),
-                                known=(kept_index[measured.sample], measured.distance))
+                                known=(kept_index[measured.sample], measured.distance),
+                                known_max=metrics.max_mm)
     tell("coverage")
     return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius, ends, distance,
                    coverage)

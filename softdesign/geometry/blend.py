@@ -149,6 +149,10 @@ class BlendedShape:
             self._framed[q] = framed
         return self._framed[q]
 
+    def built_curve(self, q: float) -> FramedSpline | None:
+        """:meth:`curve_at`'s curve at q if it is built already (in this process), else None; builds nothing."""
+        return self._framed.get(float(q))
+
     def target_curve(self) -> FramedSpline:
         """The q = 1 centerline the body's wall is fitted around, with its frames.
 

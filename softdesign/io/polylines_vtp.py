@@ -54,14 +54,45 @@ def write_polylines_vtp(
         The folder does not exist or vtk cannot write.
     """
     path = Path(path)
+    _write_atomically(_checked_polydata(polylines, point_arrays, cell_arrays), path)
+    return path
+
+
+def polylines_vtp_bytes(
+    polylines: Sequence[npt.ArrayLike],
+    point_arrays: Mapping[str, Sequence[npt.ArrayLike]] | None = None,
+    cell_arrays: Mapping[str, npt.ArrayLike] | None = None,
+) -> bytes:
+    """The file :func:`write_polylines_vtp` writes, as bytes (the same writer, to a string: the same bytes).
+
+    For a caller that writes the file itself (the build's staging) or encodes it while other work runs.
+
+    Raises
+    ------
+    InputDataError
+        As :func:`write_polylines_vtp`.
+    OSError
+        vtk cannot encode the polydata.
+    """
+    writer = polydata_writer(_checked_polydata(polylines, point_arrays, cell_arrays))
+    writer.WriteToOutputStringOn()
+    if writer.Write() != 1:
+        raise OSError("vtk could not encode the polylines as .vtp")
+    return writer.GetOutputString().encode("ascii")  # binary mode writes base64 text inline
+
+
+def _checked_polydata(
+    polylines: Sequence[npt.ArrayLike],
+    point_arrays: Mapping[str, Sequence[npt.ArrayLike]] | None,
+    cell_arrays: Mapping[str, npt.ArrayLike] | None,
+):
+    """The checked polylines and their arrays as a ``vtkPolyData`` (InputDataError naming what does not fit)."""
     lines = [_check_polyline(p, i) for i, p in enumerate(polylines)]
     sizes = [len(p) for p in lines]
     points = np.concatenate(lines) if lines else np.zeros((0, 3))
     per_point = {name: _stack_point_array(name, arrays, sizes) for name, arrays in (point_arrays or {}).items()}
     per_cell = {name: _check_cell_array(name, values, len(lines)) for name, values in (cell_arrays or {}).items()}
-    poly = _polydata(points, sizes, per_point, per_cell)
-    _write_atomically(poly, path)
-    return path
+    return _polydata(points, sizes, per_point, per_cell)
 
 
 def _check_polyline(points: npt.ArrayLike, index: int) -> np.ndarray:

@@ -30,6 +30,7 @@ from softdesign.geometry.morph_fold import MORPH_Q_SAMPLES
 from softdesign.kinematics.links import link_breaks
 from softdesign.pipeline.fit_options import AUTO_START_SPACING_MM, wall_fit_options
 from softdesign.pipeline.item_progress import step_counter
+from softdesign.pipeline.parallel import map_items
 
 if TYPE_CHECKING:
     from softdesign.config import Case
@@ -69,9 +70,11 @@ def body_field(case: Case, ingest: IngestResult, shape: BlendedShape) -> RadiusF
 
 def body_morph(shape: BlendedShape, field: RadiusField) -> MorphFold:
     """The largest rho(q) * kappa_n(q) of the body over ``shape``'s morph (the fit stage's q grid)."""
-    # serial: on the build's workers this check took more wall time, not less (1M case, jobs 2: 2.5-3.1 s against
-    # 1.6-2.7 s; each worker rebuilds the blended shape's curves), where the fit stage's gained
-    return fold_over_morph(shape.curve_at, field, np.linspace(0.0, 1.0, MORPH_Q_SAMPLES))
+    # on the build's workers, as the fit stage's: each q's curve and fold margin are their own (the same CPU in a
+    # worker as here: the blend's shape is rebuilt after, so no later stage finds the curves built here either);
+    # on a busy machine (load 5) the workers waited on the other jobs and took longer, on free cores they halve
+    # the stage's largest step
+    return fold_over_morph(shape.curve_at, field, np.linspace(0.0, 1.0, MORPH_Q_SAMPLES), map_items)
 
 
 def body_folds(fold: MorphFold) -> bool:

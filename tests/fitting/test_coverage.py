@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from softdesign.fitting import coverage as cov
+from softdesign.fitting.metrics import summarize_distances, with_exact_max
 from softdesign.fitting.projection import project_points
 from softdesign.fitting.selection import NetworkContext, WallSelection, inscribed_profile
 from softdesign.fitting.wall_fit import WallFitOptions, fit_wall
@@ -106,3 +107,27 @@ def test_above_the_sample_bound_the_own_wall_is_sampled_at_one_rate_with_the_exa
     # points' rate, their share of the sample is the whole's to within a point's rounding (measured: -0.1 %); a
     # draw that favoured either stratum (all the unfitted, or none) would be off by tens of per cent
     assert sampled.rms_mm == pytest.approx(every.rms_mm, rel=0.02)
+
+
+def test_the_kept_points_exact_max_is_the_own_walls_when_the_own_wall_is_the_kept_points(monkeypatch):
+    curve, vertices, network = bulged_vessel(bulge=False)
+    fit = fit_wall(curve, vertices, network, WallFitOptions(), np.random.default_rng(0))
+    fitted = np.flatnonzero(np.isfinite(fit.distance))
+    assert np.array_equal(np.flatnonzero(cov.own_wall(fit.polar, fit.selection)), fitted)  # the shortcut's case
+    known = np.sort(np.random.default_rng(5).choice(fitted, size=len(fitted) // 4, replace=False))
+    monkeypatch.setattr(cov, "DISTANCE_SAMPLE_MAX", 100)
+    searched = _coverage(curve, fit, fitted, known=(known, fit.distance[known])).metrics
+    # the kept points' exact max as measure_distances makes it: the sample's, then the points left out searched
+    kept = fit.polar.subset(fitted)
+    sample = np.searchsorted(fitted, known)
+    kept_max = with_exact_max(curve, fit.surface.whole, kept, sample, summarize_distances(fit.distance[known])).max_mm
+    reused = cov.measure_coverage(curve, fit.surface.whole, fit.polar, fit.selection, fitted,
+                                  fit.settings.knot_spacing_mm, None, {}, known=(known, fit.distance[known]),
+                                  known_max=kept_max).metrics
+    assert reused == searched and searched.total == len(fitted) > searched.count  # to the bit, sampled
+    # where the own wall is not the kept points, a known max is not used (a wrong one changes nothing)
+    curve, fit, fitted = _fitted_case()
+    wrong = cov.measure_coverage(curve, fit.surface.whole, fit.polar, fit.selection, fitted,
+                                 fit.settings.knot_spacing_mm, None, {}, known=(fitted, fit.distance[fitted]),
+                                 known_max=123.0).metrics
+    assert wrong == _coverage(curve, fit, fitted, known=(fitted, fit.distance[fitted])).metrics

@@ -134,6 +134,21 @@ def test_distances_of_a_large_input_come_from_a_sample_and_the_max_from_every_po
     np.testing.assert_array_equal(again.sample, sampled.sample)
 
 
+def test_the_exact_max_with_its_bounds_on_workers_is_the_same(monkeypatch):
+    from softdesign.fitting import metrics as fm
+    from softdesign.pipeline.parallel import jobs_for_build, map_items
+
+    curve, noisy = _noisy_tube()
+    spline = fit_radius_surface(noisy, curve.length, FitSettings()).whole
+    sample = np.sort(np.random.default_rng(2).choice(len(noisy), size=400, replace=False))
+    first = fm.summarize_distances(np.zeros(400))  # a sample's max of 0: every other point's bound is doubtful
+    here = fm.with_exact_max(curve, spline, noisy, sample, first)
+    monkeypatch.setattr(fm, "PROJECT_BLOCK", 300)  # the other 2000 points in 7 blocks
+    with jobs_for_build(2):
+        forked = fm.with_exact_max(curve, spline, noisy, sample, first, map_items)
+    assert forked == here and here.max_mm == fm.closest_surface_points(curve, spline, noisy)[0].max()  # every point's
+
+
 def test_fold_solves_equal_fresh_fits_on_the_other_folds():
     curve, noisy = _noisy_tube()
     labels = fold_labels(len(noisy), 4, np.random.default_rng(3))
@@ -143,6 +158,27 @@ def test_fold_solves_equal_fresh_fits_on_the_other_folds():
         fresh = fit_radius_surface(noisy.subset(labels != k), curve.length, FitSettings()).whole
         np.testing.assert_array_equal(spline.knots, fresh.knots)
         np.testing.assert_allclose(spline.coefficients, fresh.coefficients, rtol=0, atol=1e-10)
+
+
+def test_each_folds_rows_assembled_apart_on_workers_give_the_same_solves_to_the_bit():
+    from softdesign.fitting.surface_system import design_matrix
+    from softdesign.pipeline.parallel import jobs_for_build, map_items
+
+    curve, noisy = _noisy_tube()
+    labels = fold_labels(len(noisy), 4, np.random.default_rng(3))
+    with jobs_for_build(2):
+        forked = fold_solver(noisy, curve.length, FitSettings(), labels, map_items)
+    here = fold_solver(noisy, curve.length, FitSettings(), labels)
+    # the assembly it replaced: one design matrix of every point, each fold's rows taken from it
+    knots = forked(0).knots
+    design = design_matrix(knots, FitSettings().angular_intervals, noisy.l, noisy.angle)
+    rows = np.flatnonzero(labels == 1)
+    alone = design_matrix(knots, FitSettings().angular_intervals, noisy.l[rows], noisy.angle[rows])
+    for mine, theirs in zip((alone.data, alone.indices, alone.indptr), (design[rows].data, design[rows].indices,
+                                                                         design[rows].indptr), strict=True):
+        np.testing.assert_array_equal(mine, theirs)
+    for k in range(4):
+        np.testing.assert_array_equal(forked(k).coefficients, here(k).coefficients)
 
 
 def test_folds_are_balanced_and_reproducible_from_the_seed():

@@ -49,3 +49,21 @@ def test_the_grid_on_two_worker_processes_gives_the_same_fold():
     with jobs_for_build(2):
         forked = fold_over_morph(shape, field, GRID, map_items)
     assert forked == fold_over_morph(shape, field, GRID)
+
+
+def test_the_reports_around_curves_built_here_are_kept_for_a_later_stage_and_only_for_those_curves():
+    from softdesign.fitting.radius_field import fold_margin, known_fold_margin
+    from softdesign.pipeline.parallel import jobs_for_build, map_items
+
+    curves = {q: Arc(20.0 / max(q, 1e-3), 0.5 * max(q, 1e-3)) for q in GRID.tolist()}
+    built = {q: curves[q] for q in GRID.tolist()[::2]}  # the curves "built already": every other q
+    field = _round_field(lambda l: np.full_like(l, RHO))
+    with jobs_for_build(2):  # the reports come back from the workers
+        fold_over_morph(curves.__getitem__, field, GRID, map_items, built=built.get)
+    for q, curve in curves.items():
+        kept = known_fold_margin(curve, field, q)
+        assert kept == fold_margin(curve, field, q)  # kept or computed, the same report
+        assert (kept is field.__dict__["_fold_cache"].get(q, (None, None))[1]) == (q in built)
+    other = Arc(10.0, 0.5)  # another curve at a kept q is computed, not answered from the kept report
+    answer = known_fold_margin(other, field, 0.0)
+    assert answer == fold_margin(other, field, 0.0) != fold_margin(curves[0.0], field, 0.0)

@@ -27,7 +27,7 @@ import numpy as np
 from softdesign.errors import ConfigError, MeshError
 from softdesign.io.formats import FILE_UNITS, mesh_bytes
 from softdesign.io.gltf_morph import morph_glb_bytes
-from softdesign.io.polylines_vtp import write_polylines_vtp
+from softdesign.io.polylines_vtp import polylines_vtp_bytes
 from softdesign.io.pvd import pvd_bytes
 from softdesign.meshing.body.morph import MorphSurfaces, morph_surfaces
 from softdesign.meshing.body.sections import body_breaks, body_sections, body_stations
@@ -66,6 +66,9 @@ class ExportedMesh:
     figures: dict[str, Any]
     centerline: dict[str, np.ndarray]
     pieces: tuple[RegionPiece, ...] = ()
+    #: the mesh's files in the output frame, encoded as the mesh arrived (:func:`_encoded`): (relative path, bytes)
+    #: in write order; empty until then
+    files: tuple[tuple[str, bytes], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -202,10 +205,18 @@ def run_export(case: Case, kinematics: KinematicsResult, fit: FitResult,
     longest = max(key.length for key in kinematics.chain.shape.keys)
     q_values = case.export.q_values()
     counted = item_counter("export", q_values, _mesh_label)  # the command line's per-mesh bar, when it listens
-    meshes = tuple(map_items(lambda q: _solid_naming_blend(kinematics, fit, q, case, sized), q_values,
-                             most=export_workers(case, longest), on_result=counted))
-    pose = output_pose(case.export.frame, base_pose(kinematics.chain.shape))  # checked first, then moved rigidly
-    meshes = tuple(_moved(m, pose) for m in meshes)
+    pose = output_pose(case.export.frame, base_pose(kinematics.chain.shape))  # each mesh checked, then moved rigidly
+    formats = tuple(case.export.formats)
+    arrived: list[ExportedMesh] = []
+
+    def encode(q: float, mesh: ExportedMesh) -> None:  # here, while the workers build the next meshes
+        arrived.append(_encoded(_moved(mesh, pose), formats))
+        if counted is not None:
+            counted(q, mesh)
+
+    map_items(lambda q: _solid_naming_blend(kinematics, fit, q, case, sized), q_values,
+              most=export_workers(case, longest), on_result=encode)
+    meshes = tuple(arrived)
     morph = None
     if "glb" in case.export.formats and len(meshes) >= 2:
         e = case.export
@@ -246,18 +257,25 @@ def _moved(mesh: ExportedMesh, pose: np.ndarray | None) -> ExportedMesh:
                    centerline=centerline, pieces=pieces)
 
 
+def _encoded(mesh: ExportedMesh, formats: tuple[str, ...]) -> ExportedMesh:
+    """``mesh`` with its files encoded: the solid in every format, each region piece's STL, the centerline's .vtp.
+
+    The export encodes each mesh as it arrives from the workers, while they build the next ones; writing them
+    is then only the staging's (:func:`write_export`).  The same bytes as encoding at the write.
+    """
+    solid = mesh.solid
+    files = [(mesh_name(mesh.q, fmt), mesh_bytes(solid.vertices, solid.faces, fmt, solid.regions)) for fmt in formats]
+    files += [(region_name(mesh.q, piece), mesh_bytes(piece.vertices, piece.faces, "stl")) for piece in mesh.pieces]
+    arrays = {k: [v] for k, v in mesh.centerline.items() if k != "points"}
+    files.append((layout.centerline_path(mesh.q), polylines_vtp_bytes([mesh.centerline["points"]], arrays)))
+    return replace(mesh, files=tuple(files))
+
+
 def write_export(result: ExportResult, staging: Staging) -> None:
-    """Stage every mesh file, the centerline of every q, and the figures."""
+    """Stage every mesh file, the centerline of every q (encoded by :func:`run_export`), and the figures."""
     for mesh in result.meshes:
-        for fmt in result.summary["formats"]:
-            solid = mesh.solid
-            staging.write_bytes(mesh_name(mesh.q, fmt), mesh_bytes(solid.vertices, solid.faces, fmt, solid.regions))
-        for piece in mesh.pieces:
-            staging.write_bytes(region_name(mesh.q, piece), mesh_bytes(piece.vertices, piece.faces, "stl"))
-        relative = layout.centerline_path(mesh.q)
-        arrays = {k: [v] for k, v in mesh.centerline.items() if k != "points"}
-        write_polylines_vtp(staging.staged_path(relative), [mesh.centerline["points"]], arrays)
-        staging.record(relative)
+        for relative, data in mesh.files:
+            staging.write_bytes(relative, data)
     series = {layout.CENTERLINES_PVD: [(m.q, layout.centerline_path(m.q)) for m in result.meshes],
               layout.MESHES_PVD: [(m.q, mesh_name(m.q, "vtp")) for m in result.meshes]}
     for name in result.summary.get("time_series", []):

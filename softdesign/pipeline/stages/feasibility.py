@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, cast
@@ -23,7 +25,7 @@ from typing import Any, cast
 import numpy as np
 
 from softdesign.config import Case
-from softdesign.fitting.radius_field import RadiusField, fold_margin
+from softdesign.fitting.radius_field import RadiusField, known_fold_margin
 from softdesign.fitting.strain import skin_metric
 from softdesign.geometry.blend import BlendedShape
 from softdesign.meshing.body.skin_stretch import (
@@ -168,7 +170,7 @@ def _at_q(body: _Body, q: float, case: Case) -> dict[str, Any]:
         "stretch_max": skin.maximum.value,
         "stretch_min": skin.minimum.value,
         "wall_min_mm": None,
-        "rho_kappa_max": fold_margin(cast(FramedCurve, body.shape.curve_at(q)), body.field, q).max_rho_kappa,
+        "rho_kappa_max": known_fold_margin(cast(FramedCurve, body.shape.curve_at(q)), body.field, q).max_rho_kappa,
         "where": {"stretch_max": _where(skin.maximum), "stretch_min": _where(skin.minimum)},
         "per_link": [{"stretch_max": hi, "stretch_min": lo} for hi, lo in skin.per_link],
         "grid": {"spacing_mm": skin.grid.spacing_mm, "angles": skin.grid.angles, "points": skin.grid.points,
@@ -188,12 +190,12 @@ def _at_q(body: _Body, q: float, case: Case) -> dict[str, Any]:
     return row
 
 
-def _morph_search(body: _Body, most: int | None) -> tuple[MorphExtreme, MorphExtreme]:
-    """Where over q in [0, 1] the skin's stretches are extreme: searched on the first grid (the outer skin).
+def _morph_samples(body: _Body, most: int | None) -> Callable[[float], StretchExtremes]:
+    """The outer skin's extremes on the first grid at the morph search's samples, on the build's workers; returns
+    the search's ``at(q)``, which reads them and computes any other q (the bounded search's) on that grid.
 
-    The search's first samples are independent and run on the build's worker processes; the bounded
-    search that follows asks for one q at a time.  Every q's extremes stay in ``body._first``: the
-    converged extremes of the outer skin at a q searched here start from them (:func:`_extremes`).
+    Every q's extremes stay in ``body._first``: the converged extremes of the outer skin at a q sampled here
+    start from them (:func:`_extremes`); the per-q work forks after this, so its workers find them too.
     """
     g = make_grid(body.length, body.field.breaks, START_SPACING_MM,
                   START_ANGLES_PER_INTERVAL * body.field.final[0].angular_intervals)
@@ -212,7 +214,20 @@ def _morph_search(body: _Body, most: int | None) -> tuple[MorphExtreme, MorphExt
             cache[q] = on_grid(q)
         return cache[q]
 
-    return search_morph(at)
+    return at
+
+
+def _morph_search(body: _Body, at: Callable[[float], StretchExtremes]
+                  ) -> tuple[tuple[MorphExtreme, MorphExtreme], tuple[StretchExtremes, StretchExtremes]]:
+    """Where over q in [0, 1] the skin's stretches are extreme (the bounded search on the first grid, from the
+    samples ``at`` holds), and the converged extremes of the outer skin without offset at the two q found.
+
+    One task of the per-q work (:func:`run_feasibility`): the search asks for one q at a time, so it runs on one
+    worker while the others make the export q's figures; the two converged polishes follow it there, where the
+    search's first grids at their q are kept.
+    """
+    found = search_morph(at)
+    return found, (_extremes(body, found[0].q, 0.0, (0.0, 1.0)), _extremes(body, found[1].q, 0.0, (0.0, 1.0)))
 
 
 def _morph(found: tuple[MorphExtreme, MorphExtreme], polished: tuple[StretchExtremes, StretchExtremes]
@@ -234,16 +249,18 @@ def run_feasibility(case: Case, kinematics: KinematicsResult, fit: FitResult) ->
     """Every figure, then the verdict against the case's material (if any)."""
     body = _Body(kinematics.chain.shape, fit.field, body_spec(case), case.frames)
     most = meshes_at_once(case, max(key.length for key in body.shape.keys))  # a wall map is one mesh's rings
-    found = _morph_search(body, most)  # first grid only, so its two converged polishes join the per-q work
-    work: list[tuple[str, float]] = [("q", q) for q in case.export.q_values()] + [("morph", m.q) for m in found]
+    at = _morph_samples(body, most)
+    # the morph's bounded search and its polishes first, on one worker, beside the export q's figures
+    work: list[tuple[str, float]] = [("morph", math.nan)] + [("q", q) for q in case.export.q_values()]
 
     def task(item: tuple[str, float]) -> Any:
         kind, q = item
-        return _at_q(body, q, case) if kind == "q" else _extremes(body, q, 0.0, (0.0, 1.0))
+        return _at_q(body, q, case) if kind == "q" else _morph_search(body, at)
 
-    counted = item_counter("feasibility", work, lambda item: f"skin at q = {item[1]:.3g}")  # a bar, when one listens
+    counted = item_counter("feasibility", work, lambda item: "skin over the morph" if item[0] == "morph" else
+                           f"skin at q = {item[1]:.3g}")  # a bar, when one listens
     done = map_items(task, work, most=most, on_result=counted)
-    rows, polished = done[:-2], (done[-2], done[-1])
+    (found, polished), rows = done[0], done[1:]
     per_link = []
     for j in range(len(fit.field.final)):
         links = [r["per_link"][j] for r in rows]

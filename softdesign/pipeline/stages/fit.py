@@ -18,10 +18,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from softdesign.errors import ConfigError, FitError, FoldError
+from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
 from softdesign.fitting.local_cap import check_caps_on_path
 from softdesign.fitting.morph_folds import fold_over_morph
-from softdesign.fitting.projection import project_points
+from softdesign.fitting.projection import PROJECT_BLOCK, project_points
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.selection import NetworkContext, inscribed_profile
 from softdesign.fitting.wall_fit import FIT_STEPS, fit_wall
@@ -121,7 +122,9 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
                                           mould=case.export.mould is not None,
                                           parting_local=_parting_local(chain) if case.export.mould else None)}
     # the fitted body itself at every q of the morph's search, not only at q = 1 (issue 29)
-    morph = fold_over_morph(chain.shape.curve_at, field, np.linspace(0.0, 1.0, MORPH_Q_SAMPLES), map_items)
+    # its reports around the export q's curves (kinematics built them) are kept for the feasibility's per-q figures
+    morph = fold_over_morph(chain.shape.curve_at, field, np.linspace(0.0, 1.0, MORPH_Q_SAMPLES), map_items,
+                            built=chain.shape.built_curve)
     summary["morph_fold"] = morph.as_dict()
     warning = morph.warning(chain.shape.mode)
     if warning is not None:
@@ -132,7 +135,7 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     stray = centerline_stray(case, curve.curve, path)
     if stray is not None:
         summary["centerline_stray"] = stray.replace("the cause is the centerline, not the fit: ", "the centerline, ")
-    residual = wall.polar.rho - field.evaluate_pairs(1.0, wall.polar.l, wall.polar.angle)
+    residual = wall.polar.rho - fitted_rho(field, wall.polar.l, wall.polar.angle)
     points = {
         "l": wall.polar.l,
         "angle": wall.polar.angle,
@@ -142,6 +145,19 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
         "distance": wall.distance,
     }
     return FitResult(field, summary, points)
+
+
+def fitted_rho(field: RadiusField, l: FloatArray, angle: FloatArray) -> FloatArray:
+    """rho(1, l, angle) of ``field`` at every point (n,), mm: ``PROJECT_BLOCK`` points a task on the build's workers.
+
+    Each point's value is its own (its link's spline at its l and angle), so the blocks give the numbers of one
+    ``evaluate_pairs`` call over all the points; a surface's worth of points (1M vertices) no longer waits on
+    this process alone.
+    """
+    blocks = bb.chunks(len(l), PROJECT_BLOCK)
+    if len(blocks) == 1:
+        return field.evaluate_pairs(1.0, l, angle)
+    return np.concatenate(map_items(lambda rows: field.evaluate_pairs(1.0, l[rows], angle[rows]), blocks))
 
 
 def _carried_to_chain(chain: LinkChain, vessel: Any) -> dict[str, Any]:
