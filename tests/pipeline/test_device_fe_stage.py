@@ -65,4 +65,18 @@ def test_a_device_that_stops_short_is_not_feasible_and_says_where() -> None:
     assert reason.startswith("FE: pressure does not reach the shape: the whole device in finite elements finds no "
                              "equilibrium past 85.2 kPa (10.0 % of P* 852.5 kPa), bent to q = 0.1")
     assert "largest stretch 2.15 in section 5" in reason and "material.min_wall_mm" in reason
+    assert "actuation.reinforcement.ends" not in reason  # a payload without the thread's ends offers none
     assert describe_device(summary)[0].startswith("q=0.5 (426.2 kPa): stopped at 85.2 kPa (q = 0.1), there against")
+
+
+@pytest.mark.parametrize(("ends", "offered"), [("bare", True), ("patch", False)])
+def test_a_stop_with_bare_ends_offers_patching_them(ends: str, offered: bool) -> None:
+    stopped = {**_solve(0.5, 200.0, 0.004), "max_stretch": {"value": 2.15, "section": 5},
+               "reached": {"load_factor": 0.2, "q": 0.1, "pressure_kpa": 85.25, "pressures_kpa": [85.25],
+                           "stopped_because": "the whole device: the solve stopped at 85.25 kPa"}}
+    stopped["thread"] = {**stopped["thread"], "ends": ends}
+    judgement = device_judgement({"solves": [stopped]})
+    assert judgement is not None
+    (reason,) = judgement.reasons
+    assert ("patch them (actuation.reinforcement.ends: patch)" in reason) is offered
+    assert "material.min_wall_mm" in reason

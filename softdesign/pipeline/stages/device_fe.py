@@ -38,7 +38,8 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:
     from softdesign.config import Case
 
-VERSION = 3  # 2: area-matched polygons, the backbone thread embedded in the elements; 3: a stop is kept, judged
+VERSION = 4  # 2: area-matched polygons, the backbone thread embedded in the elements; 3: a stop is kept, judged;
+#             4: the thread's stabilised rule, patched ends, the thread's ends in the figures
 SUMMARY = "simulate/device.json"
 
 
@@ -132,8 +133,15 @@ def stop_reason(solve: dict[str, Any]) -> str:
     return (f"FE: pressure does not reach the shape: the whole device in finite elements finds no equilibrium past "
             f"{at}, bent to q = {held['q']:.3g} (the designed chain within {solve['versus_design']['max_mm']:.3g} "
             f"mm there; largest stretch {stretch['value']:.2f} in section {stretch['section']}): the design asks "
-            "more pressure than the body holds (a chamber's end carries no thread); ask less curvature per "
-            "pressure (larger chambers further from the axis, a thinner material.min_wall_mm) and check again")
+            f"more pressure than the body holds; {_stop_fix(solve.get('thread'))}ask less curvature per pressure "
+            "(larger chambers further from the axis, a thinner material.min_wall_mm) and check again")
+
+
+def _stop_fix(thread: dict[str, Any] | None) -> str:
+    """The end reinforcement a stopped device's reason offers: patched ends when its chambers' ends are bare."""
+    if thread is None or thread.get("ends") != "bare":
+        return ""
+    return "its chambers' ends carry no thread: patch them (actuation.reinforcement.ends: patch), or "
 
 
 def device_judgement(summary: dict[str, Any] | None) -> Judgement | None:
