@@ -80,3 +80,17 @@ def test_a_stop_with_bare_ends_offers_patching_them(ends: str, offered: bool) ->
     (reason,) = judgement.reasons
     assert ("patch them (actuation.reinforcement.ends: patch)" in reason) is offered
     assert "material.min_wall_mm" in reason
+
+
+def test_a_device_that_reaches_its_load_off_the_shape_is_not_feasible() -> None:
+    solve = _solve(1.0, 900.0, 0.01)
+    solve["sections"] = [{"section": 1, "kappa": 0.0101, "designed": {"kappa": 0.01}},
+                         {"section": 2, "kappa": 0.0713, "designed": {"kappa": 0.0386}}]
+    within = device_judgement({"solves": [solve], "shape_tolerance_mm": 0.5})  # the solve is 0.42 mm off
+    assert within is not None and not within.reasons and within.margins
+    off = device_judgement({"solves": [solve], "shape_tolerance_mm": 0.4})
+    assert off is not None and not off.margins
+    (reason,) = off.reasons
+    assert reason.startswith("FE at q = 1: pressure does not reach the shape: the whole device in finite elements "
+                             "lies 0.42 mm from the designed chain (the furthest arc section 2's, kappa 0.0713 1/mm "
+                             "against 0.0386 designed) > simulate.shape_tolerance_mm 0.4")
