@@ -215,11 +215,11 @@ def _end_notes(pressure_kpa: float, modulus_kpa: float, ends: str, what: str = "
     holds; none for patched ends (``ends``), which no closed form bounds: the whole-device FE is their check.
 
     Model: the end is taken as a cavity in an incompressible neo-Hookean solid of shear modulus ``E / 3``, which
-    has no equilibrium above ``END_LIMIT_MU`` mu (an upper bound: a finite body and a cylinder's corner give way
-    sooner).  The whole-device finite elements (``softdesign simulate --all``) of the sample single-supply case
-    stop at 2.2 mu and of the VMTK aorta at 1.8 mu, with the largest stretches where a chamber's threaded wall
-    meets its end.  The pressure scales with E, so a stiffer silicone does not help: the design must ask less
-    pressure (or the ends be held otherwise).
+    has no equilibrium above ``END_LIMIT_MU`` mu (a spherical cavity in an infinite body: a scale, not a bound for
+    a cylinder's flat end).  The finite elements' bare ends give way near it: the 12 mm test section's at 2.4 mu
+    (tests/mechanics/test_chamber_ends.py), the whole sample single-supply device's (``softdesign simulate
+    --all``) near 3.7 mu and the VMTK aorta's at 2.9 mu.  The pressure scales with E, so a stiffer silicone does
+    not help: the design must ask less pressure, or the ends be patched (``actuation.reinforcement.ends``).
     """
     mu = modulus_kpa / 3.0
     if ends == "patch" or pressure_kpa <= END_LIMIT_MU * mu:

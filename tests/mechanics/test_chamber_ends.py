@@ -21,10 +21,11 @@ from tests.helpers.fe_meshes import three_chamber_section
 from tests.mechanics.test_reinforced_section import LAW, MU, SHAPE, SIZE_MM, THREAD
 
 #: A cavity in an incompressible neo-Hookean solid has no equilibrium past 5 mu / 2 (a spherical cavity in an
-#: infinite body): an upper bound for a cylinder's flat end (its corner and the finite wall give way sooner).
+#: infinite body): the scale of a flat end's limit, not a bound for it.
 CAVITY_LIMIT_MU = 2.5
-#: The bare end gives way above this (measured 2.38 mu; the winding holds the wall, so the figure is the end's).
-BARE_FLOOR_MU = 2.0
+#: The bare end gives way within this share of the cavity's limit (measured 2.38 mu, -5 %; the winding holds the
+#: wall, so the figure is the end's).
+CAVITY_RTOL = 0.2
 #: The patched section must hold this: well past the cavity's limit.
 PATCHED_HOLDS_MU = 4.0
 SETTINGS = NewtonSettings(load_steps=8, max_cutbacks=12)
@@ -45,7 +46,8 @@ def _largest_pressure(patched: bool, asked_kpa: float) -> float:
 def test_bare_ends_give_way_near_a_cavitys_limit_pressure() -> None:
     # about 50 s of CPU
     held = _largest_pressure(False, 2 * PATCHED_HOLDS_MU * MU) / MU
-    assert BARE_FLOOR_MU < held < CAVITY_LIMIT_MU
+    # 2 * 4 mu asked: the patched figure's load, twice (the bare end must stop by itself, not at the asked load)
+    assert abs(held / CAVITY_LIMIT_MU - 1.0) < CAVITY_RTOL
 
 
 @pytest.mark.slow
