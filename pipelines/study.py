@@ -26,6 +26,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))  # the tests' helpers: each study is defined once, beside its test
 
+from tests.helpers.fibre_rules import six_point_share  # noqa: E402
 from tests.helpers.refinement_study import (  # noqa: E402
     LEVELS,
     RECORDED,
@@ -60,7 +61,8 @@ def run_study(study: Study, out: Path) -> None:
         "study": study.name,
         "pressure_kpa": STUDY_KPA,
         "thread": None if thread is None else {"pitch_mm": thread.pitch_mm, "diameter_mm": thread.diameter_mm,
-                                               "modulus_kpa": thread.modulus_kpa, "rule": study.rule},
+                                               "modulus_kpa": thread.modulus_kpa, "rule": study.rule,
+                                               "six_point_share": six_point_share(study.rule)},
         "levels": levels,
     }
     tmp = out.with_suffix(".json.tmp")

@@ -100,6 +100,9 @@ class Reinforcement(BaseModel):
     """The thread (hoops and the inextensible backbone)."""
     safety_factor: FiniteFloat = Field(4.0, ge=1.0, le=MAX_SAFETY_FACTOR)
     """A turn's tension may reach the thread's breaking load over this factor."""
+    ends: Literal["bare", "patch"] = "bare"
+    """bare: a chamber's flat ends are silicone alone; patch: a disc woven of the thread (two crossed layers at the
+    pitch) on each end of a chamber core (the FE models it; the rod model does not need it)."""
 
 
 class Actuation(BaseModel):

@@ -57,6 +57,10 @@ class Simulate(BaseModel):
     """Forward solves one inverse (one section, one q) may take."""
     timeout_s: FiniteFloat = Field(600.0, gt=0.0, le=MAX_SIMULATE_SECONDS)
     """Longest time the solves of one section (every q) may take, s; the build then fails and says so."""
+    shape_tolerance_mm: FiniteFloat = Field(2.0, gt=0.0, le=MAX_SIMULATE_SIZE_MM)
+    """supply: single: the whole device's deformed centerline may lie this far from the designed chain at each
+    exported q, mm (the design's 1 mm and as much again for the models' difference); further, pressure does not
+    reach the shape and the verdict says NOT feasible."""
 
     @field_validator("q")
     @classmethod

@@ -37,7 +37,17 @@ Direction
     into the wall.  One helix, one hand: a right-handed winding (its twist
     coupling goes as ``cos(beta)``, 1 % at a pitch of a tenth of the
     circumference).  The caps of a chamber (faces whose normal is within 45
-    degrees of the axis) carry no thread.
+    degrees of the axis) carry no winding.
+End patches
+    A bare cap is a cavity's end in rubber, which has no equilibrium past
+    about 5 mu / 2 (a spherical cavity's limit; the test section below stops
+    at 95 kPa, 2.4 mu).  With ``patched_ends`` each cap face carries two
+    crossed families of the same thread at the same pitch, each with the
+    winding's energy: a disc woven of the thread laid on each end of the
+    core before casting.  A flat patch carries the cap's pressure as a
+    membrane once it dishes, so its tension is not the winding's
+    ``P r pitch``; the finite elements report it (the largest tension is
+    over every fibre, winding and patches).
 Assumptions
     The thread is bonded to the silicone (no slip), thin against the wall
     (its bending stiffness is left out but for its buckling), linear elastic,
@@ -48,24 +58,46 @@ Derivatives
     ``W'' = k / 4``, or ``-k e_b / 2`` and 0 when buckled),
     ``f_b = sum_q w 2 W' a D_b`` and ``K_bc = sum_q w D_b D_c [4 W'' a (x) a + 2 W' I]``:
     the exact Hessian but at the buckling kink (the tests check it against finite differences).
-Integration: one point per face
-    The fibre energy is integrated at each face's centroid alone (weight
-    the face's area), not by the pressure's six-point rule.  A thread of
-    ``k`` ~ 1e5 times the wall's stiffness is nearly a constraint, and six
-    points (three would do as much: the hoop strain of a quadratic face is
-    linear on it) impose three per face, more than the wall's nodes can meet
-    with the silicone's own deformation: the discrete wall locks, as a fully
-    integrated nearly incompressible solid does (the cure is the same:
-    reduced integration, equivalent to a fibre tension constant per face,
-    Malkus and Hughes 1978).  Measured with a kevlar-like thread on the
-    per-chamber sample case's first section at 5 kPa in one chamber: six
-    points took 48 Newton iterations and 213 s (the hoop thread's force
-    134 times ``P r pitch``); one point takes 5 per load step, 16 s, and on
-    the whole single-supply device at 4.5 kPa the hoop force matches
-    ``P r pitch`` within 2 %.  The price: where a chamber has few wall faces
-    the hoop is a little slack (the sample's 1 mm chambers in a 3 mm mesh bend
-    their section 9.7 % less than the rod model, six points 2.4 %).  The long straight section's curvature against
-    ``P A d / (E I)``: -2.3 % with six points, -3.0 % with one (tests).
+Integration: the centroid, stabilised by a share on six points
+    A thread of ``k`` ~ 1e5 times the wall's stiffness is nearly a
+    constraint.  Integrated by the pressure's six-point rule alone, it imposes
+    three hoop conditions per face (the hoop strain of a quadratic face is
+    linear on it), more than a coarse wall's nodes can meet with the
+    silicone's own deformation (the wall locks, as a fully integrated nearly
+    incompressible solid does), and the points' buckling kinks switch: on
+    the whole sample device with patched ends, asked 446 kPa, Newton cycled
+    (residuals 1e0-1e3 mN for 12 iterations) and the steps halved until the
+    solve crept, 1.3 % of the load in six minutes.  At the face's centroid
+    alone (reduced
+    integration, a fibre tension constant per face, as Malkus and Hughes
+    1978 for incompressibility) the device converges in 5-6 iterations a step,
+    but the rule has a zero-energy (hourglass) mode: a face's corner nodes
+    moving out and its midside nodes in leaves the centroid's hoop length
+    unchanged.  A chamber's end, where the wall carries the largest stretch,
+    falls into it: on the reinforced test section (below) the corner-node
+    rings alternated along the chamber at radii 1.50-1.74 and 0.25-0.55 mm
+    (from 1.0) with the centroids' thread strain under 1.8e-3, and the
+    section's largest pressure was the mode's, not the rubber's.
+    The rule here is both, as hourglass control by a fraction of the full
+    rule (Belytschko and Bindeman's stabilised one-point elements): the
+    energy is ``(1 - s) w_c W(e_c) + s sum_q w_q W(e_q)`` per face, the
+    centroid's and the six points', a share ``s`` = ``FIBRE_STABILISATION``.
+    The mode then stores ``s`` of the full rule's energy, a stiffness
+    ``s k`` still 50-5000 times the wall's ``E t`` (``k`` is 1e3-1e5 times
+    it for the threads here); the constant-strain part (any uniform
+    hoop stretch) is the same on both rules.  The share is the smallest
+    that holds the mode: one chamber of the 12 mm test section (R 5 mm, a
+    2 mm chamber at 2.5 mm, 1.5 mm end walls, mu 40 kPa) pressurised past
+    its bare ends' limit stops at 75.4 kPa on the centroid alone (the mode),
+    90.4 kPa with 1 %, 95.1 kPa with 5 % and 98.8 kPa with the six-point rule
+    alone, near the 2.5 mu = 100 kPa past which a cavity in this rubber has
+    no equilibrium.  5 % is within 4 % of the full rule's limit; 1 % is 8.5 %
+    short.  Where a chamber has few wall faces the centroid alone also left
+    the hoop slack: the per-chamber sample's first section (0.8-1.1 mm
+    chambers in a 3 mm mesh) bent 9.7 % less than the rod model, 2.4 % with
+    six points alone, 2.7 % with the 5 % share.  The other known answers are
+    the tests' (the long section against ``P A d / (E I)``, symmetry, two
+    opposite sections, the rod model of a one-section device).
 Newton's method
     The derivative's fibre tension is the mixed method's (as the element
     pressure in :mod:`softdesign.mechanics.newton`): a fibre strain carried
@@ -97,17 +129,20 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from softdesign.mechanics.quadratic_pressure import triangle_shapes
+from softdesign.mechanics.quadratic_pressure import TRI_POINTS, TRI_WEIGHTS, triangle_shapes
 from softdesign.mechanics.tets import node_dofs, summed
 from softdesign.types import FloatArray, IntArray
 
 #: A wall face whose normal is within this angle of the chamber's axis is a cap: no thread on it, rad.
 CAP_ANGLE_RAD = math.pi / 4
 
-#: The fibres' rule on a 6-node face: one point, its centroid, weight 1/2 (the reference triangle's area); see
-#: "Integration" in the module's docstring.
-_, FIBRE_DXI, FIBRE_DETA = triangle_shapes(np.array([[1.0 / 3.0, 1.0 / 3.0]]))
-FIBRE_WEIGHTS = np.array([0.5])
+#: The share of the thread's energy on the six-point rule, the rest at each face's centroid: hourglass control
+#: (see "Integration" in the module's docstring).
+FIBRE_STABILISATION = 0.05
+#: The fibres' rule on a 6-node face: the centroid (weight (1 - s) / 2, the reference triangle's area times the
+#: centroid's share) and the pressure's six points (weights s times theirs, which sum to 1/2).
+_, FIBRE_DXI, FIBRE_DETA = triangle_shapes(np.vstack([[[1.0 / 3.0, 1.0 / 3.0]], TRI_POINTS]))
+FIBRE_WEIGHTS = np.concatenate([[0.5 * (1.0 - FIBRE_STABILISATION)], FIBRE_STABILISATION * TRI_WEIGHTS])
 
 
 @dataclass(frozen=True)
@@ -119,11 +154,14 @@ class HoopThread:
     pitch_mm : axial distance between turns, mm (> 0)
     diameter_mm : the thread's diameter, mm (> 0)
     modulus_kpa : the thread's Young's modulus in tension, kPa (> 0)
+    patched_ends : a woven patch of the same thread, two crossed families each at the pitch, over each chamber's
+        ends (the caps); False: bare caps
     """
 
     pitch_mm: float
     diameter_mm: float
     modulus_kpa: float
+    patched_ends: bool = False
 
     def __post_init__(self) -> None:
         values = (self.pitch_mm, self.diameter_mm, self.modulus_kpa)
@@ -239,15 +277,10 @@ class FibreMembrane:
                                                              -self.buckling_strain[:, None])
 
 
-def _surface_tangents(points: FloatArray, faces: IntArray) -> tuple[FloatArray, FloatArray]:
-    """``dX/dxi`` and ``dX/deta`` (F, Q, 3) of 6-node faces at the rule's points, reference mm."""
-    x = points[faces]
-    return np.einsum("qb,fbi->fqi", FIBRE_DXI, x), np.einsum("qb,fbi->fqi", FIBRE_DETA, x)
-
-
 def hoop_membrane(points: FloatArray, faces: IntArray, axes: FloatArray, radii_mm: FloatArray,
                   thread: HoopThread, matrix_modulus_kpa: float) -> FibreMembrane:
-    """The hoop thread's membrane on chamber walls (see the module's docstring).
+    """The hoop thread's membrane on chamber walls (see the module's docstring), and its end patches' if
+    ``thread.patched_ends``.
 
     Parameters
     ----------
@@ -258,30 +291,67 @@ def hoop_membrane(points: FloatArray, faces: IntArray, axes: FloatArray, radii_m
     thread : the thread
     matrix_modulus_kpa : the silicone's Young's modulus, kPa (holds the thread sideways: its buckling strain)
 
-    Faces whose normal lies within ``CAP_ANGLE_RAD`` of the axis (the chamber's caps) are left out.
+    Faces whose normal lies within ``CAP_ANGLE_RAD`` of the axis are the chamber's caps: no winding on them; a
+    patch's two crossed families when the ends are patched.  The fibres are the side faces' (in ``faces``'s
+    order), then each patched cap's twice (its two families).
     """
-    x_xi, x_eta = _surface_tangents(points, faces)
-    normal = np.cross(x_xi, x_eta)
-    area = np.linalg.norm(normal, axis=2)
-    n = normal / area[..., None]
+    wall = _WallGeometry.of(points, faces)
     t = np.asarray(axes, float) / np.linalg.norm(axes, axis=1)[:, None]
-    side = np.abs(np.einsum("fqi,fi->fq", n, t)).max(axis=1) < math.cos(CAP_ANGLE_RAD)
-    along = t[:, None, :] - np.einsum("fqi,fi->fq", n, t)[..., None] * n
-    along /= np.maximum(np.linalg.norm(along, axis=2), 1e-300)[..., None]  # caps (zero here) are dropped below
-    beta = np.array([thread.winding_angle_rad(float(r)) for r in radii_mm])[:, None, None]
-    a0 = np.cos(beta) * along + np.sin(beta) * np.cross(n, along)
-    # a0 = alpha X_xi + beta X_eta: the metric's inverse on the tangents' projections
-    g = np.stack([np.stack([np.einsum("fqi,fqi->fq", u, v) for v in (x_xi, x_eta)], -1) for u in (x_xi, x_eta)], -2)
-    rhs = np.stack([np.einsum("fqi,fqi->fq", u, a0) for u in (x_xi, x_eta)], axis=-1)
-    coeff = np.linalg.solve(g, rhs[..., None])[..., 0]  # (F, Q, 2)
-    directions = coeff[..., :1] * FIBRE_DXI[None] + coeff[..., 1:] * FIBRE_DETA[None]
-    reference = np.einsum("fqb,fbi->fqi", directions, np.asarray(points, float)[faces])
-    length = np.linalg.norm(reference, axis=2)  # 1 within the metric solve's round-off (1e-13): made unit
-    length = np.where(length > 0.0, length, 1.0)  # caps' zero fibres (dropped below)
-    directions, reference = directions / length[..., None], reference / length[..., None]
-    keep = side
-    count = int(keep.sum())
-    return FibreMembrane(np.asarray(faces, np.int64)[keep], directions[keep], reference[keep],
-                         (FIBRE_WEIGHTS[None] * area)[keep],
+    side = np.abs(np.einsum("fqi,fi->fq", wall.normal, t)).max(axis=1) < math.cos(CAP_ANGLE_RAD)
+    n = wall.normal[side]
+    along = t[side, None, :] - np.einsum("fqi,fi->fq", n, t[side])[..., None] * n
+    along /= np.linalg.norm(along, axis=2)[..., None]
+    beta = np.array([thread.winding_angle_rad(float(r)) for r in radii_mm[side]])[:, None, None]
+    parts = [(side, np.cos(beta) * along + np.sin(beta) * np.cross(n, along))]
+    if thread.patched_ends and not side.all():
+        parts += [(~side, a0) for a0 in _patch_directions(wall.normal[~side])]
+    chosen = np.concatenate([np.flatnonzero(keep) for keep, _ in parts])
+    fibres = [wall.fibres(np.flatnonzero(keep), a0) for keep, a0 in parts]
+    count = len(chosen)
+    return FibreMembrane(np.asarray(faces, np.int64)[chosen], np.concatenate([d for d, _ in fibres]),
+                         np.concatenate([r for _, r in fibres]), (FIBRE_WEIGHTS[None] * wall.area)[chosen],
                          np.full(count, thread.stiffness_mn_per_mm), np.full(count, thread.axial_stiffness_mn),
                          np.full(count, thread.buckling_strain(matrix_modulus_kpa)))
+
+
+def _patch_directions(normal: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """A woven patch's two crossed families (F, Q, 3) in the tangent planes of normals ``normal`` (F, Q, 3): the
+    global axis least aligned with each face's normal, projected into its plane, and the normal's cross with it."""
+    pick = np.argmin(np.abs(normal).mean(axis=1), axis=1)  # per face, so that its points share one weave
+    helper = np.eye(3)[pick][:, None, :]
+    first = helper - np.einsum("fqi,fqi->fq", normal, np.broadcast_to(helper, normal.shape))[..., None] * normal
+    first /= np.linalg.norm(first, axis=2)[..., None]
+    return first, np.cross(normal, first)
+
+
+@dataclass(frozen=True)
+class _WallGeometry:
+    """6-node faces' surface map at the fibres' rule points: tangents ``dX/dxi``, ``dX/deta``, unit normals and area
+    Jacobians (F, Q), reference mm."""
+
+    nodes: FloatArray  #: (F, 6, 3) the faces' reference nodes, mm
+    x_xi: FloatArray
+    x_eta: FloatArray
+    normal: FloatArray
+    area: FloatArray
+
+    @classmethod
+    def of(cls, points: FloatArray, faces: IntArray) -> _WallGeometry:
+        x = np.asarray(points, float)[faces]
+        x_xi, x_eta = np.einsum("qb,fbi->fqi", FIBRE_DXI, x), np.einsum("qb,fbi->fqi", FIBRE_DETA, x)
+        normal = np.cross(x_xi, x_eta)
+        area = np.linalg.norm(normal, axis=2)
+        return cls(x, x_xi, x_eta, normal / area[..., None], area)
+
+    def fibres(self, rows: IntArray, a0: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """``D_b`` (k, Q, 6) and the unit reference fibre ``A`` (k, Q, 3) along the tangent directions ``a0``
+        (k, Q, 3) on faces ``rows``: ``a0 = alpha X_xi + beta X_eta``, the metric's inverse on the tangents'
+        projections."""
+        tangents = (self.x_xi[rows], self.x_eta[rows])
+        g = np.stack([np.stack([np.einsum("fqi,fqi->fq", u, v) for v in tangents], -1) for u in tangents], -2)
+        rhs = np.stack([np.einsum("fqi,fqi->fq", u, a0) for u in tangents], axis=-1)
+        coeff = np.linalg.solve(g, rhs[..., None])[..., 0]  # (k, Q, 2)
+        directions = coeff[..., :1] * FIBRE_DXI[None] + coeff[..., 1:] * FIBRE_DETA[None]
+        reference = np.einsum("fqb,fbi->fqi", directions, self.nodes[rows])
+        length = np.linalg.norm(reference, axis=2)[..., None]  # 1 within the metric solve's round-off (1e-13)
+        return directions / length, reference / length

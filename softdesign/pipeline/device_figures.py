@@ -100,9 +100,11 @@ def _extreme(e: Any) -> dict[str, Any]:
     return {"value": e.value, "section": e.section + 1, "at_mm": np.round(e.at, 4).tolist()}
 
 
-def _thread(outcome: Any, extreme: Any, pressures: list[float], top: float | None) -> dict[str, Any] | None:
+def _thread(outcome: Any, extreme: Any, pressures: list[float], top: float | None, ends: str | None = None
+            ) -> dict[str, Any] | None:
     """A thread's largest tension (N) against its limit and, for the hoop thread of a single supply (``top``: P*),
-    the rod model's tension per turn P r pitch."""
+    the rod model's tension per turn P r pitch; ``ends``: the hoop thread's chamber ends (bare, or patched: the
+    largest tension is then over the winding and the patches)."""
     if extreme is None:
         return None
     summary = outcome.results["actuation"].summary
@@ -112,7 +114,8 @@ def _thread(outcome: Any, extreme: Any, pressures: list[float], top: float | Non
         rod = max(c["tension_per_turn_n"] for s in summary["sections"] for c in s["chambers"]) * pressures[0] / top
     value = extreme.value * 1e-3
     return {**_extreme(extreme), "value": value, "unit": "N", "limit_n": limit,
-            "fraction_of_limit": None if not limit else value / limit, "rod_model_n": rod}
+            "fraction_of_limit": None if not limit else value / limit, "rod_model_n": rod,
+            "ends": ends}
 
 
 def device_payload(outcome: Any, o: Any, device: Any, material: Any, loads: tuple[float, list[float], float | None],
@@ -151,7 +154,7 @@ def device_payload(outcome: Any, o: Any, device: Any, material: Any, loads: tupl
         "sections": sections,
         "max_stretch": {**_extreme(figures.stretch), "limit": material.max_stretch},
         "max_stress_kpa": {**_extreme(figures.stress), "tensile_strength_kpa": material.tensile_strength_kpa},
-        "thread": _thread(outcome, figures.thread, pressures, top),
+        "thread": _thread(outcome, figures.thread, pressures, top, outcome.case.actuation.reinforcement.ends),
         "backbone_thread": _thread(outcome, figures.backbone, pressures, None),
         "tie_gap_mm": figures.tie_gap_mm,
         "convergence": [{"load_factor": t, "iterations": n, "residuals_mN": h}
@@ -207,5 +210,6 @@ def _limit_lines(payload: dict[str, Any]) -> list[str]:
             continue
         limit = f" of {t['limit_n']:.3g} N limit ({100 * t['fraction_of_limit']:.1f} %)" if t["limit_n"] else ""
         rod = f"; rod model P r pitch {t['rod_model_n']:.3g} N per turn" if t["rod_model_n"] is not None else ""
+        what = "hoop thread (winding and end patches)" if t.get("ends") == "patch" else what
         lines.append(f"{what} tension {t['value']:.3g} N in section {t['section']}{limit}{rod}")
     return lines

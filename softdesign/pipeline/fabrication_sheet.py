@@ -129,6 +129,11 @@ def _winding(reinforcement: dict[str, Any] | None) -> list[str]:
              "| section | chamber | turns | tension per turn N | limit N |", "|---|---|---|---|---|"]
     lines += [f"| {w['section']} | {w['chamber']} | {w['turns']} | {w['tension_per_turn_n']:.2f} | "
               f"{w['tension_limit_n']:.2f} |" for w in reinforcement["windings"]]
+    if reinforcement.get("ends") == "patch":
+        lines += ["", f"- end patches: on each end of every chamber core, before casting, a disc woven of "
+                      f"{thread['name']} in two crossed layers at the pitch ({reinforcement['pitch_mm']:.2f} mm), as "
+                      "wide as the core's end (actuation.reinforcement.ends); their tension is the finite elements' "
+                      "(`softdesign simulate CASE --all`), not the table's P r pitch"]
     return [*lines, ""]
 
 

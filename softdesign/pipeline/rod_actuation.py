@@ -180,7 +180,7 @@ def _single(case: Case, kinematics: KinematicsResult, fit: FitResult, design: De
                                     [min(s["chambers"][0]["diameter_mm"].values()) for s in sections], lost=True,
                                     strand_mm=STRAND_FRACTION * narrowest)
     warnings += _core_notes(summary["cores"])
-    warnings += _end_notes(float(summary["design_pressure_kpa"]), setup.modulus_kpa)
+    warnings += _end_notes(float(summary["design_pressure_kpa"]), setup.modulus_kpa, _ends(case))
     warnings += [_slant_note(c) for c in summary["channels"]
                  if c["width_mm"] < MIN_CHANNEL_WIDTH_FRACTION * c["diameter_mm"]]
     document = rod_document(case, single.device.body, single.problem.stations.chamber, rod_extra(single))
@@ -205,34 +205,40 @@ def channel_figures(single: SingleDesign) -> list[dict[str, Any]]:
 END_LIMIT_MU = 2.5
 
 
-def _end_notes(pressure_kpa: float, modulus_kpa: float, what: str = "P*") -> list[str]:
-    """A warning when ``what`` (P*, or the per-chamber table's highest pressure) passes what a chamber's end holds.
+def _ends(case: Any) -> str:
+    """``actuation.reinforcement.ends`` (bare without an actuation block)."""
+    return "bare" if case.actuation is None else str(case.actuation.reinforcement.ends)
+
+
+def _end_notes(pressure_kpa: float, modulus_kpa: float, ends: str, what: str = "P*") -> list[str]:
+    """A warning when ``what`` (P*, or the per-chamber table's highest pressure) passes what a chamber's bare end
+    holds; none for patched ends (``ends``), which no closed form bounds: the whole-device FE is their check.
 
     Model: the end is taken as a cavity in an incompressible neo-Hookean solid of shear modulus ``E / 3``, which
-    has no equilibrium above ``END_LIMIT_MU`` mu (an upper bound: a finite body and a cylinder's corner give way
-    sooner).  The whole-device finite elements (``softdesign simulate --all``) of the sample single-supply case
-    stop at 2.2 mu and of the VMTK aorta at 1.8 mu, with the largest stretches where a chamber's threaded wall
-    meets its end.  The pressure scales with E, so a stiffer silicone does not help: the design must ask less
-    pressure (or the ends be held otherwise).
+    has no equilibrium above ``END_LIMIT_MU`` mu (a spherical cavity in an infinite body: a scale, not a bound for
+    a cylinder's flat end).  The finite elements' bare ends give way near it: the 12 mm test section's at 2.4 mu
+    (tests/mechanics/test_chamber_ends.py), the whole sample single-supply device's (``softdesign simulate
+    --all``) near 3.7 mu and the VMTK aorta's at 2.9 mu.  The pressure scales with E, so a stiffer silicone does
+    not help: the design must ask less pressure, or the ends be patched (``actuation.reinforcement.ends``).
     """
     mu = modulus_kpa / 3.0
-    if pressure_kpa <= END_LIMIT_MU * mu:
+    if ends == "patch" or pressure_kpa <= END_LIMIT_MU * mu:
         return []
     return [f"{what} {pressure_kpa:.1f} kPa is {pressure_kpa / mu:.1f} times the silicone's shear modulus "
             f"({mu:.1f} kPa): a chamber's end carries no thread, and a cavity in this rubber has no equilibrium "
             f"past {END_LIMIT_MU:g} times it, so the ends are likely to balloon before it (a stiffer silicone "
             "raises the pressure alike); check with `softdesign simulate CASE --all`, which reports the largest "
-            "pressure it reaches, and ask less curvature per pressure (larger chambers further from the axis, a "
-            "thinner material.min_wall_mm)"]
+            "pressure it reaches, and patch the ends (actuation.reinforcement.ends: patch) or ask less curvature per "
+            "pressure (larger chambers further from the axis, a thinner material.min_wall_mm)"]
 
 
-def table_end_notes(rows: list[dict[str, Any]], modulus_kpa: float | None) -> list[str]:
+def table_end_notes(rows: list[dict[str, Any]], modulus_kpa: float | None, ends: str) -> list[str]:
     """``supply: per_chamber``'s end-limit warning (:func:`_end_notes`) on the table's highest pressure."""
     pressured = [r for r in rows if r.get("pressure_kpa") is not None]
     if modulus_kpa is None or not pressured:
         return []
     top = max(pressured, key=lambda r: r["pressure_kpa"])
-    return _end_notes(float(top["pressure_kpa"]), modulus_kpa,
+    return _end_notes(float(top["pressure_kpa"]), modulus_kpa, ends,
                       f"the table's highest pressure (section {top['section']}, chamber {top['chamber']}, "
                       f"q = {top['q']:g})")
 

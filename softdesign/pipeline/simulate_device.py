@@ -88,7 +88,7 @@ def device_threads(case: Any) -> tuple[Any, Any]:
 
     r = actuation.reinforcement
     data = thread_presets()[r.thread.name]
-    thread = HoopThread(r.pitch_mm, data.diameter_mm, data.modulus_gpa * 1.0e6)
+    thread = HoopThread(r.pitch_mm, data.diameter_mm, data.modulus_gpa * 1.0e6, patched_ends=r.ends == "patch")
     return (thread if r.kind == "hoop" else None), (thread if actuation.backbone == "inextensible" else None)
 
 

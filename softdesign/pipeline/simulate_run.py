@@ -80,7 +80,8 @@ def thread_of(case: Any) -> Any:
     from softdesign.mechanics.reinforcement import HoopThread
 
     thread = thread_presets()[actuation.reinforcement.thread.name]
-    return HoopThread(actuation.reinforcement.pitch_mm, thread.diameter_mm, thread.modulus_gpa * 1.0e6)
+    r = actuation.reinforcement
+    return HoopThread(r.pitch_mm, thread.diameter_mm, thread.modulus_gpa * 1.0e6, patched_ends=r.ends == "patch")
 
 
 def no_law_error(case: Any, where: str) -> ConfigError:

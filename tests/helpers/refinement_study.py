@@ -13,26 +13,22 @@ says to run ``make study``.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import time
-from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
-from unittest import mock
 
 import numpy as np
 
 from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.materials.threads import thread_presets
-from softdesign.mechanics import reinforcement
 from softdesign.mechanics.newton import NewtonSettings
-from softdesign.mechanics.quadratic_pressure import TRI_POINTS, TRI_WEIGHTS, triangle_shapes
 from softdesign.mechanics.refine import refine_section
 from softdesign.mechanics.reinforcement import HoopThread
 from softdesign.mechanics.section import SectionMesh, simulate_section
 from tests.helpers.fe_meshes import three_chamber_section
+from tests.helpers.fibre_rules import fibre_rule
 
 #: Ecoflex-like neo-Hookean: mu 40 kPa, kappa / mu = 1000 (the law of tests/mechanics/test_section.py).
 LAW = HyperelasticLaw("neo-hookean", 20.0, 0.0, 0.0, 40_000.0, "test")
@@ -66,7 +62,7 @@ class Study:
     name: str
     reference: Path  #: the recorded study, written by ``make study``
     threaded: bool  #: the sample case's hoop thread on every chamber wall (:func:`sample_thread`)
-    rule: str = "one-point"  #: the thread's quadrature on a wall face: "one-point" (the solver's) or "six-point"
+    rule: str = "solver"  #: the thread's quadrature on a wall face (:data:`tests.helpers.fibre_rules.RULES`)
 
     def thread(self) -> HoopThread | None:
         """The study's thread, or None (bare)."""
@@ -80,23 +76,6 @@ STUDIES = {s.name: s for s in (BARE, THREADED, THREADED_SIX)}
 #: The studies ``make study`` re-derives unless told which: those the tests read.  The six-point one is for the
 #: comparison of the rules (its level 1 took 43 Newton iterations and 282 s of CPU, its level 2 far longer).
 RECORDED = ("bare", "thread")
-
-
-@contextlib.contextmanager
-def fibre_rule(rule: str) -> Iterator[None]:
-    """The thread's fibres integrated by ``rule`` while inside: "one-point" is the solver's own (face centroid,
-    :data:`softdesign.mechanics.reinforcement.FIBRE_WEIGHTS`); "six-point" the pressure's Dunavant rule, the one
-    the solver used before it (its module docstring: "Integration").  For the studies only: the solver's rule
-    is the module's, and this swaps its three constants, which :func:`~softdesign.mechanics.reinforcement.
-    hoop_membrane` reads when it builds the fibres."""
-    if rule == "one-point":
-        yield
-        return
-    if rule != "six-point":
-        raise ValueError(f"fibre rule must be one-point or six-point, got {rule!r}")
-    _, dxi, deta = triangle_shapes(TRI_POINTS)
-    with mock.patch.multiple(reinforcement, FIBRE_DXI=dxi, FIBRE_DETA=deta, FIBRE_WEIGHTS=TRI_WEIGHTS):
-        yield
 
 
 def coarse_section(ring_count: int = 0) -> SectionMesh:

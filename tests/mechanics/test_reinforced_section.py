@@ -69,7 +69,8 @@ def _middle_curvature(result: SectionResult) -> float:
 
 @pytest.mark.slow
 def test_a_reinforced_chamber_bends_its_section_as_a_beam() -> None:
-    # about 30-65 s (2 shared cores).  Measured: 1.2999e-4 against 1.3305e-4 1/mm (2.3 % below); unreinforced
+    # about 30-65 s (2 shared cores).  Measured: 1.2945e-4 against 1.3305e-4 1/mm (2.7 % below; the centroid
+    # alone gave 3.0 %, six points alone 2.3 %); unreinforced
     # the same section gives 3.5e-5 (the (1 - 2 nu) P A d / (E I) of a long section, nu -> 0.5, plus its ends)
     pressure = 1.0  # kPa: small (the linear range)
     area, distance, second = _holed_section_figures()
@@ -97,7 +98,7 @@ def test_a_reinforced_chamber_does_not_balloon() -> None:
 
 @pytest.mark.slow
 def test_three_equal_reinforced_chambers_barely_bend() -> None:
-    # about 40 s (with the one-chamber solve cached).  Measured: 0 against 1.23e-4 1/mm (the mesh and the
+    # about 40 s (with the one-chamber solve cached).  Measured: 0 against 1.22e-4 1/mm (the mesh and the
     # windings are three-fold symmetric)
     one = _solve((1.0, 0.0, 0.0))
     three = _solve((1.0, 1.0, 1.0))

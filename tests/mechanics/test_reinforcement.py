@@ -9,9 +9,11 @@ import numpy as np
 import pytest
 
 from softdesign.mechanics.quadratic import QuadraticMesh, quadratic_faces, quadratic_mesh
-from softdesign.mechanics.reinforcement import FibreMembrane, HoopThread, hoop_membrane
+from softdesign.mechanics.reinforcement import FIBRE_STABILISATION, FibreMembrane, HoopThread, hoop_membrane
 from softdesign.mechanics.tets import boundary_faces, make_tet_mesh
+from softdesign.types import FloatArray
 from tests.helpers.fe_meshes import quarter_tube
+from tests.helpers.fibre_rules import fibre_rule
 from tests.helpers.finite_differences import assert_columns_match_central_differences
 
 INNER, OUTER, HEIGHT = 2.0, 3.0, 1.0
@@ -24,6 +26,8 @@ FD_ATOL = 1e-4
 H = 1e-6
 #: Energies and stretches computed two ways in floating point.
 EXACT_RTOL = 1e-12
+#: An eigenvalue below this share of the six-point stiffness's largest is a zero-energy mode (round-off ~1e-16).
+ZERO_ENERGY = 1e-10
 
 
 def _wall(thread: HoopThread = THREAD) -> tuple[QuadraticMesh, FibreMembrane]:
@@ -140,3 +144,63 @@ def test_the_mixed_tangent_takes_the_carried_tension_and_the_same_forces() -> No
     extra = (K_mixed - K).toarray()
     np.testing.assert_allclose(extra, extra.T, atol=1e-9)
     assert np.trace(extra) > 0.0
+
+
+def _rest_stiffness(rule: str) -> FloatArray:
+    """The thread's stiffness at rest (dense, on the wall faces' nodes' dofs only) under fibre ``rule``."""
+    with fibre_rule(rule):
+        mesh, fibres = _wall()
+    _, K = fibres.force_and_tangent_at(np.zeros_like(mesh.points), want_tangent=True)
+    assert K is not None
+    dofs = (3 * np.unique(fibres.faces)[:, None] + np.arange(3)).ravel()
+    return np.asarray(K[dofs][:, dofs].toarray())
+
+
+def test_the_six_point_share_holds_the_centroids_hourglass_modes() -> None:
+    """The centroid alone leaves modes that stretch the thread between a face's nodes but not at its centroid
+    (corners out, midsides in: an hourglass); the solver's rule stores FIBRE_STABILISATION of the six points'
+    energy in each of them, so that its zero-energy modes are only those of both rules (rigid and sliding
+    motions of the wall, which stretch no thread anywhere)."""
+    one, six, solver = (_rest_stiffness(r) for r in ("one-point", "six-point", "solver"))
+    scale = np.linalg.eigvalsh(six)[-1]
+    values, vectors = np.linalg.eigh(one)
+    missed = vectors[:, values < ZERO_ENERGY * scale]  # the centroid's zero-energy modes
+    seen = np.linalg.eigvalsh(missed.T @ six @ missed)
+    hourglass = missed @ np.linalg.eigh(missed.T @ six @ missed)[1][:, seen > ZERO_ENERGY * scale]
+    assert hourglass.shape[1] > 0  # the centroid does miss some that the six points see
+    np.testing.assert_allclose(np.einsum("dm,de,em->m", hourglass, solver, hourglass),
+                               FIBRE_STABILISATION * np.einsum("dm,de,em->m", hourglass, six, hourglass),
+                               rtol=EXACT_RTOL * 1e3)  # both sums of some 1e2 terms of either sign
+    rank = np.linalg.matrix_rank
+    assert rank(solver, tol=ZERO_ENERGY * scale) == rank(one + six, tol=ZERO_ENERGY * scale)
+
+
+def _caps(thread: HoopThread) -> tuple[QuadraticMesh, FibreMembrane]:
+    """The quarter tube's top face as a chamber's cap (its normal along the axis z)."""
+    points, tets = quarter_tube(INNER, OUTER, HEIGHT, (2, 4, 2))
+    mesh = quadratic_mesh(make_tet_mesh(points, tets))
+    faces = boundary_faces(mesh.linear.tets)
+    top = quadratic_faces(mesh, faces[np.all(np.isclose(points[faces][..., 2], HEIGHT), axis=1)])
+    axes = np.tile([0.0, 0.0, 1.0], (len(top), 1))
+    return mesh, hoop_membrane(mesh.points, top, axes, np.full(len(top), INNER), thread, MATRIX_KPA)
+
+
+def test_bare_caps_carry_no_thread_and_a_patch_two_families() -> None:
+    """A cap stretched in its plane by lambda: a woven patch's two crossed families each strain by (lambda^2 - 1) / 2
+    and store W = k e^2 / 2 per area each; bare caps store nothing."""
+    patched = HoopThread(THREAD.pitch_mm, THREAD.diameter_mm, THREAD.modulus_kpa, patched_ends=True)
+    assert len(_caps(THREAD)[1].faces) == 0
+    mesh, fibres = _caps(patched)
+    stretch = 1.05
+    x = mesh.points * np.array([stretch - 1.0, stretch - 1.0, 0.0])
+    e = (stretch**2 - 1) / 2
+    np.testing.assert_allclose(fibres.strains_at(x), e, rtol=EXACT_RTOL * 1e2)  # mesh-sized sums of round-off
+    half = len(fibres.faces) // 2
+    assert np.array_equal(fibres.faces[:half], fibres.faces[half:])  # each cap face twice
+    np.testing.assert_allclose(np.einsum("fqi,fqi->fq", fibres.reference[:half], fibres.reference[half:]), 0.0,
+                               atol=EXACT_RTOL)  # crossed at right angles
+    area = float(fibres.weights[:half].sum())
+    # a quarter annulus of four chords (straight-sided elements): 4 (R^2 - r^2) sin(pi / 8) / 2
+    np.testing.assert_allclose(area, 2 * (OUTER**2 - INNER**2) * np.sin(np.pi / 8), rtol=EXACT_RTOL)
+    np.testing.assert_allclose(fibres.energy_at(x), 2 * patched.stiffness_mn_per_mm * e**2 / 2 * area,
+                               rtol=EXACT_RTOL * 1e2)

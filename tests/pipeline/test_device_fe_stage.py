@@ -65,4 +65,32 @@ def test_a_device_that_stops_short_is_not_feasible_and_says_where() -> None:
     assert reason.startswith("FE: pressure does not reach the shape: the whole device in finite elements finds no "
                              "equilibrium past 85.2 kPa (10.0 % of P* 852.5 kPa), bent to q = 0.1")
     assert "largest stretch 2.15 in section 5" in reason and "material.min_wall_mm" in reason
+    assert "actuation.reinforcement.ends" not in reason  # a payload without the thread's ends offers none
     assert describe_device(summary)[0].startswith("q=0.5 (426.2 kPa): stopped at 85.2 kPa (q = 0.1), there against")
+
+
+@pytest.mark.parametrize(("ends", "offered"), [("bare", True), ("patch", False)])
+def test_a_stop_with_bare_ends_offers_patching_them(ends: str, offered: bool) -> None:
+    stopped = {**_solve(0.5, 200.0, 0.004), "max_stretch": {"value": 2.15, "section": 5},
+               "reached": {"load_factor": 0.2, "q": 0.1, "pressure_kpa": 85.25, "pressures_kpa": [85.25],
+                           "stopped_because": "the whole device: the solve stopped at 85.25 kPa"}}
+    stopped["thread"] = {**stopped["thread"], "ends": ends}
+    judgement = device_judgement({"solves": [stopped]})
+    assert judgement is not None
+    (reason,) = judgement.reasons
+    assert ("patch them (actuation.reinforcement.ends: patch)" in reason) is offered
+    assert "material.min_wall_mm" in reason
+
+
+def test_a_device_that_reaches_its_load_off_the_shape_is_not_feasible() -> None:
+    solve = _solve(1.0, 900.0, 0.01)
+    solve["sections"] = [{"section": 1, "kappa": 0.0101, "designed": {"kappa": 0.01}},
+                         {"section": 2, "kappa": 0.0713, "designed": {"kappa": 0.0386}}]
+    within = device_judgement({"solves": [solve], "shape_tolerance_mm": 0.5})  # the solve is 0.42 mm off
+    assert within is not None and not within.reasons and within.margins
+    off = device_judgement({"solves": [solve], "shape_tolerance_mm": 0.4})
+    assert off is not None and not off.margins
+    (reason,) = off.reasons
+    assert reason.startswith("FE at q = 1: pressure does not reach the shape: the whole device in finite elements "
+                             "lies 0.42 mm from the designed chain (the furthest arc section 2's, kappa 0.0713 1/mm "
+                             "against 0.0386 designed) > simulate.shape_tolerance_mm 0.4")

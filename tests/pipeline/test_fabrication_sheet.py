@@ -71,6 +71,15 @@ def test_the_winding_is_in_the_sheet_when_the_actuation_gives_it_and_the_supply_
     assert "hoop winding of polyester 0.2 (0.20 mm, breaking load 9.5 N: a thread's datasheet, table 1)" in text
     assert "pitch of 0.75 mm, safety factor 3" in text and "| 1 | 2 | 31 | 0.42 | 3.17 |" in text
     assert "supply: single at 23.2 kPa" in text or "supply: single at 23.3 kPa" in text
+    assert "end patches" not in text  # the block has no ends (before round 4's patches) or bare ones alike
+    assert "end patches" not in sheet_text(figures(reinforcement={**REINFORCEMENT, "ends": "bare"}))
+
+
+def test_patched_chamber_ends_are_in_the_sheet_with_the_thread_and_pitch():
+    text = sheet_text(figures(reinforcement={**REINFORCEMENT, "ends": "patch"}))
+    winding = text[text.index("## Thread winding"):]
+    assert "end patches: on each end of every chamber core" in winding
+    assert "woven of polyester 0.2 in two crossed layers at the pitch (0.75 mm)" in winding
 
 
 def test_without_a_mould_or_material_the_sheet_says_what_to_add():

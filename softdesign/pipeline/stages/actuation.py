@@ -58,10 +58,10 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:
     from softdesign.config import Case
 
-VERSION = 7  # 2: one reason per cause (a kind of wall, a bound of extension); 3: the simulate stage's pressures;
+VERSION = 8  # 2: one reason per cause (a kind of wall, a bound of extension); 3: the simulate stage's pressures;
 #            4: angles in (-180, 180] degrees; 5: the rod model (supply, pressure_kpa); 6: series channels,
 #            the rod file (actuation/rod.json); 7: the chambers' end-limit warnings (P* and the per-chamber
-#            table's highest pressure)
+#            table's highest pressure); 8: the end-limit warning offers patched ends, and is not given for them
 SUMMARY = "actuation/summary.json"
 TABLE = "actuation.csv"
 #: The dense q grid's size (q = 0, 0.05, ..., 1).
@@ -355,7 +355,8 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult, simu
     rows = rod.rows if rod.rows is not None else _per_chamber_rows(kinematics, layout, grid)
     filled = rod.fill(rows)
     # per_chamber: the pressures are the table's (single: P*, warned of in rod.warnings)
-    table_warnings = (table_end_notes(rows, rod.summary.get("body_modulus_kpa"))
+    table_warnings = (table_end_notes(rows, rod.summary.get("body_modulus_kpa"),
+                                      "bare" if case.actuation is None else case.actuation.reinforcement.ends)
                       if rod.summary.get("supply") == "per_chamber" else [])
     _add_estimates(rows, simulated)
     qs = [q for q, _ in grid]

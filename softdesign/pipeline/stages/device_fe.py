@@ -38,7 +38,8 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:
     from softdesign.config import Case
 
-VERSION = 3  # 2: area-matched polygons, the backbone thread embedded in the elements; 3: a stop is kept, judged
+VERSION = 4  # 2: area-matched polygons, the backbone thread embedded in the elements; 3: a stop is kept, judged;
+#             4: the thread's stabilised rule, patched ends, the thread's ends in the figures
 SUMMARY = "simulate/device.json"
 
 
@@ -102,7 +103,8 @@ def run_device_stage(case: Case, results: dict[str, Any]) -> dict[str, Any] | No
             if q < max(case.export.q_values()):
                 times.append(f"q above {q:g} not solved: the solve at q = {q:g} stopped")
             break
-    return {"solves": solves, "leaves_out": list(LEAVES_OUT), "design_pressure_kpa": top, "times": times}
+    return {"solves": solves, "leaves_out": list(LEAVES_OUT), "design_pressure_kpa": top,
+            "shape_tolerance_mm": s.shape_tolerance_mm, "times": times}
 
 
 def fe_line(summary: dict[str, Any]) -> str | None:
@@ -132,8 +134,15 @@ def stop_reason(solve: dict[str, Any]) -> str:
     return (f"FE: pressure does not reach the shape: the whole device in finite elements finds no equilibrium past "
             f"{at}, bent to q = {held['q']:.3g} (the designed chain within {solve['versus_design']['max_mm']:.3g} "
             f"mm there; largest stretch {stretch['value']:.2f} in section {stretch['section']}): the design asks "
-            "more pressure than the body holds (a chamber's end carries no thread); ask less curvature per "
-            "pressure (larger chambers further from the axis, a thinner material.min_wall_mm) and check again")
+            f"more pressure than the body holds; {_stop_fix(solve.get('thread'))}ask less curvature per pressure "
+            "(larger chambers further from the axis, a thinner material.min_wall_mm) and check again")
+
+
+def _stop_fix(thread: dict[str, Any] | None) -> str:
+    """The end reinforcement a stopped device's reason offers: patched ends when its chambers' ends are bare."""
+    if thread is None or thread.get("ends") != "bare":
+        return ""
+    return "its chambers' ends carry no thread: patch them (actuation.reinforcement.ends: patch), or "
 
 
 def device_judgement(summary: dict[str, Any] | None) -> Judgement | None:
@@ -142,6 +151,7 @@ def device_judgement(summary: dict[str, Any] | None) -> Judgement | None:
     if not summary or not summary["solves"]:
         return None
     stopped = [stop_reason(s) for s in summary["solves"] if s["reached"] is not None]
+    tolerance = summary.get("shape_tolerance_mm")  # absent from device.json before device_fe v4
     line = fe_line(summary)
     reasons = list(stopped)
     for solve in summary["solves"]:
@@ -150,11 +160,28 @@ def device_judgement(summary: dict[str, Any] | None) -> Judgement | None:
             reasons.append(f"FE at q = {solve['q']:g}: stress {stress['value']:.0f} kPa in section "
                            f"{stress['section']} > the tensile strength {stress['tensile_strength_kpa']:.0f} kPa; "
                            "use a stronger material (material.name)")
+        if solve["reached"] is None and tolerance is not None and solve["versus_design"]["max_mm"] > tolerance:
+            reasons.append(f"FE at q = {solve['q']:g}: pressure does not reach the shape: the whole device in "
+                           f"finite elements lies {solve['versus_design']['max_mm']:.3g} mm from the designed chain "
+                           f"({_worst_arc(solve)}) > simulate.shape_tolerance_mm {tolerance:g}: the rod model's "
+                           "sizing does not hold at this pressure; ask less curvature per pressure (larger chambers "
+                           "further from the axis) or raise the tolerance")
         if thread and thread["fraction_of_limit"] is not None and thread["fraction_of_limit"] > 1.0:
-            reasons.append(f"FE at q = {solve['q']:g}: hoop thread {thread['value']:.3g} N > its limit "
+            what = "hoop thread (winding or end patches)" if thread.get("ends") == "patch" else "hoop thread"
+            reasons.append(f"FE at q = {solve['q']:g}: {what} {thread['value']:.3g} N > its limit "
                            f"{thread['limit_n']:.3g} N; use a finer actuation.reinforcement.pitch_mm or a stronger "
                            "thread")
     return Judgement(judged=False, reasons=tuple(reasons), margins=() if reasons or line is None else (line,))
+
+
+def _worst_arc(solve: dict[str, Any]) -> str:
+    """The section whose fitted arc's curvature is furthest from its designed one's, as words."""
+    arcs = [a for a in solve["sections"] if a["designed"]["kappa"] > 0.0]
+    if not arcs:
+        return "no section's arc to compare"
+    worst = max(arcs, key=lambda a: abs(a["kappa"] / a["designed"]["kappa"] - 1.0))
+    return (f"the furthest arc section {worst['section']}'s, kappa {worst['kappa']:.3g} 1/mm against "
+            f"{worst['designed']['kappa']:.3g} designed")
 
 
 def write_device(result: dict[str, Any] | None, staging: Staging) -> None:

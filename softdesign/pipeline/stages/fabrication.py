@@ -30,7 +30,7 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 1
+VERSION = 2  # 2: the reinforcement's chamber ends (bare or patched)
 
 
 @dataclass(frozen=True)
@@ -47,7 +47,8 @@ def fabrication_figures(case: Case, results: Results) -> dict[str, Any]:
     act = None if actuation is None else actuation.summary
     return {"name": case.name, "body_length_mm": length, "material": _material(case),
             "mould": _mould(results["mould"].summary), "cores": _cores(act, length),
-            "supply": _supply(case, act), "reinforcement": _reinforcement(act)}
+            "supply": _supply(case, act),
+            "reinforcement": _reinforcement(act, case.actuation.reinforcement.ends if case.actuation else "bare")}
 
 
 def _material(case: Case) -> dict[str, Any] | None:
@@ -111,8 +112,9 @@ def _supply(case: Case, act: dict[str, Any] | None) -> dict[str, Any] | None:
     return None
 
 
-def _reinforcement(act: dict[str, Any] | None) -> dict[str, Any] | None:
-    """The actuation's thread winding and each chamber's turns and tensions, when it gives them."""
+def _reinforcement(act: dict[str, Any] | None, ends: str) -> dict[str, Any] | None:
+    """The actuation's thread winding and each chamber's turns and tensions, when it gives them, and its chambers'
+    ends (``actuation.reinforcement.ends``: bare, or a woven patch on each)."""
     block = None if act is None else act.get("reinforcement")
     if not isinstance(block, dict) or block.get("kind") in (None, "none") or "thread" not in block:
         return None
@@ -120,7 +122,8 @@ def _reinforcement(act: dict[str, Any] | None) -> dict[str, Any] | None:
     windings = [{"section": i + 1, "chamber": j + 1, **{k: chamber[k] for k in keys}}
                 for i, section in enumerate(act.get("sections", []) if act else [])
                 for j, chamber in enumerate(section.get("chambers", [])) if all(k in chamber for k in keys)]
-    return {k: block[k] for k in ("kind", "pitch_mm", "thread", "safety_factor")} | {"windings": windings}
+    return {k: block[k] for k in ("kind", "pitch_mm", "thread", "safety_factor")} | {"windings": windings,
+                                                                                    "ends": ends}
 
 
 def sheet_text(figures: dict[str, Any]) -> str:

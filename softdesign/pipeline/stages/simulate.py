@@ -42,8 +42,9 @@ if TYPE_CHECKING:
     from softdesign.pipeline.stages.fit import FitResult
     from softdesign.pipeline.stages.kinematics import KinematicsResult
 
-VERSION = 4  # 2: the section meshes three-fold symmetric; 3: the case's hoop thread (reinforcement) in the model;
-# 4: the section mesh's polygons (chambers, feeds, skin) have their circles' areas
+VERSION = 5  # 2: the section meshes three-fold symmetric; 3: the case's hoop thread (reinforcement) in the model;
+# 4: the section mesh's polygons (chambers, feeds, skin) have their circles' areas; 5: the thread's stabilised rule
+# and patched ends (actuation.reinforcement.ends)
 SUMMARY = "simulate/summary.json"
 
 
