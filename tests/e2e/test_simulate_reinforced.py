@@ -9,9 +9,9 @@ the circles' areas).
 Measured with the thread's energy at each wall face's centroid plus 5 % on six points
 (:mod:`softdesign.mechanics.reinforcement`, "Integration"): 2.185e-4 against 2.246e-4 1/mm, -2.7 %.  At the
 centroid alone it was -9.7 %: these chambers are 0.8-1.1 mm across in a 3 mm mesh (12 nodes round each), few wall
-faces, where the centroid alone let the hoop go slack (six points alone gave -2.4 %).  So the bound is now the issue's 5 %: it fails a
-solve that loses the thread (the bare section bends by (1 - 2 nu) of this, nearly nothing), a rule that lets the
-hoop go slack again, or a rod model off by its chambers' areas.
+faces, where the centroid alone let the hoop go slack (six points alone gave -2.4 %).  So the bound is now the
+issue's 5 %: it fails a solve that loses the thread (the bare section bends by (1 - 2 nu) of this, nearly nothing),
+a rule that lets the hoop go slack again, or a rod model off by its chambers' areas.
 """
 
 from __future__ import annotations
