@@ -35,9 +35,13 @@ def test_ctrl_c_during_a_forced_rebuild_keeps_the_previous_build(tmp_path):
                              stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, stdin=subprocess.DEVNULL, text=True)
     assert child.stderr is not None
     lines = []
-    for line in child.stderr:  # interrupt once the fit has started: the new build is half made
+    # interrupt once blend has started (ingest's results are in the staging folder: the new build is half made).
+    # Not later: the test reads the child's lines when the busy suite schedules it, and the build after the fit
+    # takes about 2 s; twice in the full suite on 2 cores the child had finished before "fit: running" was read
+    # (exit 0, the signal sent to an ended process)
+    for line in child.stderr:
         lines.append(line)
-        if "fit: running" in line:
+        if "blend: running" in line:
             child.send_signal(signal.SIGINT)
             break
     rest = child.communicate(timeout=BUILD_TIMEOUT_S)[1]
