@@ -188,6 +188,11 @@ class Case(CaseBlock):
         return Path(os.path.relpath(path, self._base)).as_posix()
 
     @property
+    def chamber_ends(self) -> str:
+        """``actuation.reinforcement.ends``: bare or patch (bare for a case without an ``actuation:`` block)."""
+        return "bare" if self.actuation is None else self.actuation.reinforcement.ends
+
+    @property
     def source(self) -> dict[str, str] | None:
         """The case file it was read from: ``{"name": file name, "sha256": of its text}`` (None when not read from a
         file).  ``softdesign pressure`` answers from a build without building the case's models when both match."""

@@ -11,6 +11,11 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
+import numpy as np
+
+from softdesign.fitting import bspline_basis as bb
+from softdesign.types import FloatArray
+
 #: ``mapper(task, items)`` is ``[task(item) for item in items]``, perhaps on other processes (the build's
 #: :func:`softdesign.pipeline.parallel.map_items`); the results in the order of ``items``.
 Mapper = Callable[[Callable[[Any], Any], Sequence[Any]], list[Any]]
@@ -19,3 +24,12 @@ Mapper = Callable[[Callable[[Any], Any], Sequence[Any]], list[Any]]
 def serial_map(task: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
     """The :data:`Mapper` that runs every item here, in turn."""
     return [task(item) for item in items]
+
+
+def mapped_blocks(values: Callable[[slice], FloatArray], count: int, size: int, mapper: Mapper) -> FloatArray:
+    """``values(rows)`` over ``count`` items in blocks of ``size`` (slices, in order), joined; a single block runs
+    here, more on ``mapper``.  The same numbers as one call over every item when each item's value is its own."""
+    blocks = bb.chunks(count, size)
+    if len(blocks) == 1:
+        return values(slice(0, count))
+    return np.concatenate(mapper(values, blocks))

@@ -23,7 +23,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from softdesign.errors import ConfigError
-from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import FitSettings, RadiusSpline, fold_solver
 from softdesign.fitting.closest import (
     CurvePart,
@@ -32,7 +31,7 @@ from softdesign.fitting.closest import (
     closest_with_part,
     search_start,
 )
-from softdesign.fitting.mapping import Mapper, serial_map
+from softdesign.fitting.mapping import Mapper, mapped_blocks, serial_map
 from softdesign.fitting.projection import PROJECT_BLOCK, PolarPoints
 from softdesign.types import FloatArray, FramedCurve
 
@@ -182,9 +181,7 @@ def with_exact_max(
         return metrics
     rest = np.setdiff1d(np.arange(len(polar)), sample, assume_unique=True)
     l, angle = polar.l[rest], polar.angle[rest]
-    blocks = bb.chunks(len(rest), PROJECT_BLOCK)
-    fitted = spline.evaluate(l, angle) if len(blocks) == 1 else np.concatenate(
-        mapper(lambda rows: spline.evaluate(l[rows], angle[rows]), blocks))
+    fitted = mapped_blocks(lambda rows: spline.evaluate(l[rows], angle[rows]), len(rest), PROJECT_BLOCK, mapper)
     bound = np.abs(polar.rho[rest] - fitted)
     # a foot clamped at an end is not in p's normal plane: the radial residual bounds nothing there
     doubtful = rest[(bound >= metrics.max_mm - BOUND_SLACK_MM) | (polar.end_side[rest] != 0)]

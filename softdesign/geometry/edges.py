@@ -60,10 +60,17 @@ class EdgeTable:
         starts = run_starts(keys)
         return cls(n_vertices, keys, order, starts, np.diff(np.append(starts, len(keys))))
 
+    def edges(self) -> IntArray:
+        """(G, 2) vertex ids, smaller first, of every edge once, in key order (:attr:`uses` counts each)."""
+        return self._pairs(self.keys[self.starts])
+
     def single_edges(self) -> IntArray:
         """(B, 2) vertex ids, smaller first, of the edges used by one face edge only, in key order."""
-        single = self.keys[self.starts[self.uses == 1]]
-        return np.column_stack((single // self.n_vertices, single % self.n_vertices))
+        return self._pairs(self.keys[self.starts[self.uses == 1]])
+
+    def _pairs(self, keys: IntArray) -> IntArray:
+        """(n, 2) the vertex ids, smaller first, of edge ``keys`` (n,) (:func:`edge_keys`)."""
+        return np.column_stack((keys // self.n_vertices, keys % self.n_vertices))
 
     def face_pairs(self) -> IntArray:
         """(P, 2) the two faces on each edge that exactly two face edges use, when the faces are distinct:
@@ -81,3 +88,13 @@ def corner_planes(vertices: FloatArray, faces: IntArray) -> tuple[FloatArray, Fl
     """
     corners = np.take(np.ascontiguousarray(vertices.T), np.ascontiguousarray(faces.T), axis=1)  # (3, 3, F)
     return corners[:, 0], corners[:, 1], corners[:, 2]
+
+
+def row_cross(u: FloatArray, v: FloatArray) -> FloatArray:
+    """``u x v`` (3, F) of vectors held as coordinate rows (3, F): ``np.cross``'s products in its order, component
+    by component (``u[j] v[k] - u[k] v[j]``), the same numbers on contiguous rows."""
+    cross = np.empty_like(u)
+    for i, (j, k) in enumerate(((1, 2), (2, 0), (0, 1))):
+        np.multiply(u[j], v[k], out=cross[i])
+        cross[i] -= u[k] * v[j]
+    return cross

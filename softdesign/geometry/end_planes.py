@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from softdesign.geometry.edges import EdgeTable, corner_planes, run_starts
+from softdesign.geometry.edges import EdgeTable, corner_planes, row_cross, run_starts
 from softdesign.geometry.end_cut import MAX_CUT_TILT_DEG
 from softdesign.types import FloatArray, IntArray, Points
 
@@ -252,11 +252,7 @@ def _face_normals(vertices: Points, faces: IntArray) -> FloatArray:
     gathered (F, 3, 3) corners and strode across their coordinates.
     """
     p0, p1, p2 = corner_planes(vertices, faces)
-    u, v = p1 - p0, p2 - p1
-    normals = np.empty_like(u)
-    for i, (j, k) in enumerate(((1, 2), (2, 0), (0, 1))):
-        np.multiply(u[j], v[k], out=normals[i])
-        normals[i] -= u[k] * v[j]
+    normals = row_cross(p1 - p0, p2 - p1)
     squares = normals * normals
     length = squares[0] + squares[1]
     length += squares[2]

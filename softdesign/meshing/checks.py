@@ -20,7 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import MeshError
-from softdesign.geometry.edges import corner_planes
+from softdesign.geometry.edges import corner_planes, row_cross
 from softdesign.geometry.rows import rows_all_distinct, rows_in_first_order
 from softdesign.meshing.topology import mesh_topology
 from softdesign.meshing.volume_tolerance import MIN_ANGULAR_COUNT, VOLUME_RTOL
@@ -127,14 +127,9 @@ def _zero_area_faces(vertices: FloatArray, faces: npt.NDArray[np.int64]) -> int:
     """How many faces have a zero cross product (p1 - p0) x (p2 - p0): every square of it zero, which is when its
     length (``np.linalg.norm``, a sum of the squares) is zero; coordinate rows, ``np.cross``'s products."""
     p0, p1, p2 = corner_planes(vertices, faces)
-    u, v = p1 - p0, p2 - p0
-    zero = np.ones(faces.shape[0], bool)
-    for j, k in ((1, 2), (2, 0), (0, 1)):
-        component = u[j] * v[k]
-        component -= u[k] * v[j]
-        component *= component
-        zero &= component == 0.0
-    return int(np.count_nonzero(zero))
+    cross = row_cross(p1 - p0, p2 - p0)
+    cross *= cross
+    return int(np.count_nonzero(np.all(cross == 0.0, axis=0)))
 
 
 def inspect_mesh(

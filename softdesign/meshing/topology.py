@@ -229,8 +229,7 @@ def describe_surface(vertices: npt.ArrayLike, faces: npt.ArrayLike, table: EdgeT
     faces = np.asarray(faces, np.int64)
     count = max(len(vertices), int(faces.max(initial=-1)) + 1)
     if table is not None and table.n_vertices == count and len(table.keys) == faces.size and faces.size:
-        key = table.keys[table.starts]
-        edges, uses = np.column_stack([key // count, key % count]), table.uses
+        edges, uses = table.edges(), table.uses
     else:
         edges, uses = edge_uses(faces, count)
     boundary = edges[uses == 1]

@@ -154,7 +154,7 @@ def device_payload(outcome: Any, o: Any, device: Any, material: Any, loads: tupl
         "sections": sections,
         "max_stretch": {**_extreme(figures.stretch), "limit": material.max_stretch},
         "max_stress_kpa": {**_extreme(figures.stress), "tensile_strength_kpa": material.tensile_strength_kpa},
-        "thread": _thread(outcome, figures.thread, pressures, top, outcome.case.actuation.reinforcement.ends),
+        "thread": _thread(outcome, figures.thread, pressures, top, outcome.case.chamber_ends),
         "backbone_thread": _thread(outcome, figures.backbone, pressures, None),
         "tie_gap_mm": figures.tie_gap_mm,
         "convergence": [{"load_factor": t, "iterations": n, "residuals_mN": h}

@@ -180,7 +180,7 @@ def _single(case: Case, kinematics: KinematicsResult, fit: FitResult, design: De
                                     [min(s["chambers"][0]["diameter_mm"].values()) for s in sections], lost=True,
                                     strand_mm=STRAND_FRACTION * narrowest)
     warnings += _core_notes(summary["cores"])
-    warnings += _end_notes(float(summary["design_pressure_kpa"]), setup.modulus_kpa, _ends(case))
+    warnings += _end_notes(float(summary["design_pressure_kpa"]), setup.modulus_kpa, case.chamber_ends)
     warnings += [_slant_note(c) for c in summary["channels"]
                  if c["width_mm"] < MIN_CHANNEL_WIDTH_FRACTION * c["diameter_mm"]]
     document = rod_document(case, single.device.body, single.problem.stations.chamber, rod_extra(single))
@@ -203,11 +203,6 @@ def channel_figures(single: SingleDesign) -> list[dict[str, Any]]:
 #: A cavity in an incompressible neo-Hookean solid grows without bound at this pressure over the shear modulus
 #: (5 / 2: the spherical cavity in an infinite solid); a chamber's end carries no thread.
 END_LIMIT_MU = 2.5
-
-
-def _ends(case: Any) -> str:
-    """``actuation.reinforcement.ends`` (bare without an actuation block)."""
-    return "bare" if case.actuation is None else str(case.actuation.reinforcement.ends)
 
 
 def _end_notes(pressure_kpa: float, modulus_kpa: float, ends: str, what: str = "P*") -> list[str]:

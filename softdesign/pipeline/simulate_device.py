@@ -83,13 +83,11 @@ def device_threads(case: Any) -> tuple[Any, Any]:
     actuation = getattr(case, "actuation", None)
     if actuation is None:
         return None, None
-    from softdesign.materials.threads import thread_presets
-    from softdesign.mechanics.reinforcement import HoopThread
+    from softdesign.pipeline.simulate_run import reinforcement_thread
 
-    r = actuation.reinforcement
-    data = thread_presets()[r.thread.name]
-    thread = HoopThread(r.pitch_mm, data.diameter_mm, data.modulus_gpa * 1.0e6, patched_ends=r.ends == "patch")
-    return (thread if r.kind == "hoop" else None), (thread if actuation.backbone == "inextensible" else None)
+    thread = reinforcement_thread(actuation.reinforcement)
+    return ((thread if actuation.reinforcement.kind == "hoop" else None),
+            (thread if actuation.backbone == "inextensible" else None))
 
 
 def check_device_case(case: Any, o: DeviceOptions) -> None:

@@ -76,12 +76,19 @@ def thread_of(case: Any) -> Any:
     actuation = getattr(case, "actuation", None)
     if actuation is None or actuation.reinforcement.kind != "hoop":
         return None
+    return reinforcement_thread(actuation.reinforcement)
+
+
+def reinforcement_thread(reinforcement: Any) -> Any:
+    """``actuation.reinforcement``'s thread as the finite elements take it (a
+    :class:`~softdesign.mechanics.reinforcement.HoopThread`): its pitch, the preset's diameter and modulus, its
+    chambers' ends; the same thread for the winding and the backbone."""
     from softdesign.materials.threads import thread_presets
     from softdesign.mechanics.reinforcement import HoopThread
 
-    thread = thread_presets()[actuation.reinforcement.thread.name]
-    r = actuation.reinforcement
-    return HoopThread(r.pitch_mm, thread.diameter_mm, thread.modulus_gpa * 1.0e6, patched_ends=r.ends == "patch")
+    data = thread_presets()[reinforcement.thread.name]
+    return HoopThread(reinforcement.pitch_mm, data.diameter_mm, data.modulus_gpa * 1.0e6,
+                      patched_ends=reinforcement.ends == "patch")
 
 
 def no_law_error(case: Any, where: str) -> ConfigError:

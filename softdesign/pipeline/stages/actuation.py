@@ -355,8 +355,7 @@ def run_actuation(case: Case, kinematics: KinematicsResult, fit: FitResult, simu
     rows = rod.rows if rod.rows is not None else _per_chamber_rows(kinematics, layout, grid)
     filled = rod.fill(rows)
     # per_chamber: the pressures are the table's (single: P*, warned of in rod.warnings)
-    table_warnings = (table_end_notes(rows, rod.summary.get("body_modulus_kpa"),
-                                      "bare" if case.actuation is None else case.actuation.reinforcement.ends)
+    table_warnings = (table_end_notes(rows, rod.summary.get("body_modulus_kpa"), case.chamber_ends)
                       if rod.summary.get("supply") == "per_chamber" else [])
     _add_estimates(rows, simulated)
     qs = [q for q, _ in grid]

@@ -48,7 +48,7 @@ def fabrication_figures(case: Case, results: Results) -> dict[str, Any]:
     return {"name": case.name, "body_length_mm": length, "material": _material(case),
             "mould": _mould(results["mould"].summary), "cores": _cores(act, length),
             "supply": _supply(case, act),
-            "reinforcement": _reinforcement(act, case.actuation.reinforcement.ends if case.actuation else "bare")}
+            "reinforcement": _reinforcement(act, case.chamber_ends)}
 
 
 def _material(case: Case) -> dict[str, Any] | None:

@@ -18,9 +18,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from softdesign.errors import ConfigError, FitError, FoldError
-from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
 from softdesign.fitting.local_cap import check_caps_on_path
+from softdesign.fitting.mapping import mapped_blocks
 from softdesign.fitting.morph_folds import fold_over_morph
 from softdesign.fitting.projection import PROJECT_BLOCK, project_points
 from softdesign.fitting.radius_field import RadiusField
@@ -154,10 +154,8 @@ def fitted_rho(field: RadiusField, l: FloatArray, angle: FloatArray) -> FloatArr
     ``evaluate_pairs`` call over all the points; a surface's worth of points (1M vertices) no longer waits on
     this process alone.
     """
-    blocks = bb.chunks(len(l), PROJECT_BLOCK)
-    if len(blocks) == 1:
-        return field.evaluate_pairs(1.0, l, angle)
-    return np.concatenate(map_items(lambda rows: field.evaluate_pairs(1.0, l[rows], angle[rows]), blocks))
+    return mapped_blocks(lambda rows: field.evaluate_pairs(1.0, l[rows], angle[rows]), len(l), PROJECT_BLOCK,
+                         map_items)
 
 
 def _carried_to_chain(chain: LinkChain, vessel: Any) -> dict[str, Any]:
