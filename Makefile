@@ -104,11 +104,11 @@ test-fast: bytecode $(CLUSTER_STAMP)
 test-seconds:
 	$(BIN)/python -m tests.helpers.schedule
 
-# `make study`: re-derive the nested-refinement studies' recorded finest levels
-# (tests/mechanics/refinement_reference*.json: bare and with the sample case's hoop thread, about 12 minutes of
-# CPU each); `make study STUDY=thread` re-derives one (STUDY=thread-six: the thread's six-point rule, not read by
-# the tests, much longer).  `make test` solves the two coarser levels and says to run this when they no longer
-# match the record.
+# `make study`: re-derive the nested-refinement studies' recorded levels
+# (tests/mechanics/refinement_reference*.json: bare and with the sample case's hoop thread, 12-25 minutes of
+# CPU each, and threaded with round chambers, two levels, about 2 minutes); `make study STUDY=thread` re-derives
+# one (STUDY=thread-six: the thread's six-point rule, not read by the tests, much longer).  `make test` solves
+# the coarse level and says to run this when it no longer matches the record.
 study: $(STAMP)
 	$(BIN)/python pipelines/study.py $(if $(STUDY),--study $(STUDY))
 

@@ -1,11 +1,12 @@
 """``make study``: re-derive the recorded nested-refinement studies (tests/mechanics/refinement_reference*.json).
 
-Solves each study's section (tests/helpers/refinement_study.py: bare and with the sample case's hoop thread,
-or, when asked, with that thread under the six-point rule) at its three levels, the finest about 12 minutes of
-CPU each, and writes every level's curvature, direction error, mesh size, Newton iterations and CPU time with how
-and when they were made.  ``make test`` solves levels 0 and 1 afresh, checks them against these files and takes level 2
-from them; run this after a change to the mesher, the refinement, the thread or the solver moves them (the tests
-say so), then commit the files.
+Solves each study's section (tests/helpers/refinement_study.py: bare, with the sample case's hoop thread, and
+threaded with round chambers; or, when asked, with that thread under the six-point rule) at each of its levels
+(three, the finest 12-25 minutes of CPU; two for round chambers), and writes every level's curvature, direction
+error, mesh size, Newton iterations and CPU time with how and when they were made.  ``make test`` solves level 0
+afresh, checks it and the refined meshes' sizes against these files and takes the finer levels from them; run
+this after a change to the mesher, the refinement, the thread or the solver moves them (the tests say so), then
+commit the files.
 
 Usage: ``python pipelines/study.py [--study NAME ...] [--out FILE]`` (``--out`` with one study only).
 """
@@ -41,18 +42,20 @@ from tests.helpers.refinement_study import (  # noqa: E402
 
 def run_study(study: Study, out: Path) -> None:
     """Solve ``study`` at every level, print each, and write its record to ``out`` (whole, or not at all)."""
-    coarse = coarse_section()
+    coarse = coarse_section(study.ring_count)
     levels: list[dict[str, Any]] = []
-    for level in range(LEVELS):
+    for level in range(study.levels):
         row = solve_level(coarse, level, study)
         levels.append(row)
         print(f"{study.name} level {level}: kappa {row['kappa_per_mm']:.6e} 1/mm, direction off by "
               f"{row['phi_error_rad']:.3e} rad, {row['tets']} tets, {row['iterations']} Newton iterations, "
               f"{row['cpu_s']} s CPU", flush=True)
     kappas = np.array([row["kappa_per_mm"] for row in levels])
-    order, extrapolated = observed_order(kappas)
-    print(f"{study.name}: changes {100 * (kappas[1] / kappas[0] - 1):+.2f} %, "
-          f"{100 * (kappas[2] / kappas[1] - 1):+.2f} %; order {order:.2f}; Richardson {extrapolated:.6e} 1/mm")
+    changes = ", ".join(f"{100 * change:+.2f} %" for change in kappas[1:] / kappas[:-1] - 1)
+    if len(kappas) == LEVELS:
+        order, extrapolated = observed_order(kappas)
+        changes += f"; order {order:.2f}; Richardson {extrapolated:.6e} 1/mm"
+    print(f"{study.name}: changes {changes}")
     thread = study.thread()
     document = {
         "made_by": "make study (python pipelines/study.py): tests/helpers/refinement_study.py at every level",
@@ -60,6 +63,7 @@ def run_study(study: Study, out: Path) -> None:
         "python": f"{platform.python_implementation()} {platform.python_version()} on {platform.machine()}",
         "study": study.name,
         "pressure_kpa": STUDY_KPA,
+        "ring_count": study.ring_count,
         "thread": None if thread is None else {"pitch_mm": thread.pitch_mm, "diameter_mm": thread.diameter_mm,
                                                "modulus_kpa": thread.modulus_kpa, "rule": study.rule,
                                                "six_point_share": six_point_share(study.rule)},
