@@ -1,6 +1,7 @@
 """The inverse's linear start and its continued trials (:mod:`softdesign.mechanics.inverse`) on the straight
 three-chamber section of tests/mechanics/test_section.py: in the linear range the start is the answer, and a
-converged search's pressures give the target's arc again when solved afresh from rest."""
+converged search finds the pressures of a forward solve and gives the target's arc again when they are solved
+afresh from rest."""
 
 from __future__ import annotations
 
@@ -24,6 +25,9 @@ PATH_MM = 1e-6
 #: pressures' size (measured 1.1 %: the common pressure, which mostly lengthens the section, is the least determined
 #: direction, see the module docstring of softdesign/mechanics/inverse.py).
 LINEAR_SHARE = 0.02
+#: A converged search (TOLERANCE_MM) finds a forward solve's pressures within this share of each (measured 0.02 %,
+#: 0.07 %, 0.37 % for 12, 6, 2 kPa: the smallest is the least determined).
+PRESSURE_RTOL = 0.01
 
 
 @functools.cache
@@ -58,13 +62,14 @@ def test_in_the_linear_range_the_linear_start_is_the_answer() -> None:
 
 
 @pytest.mark.slow
-def test_a_converged_search_gives_its_target_again_when_solved_from_rest() -> None:
+def test_a_converged_search_finds_the_pressures_and_gives_its_target_again_when_solved_from_rest() -> None:
     truth = (12.0, 6.0, 2.0)
     target = _target(_forward(truth))
     told: list[np.ndarray] = []
     found = _search(target, told)
     assert found.converged
     assert float(np.linalg.norm(found.error_mm)) <= TOLERANCE_MM
+    np.testing.assert_allclose(found.pressures_kpa, truth, rtol=PRESSURE_RTOL, atol=0.0)
     fresh = simulate_section(_section(), LAW, found.pressures_kpa, NEWTON)
     error = weighted_error(arc_vector(*_target(fresh)), arc_vector(*target))
     assert float(np.linalg.norm(error)) <= TOLERANCE_MM + PATH_MM
