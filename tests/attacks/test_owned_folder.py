@@ -144,7 +144,7 @@ def test_a_report_of_an_older_version_without_marker_is_still_ours(out, tmp_path
     report.mkdir()
     (report / PAGE).write_text("<html>an older report</html>")
     (report / "morph.png").write_bytes(b"png")
-    result = runner.invoke(app, ["build", str(demo_case(tmp_path)), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(demo_case(tmp_path)), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output  # rebuilt, outputs unchanged: the report is kept (issue 34)
     assert (report / PAGE).read_text() == "<html>an older report</html>"
     commit_folder(report, {PAGE: b"new page"})  # and a new report replaces it
