@@ -273,7 +273,7 @@ def test_a_failed_run_leaves_the_previous_build_untouched(demo_case, demo_built,
 
     original = export_stage.mesh_bytes
     monkeypatch.setattr(export_stage, "mesh_bytes", failing)
-    result = runner.invoke(app, ["build", str(demo_case), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(demo_case), "--out", str(out), "--jobs", "1"])
     assert result.exit_code != 0 and len(calls) == 2
     assert snapshot(out) == before
     assert not list(tmp_path.glob(".build.staging-*"))
@@ -304,7 +304,7 @@ def test_a_build_killed_mid_export_leaves_the_previous_build_unchanged(demo_case
     before = snapshot(out)
     edit(demo_case, "export", angular_count=56)
     killed = subprocess.run(
-        [sys.executable, "-c", KILL_MID_EXPORT, "build", str(demo_case), "--out", str(out)],
+        [sys.executable, "-c", KILL_MID_EXPORT, "build", str(demo_case), "--out", str(out), "--jobs", "1"],
         capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(REPO)}, timeout=300,
     )
     assert killed.returncode == -9, killed.stderr
