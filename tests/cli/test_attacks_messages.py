@@ -69,7 +69,7 @@ def test_a_centerline_that_strays_is_warned_about_naming_the_resample_keys(prior
     out = tmp_path / "build"
     shutil.copytree(prior_build, out)
     case = demo_case(tmp_path, resample={"smoothing_mm": 2.0})
-    result = runner.invoke(app, ["build", str(case), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(case), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     assert "Traceback" not in result.output
     assert "warning: fit: the centerline, resampled every" in result.output

@@ -110,7 +110,7 @@ def test_angular_count_at_the_minimum_builds_a_round_body_that_passes_the_volume
     case = demo_case(tmp_path, initial={"kind": "straight", "radius_mm": 3.0},
                      export={"q": [0], "angular_count": MIN_ANGULAR_COUNT, "spacing_mm": 1.0})
     out = tmp_path / "out"
-    result = runner.invoke(app, ["build", str(case), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(case), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["metrics"]["export"]["resolution"]["angular_count"] == MIN_ANGULAR_COUNT

@@ -45,7 +45,7 @@ def aorta_case(folder: Path, aorta_dir: Path) -> Path:
 
 
 def build(case: Path, out: Path) -> dict:
-    result = runner.invoke(app, ["build", str(case), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(case), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     return json.loads((out / "manifest.json").read_text())
 
@@ -112,7 +112,7 @@ def test_aorta_with_actuation_and_mould(tmp_path: Path, aorta_dir: Path) -> None
 
 def test_a_layout_that_cannot_fit_is_refused_with_its_figures(tmp_path: Path) -> None:
     case = demo_case(tmp_path, {"diameter_mm": 1.2, "feed_diameter_mm": 0.6})
-    result = runner.invoke(app, ["build", str(case), "--out", str(tmp_path / "build")])
+    result = runner.invoke(app, ["build", str(case), "--out", str(tmp_path / "build"), "--jobs", "1"])
     assert result.exit_code == 2, result.output
     message = result.stderr
     assert "section 1" in message and "chamber-feed 0.135 mm" in message  # 2 d sin 15 deg - (1.2 + 0.6) / 2

@@ -28,7 +28,7 @@ def aorta_case(folder, aorta_dir, surface: str, **export) -> tuple:
     path = folder / f"{surface}.{len(export)}.yaml"
     path.write_text(yaml.safe_dump(case, sort_keys=False))
     out = folder / f"build-{path.stem}"
-    result = runner.invoke(app, ["build", str(path), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(path), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     return json.loads((out / "manifest.json").read_text()), result.output
 

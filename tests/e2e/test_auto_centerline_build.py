@@ -26,7 +26,7 @@ def _build(folder: Path, surface: Path, **final) -> tuple[dict, Path, str]:
     path = folder / "auto.yaml"
     path.write_text(yaml.safe_dump(case, sort_keys=False))
     out = folder / "build"
-    result = runner.invoke(app, ["build", str(path), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(path), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     return json.loads((out / "manifest.json").read_text()), out, result.output
 
@@ -54,7 +54,7 @@ def test_demo_builds_from_its_surface_alone_and_is_cached(tmp_path):
     assert np.linalg.norm(network.polylines[0].points[0]) < 0.5
     assert all(min(ends) > 2.0 for ends in extracted["continued_mm"])
     assert all(o["watertight"] for o in manifest["outputs"] if o["path"].startswith("meshes/"))
-    again = runner.invoke(app, ["build", str(tmp_path / "auto.yaml"), "--out", str(out)])
+    again = runner.invoke(app, ["build", str(tmp_path / "auto.yaml"), "--out", str(out), "--jobs", "1"])
     assert again.exit_code == 0 and "ingest: unchanged, skipped" in again.output
     assert json.loads((out / "manifest.json").read_text())["outputs"] == manifest["outputs"]
 

@@ -43,7 +43,7 @@ def test_a_bend_tighter_than_the_inscribed_radius_with_a_flatter_inner_side_buil
     assert inner_reach(RADIUS, INSCRIBED_REACH / RADIUS, FLATTEN) <= 0.8
     centerline, surface, axis = write_flat_bend_vessel(tmp_path / "bend", RADIUS, INSCRIBED_REACH, 135.0, FLATTEN)
     case = write_case(tmp_path, "bend", final={"centerline": str(centerline), "surface": str(surface)})
-    result = runner.invoke(app, ["build", str(case), "--out", str(tmp_path / "out")])
+    result = runner.invoke(app, ["build", str(case), "--out", str(tmp_path / "out"), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     assert "the centerline turns with r * kappa = " in result.output
     assert "on the inscribed radius 3.000 mm" in result.output
@@ -75,14 +75,14 @@ def test_a_branch_take_off_is_refused_naming_the_body_radius_that_fits_and_build
     centerline, surface = write_takeoff_vessel(tmp_path / "takeoff", 6.0, 2.5, 3.0, 3.0, 90.0)
     final = {"centerline": str(centerline), "surface": str(surface), "path": 1}
     refused = runner.invoke(app, ["build", str(write_case(tmp_path, "takeoff", final=final)),
-                                  "--out", str(tmp_path / "out")])
+                                  "--out", str(tmp_path / "out"), "--jobs", "1"])
     assert refused.exit_code == 1
     assert "the tube folds through itself" in refused.output and "tighter than the body is wide" in refused.output
     assert "mm from the inlet" in refused.output and "resample." not in refused.output
     cap = float(re.search(r"set fit\.max_radius_mm: ([0-9.]+)", refused.output).group(1))
     assert 0.5 < cap < 6.0  # thinner than the trunk, not a thread
     fixed = write_case(tmp_path, "fixed", final=final, fit={"max_radius_mm": cap})
-    result = runner.invoke(app, ["build", str(fixed), "--out", str(tmp_path / "fixed")])
+    result = runner.invoke(app, ["build", str(fixed), "--out", str(tmp_path / "fixed"), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     manifest = json.loads((tmp_path / "fixed" / "manifest.json").read_text())
     assert yaml.safe_load(fixed.read_text())["fit"]["max_radius_mm"] == cap
@@ -108,7 +108,7 @@ def test_a_take_off_refusal_offers_a_local_cap_that_builds_on_the_wall_outside_i
     centerline, surface = write_takeoff_vessel(tmp_path / "takeoff", trunk, branch, 3.0, 3.0, 90.0)
     final = {"centerline": str(centerline), "surface": str(surface), "path": 1}
     refused = runner.invoke(app, ["build", str(write_case(tmp_path, "takeoff", final=final)),
-                                  "--out", str(tmp_path / "out")])
+                                  "--out", str(tmp_path / "out"), "--jobs", "1"])
     assert refused.exit_code == 1
     text = " ".join(refused.output.split())
     where = re.search(r"it folds at ([0-9.]+)-([0-9.]+) mm from the inlet, where the body's radius goes from "
@@ -123,7 +123,7 @@ def test_a_take_off_refusal_offers_a_local_cap_that_builds_on_the_wall_outside_i
     assert "does not pass through it (final.path): path 0 (40.0 mm long)" in text  # the trunk avoids the turn
     entry = yaml.safe_load(key.group(1))
     fixed = write_case(tmp_path, "fixed", final=final, fit={"local_max_radius": [entry]})
-    result = runner.invoke(app, ["build", str(fixed), "--out", str(tmp_path / "fixed")])
+    result = runner.invoke(app, ["build", str(fixed), "--out", str(tmp_path / "fixed"), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     manifest = json.loads((tmp_path / "fixed" / "manifest.json").read_text())
     fit = manifest["metrics"]["fit"]
@@ -163,7 +163,7 @@ def test_a_bend_whose_fitted_body_kinks_on_the_linear_blend_builds_at_defaults_o
     centerline, surface = write_elliptical_bend_vessel(tmp_path / "bend", 2.0, 0.5, 8.0, 160.0)
     final = {"centerline": str(centerline), "surface": str(surface)}
     case = write_case(tmp_path, "kink", final=final, export={"q": [0.0, 0.575, 1.0]})
-    result = runner.invoke(app, ["build", str(case), "--out", str(tmp_path / "out")])
+    result = runner.invoke(app, ["build", str(case), "--out", str(tmp_path / "out"), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     manifest = json.loads((tmp_path / "out" / "manifest.json").read_text())
     blend = manifest["metrics"]["blend"]

@@ -40,7 +40,7 @@ WALL_TOL_MM = 0.005
 
 
 def build(case: Path, out: Path) -> dict:
-    result = runner.invoke(app, ["build", str(case), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(case), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     return json.loads((out / "manifest.json").read_text())
 

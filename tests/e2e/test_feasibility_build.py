@@ -68,7 +68,7 @@ def test_the_manifest_holds_the_figures_and_the_verdict(hollow):
 
 def test_strict_exits_1_only_when_infeasible(hollow, tmp_path):
     case, out, _ = hollow
-    result = runner.invoke(app, ["build", str(case), "--out", str(out), "--strict"])
+    result = runner.invoke(app, ["build", str(case), "--out", str(out), "--jobs", "1", "--strict"])
     block = json.loads((out / "manifest.json").read_text())["metrics"]["feasibility"]
     # dragon-skin-30's min_stretch 0.7 (a rule of thumb without a source) is passed on the demo: a warning, no reason
     assert block["feasible"] is (not block["reasons"])
@@ -76,7 +76,7 @@ def test_strict_exits_1_only_when_infeasible(hollow, tmp_path):
     assert any("min_stretch" in w for w in block["warnings"]) and "skin stretch" in result.output
     tight = write_case(tmp_path, "demo-hollow-tight", **{**_case_keys(case), "material": {
         "name": "dragon-skin-30", "max_stretch": 1.05}})  # a sourced limit the demo's skin passes
-    result = runner.invoke(app, ["build", str(tight), "--out", str(tmp_path / "build"), "--strict"])
+    result = runner.invoke(app, ["build", str(tight), "--out", str(tmp_path / "build"), "--jobs", "1", "--strict"])
     block = json.loads((tmp_path / "build" / "manifest.json").read_text())["metrics"]["feasibility"]
     assert block["feasible"] is False and result.exit_code == 1, result.output
     lines = result.stdout.splitlines()  # the verdict, its reasons and margins, the build folder: the last lines
@@ -85,7 +85,7 @@ def test_strict_exits_1_only_when_infeasible(hollow, tmp_path):
     assert len(verdicts) == 1 and verdicts[0].startswith("verdict: NOT feasible for dragon-skin-30")
     assert all(line.startswith("  ") for line in lines[lines.index(verdicts[0]) + 1:-1])
     assert "link" in result.stdout and "angle" in result.stdout
-    assert runner.invoke(app, ["build", str(tight), "--out", str(tmp_path / "build")]).exit_code == 0
+    assert runner.invoke(app, ["build", str(tight), "--out", str(tmp_path / "build"), "--jobs", "1"]).exit_code == 0
 
 
 def _case_keys(case):

@@ -21,7 +21,7 @@ def _init_and_build(tmp_path, *files) -> dict:
     case = tmp_path / "case.yaml"
     made = runner.invoke(app, ["init", *map(str, files), "--output", str(case)])
     assert made.exit_code == 0, made.output
-    built = runner.invoke(app, ["build", str(case), "--out", str(tmp_path / "build")])
+    built = runner.invoke(app, ["build", str(case), "--out", str(tmp_path / "build"), "--jobs", "1"])
     assert built.exit_code == 0, built.output
     manifest = json.loads((tmp_path / "build" / "manifest.json").read_text())
     meshes = [o for o in manifest["outputs"] if o["path"].startswith("meshes/q_")]

@@ -123,8 +123,8 @@ def test_a_mould_changes_only_the_cuts_it_must_and_adds_its_parts(tmp_path):
     plain, moulded = tmp_path / "plain", tmp_path / "moulded"
     (tmp_path / "a").mkdir()
     (tmp_path / "b").mkdir()
-    run("build", str(demo_case(tmp_path / "a")), "--out", str(plain))
-    run("build", str(demo_case(tmp_path / "b", mould={"up": "tip"})), "--out", str(moulded))
+    run("build", str(demo_case(tmp_path / "a")), "--out", str(plain), "--jobs", "1")
+    run("build", str(demo_case(tmp_path / "b", mould={"up": "tip"})), "--out", str(moulded), "--jobs", "1")
     before, after = files(plain), files(moulded)
     assert set(after) - set(before) == {"mould/summary.json", "meshes/mould/half_a.stl", "meshes/mould/half_b.stl"}
     for stage in ("ingest/", "blend/", "links/", "kinematics.json"):

@@ -25,7 +25,7 @@ def test_the_base_frame_puts_the_straight_body_on_the_z_axis_and_records_the_mov
         (tmp_path / frame).mkdir()
         case = demo_case(tmp_path / frame, export={"frame": frame, "mould": {}})
         outs[frame] = tmp_path / frame / "build"
-        result = runner.invoke(app, ["build", str(case), "--out", str(outs[frame])])
+        result = runner.invoke(app, ["build", str(case), "--out", str(outs[frame]), "--jobs", "1"])
         assert result.exit_code == 0, result.output
     patient = trimesh.load(outs["patient"] / "meshes" / "q_0.000.stl")
     base = trimesh.load(outs["base"] / "meshes" / "q_0.000.stl")
@@ -52,7 +52,7 @@ def test_the_base_frame_puts_the_straight_body_on_the_z_axis_and_records_the_mov
     patient_manifest = json.loads((outs["patient"] / "manifest.json").read_text())
     origin = np.array(patient_manifest["metrics"]["mould"]["frame"]["origin"])
     np.testing.assert_allclose(parting["origin"], origin @ pose[:3, :3].T + pose[:3, 3], rtol=0, atol=1e-9)
-    report = runner.invoke(app, ["report", str(outs["base"])])
+    report = runner.invoke(app, ["report", str(outs["base"]), "--jobs", "1"])
     assert report.exit_code == 0, report.output
     default = json.loads((outs["patient"] / "manifest.json").read_text())["metrics"]["export"]["frame"]
     assert default["name"] == "patient" and np.allclose(default["output_from_patient"], np.eye(4))

@@ -7,34 +7,31 @@ into ``report/report.log``.
 
 from __future__ import annotations
 
-import shutil
-
 import pytest
 from typer.testing import CliRunner
 
 from softdesign.cli import app
 from softdesign.pipeline.layout import REPORT_DIR
 from softdesign.report.writer import LOG
-from tests.helpers.shared_builds import demo_build_copy
+from tests.helpers.shared_builds import demo_build, demo_build_copy
 
 runner = CliRunner()
 
 
 @pytest.mark.slow
 def test_identical_builds_in_other_folders_give_the_same_report_bytes(tmp_path, tmp_path_factory):
-    first = demo_build_copy(tmp_path_factory, tmp_path / "folder-alpha")  # the README's demo build, no report
-    second = tmp_path / "elsewhere" / "folder-beta"
-    shutil.copytree(first, second)  # the same build, in a folder of another name and depth
-    drawn = {}
-    for folder in (first, second):
-        result = runner.invoke(app, ["report", str(folder), "--jobs", "1"])
-        assert result.exit_code == 0, result.output
-        drawn[folder] = {p.name: p.read_bytes() for p in sorted((folder / REPORT_DIR).iterdir())}
-    one, two = drawn[first], drawn[second]
+    # the README's demo build with the report `build --report` drew (made once per run, only read here), and a copy
+    # of it without the report in a folder of another name and depth, where `softdesign report` draws it again
+    first = demo_build(tmp_path_factory)
+    second = demo_build_copy(tmp_path_factory, tmp_path / "elsewhere" / "folder-beta")
+    result = runner.invoke(app, ["report", str(second), "--jobs", "1"])
+    assert result.exit_code == 0, result.output
+    one, two = ({p.name: p.read_bytes() for p in sorted((folder / REPORT_DIR).iterdir())} for folder in (first, second))
     assert sorted(one) == sorted(two) and "index.html" in one
     assert [name for name in one if one[name] != two[name] and name != LOG] == []
-    page = one["index.html"].decode("utf-8")
-    assert "folder-alpha" not in page and "time (s)" not in page and "/timing_s/" not in page
+    page = two["index.html"].decode("utf-8")
+    assert "folder-beta" not in page and "elsewhere" not in page
+    assert "time (s)" not in page and "/timing_s/" not in page
     # the log has what the page leaves out: the folder and the times
     log = two[LOG].decode("utf-8")
     assert f"build folder: {second.resolve().as_posix()}\n" in log

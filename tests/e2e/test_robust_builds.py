@@ -47,7 +47,7 @@ pytestmark = pytest.mark.slow
 
 
 def build(case: Path, out: Path):
-    return runner.invoke(app, ["build", str(case), "--out", str(out)])
+    return runner.invoke(app, ["build", str(case), "--out", str(out), "--jobs", "1"])
 
 
 def test_a_u_turn_builds_at_defaults_with_the_intrinsic_blend_and_says_why(tmp_path):

@@ -13,6 +13,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -104,12 +105,12 @@ def test_a_forward_solve_at_the_tabled_pressures_gives_the_tabled_arc_error(buil
 
 
 def test_the_stage_is_cached_and_the_report_draws_it(built: tuple[Path, Path]) -> None:
-    from softdesign.report.writer import write_report
+    from softdesign.report.writer import ReportOptions, write_report
 
     case, build_dir = built
     runs = {r.name: r.status for r in build_through(case, build_dir, "actuation").runs}
     assert runs["simulate"] == "skipped" and runs["actuation"] == "skipped"
-    report = write_report(build_dir)
+    report = write_report(build_dir, ReportOptions(gif_frames=3))  # the simulate panel is the point: 3 morph frames
     assert "simulate.png" in report.files
     page = report.page.read_text(encoding="utf-8")
     assert 'id="simulate"' in page and "Model estimates:" in page
@@ -118,19 +119,24 @@ def test_the_stage_is_cached_and_the_report_draws_it(built: tuple[Path, Path]) -
 
 def test_without_simulate_the_table_keeps_its_columns_and_rows(built: tuple[Path, Path], tmp_path: Path) -> None:
     _, build_dir = built
-    plain = case_file(tmp_path, {**SIMULATE, "enabled": False})  # the block kept but off: the same as none
-    build_through(plain, tmp_path / "build", "actuation")
+    plain = case_file(tmp_path / "on", {**SIMULATE, "enabled": False})  # the block kept but off: the same as none
+    # on a copy of the simulated build: the stages before simulate are kept (the same case but for its simulate
+    # block, as deep as the module's: the stage keys name the inputs relative to it), simulate and actuation rerun
+    shutil.copytree(build_dir, tmp_path / "build")
+    runs = {r.name: r.status for r in build_through(plain, tmp_path / "build", "actuation").runs}
+    assert runs["fit"] == "skipped" and runs["simulate"] == runs["actuation"] == "ran"
     header, table = rows(tmp_path / "build" / "actuation.csv")
     assert tuple(header) == COLUMNS
     _, simulated = rows(build_dir / "actuation.csv")
     assert table == [{k: r[k] for k in COLUMNS} for r in simulated]  # q = 1 is on the dense grid: no new rows
 
 
-def test_simulate_write_puts_one_sections_pressures_in_the_table(tmp_path: Path) -> None:
+def test_simulate_write_puts_one_sections_pressures_in_the_table(built: tuple[Path, Path], tmp_path: Path) -> None:
     from softdesign.pipeline.simulate_command import write_to_table
     from softdesign.pipeline.simulate_run import SimulateOptions
 
-    case = case_file(tmp_path, None)  # no simulate block: --write enables it for this run's section and q
+    case = case_file(tmp_path / "on", None)  # no simulate block: --write enables it for this run's section and q
+    shutil.copytree(built[1], tmp_path / "build")  # the stages before simulate kept (as above): this section solved
     options = SimulateOptions(1, None, 0.5, size_mm=4.0, layer_mm=10.0, angular_count=8, max_pressure_kpa=50.0,
                               max_solves=1)
     solve = write_to_table(case, tmp_path / "build", options, lambda line: None)

@@ -32,7 +32,7 @@ def built(tmp_path_factory) -> tuple[Path, str]:
     folder = tmp_path_factory.mktemp("single")
     case = case_from(folder, REPO / "configs" / "actuator.yaml", {"export": {"q": [0.0, 0.5, 1.0]}})
     out = folder / "build"
-    result = runner.invoke(app, ["build", str(case), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(case), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     return out, result.stdout  # progress goes to stderr
 

@@ -23,7 +23,7 @@ runner = CliRunner()
 
 
 def _build(case: Path, out: Path) -> dict:
-    result = runner.invoke(app, ["build", str(case), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(case), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     return json.loads((out / "manifest.json").read_text())
 

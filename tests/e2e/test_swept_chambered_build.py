@@ -44,7 +44,7 @@ def _keys(faces: np.ndarray) -> list[tuple[int, ...]]:
 
 def test_five_chambered_links_mesh(tmp_path: Path) -> None:
     out = tmp_path / "build"
-    result = runner.invoke(app, ["build", str(_case(tmp_path, {}, 5)), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(_case(tmp_path, {}, 5)), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     check_chambered(out, 5)
 
@@ -59,7 +59,7 @@ def test_five_chambered_links_of_the_aorta_mesh(tmp_path: Path, aorta_dir: Path)
     path = tmp_path / "aorta.yaml"
     path.write_text(yaml.safe_dump(case, sort_keys=False))
     out = tmp_path / "build"
-    result = runner.invoke(app, ["build", str(path), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(path), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     check_chambered(out, 5)
 
@@ -107,7 +107,7 @@ def test_chambers_crossing_in_the_cross_section_refused_before_the_export(tmp_pa
     sections' chambers are 2 x 2 sin 12 deg - 1 = -0.17 mm apart in the one cross-section."""
     out = tmp_path / "build"
     case = _case(tmp_path, {"diameter_mm": 1.0, "feed_diameter_mm": 0.2}, 5)
-    result = runner.invoke(app, ["build", str(case), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(case), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 2, result.output
     text = " ".join(result.output.split())
     assert "cross in the swept mesher's cross-section" in text

@@ -40,7 +40,7 @@ def _keys(faces: np.ndarray) -> list[tuple[int, ...]]:
 def test_swept_mesh_of_a_hollow_tube(tmp_path):
     case = _swept(tmp_path)
     out = tmp_path / "build"
-    result = runner.invoke(app, ["build", str(case), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(case), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     # a line per part with its time in the build's log (its printed lines), none in the summary (issue 35)
     assert re.search(r"^  mesh plan: \d+\.\d\d s$", result.output, re.M), result.output
@@ -79,7 +79,7 @@ def test_swept_mesh_of_a_hollow_tube(tmp_path):
     np.testing.assert_allclose(topology.volume, analytic, rtol=CHAMBER_RTOL)
 
     again = tmp_path / "again"
-    assert runner.invoke(app, ["build", str(case), "--out", str(again)]).exit_code == 0
+    assert runner.invoke(app, ["build", str(case), "--out", str(again), "--jobs", "1"]).exit_code == 0
     for name in ("q_0.000.vtu", "q_0.000.msh", "q_1.000.vtu", "chamber_q_1.000.stl"):
         assert (volume / name).read_bytes() == (again / "meshes" / "volume" / name).read_bytes(), name
     assert (out / "volume_mesh" / "summary.json").read_bytes() == (again / "volume_mesh" / "summary.json").read_bytes()
@@ -101,7 +101,7 @@ def test_strict_fails_on_the_3d_stress_alone(tmp_path):
                         "min_stretch": 0.01}
     case.write_text(yaml.safe_dump(data))
     out = tmp_path / "strict"
-    result = runner.invoke(app, ["build", str(case), "--out", str(out), "--strict"])
+    result = runner.invoke(app, ["build", str(case), "--out", str(out), "--jobs", "1", "--strict"])
     assert result.exit_code == 1, result.output
     assert json.loads((out / "feasibility" / "summary.json").read_text())["feasible"] is True
     summary = json.loads((out / "volume_mesh" / "summary.json").read_text())
@@ -190,8 +190,8 @@ def test_meshing_and_its_metrics_show_a_bar_on_a_terminal_and_a_line_per_part_wi
     for done, part in enumerate(parts, start=1):
         assert re.search(rf"volume_mesh: {part} \(\d+\.\d\d s\) done .*{done}/{len(parts)}", screen), screen
         assert re.search(rf"^  {part}: \d+\.\d\d s$", stdout, re.M), stdout
-    piped = subprocess.run([sys.executable, "-c", CODE, "build", str(case), "--out", str(tmp_path / "pipe")],
-                           capture_output=True, text=True, cwd=REPO, timeout=600, stdin=subprocess.DEVNULL)
+    piped = subprocess.run([sys.executable, "-c", CODE, "build", str(case), "--out", str(tmp_path / "pipe"), "--jobs",
+                            "1"], capture_output=True, text=True, cwd=REPO, timeout=600, stdin=subprocess.DEVNULL)
     assert piped.returncode == 0, piped.stderr
     assert "\x1b" not in piped.stderr and "mesh plan (" not in piped.stderr
     assert re.search(r"^  mesh plan: \d+\.\d\d s$", piped.stdout, re.M), piped.stdout

@@ -105,7 +105,7 @@ def test_hollow_tube_volume_mesh_files_figures_and_mesher_failures(tmp_path, mon
     work = tmp_path / "work"
     work.mkdir()
     monkeypatch.chdir(work)  # where fTetWild would write files of its own
-    result = runner.invoke(app, ["build", str(case), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(case), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     assert "[volume_mesh] ran" in result.output
     manifest = json.loads((out / "manifest.json").read_text())
@@ -162,7 +162,7 @@ def test_hollow_tube_volume_mesh_files_figures_and_mesher_failures(tmp_path, mon
         (failing_mesher, {"size_mm": 2.5}, "failed: RuntimeError: fTetWild: envelope check failed"),
     ]:
         monkeypatch.setattr(volume_mesh, "MESHER", mesher)
-        result = runner.invoke(app, ["build", str(tube_case(tmp_path, **volume)), "--out", str(out)])
+        result = runner.invoke(app, ["build", str(tube_case(tmp_path, **volume)), "--out", str(out), "--jobs", "1"])
         assert result.exit_code == 1, result.output
         assert "fTetWild on the body at q=0.000" in result.output and message in result.output, result.output
         assert "Traceback" not in result.output
@@ -173,7 +173,7 @@ def test_hollow_tube_volume_mesh_files_figures_and_mesher_failures(tmp_path, mon
 def test_a_sealed_chamber_stays_empty(tmp_path):
     # no port: the chamber is a closed void inside the body, which the mesher must leave empty
     out = tmp_path / "build"
-    result = runner.invoke(app, ["build", str(tube_case(tmp_path, port_mm=None)), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(tube_case(tmp_path, port_mm=None)), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     points, tets = read_volume_mesh(out / "meshes/volume/q_0.000.vtu")
     chamber_v, chamber_f = read_mesh(out / "meshes/volume/chamber_q_0.000.stl")

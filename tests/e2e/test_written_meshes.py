@@ -41,7 +41,7 @@ def _check_every_q(case: Path, out: Path) -> None:
     import manifold3d
     import trimesh
 
-    result = runner.invoke(app, ["export", str(case), "--out", str(out)])
+    result = runner.invoke(app, ["export", str(case), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     summary = json.loads((out / "export" / "summary.json").read_text())["meshes"]
     assert len(summary) == len(QS)

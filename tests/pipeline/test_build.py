@@ -56,7 +56,9 @@ def demo_case(tmp_path) -> Path:
 
 
 def build(case: Path, out: Path, *extra: str) -> str:
-    result = runner.invoke(app, ["build", str(case), "--out", str(out), *extra])
+    """``softdesign build CASE --out OUT EXTRA`` in-process on one process (the parallel path's bytes are
+    tests/pipeline/test_parallel.py's: here a pool of two would add about a second of CPU per build)."""
+    result = runner.invoke(app, ["build", str(case), "--out", str(out), "--jobs", "1", *extra])
     assert result.exit_code == 0, result.output
     return result.output
 
@@ -271,7 +273,7 @@ def test_a_failed_run_leaves_the_previous_build_untouched(demo_case, demo_built,
 
     original = export_stage.mesh_bytes
     monkeypatch.setattr(export_stage, "mesh_bytes", failing)
-    result = runner.invoke(app, ["build", str(demo_case), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(demo_case), "--out", str(out), "--jobs", "1"])
     assert result.exit_code != 0 and len(calls) == 2
     assert snapshot(out) == before
     assert not list(tmp_path.glob(".build.staging-*"))
@@ -302,7 +304,7 @@ def test_a_build_killed_mid_export_leaves_the_previous_build_unchanged(demo_case
     before = snapshot(out)
     edit(demo_case, "export", angular_count=56)
     killed = subprocess.run(
-        [sys.executable, "-c", KILL_MID_EXPORT, "build", str(demo_case), "--out", str(out)],
+        [sys.executable, "-c", KILL_MID_EXPORT, "build", str(demo_case), "--out", str(out), "--jobs", "1"],
         capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(REPO)}, timeout=300,
     )
     assert killed.returncode == -9, killed.stderr
@@ -314,13 +316,14 @@ def test_a_build_killed_mid_export_leaves_the_previous_build_unchanged(demo_case
 
 
 @pytest.mark.slow
-def test_split_regions_writes_one_stl_per_region_that_tiles_each_solid(demo_case, tmp_path):
+def test_split_regions_writes_one_stl_per_region_that_tiles_each_solid(demo_case, demo_built, tmp_path):
     import trimesh
 
     from softdesign.meshing.topology import surface_area
 
-    edit(demo_case, "export", split_regions=True)
     out = tmp_path / "out"
+    built(demo_built, demo_case, out)  # only export and what follows it run again (the cache test shows which)
+    edit(demo_case, "export", split_regions=True)
     output = build(demo_case, out)
     assert "one STL per region: wall" in output
     manifest = json.loads((out / "manifest.json").read_text())
@@ -346,13 +349,14 @@ def test_split_regions_writes_one_stl_per_region_that_tiles_each_solid(demo_case
 
 
 @pytest.mark.slow
-def test_vtp_meshes_carry_the_region_of_every_face(demo_case, tmp_path):
+def test_vtp_meshes_carry_the_region_of_every_face(demo_case, demo_built, tmp_path):
     from vtk.util.numpy_support import vtk_to_numpy
 
     from softdesign.io.vtk_polydata import read_polydata
 
-    edit(demo_case, "export", formats=["stl", "vtp"])
     out = tmp_path / "out"
+    built(demo_built, demo_case, out)
+    edit(demo_case, "export", formats=["stl", "vtp"])
     build(demo_case, out)
     manifest = json.loads((out / "manifest.json").read_text())
     outputs = {o["path"]: o for o in manifest["outputs"]}

@@ -47,7 +47,9 @@ def run(*args: str | Path) -> Result:
 
 
 def built(case: Path, out: Path) -> Result:
-    result = run("build", case, "--out", out)
+    """A build on one process (the parallel path is tests/pipeline/test_parallel.py's; a pool of two would add
+    about a second of CPU to each of this file's builds)."""
+    result = run("build", case, "--out", out, "--jobs", "1")
     assert result.exit_code == 0, result.output
     return result
 
@@ -183,7 +185,7 @@ def test_a_build_killed_during_its_commit_leaves_the_old_folder_or_the_new_one(p
     shutil.copytree(old, out)
     spec = json.dumps([call, number, when, fallback])
     killed = subprocess.run(
-        [sys.executable, "-c", KILL_AT, spec, "build", str(case), "--out", str(out)],
+        [sys.executable, "-c", KILL_AT, spec, "build", str(case), "--out", str(out), "--jobs", "1"],
         capture_output=True, text=True, env=child_env(), timeout=CHILD_TIMEOUT_S,
     )
     assert killed.returncode == -signal.SIGKILL, killed.stderr
@@ -291,7 +293,7 @@ def test_a_commit_that_fails_part_way_leaves_the_old_folder_as_it_was(fault, nee
     before = snapshot(out)
     case = write_demo(tmp_path, angular_count=56)
     fault(monkeypatch)
-    result = run("build", case, "--out", out)
+    result = run("build", case, "--out", out, "--jobs", "1")
     assert_refused(result, f"build folder {out}", str(tmp_path), *needles)
     assert snapshot(out) == before
     assert leftovers(tmp_path, "build") == []
