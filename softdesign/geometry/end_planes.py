@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from softdesign.geometry.edges import EdgeTable, corner_planes, row_cross, run_starts
+from softdesign.geometry.edges import EdgeTable, corner_planes, run_starts, unit_normal_rows
 from softdesign.geometry.end_cut import MAX_CUT_TILT_DEG
 from softdesign.types import FloatArray, IntArray, Points
 
@@ -60,9 +60,6 @@ RIM_SECTORS = 8
 MAX_FLATNESS_FRACTION = 0.05
 #: A plane tilted more than this to the end tangent is a wall facet, not an end, degrees.
 MAX_TILT_DEG = 60.0
-#: A face whose edges' cross product is no longer than this is degenerate, its normal zero (trimesh's
-#: ``util.TOL_ZERO``, 100 float64 resolutions).
-TRIMESH_TOL_ZERO = 1e-13
 #: The rim past the body's square end that the build warns about, mm (a tenth of a 2.5 mm vessel's radius).
 RIM_GAP_TOLERANCE_MM = 0.25
 
@@ -242,26 +239,10 @@ def _flat_regions(vertices: Points, faces: IntArray, edges: EdgeTable, near: np.
 
 
 def _face_normals(vertices: Points, faces: IntArray) -> FloatArray:
-    """(3, F) unit normals, x, y and z rows, as trimesh's ``face_normals`` makes them (zero for a degenerate face).
-
-    trimesh's arithmetic on coordinate rows (each corner's x, y and z as contiguous (F,) rows): the
-    cross product of p1 - p0 and p2 - p1 with ``np.cross``'s products in its order, its length from the squares
-    added x + y, then + z, as trimesh's ``np.dot`` with ones adds them, zero below trimesh's ``TOL_ZERO``
-    (1e-13), and the reciprocal length multiplied in: the same numbers, bit for bit
-    (tests/geometry/test_end_planes.py compares them), in about a third of its time on 1M faces, which
-    gathered (F, 3, 3) corners and strode across their coordinates.
-    """
-    p0, p1, p2 = corner_planes(vertices, faces)
-    normals = row_cross(p1 - p0, p2 - p1)
-    squares = normals * normals
-    length = squares[0] + squares[1]
-    length += squares[2]
-    np.sqrt(length, out=length)
-    valid = length > TRIMESH_TOL_ZERO
-    scale = np.zeros_like(length)
-    np.divide(1.0, length, out=scale, where=valid)
-    normals *= scale
-    return normals
+    """(3, F) unit normals, x, y and z rows, as trimesh's ``face_normals`` makes them (zero for a degenerate face):
+    :func:`~softdesign.geometry.edges.unit_normal_rows`, the same numbers bit for bit in about a third of
+    trimesh's time on 1M faces, which gathered (F, 3, 3) corners and strode across their coordinates."""
+    return unit_normal_rows(*corner_planes(vertices, faces))[0]
 
 
 def _pair_angles(normals: FloatArray, pairs: IntArray) -> FloatArray:
