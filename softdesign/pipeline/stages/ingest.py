@@ -30,6 +30,7 @@ from softdesign.pipeline.backbone_step import regularized_path
 from softdesign.pipeline.end_plane_step import end_plane_summary
 from softdesign.pipeline.item_progress import step_counter
 from softdesign.pipeline.notices import NOTE, Notice
+from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 from softdesign.pipeline.surface_radius import with_surface_radius
@@ -160,7 +161,7 @@ def _final_surface(case: Case, path: SelectedPath, scale: float
     if case.final.surface is None:
         return np.zeros((0, 3)), np.zeros((0, 3), np.int64), None, None
     surface_scale = UNIT_SCALE_TO_MM[case.final.surface_units] if case.final.surface_units else scale
-    vertices, faces = read_surface(case.final.surface, surface_scale)
+    vertices, faces = read_surface(case.final.surface, surface_scale, map_items)  # a big STL's merge on the workers
     check_surface_surrounds(path.points, path.radius, vertices, str(case.final.surface))
     edges = EdgeTable.of(np.asarray(faces, np.int64), len(vertices))
     return vertices, faces, describe_surface(vertices, faces, edges), edges
