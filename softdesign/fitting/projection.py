@@ -63,12 +63,11 @@ class PolarPoints:
         return len(self.l)
 
     def subset(self, mask: npt.ArrayLike) -> PolarPoints:
-        """The points selected by a boolean mask or an index array (copies)."""
+        """The points selected by a boolean mask or an index array (copies: indexing by an array makes new ones)."""
         mask = np.asarray(mask)
-        return PolarPoints(
-            self.points[mask].copy(), self.l[mask].copy(), self.angle[mask].copy(),
-            self.rho[mask].copy(), self.end_side[mask].copy(),
-        )
+        if mask.ndim != 1:
+            raise ValueError(f"PolarPoints.subset: expected a 1-D boolean mask or index array, got shape {mask.shape}")
+        return PolarPoints(self.points[mask], self.l[mask], self.angle[mask], self.rho[mask], self.end_side[mask])
 
 
 def project_points(curve: FramedCurve, points: npt.ArrayLike, mapper: Mapper = serial_map) -> PolarPoints:
