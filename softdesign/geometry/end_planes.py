@@ -105,7 +105,7 @@ class EndPlane:
 
 def end_planes(
     vertices: Points, faces: IntArray, ends: Points, tangents: Points, inscribed_mm: FloatArray,
-    table: EdgeTable | None = None,
+    table: EdgeTable | None = None, labels: np.ndarray | None = None,
 ) -> tuple[EndPlane | None, EndPlane | None]:
     """The plane at the path's inlet and at its outlet, or None where no flat cap or open loop is found.
 
@@ -116,6 +116,7 @@ def end_planes(
     tangents : (2, 3) unit tangents of the path at those points, in the path's direction
     inscribed_mm : (2,) inscribed-sphere radius at each end, mm
     table : the faces' edge table on ``len(vertices)`` vertices, when the caller has it (else made here)
+    labels : (F,) :func:`flat_labels` of the surface, when the caller has them (else found here)
     """
     vertices, faces = np.asarray(vertices, float), np.asarray(faces, np.int64)
     ends, inscribed_mm = np.asarray(ends, float), np.asarray(inscribed_mm, float)
@@ -124,7 +125,9 @@ def end_planes(
     # a cap's faces lie within its rim, whose centre is within END_SEARCH_RADII inscribed radii of the end
     reach = (END_SEARCH_RADII + 1.0 / np.cos(np.radians(MAX_TILT_DEG))) * inscribed_mm
     near = _faces_near(vertices, faces, ends, reach)
-    rims += [("flat_cap", _region_rim(faces, f, len(vertices))) for f in _flat_regions(vertices, faces, edges, near)]
+    if labels is None or len(labels) != len(faces):
+        labels = flat_labels(vertices, faces, edges)
+    rims += [("flat_cap", _region_rim(faces, f, len(vertices))) for f in _flat_regions(labels, near)]
     # a flat region with no boundary of its own (a closed flat shell) has no rim; each rim's centre serves both ends
     points = [(kind, vertices[ids]) for kind, ids in rims if len(ids) >= 3]
     candidates = [(kind, rim, rim.mean(axis=0)) for kind, rim in points]
@@ -215,19 +218,27 @@ def _faces_near(vertices: Points, faces: IntArray, ends: Points, reach: FloatArr
     return near
 
 
-def _flat_regions(vertices: Points, faces: IntArray, edges: EdgeTable, near: np.ndarray) -> list[IntArray]:
-    """Face ids of each connected region of two or more faces whose neighbours differ by < ``FLAT_ANGLE_DEG``.
+def flat_labels(vertices: Points, faces: IntArray, edges: EdgeTable) -> np.ndarray:
+    """(F,) int32: each face's flat region, the connected faces whose neighbours' normals differ by less than
+    ``FLAT_ANGLE_DEG``, numbered in the order of their smallest face id.
 
-    Only the regions holding a face of ``near`` (bool per face), in the order of their smallest face id.
+    The whole surface's work of :func:`end_planes` that does not depend on the path (normals, angles and one
+    connected-components pass over 1M faces): the ingest finds it beside its other checks of the surface.
     """
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
+    vertices, faces = np.asarray(vertices, float), np.asarray(faces, np.int64)
     pairs = edges.face_pairs()
     pairs = pairs[_pair_angles(_face_normals(vertices, faces), pairs) < np.radians(FLAT_ANGLE_DEG)]
     count = len(faces)
     graph = coo_matrix((np.ones(len(pairs), np.int8), (pairs[:, 0], pairs[:, 1])), shape=(count, count))
-    labels = connected_components(graph, directed=False)[1]  # numbered in the order of their smallest face id
+    return connected_components(graph, directed=False)[1]
+
+
+def _flat_regions(labels: np.ndarray, near: np.ndarray) -> list[IntArray]:
+    """Face ids of each flat region of two or more faces (``labels``: :func:`flat_labels`) that holds a face of
+    ``near`` (bool per face), in the order of their smallest face id."""
     sizes = np.bincount(labels)
     wanted = np.zeros(len(sizes), bool)
     wanted[labels[near]] = True
