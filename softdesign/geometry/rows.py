@@ -101,13 +101,21 @@ def rows_in_first_order(values: npt.ArrayLike, mapper: Mapper | None = None) -> 
         array = array + 0.0  # -0.0 becomes 0.0: equal values, equal bits
     hashable = array.dtype.itemsize <= 8 and array.shape[1] <= len(_MIXERS)
     if hashable and mapper is not None and array.dtype.kind in "iu" and n >= SPLIT_ROWS:
-        found = _split_hashed_groups(array, mapper)
+        joined = _split_hashed_groups(array, mapper)
+        if joined is not None:
+            return joined
+        found = None
     else:
         found = _hashed_groups(array) if hashable else None
     if found is None:
         distinct = distinct_rows(array)
         found = distinct.first, distinct.inverse
-    first, inverse = found
+    return _in_first_order(*found)
+
+
+def _in_first_order(first: np.ndarray, inverse: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The groups (``first`` (m,) distinct first indices, ``inverse`` (n,) each row's group) numbered anew in
+    increasing order of their first index: the only such numbering."""
     order = np.argsort(first, kind="stable")
     rank = np.empty(len(first), np.intp)
     rank[order] = np.arange(len(first))
@@ -168,26 +176,35 @@ def _hashed_groups(array: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
 
 
 def _split_hashed_groups(array: np.ndarray, mapper: Mapper) -> tuple[np.ndarray, np.ndarray] | None:
-    """:func:`_hashed_groups` of the integer rows (n, k) with an even first column and of those with an odd one,
-    as two tasks of ``mapper``, joined: (first index, group) with the groups numbered half by half; None on a
-    collision in either half (the caller then groups every row by :func:`distinct_rows`)."""
+    """:func:`rows_in_first_order` of the integer rows (n, k), by :func:`_hashed_groups` of the rows with an even
+    first column and of those with an odd one as two tasks of ``mapper``, joined; None on a collision in either half
+    (the caller then groups every row by :func:`distinct_rows`).
+
+    Each half comes back numbered in first-occurrence order (its renumbering done beside the other's), so its
+    first rows are increasing here too, and the two runs are merged by one stable sort that finds them.
+    """
     parts = mapper(lambda odd: _half_groups(array, odd), [0, 1])
     if any(part is None for part in parts):
         return None
+    odd_rows = (array[:, 0] & 1).astype(bool)
+    halves = (np.flatnonzero(~odd_rows), np.flatnonzero(odd_rows))  # increasing: a half's first row is its group's
+    joined = np.concatenate([rows[first] for rows, (first, _) in zip(halves, parts, strict=True)])
+    order = np.argsort(joined, kind="stable")  # two increasing runs (timsort merges them)
+    rank = np.empty(len(joined), np.intp)
+    rank[order] = np.arange(len(joined))
     inverse = np.empty(len(array), np.intp)
-    firsts, offset = [], 0
-    for odd, (first, group) in enumerate(parts):
-        rows = np.flatnonzero((array[:, 0] & 1) == odd)  # increasing: a half's first row is its group's first
-        inverse[rows] = group + offset
-        firsts.append(rows[first])
+    offset = 0
+    for rows, (first, group) in zip(halves, parts, strict=True):
+        inverse[rows] = rank[offset:offset + len(first)][group]
         offset += len(first)
-    return np.concatenate(firsts), inverse
+    return joined[order], inverse
 
 
 def _half_groups(array: np.ndarray, odd: int) -> tuple[np.ndarray, np.ndarray] | None:
-    """:func:`_hashed_groups` of the rows of ``array`` whose first column's parity is ``odd``, in their own
-    numbering (indices into those rows)."""
+    """:func:`_hashed_groups` of the rows of ``array`` whose first column's parity is ``odd``, numbered in their
+    first-occurrence order (indices into those rows); None on a collision."""
     half = array[(array[:, 0] & 1) == odd]
     if len(half) == 0:
         return np.zeros(0, np.intp), np.zeros(0, np.intp)
-    return _hashed_groups(half)
+    found = _hashed_groups(half)
+    return None if found is None else _in_first_order(*found)
