@@ -206,13 +206,22 @@ def _faces_near(vertices: Points, faces: IntArray, ends: Points, reach: FloatArr
 
     Centres are computed only for faces that have no axis on which all three vertices lie more than that
     reach (padded by a relative 1e-6, far above round-off) to one side of the end: their centres are too far.
+    Each vertex's sides of both ends are one 16-bit word (end k's six bits from bit 8 k), so the faces'
+    corners are gathered once, from coordinate rows.
     """
     near = np.zeros(len(faces), bool)
-    bits = np.array([1, 2, 4], np.uint8)
-    for end, within in zip(ends, reach, strict=True):
+    rows = np.ascontiguousarray(np.asarray(vertices, float).T)
+    side = np.zeros(len(vertices), np.uint16)
+    for k, (end, within) in enumerate(zip(ends, reach, strict=True)):
         pad = within + 1e-6 * (within + np.abs(end))
-        side = ((vertices < end - pad) @ bits) | (((vertices > end + pad) @ bits) << 3)  # axis, below | above
-        candidates = np.flatnonzero(np.bitwise_and.reduce(side[faces], axis=1) == 0)
+        for axis in range(3):  # bit axis: below the end's reach on that axis, bit 3 + axis: above it
+            side |= (rows[axis] < end[axis] - pad[axis]).astype(np.uint16) << np.uint16(8 * k + axis)
+            side |= (rows[axis] > end[axis] + pad[axis]).astype(np.uint16) << np.uint16(8 * k + 3 + axis)
+    corners = side[faces.T]  # (3, F)
+    common = corners[0] & corners[1]
+    common &= corners[2]  # a side all three corners are on
+    for k, (end, within) in enumerate(zip(ends, reach, strict=True)):
+        candidates = np.flatnonzero((common >> np.uint16(8 * k)) & np.uint16(0xFF) == 0)
         centres = vertices[faces[candidates]].mean(axis=1)
         near[candidates[np.linalg.norm(centres - end, axis=1) <= within]] = True
     return near
