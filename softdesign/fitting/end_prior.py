@@ -89,9 +89,9 @@ def end_prior(
     row = np.minimum((kept.l * intervals).astype(int), intervals - 1)
     col = np.minimum((np.mod(kept.angle, 2.0 * np.pi) * (angular_intervals / (2.0 * np.pi))).astype(int),
                      angular_intervals - 1)
-    counts = np.zeros((intervals, angular_intervals), int)
-    np.add.at(counts, (row, col), 1)
-    seen = np.array([largest_gap(kept.angle[row == k]) <= SEEN_GAP_RAD for k in range(intervals)])
+    counts = np.bincount(row * angular_intervals + col, minlength=intervals * angular_intervals).reshape(
+        intervals, angular_intervals)
+    seen = np.array([largest_gap(angles) <= SEEN_GAP_RAD for angles in _angles_by_row(kept.angle, row, intervals)])
     if not seen.any():  # nothing seen all round: no typical cell to weigh by; the surround check speaks
         return _no_prior()
     typical = float(np.median(counts[seen]))
@@ -118,6 +118,17 @@ def end_prior(
         return _no_prior()
     l, angle, rho = (np.concatenate([p[i] for p in parts]) for i in range(3))
     return EndPrior(l, angle, rho, np.full(len(l), typical / PRIOR_SUBGRID**2), ends)
+
+
+def _angles_by_row(angle: FloatArray, row: np.ndarray, intervals: int) -> list[FloatArray]:
+    """``[angle[row == k] for k in range(intervals)]`` (each in the points' order) from one ordering of the rows:
+    slices where the rows are already in order (the fit's kept points come sorted by l), where each mask was a
+    pass over every point (about 0.13 s of 0.17 s for 500k points in 237 rows)."""
+    if len(row) > 1 and not np.all(row[1:] >= row[:-1]):
+        order = np.argsort(row, kind="stable")  # stable: each row's points keep their order
+        angle, row = angle[order], row[order]
+    bounds = np.searchsorted(row, np.arange(intervals + 1))
+    return [angle[bounds[k]:bounds[k + 1]] for k in range(intervals)]
 
 
 def _cell_points(rows, cols, intervals: int, angular_intervals: int) -> tuple[FloatArray, FloatArray]:

@@ -90,6 +90,33 @@ def corner_planes(vertices: FloatArray, faces: IntArray) -> tuple[FloatArray, Fl
     return corners[:, 0], corners[:, 1], corners[:, 2]
 
 
+#: A face whose edges' cross product is no longer than this is degenerate, its normal zero (trimesh's
+#: ``util.TOL_ZERO``, 100 float64 resolutions).
+TRIMESH_TOL_ZERO = 1e-13
+
+
+def unit_normal_rows(p0: FloatArray, p1: FloatArray, p2: FloatArray) -> tuple[FloatArray, np.ndarray]:
+    """(3, F) unit normals of the faces with corners ``p0``, ``p1``, ``p2`` (3, F) mm (:func:`corner_planes`), and
+    (F,) bool, the faces long enough for one: trimesh's ``face_normals`` (zero for a degenerate face), bit for bit.
+
+    trimesh's arithmetic on coordinate rows: the cross product of p1 - p0 and p2 - p1 with ``np.cross``'s products
+    in its order, its length from the squares added x + y, then + z, as trimesh's ``np.dot`` with ones adds them,
+    zero below ``TRIMESH_TOL_ZERO``, and the reciprocal length multiplied in (tests/geometry/test_end_planes.py
+    and tests/io/test_stl_bytes.py compare them with trimesh's).
+    """
+    normals = row_cross(p1 - p0, p2 - p1)
+    squares = normals * normals
+    length = squares[0] + squares[1]
+    length += squares[2]
+    np.sqrt(length, out=length)
+    valid = length > TRIMESH_TOL_ZERO
+    scale = np.zeros_like(length)
+    np.divide(1.0, length, out=scale, where=valid)
+    normals *= scale
+    normals[:, ~valid] = 0.0  # not -0.0 where a tiny negative component met the zero scale: trimesh pads zeros
+    return normals, valid
+
+
 def row_cross(u: FloatArray, v: FloatArray) -> FloatArray:
     """``u x v`` (3, F) of vectors held as coordinate rows (3, F): ``np.cross``'s products in its order, component
     by component (``u[j] v[k] - u[k] v[j]``), the same numbers on contiguous rows."""

@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from softdesign.geometry.edges import EdgeTable, corner_planes, row_cross, run_starts
+from softdesign.geometry.edges import EdgeTable, corner_planes, run_starts, unit_normal_rows
 from softdesign.geometry.end_cut import MAX_CUT_TILT_DEG
 from softdesign.types import FloatArray, IntArray, Points
 
@@ -60,9 +60,6 @@ RIM_SECTORS = 8
 MAX_FLATNESS_FRACTION = 0.05
 #: A plane tilted more than this to the end tangent is a wall facet, not an end, degrees.
 MAX_TILT_DEG = 60.0
-#: A face whose edges' cross product is no longer than this is degenerate, its normal zero (trimesh's
-#: ``util.TOL_ZERO``, 100 float64 resolutions).
-TRIMESH_TOL_ZERO = 1e-13
 #: The rim past the body's square end that the build warns about, mm (a tenth of a 2.5 mm vessel's radius).
 RIM_GAP_TOLERANCE_MM = 0.25
 
@@ -108,7 +105,7 @@ class EndPlane:
 
 def end_planes(
     vertices: Points, faces: IntArray, ends: Points, tangents: Points, inscribed_mm: FloatArray,
-    table: EdgeTable | None = None,
+    table: EdgeTable | None = None, labels: np.ndarray | None = None,
 ) -> tuple[EndPlane | None, EndPlane | None]:
     """The plane at the path's inlet and at its outlet, or None where no flat cap or open loop is found.
 
@@ -119,6 +116,7 @@ def end_planes(
     tangents : (2, 3) unit tangents of the path at those points, in the path's direction
     inscribed_mm : (2,) inscribed-sphere radius at each end, mm
     table : the faces' edge table on ``len(vertices)`` vertices, when the caller has it (else made here)
+    labels : (F,) :func:`flat_labels` of the surface, when the caller has them (else found here)
     """
     vertices, faces = np.asarray(vertices, float), np.asarray(faces, np.int64)
     ends, inscribed_mm = np.asarray(ends, float), np.asarray(inscribed_mm, float)
@@ -127,7 +125,9 @@ def end_planes(
     # a cap's faces lie within its rim, whose centre is within END_SEARCH_RADII inscribed radii of the end
     reach = (END_SEARCH_RADII + 1.0 / np.cos(np.radians(MAX_TILT_DEG))) * inscribed_mm
     near = _faces_near(vertices, faces, ends, reach)
-    rims += [("flat_cap", _region_rim(faces, f, len(vertices))) for f in _flat_regions(vertices, faces, edges, near)]
+    if labels is None or len(labels) != len(faces):
+        labels = flat_labels(vertices, faces, edges)
+    rims += [("flat_cap", _region_rim(faces, f, len(vertices))) for f in _flat_regions(labels, near)]
     # a flat region with no boundary of its own (a closed flat shell) has no rim; each rim's centre serves both ends
     points = [(kind, vertices[ids]) for kind, ids in rims if len(ids) >= 3]
     candidates = [(kind, rim, rim.mean(axis=0)) for kind, rim in points]
@@ -206,31 +206,48 @@ def _faces_near(vertices: Points, faces: IntArray, ends: Points, reach: FloatArr
 
     Centres are computed only for faces that have no axis on which all three vertices lie more than that
     reach (padded by a relative 1e-6, far above round-off) to one side of the end: their centres are too far.
+    Each vertex's sides of both ends are one 16-bit word (end k's six bits from bit 8 k), so the faces'
+    corners are gathered once, from coordinate rows.
     """
     near = np.zeros(len(faces), bool)
-    bits = np.array([1, 2, 4], np.uint8)
-    for end, within in zip(ends, reach, strict=True):
+    rows = np.ascontiguousarray(np.asarray(vertices, float).T)
+    side = np.zeros(len(vertices), np.uint16)
+    for k, (end, within) in enumerate(zip(ends, reach, strict=True)):
         pad = within + 1e-6 * (within + np.abs(end))
-        side = ((vertices < end - pad) @ bits) | (((vertices > end + pad) @ bits) << 3)  # axis, below | above
-        candidates = np.flatnonzero(np.bitwise_and.reduce(side[faces], axis=1) == 0)
+        for axis in range(3):  # bit axis: below the end's reach on that axis, bit 3 + axis: above it
+            side |= (rows[axis] < end[axis] - pad[axis]).astype(np.uint16) << np.uint16(8 * k + axis)
+            side |= (rows[axis] > end[axis] + pad[axis]).astype(np.uint16) << np.uint16(8 * k + 3 + axis)
+    corners = side[faces.T]  # (3, F)
+    common = corners[0] & corners[1]
+    common &= corners[2]  # a side all three corners are on
+    for k, (end, within) in enumerate(zip(ends, reach, strict=True)):
+        candidates = np.flatnonzero((common >> np.uint16(8 * k)) & np.uint16(0xFF) == 0)
         centres = vertices[faces[candidates]].mean(axis=1)
         near[candidates[np.linalg.norm(centres - end, axis=1) <= within]] = True
     return near
 
 
-def _flat_regions(vertices: Points, faces: IntArray, edges: EdgeTable, near: np.ndarray) -> list[IntArray]:
-    """Face ids of each connected region of two or more faces whose neighbours differ by < ``FLAT_ANGLE_DEG``.
+def flat_labels(vertices: Points, faces: IntArray, edges: EdgeTable) -> np.ndarray:
+    """(F,) int32: each face's flat region, the connected faces whose neighbours' normals differ by less than
+    ``FLAT_ANGLE_DEG``, numbered in the order of their smallest face id.
 
-    Only the regions holding a face of ``near`` (bool per face), in the order of their smallest face id.
+    The whole surface's work of :func:`end_planes` that does not depend on the path (normals, angles and one
+    connected-components pass over 1M faces): the ingest finds it beside its other checks of the surface.
     """
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
+    vertices, faces = np.asarray(vertices, float), np.asarray(faces, np.int64)
     pairs = edges.face_pairs()
     pairs = pairs[_pair_angles(_face_normals(vertices, faces), pairs) < np.radians(FLAT_ANGLE_DEG)]
     count = len(faces)
     graph = coo_matrix((np.ones(len(pairs), np.int8), (pairs[:, 0], pairs[:, 1])), shape=(count, count))
-    labels = connected_components(graph, directed=False)[1]  # numbered in the order of their smallest face id
+    return connected_components(graph, directed=False)[1]
+
+
+def _flat_regions(labels: np.ndarray, near: np.ndarray) -> list[IntArray]:
+    """Face ids of each flat region of two or more faces (``labels``: :func:`flat_labels`) that holds a face of
+    ``near`` (bool per face), in the order of their smallest face id."""
     sizes = np.bincount(labels)
     wanted = np.zeros(len(sizes), bool)
     wanted[labels[near]] = True
@@ -242,26 +259,10 @@ def _flat_regions(vertices: Points, faces: IntArray, edges: EdgeTable, near: np.
 
 
 def _face_normals(vertices: Points, faces: IntArray) -> FloatArray:
-    """(3, F) unit normals, x, y and z rows, as trimesh's ``face_normals`` makes them (zero for a degenerate face).
-
-    trimesh's arithmetic on coordinate rows (each corner's x, y and z as contiguous (F,) rows): the
-    cross product of p1 - p0 and p2 - p1 with ``np.cross``'s products in its order, its length from the squares
-    added x + y, then + z, as trimesh's ``np.dot`` with ones adds them, zero below trimesh's ``TOL_ZERO``
-    (1e-13), and the reciprocal length multiplied in: the same numbers, bit for bit
-    (tests/geometry/test_end_planes.py compares them), in about a third of its time on 1M faces, which
-    gathered (F, 3, 3) corners and strode across their coordinates.
-    """
-    p0, p1, p2 = corner_planes(vertices, faces)
-    normals = row_cross(p1 - p0, p2 - p1)
-    squares = normals * normals
-    length = squares[0] + squares[1]
-    length += squares[2]
-    np.sqrt(length, out=length)
-    valid = length > TRIMESH_TOL_ZERO
-    scale = np.zeros_like(length)
-    np.divide(1.0, length, out=scale, where=valid)
-    normals *= scale
-    return normals
+    """(3, F) unit normals, x, y and z rows, as trimesh's ``face_normals`` makes them (zero for a degenerate face):
+    :func:`~softdesign.geometry.edges.unit_normal_rows`, the same numbers bit for bit in about a third of
+    trimesh's time on 1M faces, which gathered (F, 3, 3) corners and strode across their coordinates."""
+    return unit_normal_rows(*corner_planes(vertices, faces))[0]
 
 
 def _pair_angles(normals: FloatArray, pairs: IntArray) -> FloatArray:

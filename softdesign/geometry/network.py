@@ -15,6 +15,7 @@ import numpy as np
 
 from softdesign.errors import InputDataError
 from softdesign.geometry.inlet import widest_end_flip
+from softdesign.geometry.median import median
 from softdesign.geometry.rows import distinct_rows
 from softdesign.types import FloatArray, Points
 
@@ -198,8 +199,8 @@ def _shared_end_flip(network: CenterlineNetwork, index: int, points: Points) -> 
     others = [assemble_path(network, i)[0] for i in network.path_ids() if i != index]
     if not others:
         return False, "l = 0 at the file's first point (a single path: give final.inlet to choose the end)"
-    step = np.median(np.linalg.norm(np.diff(points, axis=0), axis=1))
-    tol = 0.25 * float(step)
+    step = median(np.linalg.norm(np.diff(points, axis=0), axis=1))
+    tol = 0.25 * step
     shared = [sum(_near(end, o, tol) for o in others) for end in (points[0], points[-1])]
     if shared[0] == shared[1]:
         return False, "l = 0 at the file's first point (neither end is shared: give final.inlet to choose)"

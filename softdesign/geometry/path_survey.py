@@ -53,6 +53,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from softdesign.geometry.median import median
 from softdesign.types import FloatArray, Points
 
 #: Path k has left path j where its centre lies farther from j than this many of its radii.
@@ -106,7 +107,7 @@ def lumen_integral(points: Points, radius: FloatArray) -> float:
 def end_radius(points: Points, radius: FloatArray) -> float:
     """The radius at the first end of a path (see the module notes): the largest within reach of it."""
     radius = np.asarray(radius, float)
-    near = arc_lengths(points) <= END_REACH_RADII * float(np.median(radius))
+    near = arc_lengths(points) <= END_REACH_RADII * median(radius)
     return float(radius[near].max())
 
 
@@ -114,7 +115,7 @@ def _tolerance(points: Points, radius: FloatArray | None) -> FloatArray:
     """(n,) the distance from another path beyond which a point of this path has left it."""
     if radius is not None:
         return LEAVE_RADII * np.asarray(radius, float)
-    step = float(np.median(np.linalg.norm(np.diff(points, axis=0), axis=1)))
+    step = median(np.linalg.norm(np.diff(points, axis=0), axis=1))
     return np.full(len(points), LEAVE_STEPS * step)
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from softdesign.errors import ConfigError, InputDataError
+from softdesign.geometry.median import median as median_of
 from softdesign.types import UNIT_SCALE_TO_MM, FloatArray, Points
 
 #: Fraction of centerline points that must lie inside the surface's bounding box.
@@ -57,9 +58,9 @@ def surrounds(points: Points, radius: FloatArray | None, vertices: Points) -> bo
     inside = np.all((points >= lo - pad) & (points <= hi + pad), axis=1).mean()
     if inside < INSIDE_FRACTION:
         return False
-    distance = np.median(nearest_distances(points, vertices))
-    if radius is not None and np.all(np.isfinite(radius)) and np.median(radius) > 0:
-        ratio = distance / float(np.median(radius))
+    distance = median_of(nearest_distances(points, vertices))
+    if radius is not None and np.all(np.isfinite(radius)) and median_of(radius) > 0:
+        ratio = distance / median_of(radius)
         return bool(WALL_RATIO_BAND[0] <= ratio <= WALL_RATIO_BAND[1])
     return bool(distance < 0.25 * float(np.min(hi - lo)))
 
@@ -143,7 +144,7 @@ def check_vessel_scale(length_mm: float, radius: FloatArray | None, units: str, 
     The message gives the figures and every other unit in which the vessel would be plausible.
     """
     known = radius is not None and len(radius) > 0 and bool(np.all(np.isfinite(radius)))
-    median = float(np.median(radius)) if radius is not None and known else None
+    median = median_of(radius) if radius is not None and known else None
     if plausible_vessel(length_mm, median):
         return
     lo, hi = PLAUSIBLE_RADIUS_MM

@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from softdesign.errors import InputDataError
+from softdesign.geometry.rows import Mapper
 from softdesign.io.atomic import write_bytes_atomically
 
 Mesh = tuple[np.ndarray, np.ndarray]
@@ -78,7 +79,13 @@ def _merge_digits(scale_to_mm: float) -> int:
     return max(0, round(-math.log10(MERGE_TOLERANCE_MM / scale_to_mm)))
 
 
-def _read_trimesh(path: Path, scale_to_mm: float = 1.0) -> Mesh:
+def read_stl(path: Path, scale_to_mm: float, mapper: Mapper) -> Mesh:
+    """:data:`FORMATS`' STL reader, a large binary STL's vertex merge in two halves on ``mapper`` (the same arrays:
+    :func:`~softdesign.geometry.rows.rows_in_first_order`)."""
+    return _read_trimesh(path, scale_to_mm, mapper)
+
+
+def _read_trimesh(path: Path, scale_to_mm: float = 1.0, mapper: Mapper | None = None) -> Mesh:
     import trimesh
 
     from softdesign.io.input_checks import stl_problem
@@ -90,7 +97,8 @@ def _read_trimesh(path: Path, scale_to_mm: float = 1.0) -> Mesh:
     try:
         if stl and (corners := _binary_stl(path)) is not None:  # the common case, without a trimesh.Trimesh
             _refuse_non_finite(path, corners[0])
-            return _merged_as_trimesh_merges(*corners, _merge_digits(scale_to_mm))
+            # trimesh's binary loader numbers the corners in order: face f is corners 3 f, 3 f + 1, 3 f + 2
+            return _merged_as_trimesh_merges(*corners, _merge_digits(scale_to_mm), mapper, in_order=True)
         mesh = _load_stl(path) if stl else trimesh.load(str(path), force="mesh", process=False)
     except InputDataError:
         raise
@@ -120,26 +128,41 @@ def _binary_stl(path: Path) -> Mesh | None:
     return np.asarray(loaded["vertices"], np.float64), np.asarray(loaded["faces"], np.int64)
 
 
-def _merged_as_trimesh_merges(vertices: np.ndarray, faces: np.ndarray, digits: int) -> Mesh:
+def _merged_as_trimesh_merges(vertices: np.ndarray, faces: np.ndarray, digits: int, mapper: Mapper | None = None,
+                              in_order: bool = False) -> Mesh:
     """``trimesh.Trimesh(vertices, faces, process=False).merge_vertices(digits_vertex=digits)``'s vertices and faces
     for a mesh without normals or texture (a binary STL's), in about half its time.
 
     Vertices are one when their coordinates times 10^digits round to the same integers; each merged vertex is
     the first of its group, in the order of first occurrence among the vertices that faces use (what trimesh
-    keeps): the same arrays, bit for bit (tests/io/test_stl_merge.py compares them).
+    keeps): the same arrays, bit for bit (tests/io/test_stl_merge.py compares them), with or without a ``mapper``
+    (:func:`~softdesign.geometry.rows.rows_in_first_order`).
+    ``in_order``: ``faces`` is ``arange(len(vertices)).reshape(-1, 3)`` (a binary STL's corners, each face's own),
+    so that every vertex is used and the faces are the merged numbering reshaped: no scatter or gather of 3 F ids.
     """
     from softdesign.geometry.rows import rows_in_first_order
 
+    if in_order:
+        first, inverse_used = rows_in_first_order(_merge_keys(vertices, digits), mapper)
+        return vertices[first], inverse_used.reshape(faces.shape)
     referenced = np.zeros(len(vertices), bool)
     referenced[faces] = True
-    if referenced.all():  # every corner is a face's (a binary STL's): the vertices as they are, no gather
-        first, inverse_used = rows_in_first_order((vertices * 10.0**digits).round().astype(np.int64))
+    if referenced.all():  # every corner is a face's: the vertices as they are, no gather
+        first, inverse_used = rows_in_first_order(_merge_keys(vertices, digits), mapper)
         return vertices[first], inverse_used[faces]
     used = np.flatnonzero(referenced)
-    first, inverse_used = rows_in_first_order((vertices[used] * 10.0**digits).round().astype(np.int64))
+    first, inverse_used = rows_in_first_order(_merge_keys(vertices[used], digits), mapper)
     inverse = np.zeros(len(vertices), np.int64)
     inverse[used] = inverse_used
     return vertices[used[first]], inverse[faces]
+
+
+def _merge_keys(vertices: np.ndarray, digits: int) -> np.ndarray:
+    """(V, 3) int64, trimesh's merge keys: the coordinates times 10^digits, rounded (one scaled copy, rounded in
+    place: ``(vertices * 10.0**digits).round()``'s numbers without its second (V, 3) float array)."""
+    scaled = vertices * 10.0**digits
+    scaled.round(out=scaled)
+    return scaled.astype(np.int64)
 
 
 def _load_stl(path: Path) -> object:

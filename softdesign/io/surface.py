@@ -14,7 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from softdesign.errors import InputDataError
-from softdesign.io.formats import FORMATS, Mesh
+from softdesign.geometry.rows import Mapper
+from softdesign.io.formats import FORMATS, Mesh, read_stl
 from softdesign.io.input_checks import check_input_file
 from softdesign.types import FloatArray
 
@@ -22,8 +23,11 @@ from softdesign.types import FloatArray
 SURFACE_FORMATS = ("stl", "ply", "obj", "vtp", "vtk")
 
 
-def read_surface(path: str | Path, scale_to_mm: float = 1.0) -> Mesh:
+def read_surface(path: str | Path, scale_to_mm: float = 1.0, mapper: Mapper | None = None) -> Mesh:
     """Vertices (V, 3) float64 mm and faces (F, 3) int64 of a surface file.
+
+    ``mapper``: runs a large binary STL's vertex merge in two halves, perhaps on other processes (the build's
+    workers); the same arrays (:func:`~softdesign.io.formats.read_stl`).
 
     Raises
     ------
@@ -38,7 +42,10 @@ def read_surface(path: str | Path, scale_to_mm: float = 1.0) -> Mesh:
             + ", ".join(sorted(f".{f}" for f in SURFACE_FORMATS))
         )
     check_input_file(path, "surface")
-    vertices, faces = FORMATS[name].read(path, scale_to_mm)
+    if mapper is not None and name == "stl":
+        vertices, faces = read_stl(path, scale_to_mm, mapper)
+    else:
+        vertices, faces = FORMATS[name].read(path, scale_to_mm)
     check_surface_arrays(path, vertices, len(faces))
     return vertices * scale_to_mm, faces
 

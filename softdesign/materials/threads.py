@@ -53,4 +53,5 @@ def thread_presets() -> dict[str, Thread]:
     import yaml
 
     text = resources.files("softdesign").joinpath("data/threads.yaml").read_text(encoding="utf-8")
-    return {name: _thread(name, raw) for name, raw in yaml.safe_load(text)["threads"].items()}
+    data = yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # libyaml's parser, as materials'
+    return {name: _thread(name, raw) for name, raw in data["threads"].items()}

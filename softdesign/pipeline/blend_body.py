@@ -54,7 +54,7 @@ def body_field(case: Case, ingest: IngestResult, shape: BlendedShape) -> RadiusF
     network = NetworkContext(path.points, tuple(p.points for p in ingest.others), *inscribed)
     rule = case.links
     breaks = link_breaks(shape.keys[-1].length, rule.count, rule.breaks, rule.length_mm)
-    options = wall_fit_options(case, tuple(float(b) for b in breaks))
+    options = wall_fit_options(case, tuple(float(b) for b in breaks), map_items)  # the projection on the workers
     if case.fit.knot_spacing_mm == "auto":  # no hold-out here: the spacing auto starts from
         options = replace(options, fit=replace(options.fit, knot_spacing_mm=AUTO_START_SPACING_MM))
     vertices = np.asarray(ingest.vertices, float)

@@ -28,11 +28,13 @@ if TYPE_CHECKING:  # only annotations: the report loads stage results without th
 
 
 def end_plane_summary(
-    case: Case, path: SelectedPath, vertices: FloatArray, faces: np.ndarray, table: EdgeTable | None = None
+    case: Case, path: SelectedPath, vertices: FloatArray, faces: np.ndarray, table: EdgeTable | None = None,
+    labels: np.ndarray | None = None,
 ) -> dict[str, dict[str, Any] | None] | None:
     """Per end ("inlet", "outlet"): the plane found there (``EndPlane.as_dict``) or None; None when not measured.
 
-    ``table``: the surface's edge table, when the caller has it (:func:`~softdesign.geometry.end_planes.end_planes`).
+    ``table``: the surface's edge table, and ``labels`` its flat regions, when the caller has them
+    (:func:`~softdesign.geometry.end_planes.end_planes`).
     Not measured: no surface, no inscribed radii, a spacing the runner refuses after ingest, or a path the
     blend stage will refuse (it says why).
     """
@@ -46,5 +48,5 @@ def end_plane_summary(
         return None
     l = np.array([0.0, 1.0])
     inscribed = np.array(end_radii(path.points, path.radius))
-    inlet, outlet = end_planes(vertices, faces, curve.points(l), curve.tangents(l), inscribed, table)
+    inlet, outlet = end_planes(vertices, faces, curve.points(l), curve.tangents(l), inscribed, table, labels)
     return {"inlet": None if inlet is None else inlet.as_dict(), "outlet": None if outlet is None else outlet.as_dict()}

@@ -28,14 +28,10 @@ builds with 1 and 2 jobs and compares every file).
 
 from __future__ import annotations
 
-import ctypes
-import multiprocessing
 import os
 import signal
 import sys
 from collections.abc import Callable, Iterator, MutableMapping, Sequence
-from concurrent.futures import ProcessPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from contextvars import ContextVar
 from typing import Any, TypeVar
@@ -138,6 +134,8 @@ def die_with_parent(parent_pid: int) -> None:
     """
     if sys.platform.startswith("linux"):
         try:
+            import ctypes
+
             libc = ctypes.CDLL(None, use_errno=True)
             libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
         except (OSError, AttributeError):
@@ -177,15 +175,29 @@ def map_items(
     As :func:`map_per_q` for any picklable items and results (the report's figures by name);
     ``on_result(item, result)`` is called in this process as each result arrives, in the order of ``items``.
     """
-    global _TASK
     workers = min(current_jobs(), len(items), most if most is not None else len(items))
-    if workers <= 1 or "fork" not in multiprocessing.get_all_start_methods():
-        results = []
-        for item in items:
-            results.append(task(item))
-            if on_result is not None:
-                on_result(item, results[-1])
-        return results
+    if workers > 1:
+        import multiprocessing  # here, not at import: the command line's start-up (validate, --help) skips them
+
+        if "fork" in multiprocessing.get_all_start_methods():
+            return _map_forked(task, items, workers, on_result)
+    results = []
+    for item in items:
+        results.append(task(item))
+        if on_result is not None:
+            on_result(item, results[-1])
+    return results
+
+
+def _map_forked(
+    task: Callable[[Any], T], items: Sequence[Any], workers: int, on_result: Callable[[Any, T], None] | None
+) -> list[T]:
+    """:func:`map_items` on ``workers`` forked processes."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures.process import BrokenProcessPool
+
+    global _TASK
     _TASK = task
     processes: dict[int, Any] = {}
     try:

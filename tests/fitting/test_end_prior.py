@@ -100,3 +100,19 @@ def test_fit_errors_other_than_a_negative_radius_are_left_alone():
         l, a = np.meshgrid(np.linspace(0, 1, 200), np.linspace(0, 2 * np.pi, 60, endpoint=False), indexing="ij")
         points = tube_points(curve, l.ravel(), a.ravel(), np.full(l.size, 5.5))
         fit_wall(curve, points, NetworkContext(axis), WallFitOptions(), np.random.default_rng(0))
+
+
+@pytest.mark.parametrize("in_order", [True, False])
+def test_the_angles_of_each_row_are_the_masks_selections_in_order_or_not(in_order):
+    from softdesign.fitting.end_prior import _angles_by_row
+
+    rng = np.random.default_rng(7)
+    row = rng.integers(0, 9, 500)
+    row[row == 4] = 5  # an empty row in the middle, and none past 8
+    if in_order:
+        row = np.sort(row)
+    angle = rng.uniform(-np.pi, np.pi, 500)
+    got = _angles_by_row(angle, row, 10)
+    assert len(got) == 10 and len(got[4]) == 0 and len(got[9]) == 0
+    for k in range(10):  # the same values in the same order: the gaps and medians read them as before
+        assert np.array_equal(got[k], angle[row == k])

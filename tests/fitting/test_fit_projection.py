@@ -73,10 +73,15 @@ def test_blocks_on_worker_processes_give_the_same_bits(monkeypatch):
     n = 2000
     points = tube_points(curve, rng.uniform(-0.02, 1.02, n), rng.uniform(-np.pi, np.pi, n), rng.uniform(0.5, 5.0, n))
     whole = project_points(curve, points)
-    monkeypatch.setattr(projection, "PROJECT_BLOCK", 300)
+    monkeypatch.setattr(projection, "SPLIT_POINTS", 200)
     mapper, blocks = two_worker_mapper()
-    split = project_points(curve, points, mapper)
-    assert blocks == [7]
-    for name in ("points", "l", "angle", "rho", "end_side"):
-        np.testing.assert_array_equal(getattr(split, name), getattr(whole, name))
-    assert split.end_side.dtype == np.int8 and split.end_side.any()
+    for block, count in ((300, 7), (1500, 2)):  # blocks of PROJECT_BLOCK, or halves below twice that
+        monkeypatch.setattr(projection, "PROJECT_BLOCK", block)
+        split = project_points(curve, points, mapper)
+        assert blocks[-1] == count
+        for name in ("points", "l", "angle", "rho", "end_side"):
+            np.testing.assert_array_equal(getattr(split, name), getattr(whole, name))
+        assert split.end_side.dtype == np.int8 and split.end_side.any()
+    monkeypatch.setattr(projection, "SPLIT_POINTS", n)  # up to SPLIT_POINTS: here in one go
+    project_points(curve, points, mapper)
+    assert len(blocks) == 2

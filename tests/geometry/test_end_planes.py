@@ -199,3 +199,17 @@ def test_the_face_normals_and_pair_angles_are_trimeshs_bit_for_bit(aorta_dir):
         pairs = EdgeTable.of(f, len(v)).face_pairs()
         assert np.array_equal(_pair_angles(normals, pairs), trimesh.geometry.vector_angle(expected[pairs]))
     assert not valid[-1] and valid[-2] and not valid[-3]  # the test has faces on both sides of the zero
+
+
+def test_the_flat_labels_given_find_the_planes_found_without_them(tmp_path):
+    from softdesign.geometry.edges import EdgeTable
+    from softdesign.geometry.end_planes import flat_labels
+
+    vertices, faces = tilted(tmp_path, 8.0)
+    table = EdgeTable.of(np.asarray(faces, np.int64), len(vertices))
+    labels = flat_labels(vertices, faces, table)
+    assert len(labels) == len(faces) and labels[0] == 0  # numbered from the smallest face id
+    found = end_planes(vertices, faces, ENDS, TANGENTS, INSCRIBED, table, labels)
+    alone = end_planes(vertices, faces, ENDS, TANGENTS, INSCRIBED)
+    assert found[0] is not None and found[1] is not None
+    assert [p.as_dict() for p in found] == [p.as_dict() for p in alone]  # the same floats, not only close ones

@@ -36,3 +36,16 @@ def test_degenerate_faces_get_zero_normals_as_trimesh_gives_them():
 def test_an_empty_mesh_is_its_header():
     empty = np.zeros((0, 3)), np.zeros((0, 3), np.int64)
     assert binary_stl_bytes(*empty) == _trimesh_stl(*empty) == bytes(84)
+
+
+def test_a_face_too_small_for_a_normal_gets_plus_zeros_whatever_the_signs_of_its_cross_product():
+    rng = np.random.default_rng(11)
+    vertices = rng.normal(size=(60, 3)) * 20.0
+    faces = np.arange(60).reshape(20, 3)
+    # corners 1e-15 mm apart: cross products of about 1e-30, far below trimesh's 1e-13, of either sign
+    vertices[1::3] = vertices[0::3] + rng.normal(size=(20, 3)) * 1e-15
+    vertices[2::3] = vertices[0::3] + rng.normal(size=(20, 3)) * 1e-15
+    data = binary_stl_bytes(vertices, faces)
+    assert data == _trimesh_stl(vertices, faces)
+    normals = np.frombuffer(data[84:], dtype=[("n", "<u4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])["n"]
+    assert np.all(normals == 0)  # the bits of +0.0, not -0.0

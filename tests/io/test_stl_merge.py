@@ -87,3 +87,51 @@ def test_rows_all_distinct_says_what_the_groups_say_and_survives_a_hash_collisio
     monkeypatch.setattr(module, "_MIXERS", (0, 0, 0, 0))  # every row one hash: settled by the groups
     for name, (rows, expected) in cases.items():
         assert rows_all_distinct(rows) is expected, name
+
+
+def _two_workers(task, items):
+    from softdesign.pipeline.parallel import jobs_for_build, map_items
+
+    with jobs_for_build(2):
+        return map_items(task, items)
+
+
+@pytest.mark.parametrize("mapper", ["serial", "two workers"])
+def test_the_groups_split_by_parity_on_a_mapper_are_the_groups_of_one_pass(mapper):
+    from softdesign.fitting.mapping import serial_map
+    from softdesign.geometry.rows import SPLIT_ROWS
+
+    run = serial_map if mapper == "serial" else _two_workers
+    rng = np.random.default_rng(8)
+    rows = rng.integers(-300, 300, size=(SPLIT_ROWS + 1001, 3))
+    rows[1::3] = rows[rng.integers(0, len(rows), size=len(rows[1::3]))]  # about a third repeat an earlier or later row
+    for case in (rows, 2 * rows, 2 * rows + 1):  # both halves, every row even, every row odd (one half empty)
+        one, split = rows_in_first_order(case), rows_in_first_order(case, run)
+        for mine, theirs in zip(split, one, strict=True):
+            assert mine.dtype == theirs.dtype and mine.tobytes() == theirs.tobytes()
+
+
+def test_a_hash_collision_in_a_half_falls_back_to_sorting_every_row(monkeypatch):
+    from softdesign.fitting.mapping import serial_map
+    from softdesign.geometry import rows as module
+
+    rng = np.random.default_rng(9)
+    rows = rng.integers(-4, 4, size=(3000, 3))
+    first, inverse = trimesh.grouping.unique_rows(rows, keep_order=True)
+    monkeypatch.setattr(module, "SPLIT_ROWS", 100)
+    monkeypatch.setattr(module, "_MIXERS", (0, 0, 0, 0))  # every row one hash: each half's check fails
+    found = rows_in_first_order(rows, serial_map)
+    np.testing.assert_array_equal(found[0], first)
+    np.testing.assert_array_equal(found[1], inverse)
+
+
+def test_the_demo_surface_read_with_its_merge_split_is_trimesh_s_merge(monkeypatch):
+    from softdesign.fitting.mapping import serial_map
+    from softdesign.geometry import rows as module
+    from softdesign.io.surface import read_surface
+
+    path = REPO / "data" / "demo" / "surface.stl"
+    loaded = trimesh.exchange.stl.load_stl_binary(path.open("rb"))
+    expected = _trimesh_merged(np.asarray(loaded["vertices"], np.float64), loaded["faces"], _merge_digits(1.0))
+    monkeypatch.setattr(module, "SPLIT_ROWS", 1000)  # the demo's 50k corners split too
+    _assert_same(read_surface(path, 1.0, serial_map), expected)

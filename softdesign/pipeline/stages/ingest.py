@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from softdesign.geometry.edges import EdgeTable
+from softdesign.geometry.end_planes import flat_labels
 from softdesign.geometry.network import CenterlineNetwork, Orientation, SelectedPath, all_paths, select_path
 from softdesign.geometry.plausibility import check_surface_surrounds, check_vessel_scale
 from softdesign.io.centerline import read_centerline_network
@@ -30,6 +31,7 @@ from softdesign.pipeline.backbone_step import regularized_path
 from softdesign.pipeline.end_plane_step import end_plane_summary
 from softdesign.pipeline.item_progress import step_counter
 from softdesign.pipeline.notices import NOTE, Notice
+from softdesign.pipeline.parallel import map_items
 from softdesign.pipeline.stage import Stage
 from softdesign.pipeline.store import Staging, load_npz, npz_bytes
 from softdesign.pipeline.surface_radius import with_surface_radius
@@ -104,13 +106,14 @@ def run_ingest(case: Case) -> IngestResult:
     notes = list(network.notes) + list(path.notes)
     if extracted is not None:
         notes += [*extracted.notes, continuation_note(extracted, case.units)]
-    vertices, faces, info, edges = _final_surface(case, path, scale)
-    step("surface")
     inlet_rule = path.notes[-1]
-    path, backbone = regularized_path(case, path, vertices, others)
+    surface = _final_surface(case, path, scale, others)
+    vertices, faces, info = surface.vertices, surface.faces, surface.info
+    step("surface")
+    path, backbone = surface.path, surface.backbone
     notes += [n for n in path.notes if n not in notes]
     step("backbone")
-    ends = end_plane_summary(case, path, vertices, faces, edges)
+    ends = end_plane_summary(case, path, vertices, faces, surface.edges, surface.flat)
     step("end planes")
     initial_path = None
     if case.initial.kind == "file" and case.initial.centerline is not None:
@@ -153,17 +156,43 @@ def _one_path(file: Path, index: int, scale: float, orientation: Orientation) ->
     return select_path(read_centerline_network(file, scale), index, orientation)
 
 
-def _final_surface(case: Case, path: SelectedPath, scale: float
-                   ) -> tuple[FloatArray, np.ndarray, SurfaceInfo | None, EdgeTable | None]:
-    """The final surface (mm), its description and its edge table (one sort of its edges, which the end planes
-    read too)."""
+@dataclass(frozen=True)
+class _Surface:
+    """The final surface (mm) and what the ingest finds on it beside the path."""
+
+    vertices: FloatArray
+    faces: np.ndarray
+    info: SurfaceInfo | None
+    edges: EdgeTable | None  # one sort of its edges, which the end planes read too
+    flat: np.ndarray | None  # its flat regions (the end planes'), or None
+    path: SelectedPath  # the path, regularized (:func:`~softdesign.pipeline.backbone_step.regularized_path`)
+    backbone: dict[str, Any] | None
+
+
+def _final_surface(case: Case, path: SelectedPath, scale: float, others: tuple[SelectedPath, ...]) -> _Surface:
+    """The final surface (mm), its description, edge table and flat regions, and the regularized path.
+
+    Two tasks on the build's workers, each the build process's serial work before: the surface's flat regions
+    (:func:`~softdesign.geometry.end_planes.flat_labels`, the path-free third of the end planes), and the check
+    that the surface surrounds the path, its description and the path regularized against it (an error of
+    theirs is raised here as before).  The same numbers in either process.
+    """
     if case.final.surface is None:
-        return np.zeros((0, 3)), np.zeros((0, 3), np.int64), None, None
+        vertices = np.zeros((0, 3))
+        regular, backbone = regularized_path(case, path, vertices, others)
+        return _Surface(vertices, np.zeros((0, 3), np.int64), None, None, None, regular, backbone)
     surface_scale = UNIT_SCALE_TO_MM[case.final.surface_units] if case.final.surface_units else scale
-    vertices, faces = read_surface(case.final.surface, surface_scale)
-    check_surface_surrounds(path.points, path.radius, vertices, str(case.final.surface))
+    vertices, faces = read_surface(case.final.surface, surface_scale, map_items)  # a big STL's merge on the workers
     edges = EdgeTable.of(np.asarray(faces, np.int64), len(vertices))
-    return vertices, faces, describe_surface(vertices, faces, edges), edges
+
+    def task(which: int) -> Any:
+        if which == 0:  # the end planes measure nothing without inscribed radii
+            return None if path.radius is None else flat_labels(vertices, faces, edges)
+        check_surface_surrounds(path.points, path.radius, vertices, str(case.final.surface))
+        return describe_surface(vertices, faces, edges), regularized_path(case, path, vertices, others)
+
+    flat, (info, (regular, backbone)) = map_items(task, [0, 1])
+    return _Surface(vertices, faces, info, edges, flat, regular, backbone)
 
 
 def _summary(case: Case, network: CenterlineNetwork, every: list[SelectedPath], path: SelectedPath,
