@@ -179,7 +179,9 @@ def with_exact_max(
     """
     if len(sample) == len(polar):
         return metrics
-    rest = np.setdiff1d(np.arange(len(polar)), sample, assume_unique=True)
+    outside = np.ones(len(polar), bool)
+    outside[sample] = False
+    rest = np.flatnonzero(outside)  # np.setdiff1d(arange, sample)'s indices, increasing, without its sort
     l, angle = polar.l[rest], polar.angle[rest]
     fitted = mapped_blocks(lambda rows: spline.evaluate(l[rows], angle[rows]), len(rest), PROJECT_BLOCK, mapper)
     bound = np.abs(polar.rho[rest] - fitted)

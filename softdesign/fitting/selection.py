@@ -291,8 +291,10 @@ def inside_end_walls(
         zone = settings.cap_zone_radii * float(np.interp(end_l, *profile))
         beside = candidate & (to_end > zone) & (to_end <= 2.0 * zone)
         wall = np.full(CAP_SECTORS, np.nan)  # a sector with no wall beside the zone drops nothing
-        for k in np.unique(sector[beside]):
-            wall[k] = np.median(polar.rho[beside & (sector == k)])
+        near = np.flatnonzero(beside)  # the few points beside the zone, each sector's in their order
+        near_sector, near_rho = sector[near], polar.rho[near]
+        for k in np.unique(near_sector):
+            wall[k] = np.median(near_rho[near_sector == k])
         inside |= candidate & (to_end <= zone) & (polar.rho < settings.cap_inner_fraction * wall[sector])
     return inside
 
