@@ -14,6 +14,9 @@ tests/helpers/schedule.py).  So that a test stays right and fast there:
   others wait on).  A test that changes such a build copies it first (see ``out`` below: a copy of
   ``prior_build``; ``demo_build_copy``).  ``functools.cache`` on a module-level builder does the same for
   in-memory results (meshes, solves).
+* A build a test makes passes ``--jobs 1`` (``jobs=1`` in-process) unless the test is about the build's pool: the
+  two workers already fill the cores, and a pool of two forked on top costs about 1-2 s of CPU a build (the pool
+  is tested by tests/pipeline/test_parallel*.py, test_report_jobs and the attacks on workers).
 * No fixed ports, no lock files but shared_builds' own, no environment changes outside ``monkeypatch``; a child
   process gets its own ``env=`` copy.
 * Mark a test ``@pytest.mark.slow`` when it takes about a second or more (``make test-fast`` leaves them out); a
