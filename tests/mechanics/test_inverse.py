@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 
 from softdesign.mechanics.inverse import InverseResult, InverseSettings, arc_vector, find_pressures, weighted_error
-from softdesign.mechanics.newton import NewtonSettings
 from softdesign.mechanics.section import SectionMesh, SectionResult, simulate_section
 from tests.helpers.fe_meshes import three_chamber_section
 from tests.mechanics.test_section import LAW, NEWTON, SHAPE, SIZE_MM
@@ -46,7 +45,7 @@ def _target(result: SectionResult) -> tuple[float, float, float]:
 
 def _search(target: tuple[float, float, float], told: list[np.ndarray]) -> InverseResult:
     settings = InverseSettings(max_pressure_kpa=30.0, start_kpa=None, max_step_kpa=10.0, tolerance_mm=TOLERANCE_MM)
-    return find_pressures(_section(), LAW, target, settings, NewtonSettings(load_steps=2),
+    return find_pressures(_section(), LAW, target, settings, NEWTON,
                           on_trial=lambda k, p, error, seconds: told.append(p))
 
 
