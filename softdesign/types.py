@@ -22,7 +22,8 @@ Meshes
 
 from __future__ import annotations
 
-from typing import Protocol
+from collections.abc import Callable, Sequence
+from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -40,6 +41,10 @@ POINT_TOL_MM = 1e-9
 FRENET_KAPPA_TOL = 1e-6
 
 UNIT_SCALE_TO_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
+
+#: ``mapper(task, items)`` is ``[task(item) for item in items]``, perhaps on other processes (the build's
+#: :func:`softdesign.pipeline.parallel.map_items`); the results in the order of ``items``.
+Mapper = Callable[[Callable[[Any], Any], Sequence[Any]], list[Any]]
 
 
 class FramedCurve(Protocol):

@@ -15,10 +15,7 @@ import numpy as np
 
 from softdesign.fitting import bspline_basis as bb
 from softdesign.types import FloatArray
-
-#: ``mapper(task, items)`` is ``[task(item) for item in items]``, perhaps on other processes (the build's
-#: :func:`softdesign.pipeline.parallel.map_items`); the results in the order of ``items``.
-Mapper = Callable[[Callable[[Any], Any], Sequence[Any]], list[Any]]
+from softdesign.types import Mapper as Mapper  # the fitting modules' name for it (softdesign.types')
 
 
 def serial_map(task: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:

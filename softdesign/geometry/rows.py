@@ -11,16 +11,13 @@ anything), as in ``np.unique``.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
-#: ``mapper(task, items)`` is ``[task(item) for item in items]``, perhaps on other processes (the build's
-#: :func:`softdesign.pipeline.parallel.map_items`), the results in the order of ``items``.
-Mapper = Callable[[Callable[[Any], Any], Sequence[Any]], list[Any]]
+from softdesign.types import Mapper
+
 #: Integer rows from which :func:`rows_in_first_order` given a mapper groups its two halves there (a 1M-triangle
 #: STL's 3M corners: 0.65 s of hashing and sorting in one process); fewer are grouped here.
 SPLIT_ROWS = 1 << 20
@@ -181,7 +178,7 @@ def _split_hashed_groups(array: np.ndarray, mapper: Mapper) -> tuple[np.ndarray,
     (the caller then groups every row by :func:`distinct_rows`).
 
     Each half comes back numbered in first-occurrence order (its renumbering done beside the other's), so its
-    first rows are increasing here too, and the two runs are merged by one stable sort that finds them.
+    first rows are increasing here too, and :func:`_in_first_order`'s stable sort merges the two runs.
     """
     parts = mapper(lambda odd: _half_groups(array, odd), [0, 1])
     if any(part is None for part in parts):
@@ -189,15 +186,12 @@ def _split_hashed_groups(array: np.ndarray, mapper: Mapper) -> tuple[np.ndarray,
     odd_rows = (array[:, 0] & 1).astype(bool)
     halves = (np.flatnonzero(~odd_rows), np.flatnonzero(odd_rows))  # increasing: a half's first row is its group's
     joined = np.concatenate([rows[first] for rows, (first, _) in zip(halves, parts, strict=True)])
-    order = np.argsort(joined, kind="stable")  # two increasing runs (timsort merges them)
-    rank = np.empty(len(joined), np.intp)
-    rank[order] = np.arange(len(joined))
     inverse = np.empty(len(array), np.intp)
     offset = 0
     for rows, (first, group) in zip(halves, parts, strict=True):
-        inverse[rows] = rank[offset:offset + len(first)][group]
+        inverse[rows] = offset + group  # the groups of the joined list
         offset += len(first)
-    return joined[order], inverse
+    return _in_first_order(joined, inverse)
 
 
 def _half_groups(array: np.ndarray, odd: int) -> tuple[np.ndarray, np.ndarray] | None:

@@ -32,8 +32,8 @@ from pathlib import Path
 import numpy as np
 
 from softdesign.errors import InputDataError
-from softdesign.geometry.rows import Mapper
 from softdesign.io.atomic import write_bytes_atomically
+from softdesign.types import Mapper
 
 Mesh = tuple[np.ndarray, np.ndarray]
 #: Encodes (vertices (V, 3) mm, faces (F, 3), regions (F,) or None) as the file's bytes.
@@ -48,9 +48,10 @@ class MeshFormat:
     ----------
     name : the suffix without its dot, as the case file names it (``stl``)
     description : what the file holds, for messages and help
-    read : (path, the file's mm per unit) -> (vertices (V, 3) float64 in the file's units, faces (F, 3) int64),
-        shared vertices merged within MERGE_TOLERANCE_MM whatever the unit; empty arrays when the file holds no
-        triangles
+    read : (path, the file's mm per unit, a mapper or None) -> (vertices (V, 3) float64 in the file's units,
+        faces (F, 3) int64), shared vertices merged within MERGE_TOLERANCE_MM whatever the unit; empty arrays when
+        the file holds no triangles.  With a mapper a large binary STL's vertex merge runs in two halves on it (the
+        same arrays: :func:`~softdesign.geometry.rows.rows_in_first_order`); other files merge here
     encode : the writer's bytes, or None for a format that is only read
     carries_regions : whether the file keeps a region label per face
     unit : the length unit of the file's coordinates (the package converts from and to mm)
@@ -58,7 +59,7 @@ class MeshFormat:
 
     name: str
     description: str
-    read: Callable[[Path, float], Mesh]
+    read: Callable[[Path, float, Mapper | None], Mesh]
     encode: Encoder | None
     carries_regions: bool = False
     unit: str = "mm"
@@ -77,12 +78,6 @@ MERGE_TOLERANCE_MM = 1e-8
 def _merge_digits(scale_to_mm: float) -> int:
     """Decimals to which trimesh rounds a coordinate in the file's units to merge within MERGE_TOLERANCE_MM."""
     return max(0, round(-math.log10(MERGE_TOLERANCE_MM / scale_to_mm)))
-
-
-def read_stl(path: Path, scale_to_mm: float, mapper: Mapper) -> Mesh:
-    """:data:`FORMATS`' STL reader, a large binary STL's vertex merge in two halves on ``mapper`` (the same arrays:
-    :func:`~softdesign.geometry.rows.rows_in_first_order`)."""
-    return _read_trimesh(path, scale_to_mm, mapper)
 
 
 def _read_trimesh(path: Path, scale_to_mm: float = 1.0, mapper: Mapper | None = None) -> Mesh:
@@ -196,7 +191,8 @@ def _refuse_non_finite(path: Path, vertices: np.ndarray) -> None:
                              "coordinates: re-export the surface, or repair it (e.g. vmtksurfacecleaner)")
 
 
-def _read_vtk(path: Path, scale_to_mm: float = 1.0) -> Mesh:  # merges exact duplicates only: any unit
+def _read_vtk(path: Path, scale_to_mm: float = 1.0, mapper: Mapper | None = None) -> Mesh:
+    # merges exact duplicates only, in any unit, here (the mapper serves a binary STL's merge)
     from softdesign.io.vtk_polydata import read_polydata, triangles_from_polydata
 
     vertices, faces = triangles_from_polydata(read_polydata(path))
@@ -245,8 +241,8 @@ def _stl_bytes(vertices: np.ndarray, faces: np.ndarray, regions: np.ndarray | No
 MM_PER_M = 1000.0
 
 
-def _read_glb(path: Path, scale_to_mm: float = 1.0) -> Mesh:
-    vertices, faces = _read_trimesh(path, MM_PER_M)
+def _read_glb(path: Path, scale_to_mm: float = 1.0, mapper: Mapper | None = None) -> Mesh:
+    vertices, faces = _read_trimesh(path, MM_PER_M, mapper)
     return vertices * MM_PER_M, faces
 
 
@@ -326,7 +322,7 @@ def read_mesh(path: str | Path) -> Mesh:
     if found is None:
         choices = ", ".join(f.suffix for f in FORMATS.values())
         raise InputDataError(f"{path}: unknown mesh format '{path.suffix}'; expected one of {choices}")
-    vertices, faces = found.read(path, 1.0)
+    vertices, faces = found.read(path, 1.0, None)
     if len(faces) == 0:
         raise InputDataError(f"{path}: the mesh has no triangles")
     return vertices, faces

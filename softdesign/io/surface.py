@@ -14,10 +14,9 @@ from pathlib import Path
 import numpy as np
 
 from softdesign.errors import InputDataError
-from softdesign.geometry.rows import Mapper
-from softdesign.io.formats import FORMATS, Mesh, read_stl
+from softdesign.io.formats import FORMATS, Mesh
 from softdesign.io.input_checks import check_input_file
-from softdesign.types import FloatArray
+from softdesign.types import FloatArray, Mapper
 
 #: The formats vessel walls come in from VMTK, 3D Slicer or ParaView (.glb is an output for viewers).
 SURFACE_FORMATS = ("stl", "ply", "obj", "vtp", "vtk")
@@ -27,7 +26,7 @@ def read_surface(path: str | Path, scale_to_mm: float = 1.0, mapper: Mapper | No
     """Vertices (V, 3) float64 mm and faces (F, 3) int64 of a surface file.
 
     ``mapper``: runs a large binary STL's vertex merge in two halves, perhaps on other processes (the build's
-    workers); the same arrays (:func:`~softdesign.io.formats.read_stl`).
+    workers); the same arrays (:class:`~softdesign.io.formats.MeshFormat`'s ``read``).
 
     Raises
     ------
@@ -42,10 +41,7 @@ def read_surface(path: str | Path, scale_to_mm: float = 1.0, mapper: Mapper | No
             + ", ".join(sorted(f".{f}" for f in SURFACE_FORMATS))
         )
     check_input_file(path, "surface")
-    if mapper is not None and name == "stl":
-        vertices, faces = read_stl(path, scale_to_mm, mapper)
-    else:
-        vertices, faces = FORMATS[name].read(path, scale_to_mm)
+    vertices, faces = FORMATS[name].read(path, scale_to_mm, mapper)
     check_surface_arrays(path, vertices, len(faces))
     return vertices * scale_to_mm, faces
 
