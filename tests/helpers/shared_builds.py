@@ -118,13 +118,27 @@ def _child_cpu_s() -> float:
     return used.ru_utime + used.ru_stime
 
 
+def one_core() -> int:
+    """The core this test process's children run on: the xdist worker's number-th of the cores it may use (the
+    first without xdist), so that the two workers' children do not share one."""
+    cores = sorted(os.sched_getaffinity(0))
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0").removeprefix("gw")
+    return cores[int(worker) % len(cores) if worker.isdigit() else 0]
+
+
 def run_once(factory: pytest.TempPathFactory, *args: str) -> Run:
     """``softdesign ARGS`` run in the shared workspace once per test run; later askers get the recorded run.
 
     Runs of different commands may go on at once (in different workers): the README's commands each write
     their own build folder.  One that depends on another's output (a designed case's build on its design) is
     asked for after it by every test that runs it.
+
+    The command runs as written, on one core (the child's CPU affinity, as a batch scheduler sets it): its
+    default ``--jobs``, the cores it may use, is then 1.  The two xdist workers already fill the cores, and a pool
+    of two forked on top cost the demo's build with its report 2.5-3 s of CPU and 3-7 s of wall time (the pool is
+    tested by tests/pipeline/test_parallel*.py, test_report_jobs and the attacks on workers).
     """
+    core = one_core()
     folder = workspace(factory)
     key = hashlib.sha256("\0".join(args).encode("utf-8")).hexdigest()[:16]
     runs = shared_root(factory) / "readme-runs"
@@ -134,7 +148,8 @@ def run_once(factory: pytest.TempPathFactory, *args: str) -> Run:
         if not record.exists():
             before = _child_cpu_s()
             done = subprocess.run([*CLI, *args], cwd=folder, capture_output=True, text=True,
-                                  timeout=COMMAND_TIMEOUT_S, stdin=subprocess.DEVNULL)
+                                  timeout=COMMAND_TIMEOUT_S, stdin=subprocess.DEVNULL,
+                                  preexec_fn=lambda: os.sched_setaffinity(0, {core}))
             run = Run(tuple(args), done.returncode, done.stdout, done.stderr, round(_child_cpu_s() - before, 2))
             partial = record.with_suffix(".partial")
             partial.write_text(json.dumps(asdict(run)), encoding="utf-8")
