@@ -37,9 +37,8 @@ from softdesign.report.writer import (
     commit_folder,
     write_report,
 )
-from tests.helpers.cases import write_case
 from tests.helpers.paths import REPO
-from tests.helpers.shared_builds import demo_build_copy
+from tests.helpers.shared_builds import aorta_build, demo_build_copy, shared_build_copy
 
 #: Builds and reports the sample case and the aorta: `make test-fast` leaves these out.
 pytestmark = pytest.mark.slow
@@ -124,15 +123,10 @@ def demo(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def aorta(tmp_path_factory, aorta_dir):
-    folder = tmp_path_factory.mktemp("aorta")
-    case = write_case(
-        folder, "aorta",
-        final={"centerline": str(aorta_dir / "aorta-centerline.vtp"), "surface": str(aorta_dir / "aorta-surface.stl"),
-               "path": 0},
-        export={"q": [0, 0.25, 0.5, 1]},
-    )
-    build_through(case, folder / "build")
-    return folder / "build", write_report(folder / "build")
+    """The run's shared aorta build (four exported q; tests/helpers/shared_builds.py), copied, with this file's
+    report."""
+    build_dir = shared_build_copy(aorta_build(tmp_path_factory), tmp_path_factory.mktemp("aorta") / "build")
+    return build_dir, write_report(build_dir)
 
 
 @pytest.fixture(params=["demo", "aorta"])
