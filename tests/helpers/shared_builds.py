@@ -127,6 +127,12 @@ def one_core() -> int:
     return cores[int(worker) % len(cores) if worker.isdigit() else 0]
 
 
+def one_core_cli() -> list[str]:
+    """:data:`CLI` pinned to :func:`one_core` by the child itself (for a runner that takes a command, no
+    ``preexec_fn``): its default ``--jobs`` is 1."""
+    return [sys.executable, "-c", f"import os; os.sched_setaffinity(0, {{{one_core()}}}); {CLI[2]}"]
+
+
 def run_once(factory: pytest.TempPathFactory, *args: str) -> Run:
     """``softdesign ARGS`` run in the shared workspace once per test run; later askers get the recorded run.
 
