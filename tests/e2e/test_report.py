@@ -384,15 +384,6 @@ def report_app() -> typer.Typer:
     return app
 
 
-def test_cli_writes_the_page_and_says_where(demo, tmp_path):
-    copy = tmp_path / "build"
-    shutil.copytree(demo[0], copy)
-    result = CliRunner().invoke(report_app(), ["report", str(copy), "--jobs", "1"])  # the pool: test_report_jobs
-    assert result.exit_code == 0, result.output
-    assert str(copy / REPORT_DIR / PAGE) in result.stdout and "checks" in result.stdout
-    assert "pcc_chambers.png" not in tree_hashes(copy / REPORT_DIR)
-
-
 @pytest.mark.parametrize(
     ("args", "message"),
     [
