@@ -16,7 +16,8 @@ tests/helpers/schedule.py).  So that a test stays right and fast there:
   in-memory results (meshes, solves).
 * A build a test makes passes ``--jobs 1`` (``jobs=1`` in-process) unless the test is about the build's pool: the
   two workers already fill the cores, and a pool of two forked on top costs about 1-2 s of CPU a build (the pool
-  is tested by tests/pipeline/test_parallel*.py, test_report_jobs and the attacks on workers).
+  is tested by tests/pipeline/test_parallel*.py, test_report_jobs and the attacks on workers).  The README's
+  commands run as written, on one core (shared_builds.run_once): their default ``--jobs`` is then 1.
 * No fixed ports, no lock files but shared_builds' own, no environment changes outside ``monkeypatch``; a child
   process gets its own ``env=`` copy.
 * Mark a test ``@pytest.mark.slow`` when it takes about a second or more (``make test-fast`` leaves them out); a

@@ -68,14 +68,22 @@ def test_demo_design_meets_the_tolerance_and_its_case_file_differs_only_in_the_l
     assert written["breaks"] == doc["breaks"]
 
 
-@pytest.mark.slow
-def test_demo_counts_never_fall_as_the_tolerance_tightens(tmp_path):
-    counts = []
+@pytest.fixture(scope="module")
+def demo_designs(tmp_path_factory) -> dict[str, dict]:
+    """The demo designed at 2, 1 and 0.5 mm (rmf frames, no --d): each design's JSON, made once for the file."""
+    folder = tmp_path_factory.mktemp("designs")
+    docs = {}
     for tolerance in ("2", "1", "0.5"):
-        code, doc, err = design_json(DEMO, tmp_path / "build", tmp_path / f"d{tolerance}.yaml", "--tolerance-mm",
+        code, doc, err = design_json(DEMO, folder / "build", folder / f"d{tolerance}.yaml", "--tolerance-mm",
                                      tolerance)
         assert code == 0, err
-        counts.append(len(doc["links"]))
+        docs[tolerance] = doc
+    return docs
+
+
+@pytest.mark.slow
+def test_demo_counts_never_fall_as_the_tolerance_tightens(demo_designs):
+    counts = [len(demo_designs[tolerance]["links"]) for tolerance in ("2", "1", "0.5")]
     assert counts == sorted(counts)
 
 
@@ -167,7 +175,7 @@ def test_the_designed_demo_case_builds(tmp_path_factory):
 
 
 @pytest.mark.slow
-def test_frenet_frames_give_the_same_design_as_rmf(tmp_path):
+def test_frenet_frames_give_the_same_design_as_rmf(tmp_path, demo_designs):
     # a PCC chain continues without twist: the design measures phi in rmf frames whatever frames: says
     case = yaml.safe_load(DEMO.read_text())
     case.update(name="demo-frenet", frames="frenet", initial={"kind": "arc", "bend_radius_mm": 200.0})
@@ -175,7 +183,7 @@ def test_frenet_frames_give_the_same_design_as_rmf(tmp_path):
         case["final"][key] = str((DEMO.parent / case["final"][key]).resolve())
     frenet = tmp_path / "frenet.yaml"
     frenet.write_text(yaml.safe_dump(case, sort_keys=False))
-    _, rmf_doc, _ = design_json(DEMO, tmp_path / "b1", tmp_path / "d1.yaml", "--tolerance-mm", "1")
+    rmf_doc = demo_designs["1"]  # the demo's own case, rmf frames
     code, frenet_doc, err = design_json(frenet, tmp_path / "b2", tmp_path / "d2.yaml", "--tolerance-mm", "1")
     assert code == 0, err
     assert frenet_doc["breaks"] == rmf_doc["breaks"]

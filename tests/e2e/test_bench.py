@@ -14,6 +14,7 @@ import pytest
 from softdesign.samples.surfaces import grid_counts, synthetic_surface
 from softdesign.samples.synthetic_vessel import SyntheticShape, make_synthetic_vessel
 from tests.helpers.paths import REPO
+from tests.helpers.shared_builds import one_core_cli
 
 BENCH_FILE = REPO / "pipelines" / "bench.py"
 
@@ -148,7 +149,11 @@ def test_the_report_line_judges_the_ratio_against_its_cases_target(bench):
 
 
 @pytest.mark.slow
-def test_report_figures_time_a_forced_build_and_its_report(bench, tmp_path):
+def test_report_figures_time_a_forced_build_and_its_report(bench, tmp_path, monkeypatch):
+    # the figures' plumbing is the point, not the pool: the build and the report run on one core (their default
+    # --jobs is then 1; the pool forked beside the other xdist worker cost 2-3 s of CPU), the entry point is the
+    # startup test's
+    monkeypatch.setattr(bench, "softdesign_command", one_core_cli)
     case = bench.synthetic_case(tmp_path / "inputs", 20_000, 2)
     figures = bench.report_figures(case.case_file, tmp_path / "run", repeats=1)
     assert figures["repeats"] == 1

@@ -18,7 +18,7 @@ from softdesign.meshing.checks import inspect_mesh
 from softdesign.meshing.mould.checks import CAVITY_RTOL
 from softdesign.meshing.solids import manifold_from_mesh
 from softdesign.report.mould_figures import mould_figure_png
-from softdesign.report.writer import EXPECTED_SIZES, write_report
+from softdesign.report.writer import EXPECTED_SIZES, ReportOptions, write_report
 from tests.helpers.paths import REPO
 
 runner = CliRunner()
@@ -108,7 +108,7 @@ def test_demo_hollow_mould_is_written_listed_and_checked(hollow_mould, tmp_path)
     # the report's fabrication section shows it, with the parts' checks in its caption (in a copy: the report is
     # written into the build folder, which the next test reads as the mould command left it)
     out = shutil.copytree(out, tmp_path / "build")
-    report = write_report(out)
+    report = write_report(out, ReportOptions(gif_frames=3, view_frames=3, q_samples=5))  # not the frames' sampling
     page = report.page.read_text()
     assert 'id="fabrication"' in page and 'src="mould.png"' in page and "core: removable" in page.lower()
     with Image.open(report.page.parent / "mould.png") as image:

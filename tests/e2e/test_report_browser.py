@@ -22,12 +22,11 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from softdesign.pipeline.api import build_through
 from softdesign.report.interactive import DIV_ID, FRAMES
 from softdesign.report.interactive_parts import CHAMBER_NAME, MOULD_PREFIX
 from softdesign.report.writer import PAGE, REPORT_DIR, ReportOptions, write_report
 from tests.helpers.paths import REPO
-from tests.helpers.shared_builds import demo_build, hollow_tube_build
+from tests.helpers.shared_builds import aorta_build, demo_build, hollow_tube_build
 
 pytestmark = pytest.mark.slow
 
@@ -72,10 +71,10 @@ PAUSE_ON_SECOND_FRAME = f"""() => {{
 }}"""
 #: While plotly animates, the slider is polled at this interval (ms) rather than on animation frames.
 POLL_MS = 50
-#: The pages that test what the page shows first and its legend (the hollow tube's, the aorta's), not the figures'
-#: sampling: 3 GIF frames, 3 views and 5 q of the kinematics plot (the report's defaults, 26, 21 and 41, drew the
-#: hollow tube's report in 5.9-7.4 s of CPU, these in 4.9 s; the demo's page, which the slider and play test, is
-#: the README's own).
+#: The page that tests its legend (the hollow tube's), not the figures' sampling: 3 GIF frames, 3 views and 5 q of
+#: the kinematics plot (the report's defaults, 26, 21 and 41, drew the hollow tube's report in 5.9-7.4 s of CPU,
+#: these in 4.9 s; the demo's page, which the slider and play test, is the README's own; the aorta's is the run's
+#: shared build's, which the one-story and report tests read).
 SMALL_REPORT = ReportOptions(gif_frames=3, view_frames=3, q_samples=5)
 
 
@@ -262,18 +261,12 @@ def test_mould_and_chamber_traces_exist_only_when_built_and_start_hidden(session
                                                                      if k != CHAMBER_NAME}
 
 
-def test_the_aortas_page_opens_on_its_verdict_not_on_its_check_tally(tmp_path, aorta_dir):
+def test_the_aortas_page_opens_on_its_verdict_not_on_its_check_tally(tmp_path_factory, aorta_dir):
     """Issue 34: the aorta's page opened on "Checks: 93 of 93 passed" above a design that is not feasible."""
     sync_api = pytest.importorskip("playwright.sync_api", reason="playwright is not installed (make install)")
     executable = chromium()
-    from tests.helpers.cases import write_case
-
-    case = write_case(tmp_path, "aorta", final={"centerline": str(aorta_dir / "aorta-centerline.vtp"),
-                                                 "surface": str(aorta_dir / "aorta-surface.stl"), "path": 0},
-                      # a sourced limit the aorta's skin passes (its min_stretch crossing is a note since issue 41)
-                      material={"name": "ecoflex-00-30", "max_stretch": 1.05})
-    build_through(case, tmp_path / "build")
-    write_report(tmp_path / "build", SMALL_REPORT)
+    # the run's shared aorta build with its report (Ecoflex 00-30 with a stretch limit its skin exceeds), only read
+    report_dir = (aorta_build(tmp_path_factory) / REPORT_DIR).resolve()
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     with sync_api.sync_playwright() as playwright:
         try:
@@ -281,7 +274,7 @@ def test_the_aortas_page_opens_on_its_verdict_not_on_its_check_tally(tmp_path, a
         except Exception as err:  # playwright's Error: the browser cannot start here
             pytest.skip(f"{executable} cannot start headless: {err}")
         page = browser.new_page(viewport=VIEWPORT)
-        page.goto((tmp_path / "build" / REPORT_DIR / PAGE).resolve().as_uri())
+        page.goto((report_dir / PAGE).as_uri())
         page.screenshot(path=str(ARTIFACTS / "aorta_first_screen.png"))
         verdict = page.evaluate("(() => { const v = document.getElementById('verdict'); "
                                 "return [v.getBoundingClientRect().top, v.dataset.status, v.innerText]; })()")

@@ -104,13 +104,16 @@ def test_a_forward_solve_at_the_tabled_pressures_gives_the_tabled_arc_error(buil
     assert math.hypot(*error) == pytest.approx(float(solved[0]["fe_pressure_arc_error_mm"]), abs=ERROR_TOL_MM)
 
 
-def test_the_stage_is_cached_and_the_report_draws_it(built: tuple[Path, Path]) -> None:
+def test_the_stage_is_cached_and_the_report_draws_it(built: tuple[Path, Path], tmp_path: Path) -> None:
     from softdesign.report.writer import ReportOptions, write_report
 
     case, build_dir = built
     runs = {r.name: r.status for r in build_through(case, build_dir, "actuation").runs}
     assert runs["simulate"] == "skipped" and runs["actuation"] == "skipped"
-    report = write_report(build_dir, ReportOptions(gif_frames=3))  # the simulate panel is the point: 3 morph frames
+    # the report on a copy (the module's build is the other tests'); the simulate panel is the point, not the figures'
+    # sampling: 3 morph frames, 3 views, 5 q of the kinematics plot
+    copy = shutil.copytree(build_dir, tmp_path / "build")
+    report = write_report(copy, ReportOptions(gif_frames=3, view_frames=3, q_samples=5))
     assert "simulate.png" in report.files
     page = report.page.read_text(encoding="utf-8")
     assert 'id="simulate"' in page and "Model estimates:" in page

@@ -21,7 +21,7 @@ from softdesign.io.volume_formats import read_volume_mesh
 from softdesign.meshing.topology import mesh_topology
 from softdesign.meshing.volume_mesh.tet_quality import tet_centroids, tet_volumes
 from softdesign.pipeline.stages import volume_mesh
-from softdesign.report.writer import write_report
+from softdesign.report.writer import ReportOptions, write_report
 from tests.helpers.cases import write_case
 from tests.helpers.vessels import straight_tube
 
@@ -132,7 +132,7 @@ def test_hollow_tube_volume_mesh_files_figures_and_mesher_failures(tmp_path, mon
     assert entry["volume_mm3"] == pytest.approx(volumes.sum(), rel=1e-9)
     assert entry["size_mm"] == 2.0 and entry["min_dihedral_deg"] > 0 and entry["max_radius_edge"] >= np.sqrt(6) / 4
     # the report's fabrication section tables the mesh and its checks join the page's checks
-    report = write_report(out)
+    report = write_report(out, ReportOptions(gif_frames=3, view_frames=3, q_samples=5))  # not the frames' sampling
     page = report.page.read_text()
     assert 'id="fabrication"' in page and "Volume meshes (fTetWild)" in page and f">{len(tets)}<" in page
     assert report.checks_passed == report.checks_total and "volume mesh q=0.000" in page
