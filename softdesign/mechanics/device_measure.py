@@ -131,7 +131,7 @@ def _thread_extremes(solve: DeviceSolve) -> tuple[Extreme | None, Extreme | None
         return None, None
     mesh = solve.problem.mesh
     assert isinstance(mesh, QuadraticMesh)
-    tension = fibres.thread_tension_at(solve.u).max(axis=1)
+    tension = fibres.thread_tension_at(solve.u)
     out: list[Extreme | None] = []
     for part in (slice(0, solve.hoop_fibres), slice(solve.hoop_fibres, None)):
         if not len(tension[part]):

@@ -44,8 +44,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from softdesign.errors import MeshError
+from softdesign.mechanics import reinforcement
 from softdesign.mechanics.quadratic import QuadraticMesh
-from softdesign.mechanics.reinforcement import FIBRE_WEIGHTS, FibreMembrane, HoopThread
+from softdesign.mechanics.reinforcement import FibreMembrane, HoopThread
 from softdesign.mechanics.section import locate
 from softdesign.mechanics.tets import TetMesh, make_tet_mesh
 from softdesign.types import FloatArray, IntArray
@@ -104,13 +105,16 @@ def embedded_fibres(mesh: QuadraticMesh, polyline: FloatArray, thread: HoopThrea
     bary = np.concatenate([b for _, b in found])
     grads = quadratic_gradients_at(mesh.linear.grads[host], bary)  # (k, 10, 3)
     d = np.einsum("kbi,ki->kb", grads, tangents)
-    q = len(FIBRE_WEIGHTS)  # the hoop thread's rule's count, so that both sets join
+    q = len(reinforcement.FIBRE_WEIGHTS)  # the hoop thread's rule's count and kind, so that both sets join
     count = len(middles)
     reference = np.einsum("kb,kbi->ki", d, mesh.points[mesh.cells[host]])  # t, to rounding
+    weights = np.zeros((count, q))
+    weights[:, 0] = lengths  # the law at point 0, whatever the rule: the other points are copies of it
     return ThreadFibres(mesh.cells[host], np.repeat(d[:, None, :], q, axis=1),
-                        np.repeat(reference[:, None, :], q, axis=1), np.repeat(lengths[:, None] / q, q, axis=1),
+                        np.repeat(reference[:, None, :], q, axis=1), weights,
                         np.full(count, thread.axial_stiffness_mn), np.full(count, thread.axial_stiffness_mn),
-                        np.full(count, thread.buckling_strain(matrix_modulus_kpa)))
+                        np.full(count, thread.buckling_strain(matrix_modulus_kpa)),
+                        reinforcement.FIBRE_ANCHORED and q > 1)
 
 
 def _sub_mesh(mesh: QuadraticMesh, pool: IntArray) -> TetMesh:
@@ -134,7 +138,7 @@ class ThreadFibres(FibreMembrane):
             if rows.size:
                 part = FibreMembrane(self.faces[rows, :width], self.directions[rows, :, :width], self.reference[rows],
                                      self.weights[rows], self.stiffness[rows], self.axial_stiffness_mn[rows],
-                                     self.buckling_strain[rows])
+                                     self.buckling_strain[rows], self.anchored)
                 f, k = part.force_and_tangent_at(displacement, want_tangent, None if strain is None else strain[rows])
                 force += f
                 if tangent is not None and k is not None:
@@ -147,6 +151,8 @@ def thread_fibres(sets: Sequence[FibreMembrane | None]) -> ThreadFibres | None:
     present = [s for s in sets if s is not None]
     if not present:
         return None
+    if len({s.anchored for s in present}) > 1:
+        raise ValueError("fibre sets to join must share one rule (all anchored or none)")
     keys = ("faces", "directions", "reference", "weights", "stiffness", "axial_stiffness_mn", "buckling_strain")
     parts: dict[str, list[np.ndarray]] = {k: [] for k in keys}
     for s in present:
@@ -155,4 +161,4 @@ def thread_fibres(sets: Sequence[FibreMembrane | None]) -> ThreadFibres | None:
         parts["directions"].append(np.concatenate([s.directions, np.zeros(s.directions.shape[:2] + (pad,))], axis=2))
         for k in ("reference", "weights", "stiffness", "axial_stiffness_mn", "buckling_strain"):
             parts[k].append(getattr(s, k))
-    return ThreadFibres(*(np.concatenate(parts[k]) for k in parts))
+    return ThreadFibres(**{k: np.concatenate(v) for k, v in parts.items()}, anchored=present[0].anchored)

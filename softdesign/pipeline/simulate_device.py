@@ -49,7 +49,7 @@ class DeviceOptions:
     angular_count: int = 12
     load_steps: int = 8
     max_iterations: int = 12
-    max_cutbacks: int = 20
+    max_cutbacks: int = 10  #: the smallest load step: 1 / (load_steps 2^max_cutbacks) of the load
     timeout_s: float = 600.0
     #: a context manager yielding the solve's step listener (the command line's progress), or None
     step_progress: Any = None

@@ -1,8 +1,8 @@
-"""The hoop thread's quadrature on a wall face, swapped for a comparison: the solver's (the centroid stabilised by
-a share on six points, :data:`softdesign.mechanics.reinforcement.FIBRE_WEIGHTS`), the centroid alone, or the
-pressure's six points alone (the module's docstring: "Integration").  For tests and studies only: the solver's rule
-is the module's, and this swaps its three constants, which :func:`~softdesign.mechanics.reinforcement.
-hoop_membrane` reads when it builds the fibres."""
+"""The hoop thread's quadrature on a wall face, swapped for a comparison: the solver's (the law at the centroid,
+hourglass control on six points, :data:`softdesign.mechanics.reinforcement.FIBRE_WEIGHTS`), the centroid alone, or
+the law at the pressure's six points alone (the module's docstring: "Integration").  For tests and studies only:
+the solver's rule is the module's, and this swaps its four constants, which
+:func:`~softdesign.mechanics.reinforcement.hoop_membrane` reads when it builds the fibres."""
 
 from __future__ import annotations
 
@@ -32,7 +32,8 @@ def fibre_rule(rule: str) -> Iterator[None]:
     else:
         raise ValueError(f"fibre rule must be one of {', '.join(RULES)}, got {rule!r}")
     _, dxi, deta = triangle_shapes(points)
-    with mock.patch.multiple(reinforcement, FIBRE_DXI=dxi, FIBRE_DETA=deta, FIBRE_WEIGHTS=weights):
+    with mock.patch.multiple(reinforcement, FIBRE_DXI=dxi, FIBRE_DETA=deta, FIBRE_WEIGHTS=weights,
+                             FIBRE_ANCHORED=False):
         yield
 
 

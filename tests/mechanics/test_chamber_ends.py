@@ -5,9 +5,9 @@ the thread on each end holds past it.
 The 12 mm test section of tests/mechanics/test_reinforced_section.py (R 5 mm, one 2 mm chamber at 2.5 mm, 1.5 mm
 end walls, neo-Hookean mu 40 kPa, a 0.2 mm 2 GPa thread at 0.5 mm pitch), chamber 0 pressurised.  Bare, the
 volume-controlled path (:mod:`softdesign.mechanics.continuation`) finds the pressure's limit point: measured
-95.0 kPa (2.375 mu, bracketed within 1 %; load steps that halve on failure stop at 94.4-95.1 kPa, 92.6 kPa at a
-1.4 mm mesh, 98.8 / 96.4 kPa with the thread on the six-point rule alone).  Patched, load steps reach the asked
-4 mu; they reach 356 kPa (8.9 mu) before they stop.
+95.0 kPa (2.375 mu, bracketed within 1 %; load steps that halve on failure stop at 95.03 kPa asked 160 or 320 kPa,
+92.6 kPa at a 1.4 mm mesh, 98.8 / 96.4 kPa with the thread on the six-point rule alone).  Patched, load steps
+reach the asked 4 mu; asked 800 kPa, they reach 681 kPa (17 mu) before a step of 1/512 of it fails.
 """
 
 from __future__ import annotations

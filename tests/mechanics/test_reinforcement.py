@@ -71,7 +71,7 @@ def test_a_uniformly_scaled_wall_stores_the_threads_energy(stretch: float) -> No
     hoop = HoopThread(pitch_mm=1e-6, diameter_mm=0.2, modulus_kpa=2.0e6)  # a pitch that makes it pure hoop
     mesh, fibres = _wall(hoop)
     x = mesh.points * np.array([stretch - 1.0, stretch - 1.0, 0.0])  # the displacement, mm
-    area, k = float(fibres.weights.sum()), hoop.stiffness_mn_per_mm
+    area, k = float(fibres.law_weights.sum()), hoop.stiffness_mn_per_mm
     e, e_b = (stretch**2 - 1) / 2, hoop.buckling_strain(MATRIX_KPA)
     expected = k * e**2 / 2 if e >= -e_b else k * e_b**2 / 2 - k * e_b * (e + e_b)
     np.testing.assert_allclose(fibres.energy_at(x), expected * area, rtol=1e-9)  # the pitch's cos(beta) ~ 1e-7 squared
@@ -156,6 +156,16 @@ def _rest_stiffness(rule: str) -> FloatArray:
     return np.asarray(K[dofs][:, dofs].toarray())
 
 
+def _hourglass_modes(one: FloatArray, six: FloatArray) -> FloatArray:
+    """The modes (columns, on the wall's dofs) that the centroid's rest stiffness ``one`` misses and the six
+    points' ``six`` sees: corners out, midsides in."""
+    scale = np.linalg.eigvalsh(six)[-1]
+    values, vectors = np.linalg.eigh(one)
+    missed = vectors[:, values < ZERO_ENERGY * scale]  # the centroid's zero-energy modes
+    seen, within = np.linalg.eigh(missed.T @ six @ missed)
+    return np.asarray(missed @ within[:, seen > ZERO_ENERGY * scale])
+
+
 def test_the_six_point_share_holds_the_centroids_hourglass_modes() -> None:
     """The centroid alone leaves modes that stretch the thread between a face's nodes but not at its centroid
     (corners out, midsides in: an hourglass); the solver's rule stores FIBRE_STABILISATION of the six points'
@@ -163,16 +173,39 @@ def test_the_six_point_share_holds_the_centroids_hourglass_modes() -> None:
     motions of the wall, which stretch no thread anywhere)."""
     one, six, solver = (_rest_stiffness(r) for r in ("one-point", "six-point", "solver"))
     scale = np.linalg.eigvalsh(six)[-1]
-    values, vectors = np.linalg.eigh(one)
-    missed = vectors[:, values < ZERO_ENERGY * scale]  # the centroid's zero-energy modes
-    seen = np.linalg.eigvalsh(missed.T @ six @ missed)
-    hourglass = missed @ np.linalg.eigh(missed.T @ six @ missed)[1][:, seen > ZERO_ENERGY * scale]
+    hourglass = _hourglass_modes(one, six)
     assert hourglass.shape[1] > 0  # the centroid does miss some that the six points see
     np.testing.assert_allclose(np.einsum("dm,de,em->m", hourglass, solver, hourglass),
                                FIBRE_STABILISATION * np.einsum("dm,de,em->m", hourglass, six, hourglass),
                                rtol=EXACT_RTOL * 1e3)  # both sums of some 1e2 terms of either sign
     rank = np.linalg.matrix_rank
     assert rank(solver, tol=ZERO_ENERGY * scale) == rank(one + six, tol=ZERO_ENERGY * scale)
+
+
+def test_the_control_holds_in_a_buckled_thread_and_carries_no_tension() -> None:
+    """Compressed past its buckling strain (the wall scaled radially by 0.9: e = -0.095), the thread's force is
+    the buckled one, and the hourglass modes are still held: the control is a penalty on each point's departure
+    from the centroid's strain, which does not buckle (a share of the thread's law at the six points would
+    buckle with it and leave the mode free).  The thread's tension is the centroid's whatever the mode does."""
+    one, six = _rest_stiffness("one-point"), _rest_stiffness("six-point")
+    mode = _hourglass_modes(one, six)[:, -1]  # the one the six points hold most
+    mesh, fibres = _wall()
+    dofs = (3 * np.unique(fibres.faces)[:, None] + np.arange(3)).ravel()
+    along = np.zeros(mesh.points.size)
+    along[dofs] = mode
+    along = along.reshape(-1, 3)
+    stretch, e_b = 0.9, THREAD.buckling_strain(MATRIX_KPA)
+    base = mesh.points * np.array([stretch - 1.0, stretch - 1.0, 0.0])
+    step = 1e-4  # mm: a mode's strain of ~1e-4, small against the compression
+    energies = [fibres.energy_at(base + k * step * along) for k in (-1, 0, 1)]
+    curvature = (energies[0] - 2 * energies[1] + energies[2]) / step**2
+    at_rest = FIBRE_STABILISATION * float(mode @ six @ mode)
+    # the departures' gradient a D is the rest's A D scaled by about the stretch: stiffness ~0.81 of the rest's
+    assert 0.5 * at_rest < curvature < at_rest
+    moved = base + 0.05 * along
+    centroid = fibres.strains_at(moved)[:, 0]
+    assert np.all(centroid < -e_b)
+    np.testing.assert_allclose(fibres.thread_tension_at(moved), -THREAD.axial_stiffness_mn * e_b, rtol=EXACT_RTOL)
 
 
 def _caps(thread: HoopThread) -> tuple[QuadraticMesh, FibreMembrane]:
@@ -199,7 +232,7 @@ def test_bare_caps_carry_no_thread_and_a_patch_two_families() -> None:
     assert np.array_equal(fibres.faces[:half], fibres.faces[half:])  # each cap face twice
     np.testing.assert_allclose(np.einsum("fqi,fqi->fq", fibres.reference[:half], fibres.reference[half:]), 0.0,
                                atol=EXACT_RTOL)  # crossed at right angles
-    area = float(fibres.weights[:half].sum())
+    area = float(fibres.law_weights[:half].sum())
     # a quarter annulus of four chords (straight-sided elements): 4 (R^2 - r^2) sin(pi / 8) / 2
     np.testing.assert_allclose(area, 2 * (OUTER**2 - INNER**2) * np.sin(np.pi / 8), rtol=EXACT_RTOL)
     np.testing.assert_allclose(fibres.energy_at(x), 2 * patched.stiffness_mn_per_mm * e**2 / 2 * area,

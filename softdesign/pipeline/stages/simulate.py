@@ -42,9 +42,10 @@ if TYPE_CHECKING:
     from softdesign.pipeline.stages.fit import FitResult
     from softdesign.pipeline.stages.kinematics import KinematicsResult
 
-VERSION = 5  # 2: the section meshes three-fold symmetric; 3: the case's hoop thread (reinforcement) in the model;
+VERSION = 6  # 2: the section meshes three-fold symmetric; 3: the case's hoop thread (reinforcement) in the model;
 # 4: the section mesh's polygons (chambers, feeds, skin) have their circles' areas; 5: the thread's stabilised rule
-# and patched ends (actuation.reinforcement.ends)
+# and patched ends (actuation.reinforcement.ends); 6: the thread's hourglass control a penalty, load steps
+# bounded by length
 SUMMARY = "simulate/summary.json"
 
 
