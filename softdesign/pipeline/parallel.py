@@ -201,8 +201,9 @@ def _map_forked(
     _TASK = task
     processes: dict[int, Any] = {}
     try:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
-                                 initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
+                                   initializer=die_with_parent, initargs=(os.getpid(),))
+        try:
             found = getattr(pool, "_processes", None)  # the workers (filled as they start), to say how one died
             processes = found if isinstance(found, dict) else {}
             results = []
@@ -210,7 +211,13 @@ def _map_forked(
                 results.append(result)
                 if on_result is not None:
                     on_result(item, result)
-            return results
+        except BaseException:
+            pool.shutdown(wait=True)  # every worker stopped and reaped before the error goes on
+            raise
+        # every result is here: the workers end on their own (told to by the pool's thread, which reaps them; the
+        # interpreter joins it at exit), while this process goes on, instead of waiting on their exits
+        pool.shutdown(wait=False)
+        return results
     except BrokenProcessPool:  # the pool has stopped and reaped every worker by now
         what, kept = _WORK.get()
         raise SoftdesignError(f"a worker died ({_how_died(list(processes.values()))}) during {what}; {kept} "
