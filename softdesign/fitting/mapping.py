@@ -30,3 +30,18 @@ def mapped_blocks(values: Callable[[slice], FloatArray], count: int, size: int, 
     if len(blocks) == 1:
         return values(slice(0, count))
     return np.concatenate(mapper(values, blocks))
+
+
+Job = tuple[Callable[[Any], Any], Sequence[Any]]
+
+
+def map_together(mapper: Mapper, first: Job, second: Job) -> tuple[list[Any], list[Any]]:
+    """Two independent maps ``(task, items)`` as one call of ``mapper``: each one's results, in its items' order.
+
+    The same results as two calls (every item is its own); on a pool of processes the second's items keep a
+    worker busy while the first's last ones run, where a few long items alone leave one idle.
+    """
+    (task_a, items_a), (task_b, items_b) = first, second
+    tagged = [(0, item) for item in items_a] + [(1, item) for item in items_b]
+    results = mapper(lambda pair: (task_a if pair[0] == 0 else task_b)(pair[1]), tagged)
+    return list(results[:len(items_a)]), list(results[len(items_a):])

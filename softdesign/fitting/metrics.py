@@ -18,6 +18,7 @@ fold is measured against the fit on the other k - 1 folds.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -232,16 +233,51 @@ def holdout_rms(
         :class:`SearchStart` (:attr:`MeasuredDistances.start`) also carries the centerline's part there
     mapper : runs the held-out folds' distances (independent of each other); the same figures for any
     """
+    return holdout_job(curve, polar, settings, rng, holdout, start, mapper).run(mapper)
+
+
+@dataclass(frozen=True)
+class HoldoutJob:
+    """The hold-out's last step: each fold's fit and distances (``task(k)`` for k in ``folds``, each its own), and
+    the report from them; :func:`holdout_rms` runs it, a caller with other independent work may run both in one
+    call of its mapper (:func:`~softdesign.fitting.mapping.map_together`), the same figures either way."""
+
+    task: Callable[[int], FloatArray]
+    folds: list[int]
+    points: int
+
+    def report(self, distances: Sequence[FloatArray]) -> HoldoutReport:
+        """The pooled RMS and each fold's from the held-out distances of every fold (in ``folds``' order), mm."""
+        squares = [d**2 for d in distances]
+        fold_rms = [np.sqrt(np.mean(square)) for square in squares]
+        return HoldoutReport(float(np.sqrt(np.mean(np.concatenate(squares)))), np.array(fold_rms), self.points)
+
+    def run(self, mapper: Mapper = serial_map) -> HoldoutReport:
+        """The report, the folds run by ``mapper``."""
+        return self.report(mapper(self.task, self.folds))
+
+
+def holdout_job(
+    curve: FramedCurve,
+    polar: PolarPoints,
+    settings: FitSettings,
+    rng: np.random.Generator,
+    holdout: HoldoutSettings = HoldoutSettings(),
+    start: tuple[FloatArray, FloatArray] | SearchStart | None = None,
+    mapper: Mapper = serial_map,
+) -> HoldoutJob:
+    """:func:`holdout_rms` up to its folds' fits and distances: the sample and the folds drawn (``rng``, as
+    there), each fold's system assembled (``mapper``); the parameters are :func:`holdout_rms`'s."""
     sample = holdout_sample(len(polar), holdout.max_points, rng)
     labels = fold_labels(len(sample), holdout.folds, rng)
     begin = None if start is None else search_start(polar, start).subset(sample)
-    return _holdout(curve, polar.subset(sample), settings, labels, begin, mapper)
+    return _fold_job(curve, polar.subset(sample), settings, labels, begin, mapper)
 
 
-def _holdout(
+def _fold_job(
     curve: FramedCurve, polar: PolarPoints, settings: FitSettings, labels: np.ndarray,
     start: SearchStart | None = None, mapper: Mapper = serial_map,
-) -> HoldoutReport:
+) -> HoldoutJob:
     solve = fold_solver(polar, curve.length, settings, labels, mapper)  # each fold's rows assembled by mapper too
 
     def held_out(k: int) -> FloatArray:  # fold k's fit and its distances: on one process, after the assembly
@@ -249,11 +285,7 @@ def _holdout(
         begin = None if start is None else start.subset(test)
         return closest_surface_points(curve, solve(k), polar.subset(test), begin)[0]
 
-    squares, fold_rms = [], []
-    for d in mapper(held_out, range(int(labels.max()) + 1)):
-        squares.append(d**2)
-        fold_rms.append(np.sqrt(np.mean(d**2)))
-    return HoldoutReport(float(np.sqrt(np.mean(np.concatenate(squares)))), np.array(fold_rms), len(polar))
+    return HoldoutJob(held_out, list(range(int(labels.max()) + 1)), len(polar))
 
 
 def choose_knot_spacing(
@@ -276,6 +308,6 @@ def choose_knot_spacing(
     scores = {}
     for spacing in holdout.candidates_mm:
         trial = FitSettings(spacing, settings.angular_intervals, settings.smoothing, settings.breaks)
-        scores[float(spacing)] = _holdout(curve, sample, trial, labels).rms_mm
+        scores[float(spacing)] = _fold_job(curve, sample, trial, labels).run().rms_mm
     best = min(scores, key=lambda s: (scores[s], -s))
     return best, scores

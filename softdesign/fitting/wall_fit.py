@@ -16,22 +16,24 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import FitError, FoldError
+from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import FitSettings, SurfaceFit, fit_radius_surface, intervals_per_link
 from softdesign.fitting.coverage import WallCoverage, measure_coverage
 from softdesign.fitting.end_checks import end_radii, negative_radius_cause
 from softdesign.fitting.end_hold import negative_end
 from softdesign.fitting.end_prior import end_prior
 from softdesign.fitting.local_cap import LocalCap, fold_advice, fold_stretches, surface_capped_locally
-from softdesign.fitting.mapping import Mapper, serial_map
+from softdesign.fitting.mapping import Mapper, map_together, serial_map
 from softdesign.fitting.metrics import (
     FitMetrics,
     HoldoutReport,
     HoldoutSettings,
+    MeasuredDistances,
     choose_knot_spacing,
-    holdout_rms,
+    holdout_job,
     measure_distances,
 )
-from softdesign.fitting.projection import PolarPoints, project_points
+from softdesign.fitting.projection import PROJECT_BLOCK, PolarPoints, project_points
 from softdesign.fitting.radius_field import (
     FOLD_SPACING_MM,
     FoldReport,
@@ -105,6 +107,8 @@ class WallFit:
     distance: FloatArray = dataclasses.field(default_factory=lambda: np.zeros(0))
     #: the fit against all of the path's own wall, and where it saw none (None: not measured)
     coverage: WallCoverage | None = None
+    #: (n,) mm per surface vertex: rho - rho(1, l, a) of ``field`` (empty when not measured)
+    residual: FloatArray = dataclasses.field(default_factory=lambda: np.zeros(0))
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready figures for the manifest (mm, rad; snake_case keys)."""
@@ -224,12 +228,10 @@ def fit_wall(
     tell("spline")
     measured = measure_distances(curve, surface.whole, kept, rng, mapper=options.mapper)
     tell("distances")
-    # the hold-out folds are dealt from the measured points, each starting from its closest point
-    holdout = holdout_rms(curve, kept.subset(measured.sample), settings, rng, options.holdout,
-                          start=measured.start, mapper=options.mapper)
+    radius = RadiusField.from_links(settings.breaks, surface.links, options.initial_radius_mm)
+    holdout, residual = _holdout_and_residual(curve, polar, kept, measured, settings, radius, options, rng)
     tell("hold-out")
     metrics = measured.metrics
-    radius = RadiusField.from_links(settings.breaks, surface.links, options.initial_radius_mm)
     try:
         folding = check_self_folding(curve, radius, q=1.0, limit=options.fold_limit)
     except FoldError as err:  # the stretches that fold, each with a cap of its own, before the whole path's
@@ -258,4 +260,25 @@ def fit_wall(
                                 known_max=metrics.max_mm)
     tell("coverage")
     return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius, ends, distance,
-                   coverage)
+                   coverage, residual)
+
+
+def _holdout_and_residual(
+    curve: FramedCurve, polar: PolarPoints, kept: PolarPoints, measured: MeasuredDistances, settings: FitSettings,
+    radius: RadiusField, options: WallFitOptions, rng: np.random.Generator,
+) -> tuple[HoldoutReport, FloatArray]:
+    """The hold-out, its folds dealt from the measured points (each starting from its closest point), and every
+    point's radial residual against ``radius`` at q = 1 (n,) mm, in one call of the mapper.
+
+    The residual's blocks of ``PROJECT_BLOCK`` points keep a worker busy while the folds' last fits run (five
+    folds on two workers leave one idle for a fold's time); each block's values are its points' own, so the
+    residual is that of one ``evaluate_pairs`` over every point, the hold-out that of :func:`holdout_rms`.
+    """
+    job = holdout_job(curve, kept.subset(measured.sample), settings, rng, options.holdout, start=measured.start,
+                      mapper=options.mapper)
+
+    def fitted(rows: slice) -> FloatArray:
+        return radius.evaluate_pairs(1.0, polar.l[rows], polar.angle[rows])
+
+    distances, rho = map_together(options.mapper, (job.task, job.folds), (fitted, bb.chunks(len(polar), PROJECT_BLOCK)))
+    return job.report(distances), polar.rho - np.concatenate(rho)
