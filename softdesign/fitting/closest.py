@@ -8,6 +8,7 @@ distances say about the fit (RMS, percentiles, the hold-out) is :mod:`softdesign
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -134,18 +135,38 @@ def closest_with_part(
     the processor's caches (the same numbers as all at once, in less time), the blocks by ``mapper``
     (perhaps on other processes: the same numbers; a single block always runs here).
     """
-    twist = frame_twist_table(curve)
-    rows = bb.chunks(len(p), CLOSEST_CHUNK)
+    job = closest_job(curve, spline, p, start)
+    return job.join(mapper(job.task, job.items) if len(job.items) > 1 else [job.task(job.items[0])])
 
-    def piece(r: slice) -> tuple[FloatArray, FloatArray, FloatArray, CurvePart]:
+
+Found = tuple[FloatArray, FloatArray, FloatArray, CurvePart]
+
+
+@dataclass(frozen=True)
+class ClosestJob:
+    """:func:`closest_with_part` as a task over its blocks of points (``items``, slices in order, each its own) and
+    the join of their results, for a caller that runs the blocks beside other work."""
+
+    task: Callable[[slice], Found]
+    items: list[slice]
+
+    def join(self, pieces: Sequence[Found]) -> Found:
+        """distance, l, angle and the curve's part of every point, from the blocks' results in order."""
+        if len(pieces) == 1:
+            return pieces[0]
+        dist, l, a = (np.concatenate([piece[k] for piece in pieces]) for k in range(3))
+        arrays = zip(*(piece[3].arrays() for piece in pieces), strict=True)
+        return dist, l, a, CurvePart(*(np.concatenate(parts) for parts in arrays))
+
+
+def closest_job(curve: FramedCurve, spline: RadiusSurface, p: Points, start: SearchStart) -> ClosestJob:
+    """The blocks of :func:`closest_with_part`'s search, its parameters but the mapper."""
+    twist = frame_twist_table(curve)
+
+    def piece(r: slice) -> Found:
         return _closest_piece(curve, spline, twist, p[r], start.subset(r))
 
-    pieces = mapper(piece, rows) if len(rows) > 1 else [piece(rows[0])]
-    if len(pieces) == 1:
-        return pieces[0]
-    dist, l, a = (np.concatenate([piece[k] for piece in pieces]) for k in range(3))
-    part = CurvePart(*(np.concatenate(arrays) for arrays in zip(*(piece[3].arrays() for piece in pieces), strict=True)))
-    return dist, l, a, part
+    return ClosestJob(piece, bb.chunks(len(p), CLOSEST_CHUNK))
 
 
 def _closest_piece(

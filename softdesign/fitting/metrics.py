@@ -20,16 +20,19 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
 from softdesign.errors import ConfigError
-from softdesign.fitting.bspline_surface import FitSettings, RadiusSpline, fold_solver
+from softdesign.fitting.bspline_surface import FitSettings, RadiusSpline, fold_assembly, fold_solver_from
 from softdesign.fitting.closest import (
+    ClosestJob,
     CurvePart,
+    Found,
     SearchStart,
+    closest_job,
     closest_surface_points,
-    closest_with_part,
     search_start,
 )
 from softdesign.fitting.mapping import Mapper, mapped_blocks, serial_map
@@ -160,12 +163,40 @@ def measure_distances(
     -------
     MeasuredDistances; ``metrics.max_mm`` is the largest distance of any kept point.
     """
+    return distances_job(curve, spline, polar, rng, max_points).run(mapper)
+
+
+@dataclass(frozen=True)
+class DistancesJob:
+    """:func:`measure_distances` with its sample drawn: the search's blocks of points (``closest``, each its own)
+    and what follows them, for a caller that runs the blocks beside other work in one call of its mapper."""
+
+    curve: FramedCurve
+    spline: RadiusSpline
+    polar: PolarPoints
+    sample: np.ndarray
+    closest: ClosestJob
+
+    def finish(self, pieces: Sequence[Found], mapper: Mapper = serial_map) -> MeasuredDistances:
+        """The distances from the blocks' results (in order); the exact max over every point on ``mapper``."""
+        distance, l, angle, part = self.closest.join(pieces)
+        metrics = with_exact_max(self.curve, self.spline, self.polar, self.sample, summarize_distances(distance),
+                                 mapper)
+        return MeasuredDistances(metrics, self.sample, distance, l, angle, part)
+
+    def run(self, mapper: Mapper = serial_map) -> MeasuredDistances:
+        """:func:`measure_distances`' result (a single block here, more on ``mapper``)."""
+        task, items = self.closest.task, self.closest.items
+        return self.finish(mapper(task, items) if len(items) > 1 else [task(items[0])], mapper)
+
+
+def distances_job(curve: FramedCurve, spline: RadiusSpline, polar: PolarPoints, rng: np.random.Generator,
+                  max_points: int = DISTANCE_SAMPLE_MAX) -> DistancesJob:
+    """:func:`measure_distances` up to its search: the sample drawn (``rng``), the search's blocks prepared."""
     sample = holdout_sample(len(polar), max_points, rng)
     measured = polar.subset(sample)
-    distance, l, angle, part = closest_with_part(curve, spline, measured.points,
-                                                 SearchStart(measured.l, measured.angle), mapper)
-    metrics = with_exact_max(curve, spline, polar, sample, summarize_distances(distance), mapper)
-    return MeasuredDistances(metrics, sample, distance, l, angle, part)
+    return DistancesJob(curve, spline, polar, sample,
+                        closest_job(curve, spline, measured.points, SearchStart(measured.l, measured.angle)))
 
 
 def with_exact_max(
@@ -233,14 +264,47 @@ def holdout_rms(
         :class:`SearchStart` (:attr:`MeasuredDistances.start`) also carries the centerline's part there
     mapper : runs the held-out folds' distances (independent of each other); the same figures for any
     """
-    return holdout_job(curve, polar, settings, rng, holdout, start, mapper).run(mapper)
+    return holdout_plan(curve, polar, settings, rng, holdout).run(mapper, start)
+
+
+@dataclass(frozen=True)
+class HoldoutPlan:
+    """The hold-out with its sample and folds drawn: each fold's system to assemble (``assemble`` over ``rows``,
+    each fold's own), then :meth:`job`, its fits and distances; :meth:`run` runs both on one mapper, a caller
+    with other independent work may run each step beside it (:func:`~softdesign.fitting.mapping.map_together`)."""
+
+    curve: FramedCurve
+    polar: PolarPoints  # the points the folds are dealt from (the drawn ones)
+    settings: FitSettings
+    labels: np.ndarray
+    sample: np.ndarray  # their indices among the points the plan was drawn from
+    assemble: Callable[[np.ndarray], Any]
+    rows: list[np.ndarray]
+
+    def job(self, parts: list[Any], start: tuple[FloatArray, FloatArray] | SearchStart | None = None) -> HoldoutJob:
+        """The folds' fits and distances, from the assembly's results ``parts`` (in fold order); ``start`` as
+        :func:`holdout_rms`'s, for the points the plan was drawn from."""
+        solve = fold_solver_from(self.polar, self.curve.length, self.settings, self.rows, parts)
+        begin = None if start is None else search_start(self.polar, start).subset(self.sample)
+        curve, polar, labels = self.curve, self.polar, self.labels
+
+        def held_out(k: int) -> FloatArray:  # fold k's fit and its distances: on one process, after the assembly
+            test = labels == k
+            return closest_surface_points(curve, solve(k), polar.subset(test),
+                                          None if begin is None else begin.subset(test))[0]
+
+        return HoldoutJob(held_out, list(range(len(self.rows))), len(polar))
+
+    def run(self, mapper: Mapper = serial_map,
+            start: tuple[FloatArray, FloatArray] | SearchStart | None = None) -> HoldoutReport:
+        """The hold-out's report, every step on ``mapper``."""
+        return self.job(mapper(self.assemble, self.rows), start).run(mapper)
 
 
 @dataclass(frozen=True)
 class HoldoutJob:
     """The hold-out's last step: each fold's fit and distances (``task(k)`` for k in ``folds``, each its own), and
-    the report from them; :func:`holdout_rms` runs it, a caller with other independent work may run both in one
-    call of its mapper (:func:`~softdesign.fitting.mapping.map_together`), the same figures either way."""
+    the report from them."""
 
     task: Callable[[int], FloatArray]
     folds: list[int]
@@ -257,35 +321,17 @@ class HoldoutJob:
         return self.report(mapper(self.task, self.folds))
 
 
-def holdout_job(
-    curve: FramedCurve,
-    polar: PolarPoints,
-    settings: FitSettings,
-    rng: np.random.Generator,
-    holdout: HoldoutSettings = HoldoutSettings(),
-    start: tuple[FloatArray, FloatArray] | SearchStart | None = None,
-    mapper: Mapper = serial_map,
-) -> HoldoutJob:
-    """:func:`holdout_rms` up to its folds' fits and distances: the sample and the folds drawn (``rng``, as
-    there), each fold's system assembled (``mapper``); the parameters are :func:`holdout_rms`'s."""
+def holdout_plan(curve: FramedCurve, polar: PolarPoints, settings: FitSettings, rng: np.random.Generator,
+                 holdout: HoldoutSettings = HoldoutSettings()) -> HoldoutPlan:
+    """:func:`holdout_rms` up to its assembly: the sample and the folds drawn (``rng``, as there)."""
     sample = holdout_sample(len(polar), holdout.max_points, rng)
-    labels = fold_labels(len(sample), holdout.folds, rng)
-    begin = None if start is None else search_start(polar, start).subset(sample)
-    return _fold_job(curve, polar.subset(sample), settings, labels, begin, mapper)
+    return _fold_plan(curve, polar.subset(sample), settings, fold_labels(len(sample), holdout.folds, rng), sample)
 
 
-def _fold_job(
-    curve: FramedCurve, polar: PolarPoints, settings: FitSettings, labels: np.ndarray,
-    start: SearchStart | None = None, mapper: Mapper = serial_map,
-) -> HoldoutJob:
-    solve = fold_solver(polar, curve.length, settings, labels, mapper)  # each fold's rows assembled by mapper too
-
-    def held_out(k: int) -> FloatArray:  # fold k's fit and its distances: on one process, after the assembly
-        test = labels == k
-        begin = None if start is None else start.subset(test)
-        return closest_surface_points(curve, solve(k), polar.subset(test), begin)[0]
-
-    return HoldoutJob(held_out, list(range(int(labels.max()) + 1)), len(polar))
+def _fold_plan(curve: FramedCurve, polar: PolarPoints, settings: FitSettings, labels: np.ndarray,
+               sample: np.ndarray) -> HoldoutPlan:
+    assemble, rows = fold_assembly(polar, curve.length, settings, labels)
+    return HoldoutPlan(curve, polar, settings, labels, sample, assemble, rows)
 
 
 def choose_knot_spacing(
@@ -303,11 +349,12 @@ def choose_knot_spacing(
     -------
     the chosen spacing (mm), and the hold-out RMS (mm) of every candidate
     """
-    sample = polar.subset(holdout_sample(len(polar), holdout.max_points, rng))
+    drawn = holdout_sample(len(polar), holdout.max_points, rng)
+    sample = polar.subset(drawn)
     labels = fold_labels(len(sample), holdout.folds, rng)
     scores = {}
     for spacing in holdout.candidates_mm:
         trial = FitSettings(spacing, settings.angular_intervals, settings.smoothing, settings.breaks)
-        scores[float(spacing)] = _fold_job(curve, sample, trial, labels).run().rms_mm
+        scores[float(spacing)] = _fold_plan(curve, sample, trial, labels, drawn).run().rms_mm
     best = min(scores, key=lambda s: (scores[s], -s))
     return best, scores

@@ -17,7 +17,13 @@ import numpy.typing as npt
 
 from softdesign.errors import FitError, FoldError
 from softdesign.fitting import bspline_basis as bb
-from softdesign.fitting.bspline_surface import FitSettings, SurfaceFit, fit_radius_surface, intervals_per_link
+from softdesign.fitting.bspline_surface import (
+    FitSettings,
+    RadiusSpline,
+    SurfaceFit,
+    fit_radius_surface,
+    intervals_per_link,
+)
 from softdesign.fitting.coverage import WallCoverage, measure_coverage
 from softdesign.fitting.end_checks import end_radii, negative_radius_cause
 from softdesign.fitting.end_hold import negative_end
@@ -26,12 +32,13 @@ from softdesign.fitting.local_cap import LocalCap, fold_advice, fold_stretches, 
 from softdesign.fitting.mapping import Mapper, map_together, serial_map
 from softdesign.fitting.metrics import (
     FitMetrics,
+    HoldoutJob,
     HoldoutReport,
     HoldoutSettings,
     MeasuredDistances,
     choose_knot_spacing,
-    holdout_job,
-    measure_distances,
+    distances_job,
+    holdout_plan,
 )
 from softdesign.fitting.projection import PROJECT_BLOCK, PolarPoints, project_points
 from softdesign.fitting.radius_field import (
@@ -226,10 +233,10 @@ def fit_wall(
         kept, kept_index = kept.subset(keep), kept_index[keep]
         settings, scores, prior, surface = _fit_kept(curve, kept, options, reference, rng)
     tell("spline")
-    measured = measure_distances(curve, surface.whole, kept, rng, mapper=options.mapper)
+    measured, folds = _distances_and_folds(curve, surface.whole, kept, settings, options, rng)
     tell("distances")
     radius = RadiusField.from_links(settings.breaks, surface.links, options.initial_radius_mm)
-    holdout, residual = _holdout_and_residual(curve, polar, kept, measured, settings, radius, options, rng)
+    holdout, residual = _holdout_and_residual(folds, polar, radius, options.mapper)
     tell("hold-out")
     metrics = measured.metrics
     try:
@@ -263,22 +270,36 @@ def fit_wall(
                    coverage, residual)
 
 
-def _holdout_and_residual(
-    curve: FramedCurve, polar: PolarPoints, kept: PolarPoints, measured: MeasuredDistances, settings: FitSettings,
-    radius: RadiusField, options: WallFitOptions, rng: np.random.Generator,
-) -> tuple[HoldoutReport, FloatArray]:
-    """The hold-out, its folds dealt from the measured points (each starting from its closest point), and every
-    point's radial residual against ``radius`` at q = 1 (n,) mm, in one call of the mapper.
+def _distances_and_folds(
+    curve: FramedCurve, spline: RadiusSpline, kept: PolarPoints, settings: FitSettings, options: WallFitOptions,
+    rng: np.random.Generator,
+) -> tuple[MeasuredDistances, HoldoutJob]:
+    """The kept points' true distances (:func:`~softdesign.fitting.metrics.measure_distances`), and the hold-out's
+    folds, dealt from the measured points, each to start from its closest point.
+
+    The search's blocks of points and the folds' assemblies run in one call of the mapper (each item its own;
+    the draws in the order of ``measure_distances`` then ``holdout_rms``): the folds' assemblies fill a worker
+    the search's last blocks leave idle, where each was a pool of its own.
+    """
+    measuring = distances_job(curve, spline, kept, rng)
+    plan = holdout_plan(curve, kept.subset(measuring.sample), settings, rng, options.holdout)
+    pieces, parts = map_together(options.mapper, (measuring.closest.task, measuring.closest.items),
+                                 (plan.assemble, plan.rows))
+    measured = measuring.finish(pieces, options.mapper)
+    return measured, plan.job(parts, measured.start)
+
+
+def _holdout_and_residual(job: HoldoutJob, polar: PolarPoints, radius: RadiusField, mapper: Mapper
+                          ) -> tuple[HoldoutReport, FloatArray]:
+    """The hold-out's report, and every point's radial residual against ``radius`` at q = 1 (n,) mm, in one call
+    of the mapper.
 
     The residual's blocks of ``PROJECT_BLOCK`` points keep a worker busy while the folds' last fits run (five
     folds on two workers leave one idle for a fold's time); each block's values are its points' own, so the
-    residual is that of one ``evaluate_pairs`` over every point, the hold-out that of :func:`holdout_rms`.
+    residual is that of one ``evaluate_pairs`` over every point, the hold-out that of ``holdout_rms``.
     """
-    job = holdout_job(curve, kept.subset(measured.sample), settings, rng, options.holdout, start=measured.start,
-                      mapper=options.mapper)
-
     def fitted(rows: slice) -> FloatArray:
         return radius.evaluate_pairs(1.0, polar.l[rows], polar.angle[rows])
 
-    distances, rho = map_together(options.mapper, (job.task, job.folds), (fitted, bb.chunks(len(polar), PROJECT_BLOCK)))
+    distances, rho = map_together(mapper, (job.task, job.folds), (fitted, bb.chunks(len(polar), PROJECT_BLOCK)))
     return job.report(distances), polar.rho - np.concatenate(rho)
