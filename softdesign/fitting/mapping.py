@@ -35,13 +35,16 @@ def mapped_blocks(values: Callable[[slice], FloatArray], count: int, size: int, 
 Job = tuple[Callable[[Any], Any], Sequence[Any]]
 
 
-def map_together(mapper: Mapper, first: Job, second: Job) -> tuple[list[Any], list[Any]]:
-    """Two independent maps ``(task, items)`` as one call of ``mapper``: each one's results, in its items' order.
+def map_together(mapper: Mapper, *jobs: Job) -> list[list[Any]]:
+    """Independent maps ``(task, items)`` as one call of ``mapper``: each one's results, in its items' order.
 
-    The same results as two calls (every item is its own); on a pool of processes the second's items keep a
-    worker busy while the first's last ones run, where a few long items alone leave one idle.
+    The same results as a call each (every item is its own); on a pool of processes the later maps' items keep
+    a worker busy while the earlier ones' last items run, where a few long items alone leave one idle.
     """
-    (task_a, items_a), (task_b, items_b) = first, second
-    tagged = [(0, item) for item in items_a] + [(1, item) for item in items_b]
-    results = mapper(lambda pair: (task_a if pair[0] == 0 else task_b)(pair[1]), tagged)
-    return list(results[:len(items_a)]), list(results[len(items_a):])
+    tagged = [(j, item) for j, (_, items) in enumerate(jobs) for item in items]
+    results = mapper(lambda pair: jobs[pair[0]][0](pair[1]), tagged)
+    out, start = [], 0
+    for _, items in jobs:
+        out.append(list(results[start:start + len(items)]))
+        start += len(items)
+    return out

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from softdesign.errors import ConfigError
+from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import FitSettings, RadiusSpline, fold_assembly, fold_solver_from
 from softdesign.fitting.closest import (
     ClosestJob,
@@ -35,7 +36,7 @@ from softdesign.fitting.closest import (
     closest_surface_points,
     search_start,
 )
-from softdesign.fitting.mapping import Mapper, mapped_blocks, serial_map
+from softdesign.fitting.mapping import Mapper, serial_map
 from softdesign.fitting.projection import PROJECT_BLOCK, PolarPoints
 from softdesign.types import FloatArray, FramedCurve
 
@@ -168,26 +169,29 @@ def measure_distances(
 
 @dataclass(frozen=True)
 class DistancesJob:
-    """:func:`measure_distances` with its sample drawn: the search's blocks of points (``closest``, each its own)
-    and what follows them, for a caller that runs the blocks beside other work in one call of its mapper."""
+    """:func:`measure_distances` with its sample drawn: the search's blocks of points (``closest``), and the
+    fitted rho at the points outside the sample in blocks (``bounds``, for the exact max), each block its own,
+    then what follows them; for a caller that runs the blocks beside other work in one call of its mapper."""
 
     curve: FramedCurve
     spline: RadiusSpline
     polar: PolarPoints
     sample: np.ndarray
     closest: ClosestJob
+    bounds: ExactMaxBounds
 
-    def finish(self, pieces: Sequence[Found], mapper: Mapper = serial_map) -> MeasuredDistances:
-        """The distances from the blocks' results (in order); the exact max over every point on ``mapper``."""
+    def finish(self, pieces: Sequence[Found], fitted: Sequence[FloatArray]) -> MeasuredDistances:
+        """The distances from the search's results and the bounds' (each in its blocks' order)."""
         distance, l, angle, part = self.closest.join(pieces)
-        metrics = with_exact_max(self.curve, self.spline, self.polar, self.sample, summarize_distances(distance),
-                                 mapper)
+        metrics = self.bounds.exact_max(self.curve, self.spline, self.polar, fitted, summarize_distances(distance))
         return MeasuredDistances(metrics, self.sample, distance, l, angle, part)
 
     def run(self, mapper: Mapper = serial_map) -> MeasuredDistances:
         """:func:`measure_distances`' result (a single block here, more on ``mapper``)."""
-        task, items = self.closest.task, self.closest.items
-        return self.finish(mapper(task, items) if len(items) > 1 else [task(items[0])], mapper)
+        def blocks(task: Callable[[slice], Any], items: list[slice]) -> list[Any]:
+            return mapper(task, items) if len(items) > 1 else [task(item) for item in items]
+
+        return self.finish(blocks(self.closest.task, self.closest.items), blocks(self.bounds.task, self.bounds.items))
 
 
 def distances_job(curve: FramedCurve, spline: RadiusSpline, polar: PolarPoints, rng: np.random.Generator,
@@ -196,7 +200,8 @@ def distances_job(curve: FramedCurve, spline: RadiusSpline, polar: PolarPoints, 
     sample = holdout_sample(len(polar), max_points, rng)
     measured = polar.subset(sample)
     return DistancesJob(curve, spline, polar, sample,
-                        closest_job(curve, spline, measured.points, SearchStart(measured.l, measured.angle)))
+                        closest_job(curve, spline, measured.points, SearchStart(measured.l, measured.angle)),
+                        exact_max_bounds(spline, polar, sample))
 
 
 def with_exact_max(
@@ -209,20 +214,47 @@ def with_exact_max(
     the sample's largest distance, or whose foot is clamped at an end, are measured; ``total`` counts them all.
     ``mapper`` runs the residuals in blocks of ``PROJECT_BLOCK`` points (each point's own: the same numbers).
     """
+    bounds = exact_max_bounds(spline, polar, sample)
+    items = bounds.items
+    fitted = mapper(bounds.task, items) if len(items) > 1 else [bounds.task(item) for item in items]
+    return bounds.exact_max(curve, spline, polar, fitted, metrics)
+
+
+@dataclass(frozen=True)
+class ExactMaxBounds:
+    """:func:`with_exact_max`'s residuals as a task over blocks of the points outside the sample (``rest``, none
+    when the sample holds every point), and the exact max from them."""
+
+    rest: np.ndarray
+    task: Callable[[slice], FloatArray]
+    items: list[slice]
+
+    def exact_max(self, curve: FramedCurve, spline: RadiusSpline, polar: PolarPoints, fitted: Sequence[FloatArray],
+                  metrics: FitMetrics) -> FitMetrics:
+        """``metrics`` with the max over every point of ``polar``, from the fitted rho of the blocks (in order)."""
+        if not self.items:
+            return metrics
+        rest = self.rest
+        bound = np.abs(polar.rho[rest] - np.concatenate(fitted))
+        # a foot clamped at an end is not in p's normal plane: the radial residual bounds nothing there
+        doubtful = rest[(bound >= metrics.max_mm - BOUND_SLACK_MM) | (polar.end_side[rest] != 0)]
+        largest = metrics.max_mm
+        if doubtful.size:
+            largest = max(largest, float(closest_surface_points(curve, spline, polar.subset(doubtful))[0].max()))
+        return replace(metrics, max_mm=largest, total=len(polar))
+
+
+def exact_max_bounds(spline: RadiusSpline, polar: PolarPoints, sample: np.ndarray) -> ExactMaxBounds:
+    """The residuals :func:`with_exact_max` bounds the points outside ``sample`` by, as a task over blocks of
+    ``PROJECT_BLOCK`` points (none when the sample holds every point)."""
     if len(sample) == len(polar):
-        return metrics
+        return ExactMaxBounds(np.zeros(0, np.int64), lambda rows: np.zeros(0), [])
     outside = np.ones(len(polar), bool)
     outside[sample] = False
     rest = np.flatnonzero(outside)  # np.setdiff1d(arange, sample)'s indices, increasing, without its sort
     l, angle = polar.l[rest], polar.angle[rest]
-    fitted = mapped_blocks(lambda rows: spline.evaluate(l[rows], angle[rows]), len(rest), PROJECT_BLOCK, mapper)
-    bound = np.abs(polar.rho[rest] - fitted)
-    # a foot clamped at an end is not in p's normal plane: the radial residual bounds nothing there
-    doubtful = rest[(bound >= metrics.max_mm - BOUND_SLACK_MM) | (polar.end_side[rest] != 0)]
-    largest = metrics.max_mm
-    if doubtful.size:
-        largest = max(largest, float(closest_surface_points(curve, spline, polar.subset(doubtful))[0].max()))
-    return replace(metrics, max_mm=largest, total=len(polar))
+    return ExactMaxBounds(rest, lambda rows: spline.evaluate(l[rows], angle[rows]),
+                          bb.chunks(len(rest), PROJECT_BLOCK))
 
 
 def fold_labels(count: int, folds: int, rng: np.random.Generator) -> np.ndarray:

@@ -277,15 +277,16 @@ def _distances_and_folds(
     """The kept points' true distances (:func:`~softdesign.fitting.metrics.measure_distances`), and the hold-out's
     folds, dealt from the measured points, each to start from its closest point.
 
-    The search's blocks of points and the folds' assemblies run in one call of the mapper (each item its own;
-    the draws in the order of ``measure_distances`` then ``holdout_rms``): the folds' assemblies fill a worker
-    the search's last blocks leave idle, where each was a pool of its own.
+    The search's blocks of points, the exact max's residuals of the points outside its sample and the folds'
+    assemblies run in one call of the mapper (each item its own; the draws in the order of ``measure_distances``
+    then ``holdout_rms``): the shorter items fill a worker the search's last blocks leave idle, where each was a
+    pool of its own.
     """
     measuring = distances_job(curve, spline, kept, rng)
     plan = holdout_plan(curve, kept.subset(measuring.sample), settings, rng, options.holdout)
-    pieces, parts = map_together(options.mapper, (measuring.closest.task, measuring.closest.items),
-                                 (plan.assemble, plan.rows))
-    measured = measuring.finish(pieces, options.mapper)
+    pieces, fitted, parts = map_together(options.mapper, (measuring.closest.task, measuring.closest.items),
+                                         (measuring.bounds.task, measuring.bounds.items), (plan.assemble, plan.rows))
+    measured = measuring.finish(pieces, fitted)
     return measured, plan.job(parts, measured.start)
 
 
