@@ -224,6 +224,9 @@ class StageClock:
         self._start = (time.perf_counter(), _cpu_s())
 
     def end(self, name: str) -> None:
+        from softdesign.pipeline.parallel import settle_workers
+
+        settle_workers()  # the stage's workers end without the build waiting on them: reaped here, counted here
         wall, cpu = time.perf_counter() - self._start[0], _cpu_s() - self._start[1]
         if self._profiler is not None and self.profile_dir is not None:  # a profiler runs only with a folder
             self._profiler.disable()
@@ -235,7 +238,8 @@ class StageClock:
 
 
 def _cpu_s() -> float:
-    """CPU seconds of this process and of its workers that have ended (a stage's pool ends within the stage)."""
+    """CPU seconds of this process and of its workers that have ended and been reaped (a stage's, at its end:
+    :meth:`StageClock.end` waits for them)."""
     own, workers = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
     return own.ru_utime + own.ru_stime + workers.ru_utime + workers.ru_stime
 
@@ -315,6 +319,7 @@ def run_worker(case_file: Path, out_dir: Path, profile_dir: Path | None, jobs: i
     """
     import_s = import_heavy_libraries()
     from softdesign.config import load_case
+    from softdesign.pipeline.parallel import settle_workers
     from softdesign.pipeline.runner import RunOptions, run_stages
     from softdesign.pipeline.stage_order import STAGES, input_files
 
@@ -326,6 +331,7 @@ def run_worker(case_file: Path, out_dir: Path, profile_dir: Path | None, jobs: i
     start = time.perf_counter(), _cpu_s()
     options = RunOptions(force=True, jobs=jobs)
     run_stages(case, out_dir / "build", measured(STAGES, clock), input_files(case), options)
+    settle_workers()  # every worker reaped: its CPU time counted
     total = {"wall_s": time.perf_counter() - start[0], "cpu_s": _cpu_s() - start[1]}
     total["peak_mib"] = max(clock.overall_peak, memory.peak_mib())
     manifest = json.loads((out_dir / "build" / "manifest.json").read_text())

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -253,14 +254,27 @@ def fold_solver(
     it with the fold's distances, perhaps on another process): the same spline whenever and
     wherever it is solved.
     """
+    assembled, rows = fold_assembly(polar, length_mm, settings, labels)
+    return fold_solver_from(polar, length_mm, settings, rows, mapper(assembled, rows))
+
+
+def fold_assembly(polar: PolarPoints, length_mm: float, settings: FitSettings, labels: np.ndarray
+                  ) -> tuple[Callable[[np.ndarray], tuple[sp.csc_matrix, FloatArray]], list[np.ndarray]]:
+    """:func:`fold_solver`'s assembly as a task and its items: ``A_k^T A_k`` and ``A_k^T rho_k`` of each fold's
+    rows (the items, in fold order), for any mapper (each fold's own)."""
     knots = path_knots(length_mm, settings)
-    rows = [np.flatnonzero(labels == k) for k in range(int(labels.max()) + 1)]
 
     def assembled(r: np.ndarray) -> tuple[sp.csc_matrix, FloatArray]:
         design = design_matrix(knots, settings.angular_intervals, polar.l[r], polar.angle[r])
         return design.T @ design, design.T @ polar.rho[r]
 
-    parts = mapper(assembled, rows)
+    return assembled, [np.flatnonzero(labels == k) for k in range(int(labels.max()) + 1)]
+
+
+def fold_solver_from(polar: PolarPoints, length_mm: float, settings: FitSettings, rows: list[np.ndarray],
+                     parts: list[Any]) -> Callable[[int], RadiusSpline]:
+    """:func:`fold_solver` from its assembly's results ``parts`` for the folds' ``rows`` (:func:`fold_assembly`)."""
+    knots = path_knots(length_mm, settings)
     gram, moment = sum(p[0] for p in parts), sum(p[1] for p in parts)
 
     def solve(k: int) -> RadiusSpline:

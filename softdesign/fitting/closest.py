@@ -8,6 +8,7 @@ distances say about the fit (RMS, percentiles, the hold-out) is :mod:`softdesign
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -134,18 +135,38 @@ def closest_with_part(
     the processor's caches (the same numbers as all at once, in less time), the blocks by ``mapper``
     (perhaps on other processes: the same numbers; a single block always runs here).
     """
-    twist = frame_twist_table(curve)
-    rows = bb.chunks(len(p), CLOSEST_CHUNK)
+    job = closest_job(curve, spline, p, start)
+    return job.join(mapper(job.task, job.items) if len(job.items) > 1 else [job.task(job.items[0])])
 
-    def piece(r: slice) -> tuple[FloatArray, FloatArray, FloatArray, CurvePart]:
+
+Found = tuple[FloatArray, FloatArray, FloatArray, CurvePart]
+
+
+@dataclass(frozen=True)
+class ClosestJob:
+    """:func:`closest_with_part` as a task over its blocks of points (``items``, slices in order, each its own) and
+    the join of their results, for a caller that runs the blocks beside other work."""
+
+    task: Callable[[slice], Found]
+    items: list[slice]
+
+    def join(self, pieces: Sequence[Found]) -> Found:
+        """distance, l, angle and the curve's part of every point, from the blocks' results in order."""
+        if len(pieces) == 1:
+            return pieces[0]
+        dist, l, a = (np.concatenate([piece[k] for piece in pieces]) for k in range(3))
+        arrays = zip(*(piece[3].arrays() for piece in pieces), strict=True)
+        return dist, l, a, CurvePart(*(np.concatenate(parts) for parts in arrays))
+
+
+def closest_job(curve: FramedCurve, spline: RadiusSurface, p: Points, start: SearchStart) -> ClosestJob:
+    """The blocks of :func:`closest_with_part`'s search, its parameters but the mapper."""
+    twist = frame_twist_table(curve)
+
+    def piece(r: slice) -> Found:
         return _closest_piece(curve, spline, twist, p[r], start.subset(r))
 
-    pieces = mapper(piece, rows) if len(rows) > 1 else [piece(rows[0])]
-    if len(pieces) == 1:
-        return pieces[0]
-    dist, l, a = (np.concatenate([piece[k] for piece in pieces]) for k in range(3))
-    part = CurvePart(*(np.concatenate(arrays) for arrays in zip(*(piece[3].arrays() for piece in pieces), strict=True)))
-    return dist, l, a, part
+    return ClosestJob(piece, bb.chunks(len(p), CLOSEST_CHUNK))
 
 
 def _closest_piece(
@@ -157,17 +178,20 @@ def _closest_piece(
     part = CurvePart(*(np.array(v, float) for v in part.arrays()))  # updated in place below
     surface, du, dv = _surface_and_tangents(part, spline, l, a)
     dist = np.linalg.norm(p - surface, axis=1)
+    state = (l, a, surface, du, dv, dist, *part.arrays())
     active = np.ones(len(l), bool)
     for _ in range(CLOSEST_MAX_STEPS):
         idx = np.flatnonzero(active)
         if idx.size == 0:
             break
-        current = (l[idx], a[idx], surface[idx], du[idx], dv[idx], dist[idx], *(v[idx] for v in part.arrays()))
-        step = _gauss_newton_step(p[idx] - surface[idx], du[idx], dv[idx])
-        update = _damped_update(curve, spline, twist, p[idx], current, step)
-        moved = np.linalg.norm(update[2] - surface[idx], axis=1)
-        for target, value in zip((l, a, surface, du, dv, dist, *part.arrays()), update, strict=True):
-            target[idx] = value
+        every = idx.size == len(l)  # every point still moves: the state itself is updated, no gather and scatter
+        current = state if every else tuple(v[idx] for v in state)
+        points = p if every else p[idx]
+        step = _gauss_newton_step(points - current[2], current[3], current[4])
+        moved = _damped_update(curve, spline, twist, points, current, step)
+        if not every:
+            for target, value in zip(state, current, strict=True):
+                target[idx] = value
         active[idx[moved <= CLOSEST_TOL_MM]] = False
     return dist, l, a, part
 
@@ -237,28 +261,34 @@ def _gauss_newton_step(residual: Points, du: Points, dv: Points) -> FloatArray:
     return np.where(np.isfinite(step), step, 0.0)
 
 
-def _damped_update(curve, spline, twist, p, current, step):
+def _damped_update(curve, spline, twist, p, current, step) -> FloatArray:
     """Take the Gauss-Newton step, halving it (up to 8 times) for the points where it does not help.
 
-    ``current`` is (l, a, S, dS/dl, dS/da, distance, then the fields of the curve's part);
-    returns the same at the new (l, a).
-    A point whose step never reduces the distance stays where it was (it has converged).
+    ``current`` is (l, a, S, dS/dl, dS/da, distance, then the fields of the curve's part), each (n, ...):
+    updated in place to the same at the new (l, a) of each point whose distance a step does not increase
+    (a point whose step never reduces the distance stays where it was: it has converged).
+
+    Returns
+    -------
+    (n,) mm, how far each point's surface point moved (0 where it stayed).
     """
-    l0, a0, dist0 = current[0], current[1], current[5]
-    out = tuple(v.copy() for v in current)
+    l0, a0, surface0, dist0 = current[0], current[1], current[2], current[5]
+    moved = np.zeros(len(l0))
     pending = np.arange(len(l0))
     scale = 1.0
-    for _ in range(8):
+    for _ in range(8):  # a row is written once, when it leaves ``pending``: the rows still read are the start's
         l = np.clip(l0[pending] + scale * step[pending, 0], 0.0, 1.0)
         a = a0[pending] + scale * step[pending, 1]
         part = _curve_part(curve, twist, l)
         surface, du, dv = _surface_and_tangents(part, spline, l, a)
         d = np.linalg.norm(p[pending] - surface, axis=1)
         better = d <= dist0[pending]
-        for target, value in zip(out, (l, a, surface, du, dv, d, *part.arrays()), strict=True):
-            target[pending[better]] = value[better]
+        rows = pending[better]
+        moved[rows] = np.linalg.norm(surface[better] - surface0[rows], axis=1)
+        for target, value in zip(current, (l, a, surface, du, dv, d, *part.arrays()), strict=True):
+            target[rows] = value[better]
         pending = pending[~better]
         if pending.size == 0:
             break
         scale *= 0.5
-    return out
+    return moved

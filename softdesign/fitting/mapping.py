@@ -30,3 +30,21 @@ def mapped_blocks(values: Callable[[slice], FloatArray], count: int, size: int, 
     if len(blocks) == 1:
         return values(slice(0, count))
     return np.concatenate(mapper(values, blocks))
+
+
+Job = tuple[Callable[[Any], Any], Sequence[Any]]
+
+
+def map_together(mapper: Mapper, *jobs: Job) -> list[list[Any]]:
+    """Independent maps ``(task, items)`` as one call of ``mapper``: each one's results, in its items' order.
+
+    The same results as a call each (every item is its own); on a pool of processes the later maps' items keep
+    a worker busy while the earlier ones' last items run, where a few long items alone leave one idle.
+    """
+    tagged = [(j, item) for j, (_, items) in enumerate(jobs) for item in items]
+    results = mapper(lambda pair: jobs[pair[0]][0](pair[1]), tagged)
+    out, start = [], 0
+    for _, items in jobs:
+        out.append(list(results[start:start + len(items)]))
+        start += len(items)
+    return out

@@ -18,20 +18,25 @@ fold is measured against the fit on the other k - 1 folds.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
 from softdesign.errors import ConfigError
-from softdesign.fitting.bspline_surface import FitSettings, RadiusSpline, fold_solver
+from softdesign.fitting import bspline_basis as bb
+from softdesign.fitting.bspline_surface import FitSettings, RadiusSpline, fold_assembly, fold_solver_from
 from softdesign.fitting.closest import (
+    ClosestJob,
     CurvePart,
+    Found,
     SearchStart,
+    closest_job,
     closest_surface_points,
-    closest_with_part,
     search_start,
 )
-from softdesign.fitting.mapping import Mapper, mapped_blocks, serial_map
+from softdesign.fitting.mapping import Mapper, serial_map
 from softdesign.fitting.projection import PROJECT_BLOCK, PolarPoints
 from softdesign.types import FloatArray, FramedCurve
 
@@ -159,12 +164,44 @@ def measure_distances(
     -------
     MeasuredDistances; ``metrics.max_mm`` is the largest distance of any kept point.
     """
+    return distances_job(curve, spline, polar, rng, max_points).run(mapper)
+
+
+@dataclass(frozen=True)
+class DistancesJob:
+    """:func:`measure_distances` with its sample drawn: the search's blocks of points (``closest``), and the
+    fitted rho at the points outside the sample in blocks (``bounds``, for the exact max), each block its own,
+    then what follows them; for a caller that runs the blocks beside other work in one call of its mapper."""
+
+    curve: FramedCurve
+    spline: RadiusSpline
+    polar: PolarPoints
+    sample: np.ndarray
+    closest: ClosestJob
+    bounds: ExactMaxBounds
+
+    def finish(self, pieces: Sequence[Found], fitted: Sequence[FloatArray]) -> MeasuredDistances:
+        """The distances from the search's results and the bounds' (each in its blocks' order)."""
+        distance, l, angle, part = self.closest.join(pieces)
+        metrics = self.bounds.exact_max(self.curve, self.spline, self.polar, fitted, summarize_distances(distance))
+        return MeasuredDistances(metrics, self.sample, distance, l, angle, part)
+
+    def run(self, mapper: Mapper = serial_map) -> MeasuredDistances:
+        """:func:`measure_distances`' result (a single block here, more on ``mapper``)."""
+        def blocks(task: Callable[[slice], Any], items: list[slice]) -> list[Any]:
+            return mapper(task, items) if len(items) > 1 else [task(item) for item in items]
+
+        return self.finish(blocks(self.closest.task, self.closest.items), blocks(self.bounds.task, self.bounds.items))
+
+
+def distances_job(curve: FramedCurve, spline: RadiusSpline, polar: PolarPoints, rng: np.random.Generator,
+                  max_points: int = DISTANCE_SAMPLE_MAX) -> DistancesJob:
+    """:func:`measure_distances` up to its search: the sample drawn (``rng``), the search's blocks prepared."""
     sample = holdout_sample(len(polar), max_points, rng)
     measured = polar.subset(sample)
-    distance, l, angle, part = closest_with_part(curve, spline, measured.points,
-                                                 SearchStart(measured.l, measured.angle), mapper)
-    metrics = with_exact_max(curve, spline, polar, sample, summarize_distances(distance), mapper)
-    return MeasuredDistances(metrics, sample, distance, l, angle, part)
+    return DistancesJob(curve, spline, polar, sample,
+                        closest_job(curve, spline, measured.points, SearchStart(measured.l, measured.angle)),
+                        exact_max_bounds(spline, polar, sample))
 
 
 def with_exact_max(
@@ -177,20 +214,47 @@ def with_exact_max(
     the sample's largest distance, or whose foot is clamped at an end, are measured; ``total`` counts them all.
     ``mapper`` runs the residuals in blocks of ``PROJECT_BLOCK`` points (each point's own: the same numbers).
     """
+    bounds = exact_max_bounds(spline, polar, sample)
+    items = bounds.items
+    fitted = mapper(bounds.task, items) if len(items) > 1 else [bounds.task(item) for item in items]
+    return bounds.exact_max(curve, spline, polar, fitted, metrics)
+
+
+@dataclass(frozen=True)
+class ExactMaxBounds:
+    """:func:`with_exact_max`'s residuals as a task over blocks of the points outside the sample (``rest``, none
+    when the sample holds every point), and the exact max from them."""
+
+    rest: np.ndarray
+    task: Callable[[slice], FloatArray]
+    items: list[slice]
+
+    def exact_max(self, curve: FramedCurve, spline: RadiusSpline, polar: PolarPoints, fitted: Sequence[FloatArray],
+                  metrics: FitMetrics) -> FitMetrics:
+        """``metrics`` with the max over every point of ``polar``, from the fitted rho of the blocks (in order)."""
+        if not self.items:
+            return metrics
+        rest = self.rest
+        bound = np.abs(polar.rho[rest] - np.concatenate(fitted))
+        # a foot clamped at an end is not in p's normal plane: the radial residual bounds nothing there
+        doubtful = rest[(bound >= metrics.max_mm - BOUND_SLACK_MM) | (polar.end_side[rest] != 0)]
+        largest = metrics.max_mm
+        if doubtful.size:
+            largest = max(largest, float(closest_surface_points(curve, spline, polar.subset(doubtful))[0].max()))
+        return replace(metrics, max_mm=largest, total=len(polar))
+
+
+def exact_max_bounds(spline: RadiusSpline, polar: PolarPoints, sample: np.ndarray) -> ExactMaxBounds:
+    """The residuals :func:`with_exact_max` bounds the points outside ``sample`` by, as a task over blocks of
+    ``PROJECT_BLOCK`` points (none when the sample holds every point)."""
     if len(sample) == len(polar):
-        return metrics
+        return ExactMaxBounds(np.zeros(0, np.int64), lambda rows: np.zeros(0), [])
     outside = np.ones(len(polar), bool)
     outside[sample] = False
     rest = np.flatnonzero(outside)  # np.setdiff1d(arange, sample)'s indices, increasing, without its sort
     l, angle = polar.l[rest], polar.angle[rest]
-    fitted = mapped_blocks(lambda rows: spline.evaluate(l[rows], angle[rows]), len(rest), PROJECT_BLOCK, mapper)
-    bound = np.abs(polar.rho[rest] - fitted)
-    # a foot clamped at an end is not in p's normal plane: the radial residual bounds nothing there
-    doubtful = rest[(bound >= metrics.max_mm - BOUND_SLACK_MM) | (polar.end_side[rest] != 0)]
-    largest = metrics.max_mm
-    if doubtful.size:
-        largest = max(largest, float(closest_surface_points(curve, spline, polar.subset(doubtful))[0].max()))
-    return replace(metrics, max_mm=largest, total=len(polar))
+    return ExactMaxBounds(rest, lambda rows: spline.evaluate(l[rows], angle[rows]),
+                          bb.chunks(len(rest), PROJECT_BLOCK))
 
 
 def fold_labels(count: int, folds: int, rng: np.random.Generator) -> np.ndarray:
@@ -232,28 +296,74 @@ def holdout_rms(
         :class:`SearchStart` (:attr:`MeasuredDistances.start`) also carries the centerline's part there
     mapper : runs the held-out folds' distances (independent of each other); the same figures for any
     """
+    return holdout_plan(curve, polar, settings, rng, holdout).run(mapper, start)
+
+
+@dataclass(frozen=True)
+class HoldoutPlan:
+    """The hold-out with its sample and folds drawn: each fold's system to assemble (``assemble`` over ``rows``,
+    each fold's own), then :meth:`job`, its fits and distances; :meth:`run` runs both on one mapper, a caller
+    with other independent work may run each step beside it (:func:`~softdesign.fitting.mapping.map_together`)."""
+
+    curve: FramedCurve
+    polar: PolarPoints  # the points the folds are dealt from (the drawn ones)
+    settings: FitSettings
+    labels: np.ndarray
+    sample: np.ndarray  # their indices among the points the plan was drawn from
+    assemble: Callable[[np.ndarray], Any]
+    rows: list[np.ndarray]
+
+    def job(self, parts: list[Any], start: tuple[FloatArray, FloatArray] | SearchStart | None = None) -> HoldoutJob:
+        """The folds' fits and distances, from the assembly's results ``parts`` (in fold order); ``start`` as
+        :func:`holdout_rms`'s, for the points the plan was drawn from."""
+        solve = fold_solver_from(self.polar, self.curve.length, self.settings, self.rows, parts)
+        begin = None if start is None else search_start(self.polar, start).subset(self.sample)
+        curve, polar, labels = self.curve, self.polar, self.labels
+
+        def held_out(k: int) -> FloatArray:  # fold k's fit and its distances: on one process, after the assembly
+            test = labels == k
+            return closest_surface_points(curve, solve(k), polar.subset(test),
+                                          None if begin is None else begin.subset(test))[0]
+
+        return HoldoutJob(held_out, list(range(len(self.rows))), len(polar))
+
+    def run(self, mapper: Mapper = serial_map,
+            start: tuple[FloatArray, FloatArray] | SearchStart | None = None) -> HoldoutReport:
+        """The hold-out's report, every step on ``mapper``."""
+        return self.job(mapper(self.assemble, self.rows), start).run(mapper)
+
+
+@dataclass(frozen=True)
+class HoldoutJob:
+    """The hold-out's last step: each fold's fit and distances (``task(k)`` for k in ``folds``, each its own), and
+    the report from them."""
+
+    task: Callable[[int], FloatArray]
+    folds: list[int]
+    points: int
+
+    def report(self, distances: Sequence[FloatArray]) -> HoldoutReport:
+        """The pooled RMS and each fold's from the held-out distances of every fold (in ``folds``' order), mm."""
+        squares = [d**2 for d in distances]
+        fold_rms = [np.sqrt(np.mean(square)) for square in squares]
+        return HoldoutReport(float(np.sqrt(np.mean(np.concatenate(squares)))), np.array(fold_rms), self.points)
+
+    def run(self, mapper: Mapper = serial_map) -> HoldoutReport:
+        """The report, the folds run by ``mapper``."""
+        return self.report(mapper(self.task, self.folds))
+
+
+def holdout_plan(curve: FramedCurve, polar: PolarPoints, settings: FitSettings, rng: np.random.Generator,
+                 holdout: HoldoutSettings = HoldoutSettings()) -> HoldoutPlan:
+    """:func:`holdout_rms` up to its assembly: the sample and the folds drawn (``rng``, as there)."""
     sample = holdout_sample(len(polar), holdout.max_points, rng)
-    labels = fold_labels(len(sample), holdout.folds, rng)
-    begin = None if start is None else search_start(polar, start).subset(sample)
-    return _holdout(curve, polar.subset(sample), settings, labels, begin, mapper)
+    return _fold_plan(curve, polar.subset(sample), settings, fold_labels(len(sample), holdout.folds, rng), sample)
 
 
-def _holdout(
-    curve: FramedCurve, polar: PolarPoints, settings: FitSettings, labels: np.ndarray,
-    start: SearchStart | None = None, mapper: Mapper = serial_map,
-) -> HoldoutReport:
-    solve = fold_solver(polar, curve.length, settings, labels, mapper)  # each fold's rows assembled by mapper too
-
-    def held_out(k: int) -> FloatArray:  # fold k's fit and its distances: on one process, after the assembly
-        test = labels == k
-        begin = None if start is None else start.subset(test)
-        return closest_surface_points(curve, solve(k), polar.subset(test), begin)[0]
-
-    squares, fold_rms = [], []
-    for d in mapper(held_out, range(int(labels.max()) + 1)):
-        squares.append(d**2)
-        fold_rms.append(np.sqrt(np.mean(d**2)))
-    return HoldoutReport(float(np.sqrt(np.mean(np.concatenate(squares)))), np.array(fold_rms), len(polar))
+def _fold_plan(curve: FramedCurve, polar: PolarPoints, settings: FitSettings, labels: np.ndarray,
+               sample: np.ndarray) -> HoldoutPlan:
+    assemble, rows = fold_assembly(polar, curve.length, settings, labels)
+    return HoldoutPlan(curve, polar, settings, labels, sample, assemble, rows)
 
 
 def choose_knot_spacing(
@@ -271,11 +381,12 @@ def choose_knot_spacing(
     -------
     the chosen spacing (mm), and the hold-out RMS (mm) of every candidate
     """
-    sample = polar.subset(holdout_sample(len(polar), holdout.max_points, rng))
+    drawn = holdout_sample(len(polar), holdout.max_points, rng)
+    sample = polar.subset(drawn)
     labels = fold_labels(len(sample), holdout.folds, rng)
     scores = {}
     for spacing in holdout.candidates_mm:
         trial = FitSettings(spacing, settings.angular_intervals, settings.smoothing, settings.breaks)
-        scores[float(spacing)] = _holdout(curve, sample, trial, labels).rms_mm
+        scores[float(spacing)] = _fold_plan(curve, sample, trial, labels, drawn).run().rms_mm
     best = min(scores, key=lambda s: (scores[s], -s))
     return best, scores

@@ -16,22 +16,31 @@ import numpy as np
 import numpy.typing as npt
 
 from softdesign.errors import FitError, FoldError
-from softdesign.fitting.bspline_surface import FitSettings, SurfaceFit, fit_radius_surface, intervals_per_link
+from softdesign.fitting import bspline_basis as bb
+from softdesign.fitting.bspline_surface import (
+    FitSettings,
+    RadiusSpline,
+    SurfaceFit,
+    fit_radius_surface,
+    intervals_per_link,
+)
 from softdesign.fitting.coverage import WallCoverage, measure_coverage
 from softdesign.fitting.end_checks import end_radii, negative_radius_cause
 from softdesign.fitting.end_hold import negative_end
 from softdesign.fitting.end_prior import end_prior
 from softdesign.fitting.local_cap import LocalCap, fold_advice, fold_stretches, surface_capped_locally
-from softdesign.fitting.mapping import Mapper, serial_map
+from softdesign.fitting.mapping import Mapper, map_together, serial_map
 from softdesign.fitting.metrics import (
     FitMetrics,
+    HoldoutJob,
     HoldoutReport,
     HoldoutSettings,
+    MeasuredDistances,
     choose_knot_spacing,
-    holdout_rms,
-    measure_distances,
+    distances_job,
+    holdout_plan,
 )
-from softdesign.fitting.projection import PolarPoints, project_points
+from softdesign.fitting.projection import PROJECT_BLOCK, PolarPoints, project_points
 from softdesign.fitting.radius_field import (
     FOLD_SPACING_MM,
     FoldReport,
@@ -105,6 +114,8 @@ class WallFit:
     distance: FloatArray = dataclasses.field(default_factory=lambda: np.zeros(0))
     #: the fit against all of the path's own wall, and where it saw none (None: not measured)
     coverage: WallCoverage | None = None
+    #: (n,) mm per surface vertex: rho - rho(1, l, a) of ``field`` (empty when not measured)
+    residual: FloatArray = dataclasses.field(default_factory=lambda: np.zeros(0))
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready figures for the manifest (mm, rad; snake_case keys)."""
@@ -222,14 +233,12 @@ def fit_wall(
         kept, kept_index = kept.subset(keep), kept_index[keep]
         settings, scores, prior, surface = _fit_kept(curve, kept, options, reference, rng)
     tell("spline")
-    measured = measure_distances(curve, surface.whole, kept, rng, mapper=options.mapper)
+    measured, folds = _distances_and_folds(curve, surface.whole, kept, settings, options, rng)
     tell("distances")
-    # the hold-out folds are dealt from the measured points, each starting from its closest point
-    holdout = holdout_rms(curve, kept.subset(measured.sample), settings, rng, options.holdout,
-                          start=measured.start, mapper=options.mapper)
+    radius = RadiusField.from_links(settings.breaks, surface.links, options.initial_radius_mm)
+    holdout, residual = _holdout_and_residual(folds, polar, radius, options.mapper)
     tell("hold-out")
     metrics = measured.metrics
-    radius = RadiusField.from_links(settings.breaks, surface.links, options.initial_radius_mm)
     try:
         folding = check_self_folding(curve, radius, q=1.0, limit=options.fold_limit)
     except FoldError as err:  # the stretches that fold, each with a cap of its own, before the whole path's
@@ -258,4 +267,40 @@ def fit_wall(
                                 known_max=metrics.max_mm)
     tell("coverage")
     return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius, ends, distance,
-                   coverage)
+                   coverage, residual)
+
+
+def _distances_and_folds(
+    curve: FramedCurve, spline: RadiusSpline, kept: PolarPoints, settings: FitSettings, options: WallFitOptions,
+    rng: np.random.Generator,
+) -> tuple[MeasuredDistances, HoldoutJob]:
+    """The kept points' true distances (:func:`~softdesign.fitting.metrics.measure_distances`), and the hold-out's
+    folds, dealt from the measured points, each to start from its closest point.
+
+    The search's blocks of points, the exact max's residuals of the points outside its sample and the folds'
+    assemblies run in one call of the mapper (each item its own; the draws in the order of ``measure_distances``
+    then ``holdout_rms``): the shorter items fill a worker the search's last blocks leave idle, where each was a
+    pool of its own.
+    """
+    measuring = distances_job(curve, spline, kept, rng)
+    plan = holdout_plan(curve, kept.subset(measuring.sample), settings, rng, options.holdout)
+    pieces, fitted, parts = map_together(options.mapper, (measuring.closest.task, measuring.closest.items),
+                                         (measuring.bounds.task, measuring.bounds.items), (plan.assemble, plan.rows))
+    measured = measuring.finish(pieces, fitted)
+    return measured, plan.job(parts, measured.start)
+
+
+def _holdout_and_residual(job: HoldoutJob, polar: PolarPoints, radius: RadiusField, mapper: Mapper
+                          ) -> tuple[HoldoutReport, FloatArray]:
+    """The hold-out's report, and every point's radial residual against ``radius`` at q = 1 (n,) mm, in one call
+    of the mapper.
+
+    The residual's blocks of ``PROJECT_BLOCK`` points keep a worker busy while the folds' last fits run (five
+    folds on two workers leave one idle for a fold's time); each block's values are its points' own, so the
+    residual is that of one ``evaluate_pairs`` over every point, the hold-out that of ``holdout_rms``.
+    """
+    def fitted(rows: slice) -> FloatArray:
+        return radius.evaluate_pairs(1.0, polar.l[rows], polar.angle[rows])
+
+    distances, rho = map_together(mapper, (job.task, job.folds), (fitted, bb.chunks(len(polar), PROJECT_BLOCK)))
+    return job.report(distances), polar.rho - np.concatenate(rho)

@@ -201,8 +201,9 @@ def _map_forked(
     _TASK = task
     processes: dict[int, Any] = {}
     try:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
-                                 initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
+                                   initializer=die_with_parent, initargs=(os.getpid(),))
+        try:
             found = getattr(pool, "_processes", None)  # the workers (filled as they start), to say how one died
             processes = found if isinstance(found, dict) else {}
             results = []
@@ -210,7 +211,17 @@ def _map_forked(
                 results.append(result)
                 if on_result is not None:
                     on_result(item, result)
-            return results
+        except BaseException:
+            pool.shutdown(wait=True)  # every worker stopped and reaped before the error goes on
+            raise
+        # every result is here: the workers end on their own (told to by the pool's thread, which reaps them; the
+        # interpreter joins it at exit), while this process goes on, instead of waiting on their exits
+        _ENDING[:] = [thread for thread in _ENDING if thread.is_alive()]
+        thread = getattr(pool, "_executor_manager_thread", None)
+        pool.shutdown(wait=False)
+        if thread is not None:
+            _ENDING.append(thread)
+        return results
     except BrokenProcessPool:  # the pool has stopped and reaped every worker by now
         what, kept = _WORK.get()
         raise SoftdesignError(f"a worker died ({_how_died(list(processes.values()))}) during {what}; {kept} "
@@ -218,6 +229,21 @@ def _map_forked(
                               "memory)") from None
     finally:
         _TASK = None
+
+
+#: The threads of pools whose workers were told to end without a wait (each reaps its pool's workers, then ends).
+_ENDING: list[Any] = []
+
+
+def settle_workers() -> None:
+    """Wait until every worker told to end has ended and been reaped.
+
+    A build does not wait on its workers' exits (:func:`map_items`); a measurement of the CPU time of this
+    process's children (``RUSAGE_CHILDREN`` counts reaped ones only) calls this first, so that a stage's
+    workers are counted in that stage.
+    """
+    while _ENDING:
+        _ENDING.pop().join()
 
 
 def _how_died(processes: list[Any]) -> str:

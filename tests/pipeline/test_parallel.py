@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import json
+import multiprocessing
 import os
 import re
+import resource
+import time
 from pathlib import Path
 
 import pytest
@@ -14,7 +17,14 @@ from typer.testing import CliRunner
 from softdesign.cli import app
 from softdesign.errors import MeshError
 from softdesign.pipeline.bounds import VERTICES_PER_WORKER
-from softdesign.pipeline.parallel import MAX_JOBS, available_cores, checked_jobs, jobs_for_build, map_per_q
+from softdesign.pipeline.parallel import (
+    MAX_JOBS,
+    available_cores,
+    checked_jobs,
+    jobs_for_build,
+    map_per_q,
+    settle_workers,
+)
 from tests.helpers.paths import REPO
 
 runner = CliRunner()
@@ -38,6 +48,32 @@ def test_results_come_back_in_order_from_other_processes():
         done = map_per_q(_pid_and_square, q_values)
     assert [square for _, square in done] == [q * q for q in q_values]
     assert {pid for pid, _ in done} - {os.getpid()}, "no q ran in a worker process"
+
+
+#: CPU seconds each worker spends in :func:`_busy`: far above the kernel's accounting tick (1-10 ms).
+BUSY_CPU_S = 0.05
+
+
+def _busy(q: float) -> float:
+    start = time.process_time()
+    while time.process_time() - start < BUSY_CPU_S:
+        pass
+    return q
+
+
+def _children_cpu_s() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def test_settled_workers_have_ended_and_their_cpu_time_is_counted():
+    # a build goes on while its workers end; a measurement settles them first (RUSAGE_CHILDREN counts reaped ones)
+    before = _children_cpu_s()
+    with jobs_for_build(2):
+        assert map_per_q(_busy, [0.0, 1.0]) == [0.0, 1.0]
+    settle_workers()
+    assert multiprocessing.active_children() == []
+    assert _children_cpu_s() - before >= 2 * BUSY_CPU_S * 0.9  # both workers' loops, less the accounting's tick
 
 
 def test_one_job_or_a_bound_of_one_runs_in_this_process():

@@ -135,7 +135,9 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     stray = centerline_stray(case, curve.curve, path)
     if stray is not None:
         summary["centerline_stray"] = stray.replace("the cause is the centerline, not the fit: ", "the centerline, ")
-    residual = wall.polar.rho - fitted_rho(field, wall.polar.l, wall.polar.angle)
+    # the fit measured it against its own field (beside the hold-out); a fitted initial surface is a new field
+    residual = wall.residual if field is wall.field else wall.polar.rho - fitted_rho(field, wall.polar.l,
+                                                                                 wall.polar.angle)
     points = {
         "l": wall.polar.l,
         "angle": wall.polar.angle,
