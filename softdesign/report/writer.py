@@ -174,6 +174,7 @@ def report_sections(
     data: BuildData, options: ReportOptions, timer: PartTimer | None = None
 ) -> tuple[list[Section], list[Check], list[str]]:
     """The sections of the page, every check, and the notes on what was left out."""
+    check_pcc_count(data, options)  # before any drawing: a bad count is refused at once
     run = timer or PartTimer(None)
     run.prefetch(_slow_parts(data, options))
     notes: list[str] = []
@@ -227,6 +228,15 @@ def report_sections(
     if make_it is not None:
         sections.insert(-2, make_it)
     return sections, checks, notes
+
+
+def check_pcc_count(data: BuildData, options: ReportOptions) -> None:
+    """Refuse a ``--pcc-d`` that gives neither one distance nor one per link of the build (ConfigError, exit 2)."""
+    if options.pcc_d is not None and len(options.pcc_d) not in (1, data.link_count):
+        raise ConfigError(
+            f"--pcc-d: got {len(options.pcc_d)} distances, the build has {data.link_count} link(s); "
+            f"give one value for every link or {data.link_count}, one per link"
+        )
 
 
 def _slow_parts(data: BuildData, options: ReportOptions) -> dict[str, Callable[[], Any]]:
@@ -308,11 +318,6 @@ def _kinematics_section(data: BuildData, options: ReportOptions, notes: list[str
         section.notes.append(note)
         notes.append(note)
         return section
-    if len(options.pcc_d) not in (1, data.link_count):
-        raise ConfigError(
-            f"--pcc-d: got {len(options.pcc_d)} distances, the build has {data.link_count} link(s); "
-            f"give one value for every link or {data.link_count}, one per link"
-        )
     d = options.pcc_d[0] if len(options.pcc_d) == 1 else list(options.pcc_d)
     series = kinematics_figures.kinematics_series(data.kinematics.chain, data.export_q, options.q_samples)
     picture, design_notes = run("pcc_chambers.png", lambda: kinematics_figures.pcc_picture(data.kinematics.chain,

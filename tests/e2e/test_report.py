@@ -23,6 +23,7 @@ import typer
 from PIL import Image
 from typer.testing import CliRunner
 
+from softdesign.errors import ConfigError
 from softdesign.pipeline.api import build_through
 from softdesign.pipeline.manifest import STALE_TEXT
 from softdesign.pipeline.owned import REPORT_MARKER
@@ -403,6 +404,19 @@ def test_cli_bad_input_exits_2_with_a_message(demo, tmp_path, args, message):
     assert result.exit_code == 2, result.output
     assert message in result.output and "Traceback" not in result.output
     assert tree_hashes(demo[0] / REPORT_DIR) == before
+
+
+def test_a_bad_pcc_count_is_refused_before_any_figure(demo, monkeypatch):
+    """The count of --pcc-d is checked once the build is loaded: no figure is drawn for a report it refuses."""
+    import softdesign.report.writer as writer
+
+    def drawn(*_args, **_kwargs):
+        raise AssertionError("a figure was drawn before the --pcc-d count was checked")
+
+    monkeypatch.setattr(writer, "_slow_parts", drawn)
+    monkeypatch.setattr(writer, "_view_section", drawn)
+    with pytest.raises(ConfigError, match=r"--pcc-d: got 2 distances, the build has 4 link\(s\)"):
+        write_report(demo[0], ReportOptions(pcc_d=(1.0, 2.0)))
 
 
 def test_cli_help_names_the_option():

@@ -179,7 +179,18 @@ def checks_passed(figures: dict[str, Any], frame: PartingFrame) -> None:
 
 
 def _check(parts: MouldParts, frame: PartingFrame, name: Callable[[int, int], str], facet_tol: float) -> dict:
-    """Every check of :mod:`~softdesign.meshing.mould.checks`; refuse an undercut, MeshError on anything else."""
+    """Every check of :mod:`~softdesign.meshing.mould.checks`; refuse an undercut, MeshError on anything else.
+
+    The pulls come first: an undercut is refused before the seconds of the cavity's figures, which cannot change
+    that verdict."""
+    whole = parts.box + parts.core if parts.core is not None else parts.box
+    pulls = {}
+    for half, solid, pull in (("A", parts.half_a, np.array([0.0, 0.0, 1.0])),
+                              ("B", parts.half_b, np.array([0.0, 0.0, -1.0]))):
+        result, failures = pull_check(solid, pull, whole - solid, parts.box.original_id(), name, facet_tol)
+        if failures:
+            _refuse_undercut(half, pull, frame, failures, len(failures))
+        pulls[f"half_{half.lower()}"] = {**result, "pull": (frame.axes.T @ pull).tolist()}
     solids = {"half_a": parts.half_a, "half_b": parts.half_b}
     if parts.core is not None:
         solids["core"] = parts.core
@@ -192,14 +203,6 @@ def _check(parts: MouldParts, frame: PartingFrame, name: Callable[[int, int], st
     figures["cavity"] = {**cavity_figures(parts.half_a, parts.half_b, parts.core, parts.box, parts.body,
                                           parts.casting, parts.channels, parts.bumps, parts.sockets),
                          "tolerance": CAVITY_RTOL}
-    whole = parts.box + parts.core if parts.core is not None else parts.box
-    pulls = {}
-    for half, solid, pull in (("A", parts.half_a, np.array([0.0, 0.0, 1.0])),
-                              ("B", parts.half_b, np.array([0.0, 0.0, -1.0]))):
-        result, failures = pull_check(solid, pull, whole - solid, parts.box.original_id(), name, facet_tol)
-        if failures:
-            _refuse_undercut(half, pull, frame, failures, len(failures))
-        pulls[f"half_{half.lower()}"] = {**result, "pull": (frame.axes.T @ pull).tolist()}
     figures["pull"] = pulls
     checks_passed(figures, frame)
     figures["casting"] = {"up": (frame.axes.T @ parts.up).tolist(), "pour_at": (frame.axes.T @ parts.pour_at
