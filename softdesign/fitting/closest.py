@@ -17,7 +17,7 @@ import numpy.typing as npt
 
 from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import RadiusSpline
-from softdesign.fitting.mapping import Mapper, serial_map
+from softdesign.fitting.mapping import Mapper, mapped, serial_map
 from softdesign.fitting.projection import PolarPoints
 from softdesign.types import FloatArray, FramedCurve, Points
 
@@ -136,7 +136,7 @@ def closest_with_part(
     (perhaps on other processes: the same numbers; a single block always runs here).
     """
     job = closest_job(curve, spline, p, start)
-    return job.join(mapper(job.task, job.items) if len(job.items) > 1 else [job.task(job.items[0])])
+    return job.join(mapped(mapper, job.task, job.items))
 
 
 Found = tuple[FloatArray, FloatArray, FloatArray, CurvePart]

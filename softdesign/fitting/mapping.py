@@ -23,6 +23,11 @@ def serial_map(task: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
     return [task(item) for item in items]
 
 
+def mapped(mapper: Mapper, task: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
+    """``mapper(task, items)`` when there are several items; a single one (or none) runs here, without a pool."""
+    return mapper(task, items) if len(items) > 1 else serial_map(task, items)
+
+
 def mapped_blocks(values: Callable[[slice], FloatArray], count: int, size: int, mapper: Mapper) -> FloatArray:
     """``values(rows)`` over ``count`` items in blocks of ``size`` (slices, in order), joined; a single block runs
     here, more on ``mapper``.  The same numbers as one call over every item when each item's value is its own."""

@@ -36,7 +36,7 @@ from softdesign.fitting.closest import (
     closest_surface_points,
     search_start,
 )
-from softdesign.fitting.mapping import Mapper, serial_map
+from softdesign.fitting.mapping import Mapper, mapped, serial_map
 from softdesign.fitting.projection import PROJECT_BLOCK, PolarPoints
 from softdesign.types import FloatArray, FramedCurve
 
@@ -188,10 +188,8 @@ class DistancesJob:
 
     def run(self, mapper: Mapper = serial_map) -> MeasuredDistances:
         """:func:`measure_distances`' result (a single block here, more on ``mapper``)."""
-        def blocks(task: Callable[[slice], Any], items: list[slice]) -> list[Any]:
-            return mapper(task, items) if len(items) > 1 else [task(item) for item in items]
-
-        return self.finish(blocks(self.closest.task, self.closest.items), blocks(self.bounds.task, self.bounds.items))
+        return self.finish(mapped(mapper, self.closest.task, self.closest.items),
+                           mapped(mapper, self.bounds.task, self.bounds.items))
 
 
 def distances_job(curve: FramedCurve, spline: RadiusSpline, polar: PolarPoints, rng: np.random.Generator,
@@ -215,9 +213,7 @@ def with_exact_max(
     ``mapper`` runs the residuals in blocks of ``PROJECT_BLOCK`` points (each point's own: the same numbers).
     """
     bounds = exact_max_bounds(spline, polar, sample)
-    items = bounds.items
-    fitted = mapper(bounds.task, items) if len(items) > 1 else [bounds.task(item) for item in items]
-    return bounds.exact_max(curve, spline, polar, fitted, metrics)
+    return bounds.exact_max(curve, spline, polar, mapped(mapper, bounds.task, bounds.items), metrics)
 
 
 @dataclass(frozen=True)

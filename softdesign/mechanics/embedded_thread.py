@@ -114,7 +114,7 @@ def embedded_fibres(mesh: QuadraticMesh, polyline: FloatArray, thread: HoopThrea
                         np.repeat(reference[:, None, :], q, axis=1), weights,
                         np.full(count, thread.axial_stiffness_mn), np.full(count, thread.axial_stiffness_mn),
                         np.full(count, thread.buckling_strain(matrix_modulus_kpa)),
-                        reinforcement.FIBRE_ANCHORED and q > 1)
+                        reinforcement.anchored_rule())
 
 
 def _sub_mesh(mesh: QuadraticMesh, pool: IntArray) -> TetMesh:

@@ -165,6 +165,12 @@ FIBRE_WEIGHTS = np.concatenate([[0.5], FIBRE_STABILISATION * TRI_WEIGHTS])
 FIBRE_ANCHORED = True
 
 
+def anchored_rule() -> bool:
+    """Whether fibres built now take the anchored rule (:data:`FIBRE_ANCHORED`, and a rule of more than one point),
+    read at each call so that a comparison that swaps the rule's constants builds every fibre set alike."""
+    return FIBRE_ANCHORED and len(FIBRE_WEIGHTS) > 1
+
+
 @dataclass(frozen=True)
 class HoopThread:
     """The thread wound round each chamber (mm, kPa).
@@ -294,14 +300,16 @@ class FibreMembrane:
         place of the displacement's own; the forces are always those of the displacement.
         """
         a, e = self.fibre_vectors(displacement)
-        forces = np.einsum("fq,fqi,fqb->fbi", 2.0 * self._first(e), a, self.directions)
+        first = self._first(e)
+        forces = np.einsum("fq,fqi,fqb->fbi", 2.0 * first, a, self.directions)
         dofs = node_dofs(self.faces)  # 18 on 6-node faces; any node count per fibre assembles alike
         width = dofs.shape[1]
         n = displacement.size
         f = summed(dofs, forces.reshape(len(self.faces), width), n)
         if not want_tangent:
             return f, None
-        e = e if strain is None else strain
+        if strain is not None:
+            e, first = strain, self._first(strain)
         law, penalty = self._split_weights()
         k = self.stiffness[:, None]
         # the material part: k w e' e'^T, with e' = a D (the law's, but none when buckled) and the deviations'
@@ -311,7 +319,7 @@ class FibreMembrane:
         blocks = (np.einsum("fq,fqm,fqn->fmn", elastic, grads, grads)
                   + np.einsum("fq,fqm,fqn->fmn", penalty * k, deviations, deviations))
         # the geometric part: 2 dE/dI4 D_b D_c I
-        geometric = np.einsum("fq,fqb,fqc->fbc", 2.0 * self._first(e), self.directions, self.directions)
+        geometric = np.einsum("fq,fqb,fqc->fbc", 2.0 * first, self.directions, self.directions)
         blocks += np.einsum("fbc,ik->fbick", geometric, np.eye(3)).reshape(blocks.shape)
         rows = np.broadcast_to(dofs[:, :, None], blocks.shape).ravel()
         cols = np.broadcast_to(dofs[:, None, :], blocks.shape).ravel()
@@ -369,7 +377,7 @@ def hoop_membrane(points: FloatArray, faces: IntArray, axes: FloatArray, radii_m
                          np.concatenate([r for _, r in fibres]), (FIBRE_WEIGHTS[None] * wall.area)[chosen],
                          np.full(count, thread.stiffness_mn_per_mm), np.full(count, thread.axial_stiffness_mn),
                          np.full(count, thread.buckling_strain(matrix_modulus_kpa)),
-                         FIBRE_ANCHORED and len(FIBRE_WEIGHTS) > 1)
+                         anchored_rule())
 
 
 def _patch_directions(normal: FloatArray) -> tuple[FloatArray, FloatArray]:
