@@ -71,8 +71,22 @@ def fold_over_morph(shape_at: Callable[[float], FramedCurve], field: RadiusField
         grid's reports around those curves are kept on ``field`` (:meth:`RadiusField.keep_fold`), for a later
         stage that asks for them again (the feasibility's per export q); None keeps none
     """
+    task, items = morph_grid(shape_at, field, q_grid)
+    return fold_over_morph_from(shape_at, field, q_grid, mapper(task, items), built)
+
+
+def morph_grid(shape_at: Callable[[float], FramedCurve], field: RadiusField, q_grid: np.ndarray
+               ) -> tuple[Callable[[float], FoldReport], list[float]]:
+    """:func:`fold_over_morph`'s grid as a task and its items (the q values, each its own), for a caller that runs
+    them in a call of its mapper with other work; their reports, in order, go to :func:`fold_over_morph_from`."""
+    return (lambda q: fold_margin(shape_at(float(q)), field, float(q))), np.asarray(q_grid, float).tolist()
+
+
+def fold_over_morph_from(shape_at: Callable[[float], FramedCurve], field: RadiusField, q_grid: np.ndarray,
+                         reports: list[FoldReport], built: Callable[[float], FramedCurve | None] | None = None
+                         ) -> MorphFold:
+    """:func:`fold_over_morph` given the grid's ``reports`` (:func:`morph_grid`'s task on each of its items)."""
     q_grid = np.asarray(q_grid, float)
-    reports = mapper(lambda q: fold_margin(shape_at(float(q)), field, float(q)), q_grid.tolist())
     for q, r in zip(q_grid.tolist(), reports, strict=True):
         curve = None if built is None else built(q)
         if curve is not None:

@@ -29,7 +29,7 @@ from softdesign.fitting.end_checks import end_radii, negative_radius_cause
 from softdesign.fitting.end_hold import negative_end
 from softdesign.fitting.end_prior import end_prior
 from softdesign.fitting.local_cap import LocalCap, fold_advice, fold_stretches, surface_capped_locally
-from softdesign.fitting.mapping import Mapper, map_together, serial_map
+from softdesign.fitting.mapping import Job, Mapper, map_together, serial_map
 from softdesign.fitting.metrics import (
     FitMetrics,
     HoldoutJob,
@@ -80,6 +80,9 @@ class WallFitOptions:
         fit is still measured on the kept points)
     mapper : runs independent pieces (the hold-out's folds, the projection's and the metrics' blocks of
         points), perhaps on other processes; the same figures for any
+    with_field : more work on the fitted radius field, ``field -> (task, items)`` (each item its own), run in the
+        hold-out's call of the mapper, where its items keep a worker busy while the folds' last fits run; its
+        results, in the order of its items, are ``WallFit.field_results`` (None: no such work)
     """
 
     fit: FitSettings = field(default_factory=FitSettings)
@@ -94,6 +97,7 @@ class WallFitOptions:
     mapper: Mapper = serial_map
     progress: Callable[[str], None] | None = None
     fit_points: int = MAX_FIT_POINTS
+    with_field: Callable[[RadiusField], Job] | None = None
 
 
 @dataclass(frozen=True)
@@ -116,6 +120,8 @@ class WallFit:
     coverage: WallCoverage | None = None
     #: (n,) mm per surface vertex: rho - rho(1, l, a) of ``field`` (empty when not measured)
     residual: FloatArray = dataclasses.field(default_factory=lambda: np.zeros(0))
+    #: the results of ``WallFitOptions.with_field``'s work on ``field``, in its items' order (empty without it)
+    field_results: tuple[Any, ...] = ()
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready figures for the manifest (mm, rad; snake_case keys)."""
@@ -236,7 +242,8 @@ def fit_wall(
     measured, folds = _distances_and_folds(curve, surface.whole, kept, settings, options, rng)
     tell("distances")
     radius = RadiusField.from_links(settings.breaks, surface.links, options.initial_radius_mm)
-    holdout, residual = _holdout_and_residual(folds, polar, radius, options.mapper)
+    extra = None if options.with_field is None else options.with_field(radius)
+    holdout, residual, field_results = _holdout_and_residual(folds, polar, radius, options.mapper, extra)
     tell("hold-out")
     metrics = measured.metrics
     try:
@@ -267,7 +274,7 @@ def fit_wall(
                                 known_max=metrics.max_mm)
     tell("coverage")
     return WallFit(polar, selection, settings, scores, surface, metrics, holdout, folding, radius, ends, distance,
-                   coverage, residual)
+                   coverage, residual, tuple(field_results))
 
 
 def _distances_and_folds(
@@ -290,10 +297,10 @@ def _distances_and_folds(
     return measured, plan.job(parts, measured.start)
 
 
-def _holdout_and_residual(job: HoldoutJob, polar: PolarPoints, radius: RadiusField, mapper: Mapper
-                          ) -> tuple[HoldoutReport, FloatArray]:
-    """The hold-out's report, and every point's radial residual against ``radius`` at q = 1 (n,) mm, in one call
-    of the mapper.
+def _holdout_and_residual(job: HoldoutJob, polar: PolarPoints, radius: RadiusField, mapper: Mapper,
+                          extra: Job | None = None) -> tuple[HoldoutReport, FloatArray, list[Any]]:
+    """The hold-out's report, every point's radial residual against ``radius`` at q = 1 (n,) mm, and the results of
+    ``extra`` (:attr:`WallFitOptions.with_field`'s work; empty without it), in one call of the mapper.
 
     The residual's blocks of ``PROJECT_BLOCK`` points keep a worker busy while the folds' last fits run (five
     folds on two workers leave one idle for a fold's time); each block's values are its points' own, so the
@@ -302,5 +309,6 @@ def _holdout_and_residual(job: HoldoutJob, polar: PolarPoints, radius: RadiusFie
     def fitted(rows: slice) -> FloatArray:
         return radius.evaluate_pairs(1.0, polar.l[rows], polar.angle[rows])
 
-    distances, rho = map_together(mapper, (job.task, job.folds), (fitted, bb.chunks(len(polar), PROJECT_BLOCK)))
-    return job.report(distances), polar.rho - np.concatenate(rho)
+    jobs: list[Job] = [(job.task, job.folds), (fitted, bb.chunks(len(polar), PROJECT_BLOCK))]
+    distances, rho, *more = map_together(mapper, *jobs, *([] if extra is None else [extra]))
+    return job.report(distances), polar.rho - np.concatenate(rho), more[0] if more else []

@@ -189,10 +189,29 @@ def map_items(
     return results
 
 
+def map_items_beside(task: Callable[[Any], T], items: Sequence[Any], beside: Callable[[], Any]) -> list[T]:
+    """``[task(item) for item in items]`` on up to :func:`current_jobs` forked processes while this process runs
+    ``beside()`` (work of its own that needs none of their results, e.g. imports); the results in order.
+
+    Unlike :func:`map_items`, a single item goes to a worker too when jobs allow, so that it runs beside; with one
+    job (or no ``fork``) ``beside()`` runs first, then the items here.  An error of ``beside`` stops the workers
+    (every one reaped) before it goes on; an item's error is raised once ``beside`` is done.
+    """
+    workers = min(current_jobs(), len(items))
+    if workers >= 1 and current_jobs() > 1:
+        import multiprocessing
+
+        if "fork" in multiprocessing.get_all_start_methods():
+            return _map_forked(task, items, workers, None, beside)
+    beside()
+    return [task(item) for item in items]
+
+
 def _map_forked(
-    task: Callable[[Any], T], items: Sequence[Any], workers: int, on_result: Callable[[Any, T], None] | None
+    task: Callable[[Any], T], items: Sequence[Any], workers: int, on_result: Callable[[Any, T], None] | None,
+    beside: Callable[[], Any] | None = None,
 ) -> list[T]:
-    """:func:`map_items` on ``workers`` forked processes."""
+    """:func:`map_items` on ``workers`` forked processes (``beside``: run here once the items are handed out)."""
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
     from concurrent.futures.process import BrokenProcessPool
@@ -207,7 +226,10 @@ def _map_forked(
             found = getattr(pool, "_processes", None)  # the workers (filled as they start), to say how one died
             processes = found if isinstance(found, dict) else {}
             results = []
-            for item, result in zip(items, pool.map(_call, items), strict=True):
+            arriving = pool.map(_call, items)  # every item handed out now; the results come in order below
+            if beside is not None:
+                beside()
+            for item, result in zip(items, arriving, strict=True):
                 results.append(result)
                 if on_result is not None:
                     on_result(item, result)

@@ -58,6 +58,10 @@ class BuildData:
 
         return decimated_vessel(self.ingest.vertices, self.ingest.faces)
 
+    def keep_vessel_display(self, shown: tuple[Any, Any, float]) -> None:
+        """Keep ``shown``, :attr:`vessel_display` found from this data on a worker process, as its value here."""
+        self.__dict__["vessel_display"] = shown
+
     @property
     def name(self) -> str:
         """The case's name."""

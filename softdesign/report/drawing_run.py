@@ -8,9 +8,12 @@ import gc
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
-from softdesign.pipeline.parallel import jobs_for_build, map_items, working_on
+from softdesign.pipeline.parallel import jobs_for_build, map_items, map_items_beside, working_on
+
+if TYPE_CHECKING:
+    from softdesign.report.build_folder import BuildData
 
 T = TypeVar("T")
 
@@ -69,7 +72,7 @@ GC_THRESHOLD = 5000
 
 
 @contextmanager
-def collector_for_figures() -> Iterator[None]:
+def collector_for_figures(data: BuildData | None = None, jobs: int = 1) -> Iterator[None]:
     """Let the cyclic garbage collector skip what is already loaded and run less often while figures are drawn.
 
     Drawing makes hundreds of thousands of short-lived matplotlib objects, and each full collection walked the
@@ -77,8 +80,11 @@ def collector_for_figures() -> Iterator[None]:
     :func:`gc.freeze` moves the objects alive now out of the collector's reach (forked workers inherit that, and
     no longer touch those pages, which the kernel would otherwise copy), and a higher first-generation threshold
     lets fewer collections run.  What the figures leave in reference cycles is still collected.
+
+    With ``data`` and ``jobs`` >= 2 the vessel as the report shows it is found on a worker while the drawing
+    libraries are imported here (:func:`vessel_beside_imports`).
     """
-    _import_drawing_libraries()  # here, not once per forked worker, and frozen with the rest
+    vessel_beside_imports(data, jobs)  # the imports here, not once per forked worker, and frozen with the rest
     threshold = gc.get_threshold()
     gc.freeze()
     gc.set_threshold(GC_THRESHOLD, *threshold[1:])
@@ -98,3 +104,31 @@ def _import_drawing_libraries() -> None:
     import plotly.io  # noqa: F401
 
     import softdesign.report.flat_triangles  # noqa: F401
+
+
+def vessel_beside_imports(data: BuildData | None, jobs: int) -> None:
+    """Import the drawing libraries; with ``jobs`` >= 2 and a vessel surface in ``data``, find its display
+    (:attr:`BuildData.vessel_display <softdesign.report.build_folder.BuildData.vessel_display>`) on a worker
+    meanwhile, and keep it on ``data`` before the figures' workers fork.
+
+    The 3D view and the surface figure both show the decimated vessel, and each is a task of its own on the
+    figures' workers (:meth:`PartTimer.prefetch`): on two workers each decimated it (1.6 and 1.9 s of CPU on the
+    1M-triangle bench vessel), and on one it still waited for the imports, a second with a core idle.  Found
+    once, beside the imports, the figures' workers inherit it: the same numbers (the same call on the same
+    arrays).  A failure there is left to the figures, which find it again and fail as before.
+    """
+    if data is None or jobs < 2 or not len(data.ingest.faces):
+        _import_drawing_libraries()
+        return
+    with jobs_for_build(jobs), working_on("the report", "the previous report is kept"):
+        (shown,) = map_items_beside(lambda _: _vessel_display_or_none(data), [0], _import_drawing_libraries)
+    if shown is not None:
+        data.keep_vessel_display(shown)
+
+
+def _vessel_display_or_none(data: BuildData) -> tuple[Any, Any, float] | None:
+    """``data.vessel_display``, or None when finding it fails (the figures that show it then fail as before)."""
+    try:
+        return data.vessel_display
+    except Exception:  # noqa: BLE001 - raised again, the same, by the figure that asks for it
+        return None

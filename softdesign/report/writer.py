@@ -146,7 +146,7 @@ def write_report(
 def _write_report(build_dir: Path, options: ReportOptions, progress: Progress | None, jobs: int) -> ReportResult:
     timer = PartTimer(progress, jobs)
     data = timer("load the build", lambda: load_build(build_dir))
-    with collector_for_figures():
+    with collector_for_figures(data, jobs):
         sections, checks, notes = report_sections(data, options, timer)
     passed = sum(c.passed for c in checks)
     summary = _summary(data)

@@ -122,3 +122,36 @@ def test_the_holdout_folds_on_worker_processes_give_the_same_figures():
     assert pids - {os.getpid()}, "no fold ran in a worker process"
     assert result.holdout.rms_mm > 0.01 and len(result.holdout.fold_rms_mm) == HoldoutSettings().folds
     assert summaries[0] == summaries[1]
+
+
+def test_work_on_the_fitted_field_runs_in_the_holdouts_call_of_the_mapper_with_its_results_in_order():
+    """``with_field``: the fit stage's morph grid joins the hold-out's pool; its reports are those of a pool of its
+    own (fold_over_morph on the same field), in the grid's order, and every other figure is unchanged."""
+    from softdesign.fitting.morph_folds import fold_over_morph, fold_over_morph_from, morph_grid
+    from softdesign.pipeline.parallel import jobs_for_build, map_items
+
+    curve = Arc(40.0, 1.2)
+    vertices, _ = _capped_torus(curve, np.random.default_rng(3))
+    network = NetworkContext(curve.points(np.linspace(0.0, 1.0, 49)))
+    grid = np.linspace(0.0, 1.0, 9)
+    shapes = {q: Arc(40.0 / max(q, 1e-3), 1.2 * max(q, 1e-3)) for q in grid.tolist()}
+    calls: list[int] = []
+
+    def counted(task, items):
+        calls.append(len(items))
+        return map_items(task, items)
+
+    base = WallFitOptions(fit=FitSettings(breaks=(0.0, 0.5, 1.0)), initial_radius_mm=2.0, mapper=counted)
+    with jobs_for_build(2):
+        plain = fit_wall(curve, vertices, network, base, np.random.default_rng(0))
+        plain_calls = list(calls)
+        calls.clear()
+        joined = fit_wall(curve, vertices, network,
+                          WallFitOptions(**{**base.__dict__, "with_field": lambda f: morph_grid(shapes.get, f, grid)}),
+                          np.random.default_rng(0))
+        alone = fold_over_morph(shapes.get, joined.field, grid, map_items)
+    assert plain.field_results == () and len(joined.field_results) == len(grid)
+    assert len(calls) == len(plain_calls) and calls[-1] == plain_calls[-1] + len(grid)  # no call of its own
+    assert fold_over_morph_from(shapes.get, joined.field, grid, list(joined.field_results)) == alone
+    assert json.dumps(joined.summary(), sort_keys=True) == json.dumps(plain.summary(), sort_keys=True)
+    np.testing.assert_array_equal(joined.residual, plain.residual)

@@ -11,6 +11,7 @@ joint jumps, rho * kappa at q = 1).
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -21,7 +22,7 @@ from softdesign.errors import ConfigError, FitError, FoldError
 from softdesign.fitting.bspline_surface import FitSettings, fit_radius_surface
 from softdesign.fitting.local_cap import check_caps_on_path
 from softdesign.fitting.mapping import mapped_blocks
-from softdesign.fitting.morph_folds import fold_over_morph
+from softdesign.fitting.morph_folds import fold_over_morph, fold_over_morph_from, morph_grid
 from softdesign.fitting.projection import PROJECT_BLOCK, project_points
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.selection import NetworkContext, inscribed_profile
@@ -100,6 +101,9 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     fit = case.fit
     options = wall_fit_options(case, tuple(chain.breaks), map_items)  # the hold-out's folds on the build's workers
     options = replace(options, progress=step_counter("fit", FIT_STEPS))  # a bar on a terminal
+    q_grid = np.linspace(0.0, 1.0, MORPH_Q_SAMPLES)
+    if ingest.initial_surface is None:  # the body is the wall's field: its morph's grid joins the hold-out's pool
+        options = replace(options, with_field=lambda field: _morph_job(chain, field, q_grid))
     problems = check_caps_on_path(options.local_caps, curve.length)
     if problems:
         raise ConfigError(f"{problems[0]}; move or remove that entry")
@@ -123,8 +127,11 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
                                           parting_local=_parting_local(chain) if case.export.mould else None)}
     # the fitted body itself at every q of the morph's search, not only at q = 1 (issue 29)
     # its reports around the export q's curves (kinematics built them) are kept for the feasibility's per-q figures
-    morph = fold_over_morph(chain.shape.curve_at, field, np.linspace(0.0, 1.0, MORPH_Q_SAMPLES), map_items,
-                            built=chain.shape.built_curve)
+    if field is wall.field and wall.field_results:
+        reports = [_raised(r) for r in wall.field_results]
+        morph = fold_over_morph_from(chain.shape.curve_at, field, q_grid, reports, built=chain.shape.built_curve)
+    else:
+        morph = fold_over_morph(chain.shape.curve_at, field, q_grid, map_items, built=chain.shape.built_curve)
     summary["morph_fold"] = morph.as_dict()
     warning = morph.warning(chain.shape.mode)
     if warning is not None:
@@ -147,6 +154,28 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
         "distance": wall.distance,
     }
     return FitResult(field, summary, points)
+
+
+def _morph_job(chain: LinkChain, field: RadiusField, q_grid: FloatArray) -> tuple[Callable[[float], Any], list[float]]:
+    """The fitted body's morph grid (:func:`~softdesign.fitting.morph_folds.morph_grid`) as work the wall fit runs
+    in its hold-out's pool: a q whose check raises returns the error instead, raised by :func:`_raised` where the
+    morph is checked, after the fit's own checks (the same error, in the same place, as a pool of its own)."""
+    task, items = morph_grid(chain.shape.curve_at, field, q_grid)
+
+    def kept(q: float) -> Any:
+        try:
+            return task(q)
+        except Exception as err:  # noqa: BLE001 - raised again, unchanged, by _raised
+            return err
+
+    return kept, items
+
+
+def _raised(result: Any) -> Any:
+    """``result``, or raised when it is an error :func:`_morph_job` kept."""
+    if isinstance(result, Exception):
+        raise result
+    return result
 
 
 def fitted_rho(field: RadiusField, l: FloatArray, angle: FloatArray) -> FloatArray:
