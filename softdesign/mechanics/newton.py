@@ -195,14 +195,18 @@ def _residual(problem: PressureProblem, u: FloatArray, cavity_pressures: FloatAr
 
 def tangent_solver(tangent: Tangent, free: np.ndarray, solver: TangentSolver) -> Callable[[FloatArray], FloatArray]:
     """The solver ``r (3V,) -> du (3V,)`` of the Newton matrix on the free unknowns (fixed ones get 0)."""
-    matrix = sp.csc_matrix(tangent.K[free][:, free])
+    n_free = int(free.sum())
     if tangent.G.shape[0]:  # linear tetrahedra: the augmented system with one volume unknown per node
         G = sp.csr_matrix(tangent.G[:, free])
-        blocks = [[sp.csr_matrix(matrix), sp.csr_matrix(G.T)], [G, sp.csr_matrix(sp.diags(-tangent.compliance))]]
-        matrix = sp.csc_matrix(sp.bmat(blocks))
-    n_free = int(free.sum())
-    padding = np.zeros(matrix.shape[0] - n_free)
-    factors = solver.factor(matrix)
+        blocks = [[sp.csr_matrix(tangent.K[free][:, free]), sp.csr_matrix(G.T)],
+                  [G, sp.csr_matrix(sp.diags(-tangent.compliance))]]
+        factors = solver.factor(sp.csc_matrix(sp.bmat(blocks)))
+        padding = np.zeros(factors.shape[0] - n_free)
+    else:  # quadratic tetrahedra: the matrix on the free unknowns, gathered by the solver's kept plan
+        whole = sp.csr_matrix(tangent.K)
+        if not whole.has_canonical_format:
+            whole.sum_duplicates()
+        factors, padding = solver.factor_free(whole, free), np.zeros(0)
 
     def solve(r: FloatArray) -> FloatArray:
         du = np.zeros(len(free))
