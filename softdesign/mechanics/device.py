@@ -47,6 +47,9 @@ from softdesign.types import FloatArray, IntArray
 
 #: The threads' rounding floor on the residual over its estimate (:func:`roundoff_floor_mn`): a safety factor.
 FIBRE_ROUNDOFF = 10.0
+#: The tolerance of the device's load steps before the last, relative to their pressure load (the last converges to
+#: the settings' ``rtol``): the path's equilibria only start the next step (NewtonSettings.path_rtol).
+DEVICE_PATH_RTOL = 1e-4
 #: Centerline points located per batch (each batch holds an (n, E, 4) array of barycentric coordinates).
 LOCATE_BATCH = 16
 
@@ -303,7 +306,8 @@ def solve_device(device: DeviceMesh, law: HyperelasticLaw, pressures: FloatArray
     problem, ties, hoops = device_problem(device, law, thread, backbone)
     located = locate_samples(device)
     every = np.concatenate([pressures, feeds])
-    settings = replace(settings, atol=max(settings.atol, roundoff_floor_mn(problem)))
+    path_rtol = DEVICE_PATH_RTOL if settings.path_rtol is None else settings.path_rtol
+    settings = replace(settings, atol=max(settings.atol, roundoff_floor_mn(problem)), path_rtol=path_rtol)
     try:
         u, record = solve_pressures(problem, every, settings, solver=TangentSolver(), on_step=on_step)
     except SolveStopped as err:

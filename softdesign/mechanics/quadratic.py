@@ -39,6 +39,7 @@ import scipy.sparse as sp
 
 from softdesign.continuum.laws import HyperelasticLaw, isochoric_stress, isochoric_tangent
 from softdesign.mechanics.assembly import InvertedElementError
+from softdesign.mechanics.element_threads import in_parts
 from softdesign.mechanics.tets import TetMesh, node_dofs, summed
 from softdesign.types import FloatArray, IntArray
 
@@ -212,28 +213,40 @@ def quadratic_force_and_tangent(mesh: QuadraticMesh, law: HyperelasticLaw, state
     volume takes that pressure instead of ``U'(theta)`` (the mixed Newton matrix of
     :mod:`softdesign.mechanics.newton`, whose element pressures are updated by their linearization).
     """
-    E, Q = mesh.weights.shape
-    P_iso, A_iso = isochoric_tangent(law, state.F.reshape(E * Q, 3, 3))
-    dv = _volume_gradient(mesh, state)
-    forces = (np.einsum("eq,eqiJ,eqaJ->eai", mesh.weights, P_iso.reshape(E, Q, 3, 3), mesh.grads)
-              + state.pressure[:, None, None] * dv)
-    # K_(ai)(bk) = sum_q w G_aJ A_iJkL G_bL as batched products: B (EQ, 30, 9) with B_(ai)(i'J) = d_ii' G_aJ
-    B = np.einsum("eqaJ,ij->eqaijJ", mesh.grads, np.eye(3)).reshape(E * Q, 30, 9)
-    A = A_iso.reshape(E * Q, 9, 9) * mesh.weights.reshape(E * Q, 1, 1)
-    K = (B @ A @ B.transpose(0, 2, 1)).reshape(E, Q, 30, 30).sum(axis=1)
-    # geometric part of the volume: p_e sum_q w J (g_ai g_bk - g_ak g_bi), and U''/V_e dv (x) dv
-    # as one batched product M_(ai)(bk) = sum_q c_q g_ai g_bk; the second term is M with i and k swapped
+    E = len(mesh.cells)
+    forces, K = np.empty((E, 30)), np.empty((E, 30, 30))
     pressure = state.pressure if element_pressure is None else element_pressure
-    g = state.spatial_grads.reshape(E, Q, 30)
-    weighted = (mesh.weights * state.J * pressure[:, None])[:, :, None] * g
-    M = (g.transpose(0, 2, 1) @ weighted).reshape(E, 10, 3, 10, 3)
-    K += (M - M.transpose(0, 1, 4, 3, 2)).reshape(E, 30, 30)
-    flat = dv.reshape(E, 30)
-    K += (law.bulk_kpa / mesh.volumes)[:, None, None] * flat[:, :, None] * flat[:, None, :]
+    in_parts(E, lambda part: _element_forces_and_tangents(mesh, law, state, pressure, part, forces, K))
     n = mesh.dof_count
     indptr, indices, slot = mesh.stiffness_pattern
     tangent = sp.csr_matrix((summed(slot, K, len(indices)), indices, indptr), shape=(n, n))
-    return summed(cell_dofs(mesh.cells), forces.reshape(E, 30), n), tangent
+    return summed(cell_dofs(mesh.cells), forces, n), tangent
+
+
+def _element_forces_and_tangents(mesh: QuadraticMesh, law: HyperelasticLaw, state: QuadraticState,
+                                 pressure: FloatArray, part: slice, forces: FloatArray, K: FloatArray) -> None:
+    """The elements ``part``'s forces into ``forces[part]`` (e, 30) mN and tangents into ``K[part]`` (e, 30, 30)
+    mN/mm; ``pressure`` (E,) kPa: the geometric part's element pressures."""
+    grads, weights, volumes = mesh.grads[part], mesh.weights[part], mesh.volumes[part]
+    F, J, g4 = state.F[part], state.J[part], state.spatial_grads[part]
+    E, Q = weights.shape
+    P_iso, A_iso = isochoric_tangent(law, F.reshape(E * Q, 3, 3))
+    dv = np.einsum("eq,eqai->eai", weights * J, g4)
+    forces[part] = (np.einsum("eq,eqiJ,eqaJ->eai", weights, P_iso.reshape(E, Q, 3, 3), grads)
+                    + state.pressure[part, None, None] * dv).reshape(E, 30)
+    # K_(ai)(bk) = sum_q w G_aJ A_iJkL G_bL as batched products: B (EQ, 30, 9) with B_(ai)(i'J) = d_ii' G_aJ
+    B = np.einsum("eqaJ,ij->eqaijJ", grads, np.eye(3)).reshape(E * Q, 30, 9)
+    A = A_iso.reshape(E * Q, 9, 9) * weights.reshape(E * Q, 1, 1)
+    Ke = (B @ A @ B.transpose(0, 2, 1)).reshape(E, Q, 30, 30).sum(axis=1)
+    # geometric part of the volume: p_e sum_q w J (g_ai g_bk - g_ak g_bi), and U''/V_e dv (x) dv
+    # as one batched product M_(ai)(bk) = sum_q c_q g_ai g_bk; the second term is M with i and k swapped
+    g = g4.reshape(E, Q, 30)
+    weighted = (weights * J * pressure[part, None])[:, :, None] * g
+    M = (g.transpose(0, 2, 1) @ weighted).reshape(E, 10, 3, 10, 3)
+    Ke += (M - M.transpose(0, 1, 4, 3, 2)).reshape(E, 30, 30)
+    flat = dv.reshape(E, 30)
+    Ke += (law.bulk_kpa / volumes)[:, None, None] * flat[:, :, None] * flat[:, None, :]
+    K[part] = Ke
 
 
 def linearized_pressure(mesh: QuadraticMesh, law: HyperelasticLaw, state: QuadraticState, step: FloatArray

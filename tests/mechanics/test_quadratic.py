@@ -109,3 +109,22 @@ def test_the_mixed_tangent_takes_the_given_element_pressures() -> None:
     difference = other - exact
     assert abs(difference).max() > 0.0
     assert abs(difference - difference.T).max() <= 1e-9 * abs(difference).max()  # p sum w J (g g - g g): symmetric
+
+
+def test_the_tangent_is_the_same_bit_for_bit_in_one_thread_or_several(monkeypatch: pytest.MonkeyPatch) -> None:
+    # the element loop split over threads (softdesign.mechanics.element_threads) changes the time, not the answer
+    import softdesign.mechanics.element_threads as threads
+
+    points, tets = quarter_tube(2.0, 3.0, 1.0, (4, 5, 4))
+    mesh = quadratic_mesh(make_tet_mesh(points, tets))
+    u = 0.01 * np.random.default_rng(11).standard_normal(mesh.points.shape)
+    state = quadratic_state(mesh, LAW, u)
+    monkeypatch.setattr(threads, "_cores", lambda: 1)
+    f1, K1 = quadratic_force_and_tangent(mesh, LAW, state)
+    monkeypatch.setattr(threads, "_cores", lambda: 3)
+    monkeypatch.setattr(threads, "MIN_PART_ELEMENTS", 7)  # three uneven parts of this small mesh
+    assert len(mesh.cells) // threads.MIN_PART_ELEMENTS >= 3
+    f3, K3 = quadratic_force_and_tangent(mesh, LAW, state)
+    assert np.array_equal(f1, f3)
+    assert np.array_equal(K1.indptr, K3.indptr) and np.array_equal(K1.indices, K3.indices)
+    assert np.array_equal(K1.data, K3.data)

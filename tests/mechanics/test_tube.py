@@ -12,7 +12,13 @@ import pytest
 from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.errors import SolveError
 from softdesign.mechanics.continuation import ContinuationSettings, follow_pressures
-from softdesign.mechanics.newton import NewtonSettings, PressureProblem, pressure_sensitivity, solve_pressures
+from softdesign.mechanics.newton import (
+    NewtonSettings,
+    PressureProblem,
+    pressure_forces,
+    pressure_sensitivity,
+    solve_pressures,
+)
 from softdesign.mechanics.quadratic import quadratic_faces, quadratic_fixed, quadratic_mesh
 from softdesign.mechanics.tets import boundary_faces, make_tet_mesh
 from tests.helpers.fe_meshes import quarter_tube
@@ -120,3 +126,17 @@ def test_a_path_that_cannot_step_says_the_largest_load_it_reached() -> None:
     assert path.status == "stopped" and path.load_factor == 0.0
     assert "stopped at 0 kPa (load factor 0, the largest it reached towards 20 kPa)" in path.stopped_because(
         np.array([20.0]))
+
+
+def test_a_looser_path_ends_on_the_same_equilibrium_with_its_last_step_converged_in_full() -> None:
+    # NewtonSettings.path_rtol loosens only the steps before the last (a hyperelastic equilibrium does not depend on
+    # the path): the end is the fully converged solve's, to the last step's tolerance
+    _, problem = _problem(DEFAULT_COUNTS)
+    full, full_record = solve_pressures(problem, np.array([20.0]), NewtonSettings(load_steps=4))
+    loose, loose_record = solve_pressures(problem, np.array([20.0]), NewtonSettings(load_steps=4, path_rtol=1e-3))
+    assert loose_record.load_factors[-1] == 1.0
+    load, _ = pressure_forces(problem, problem.mesh.points + loose, np.array([20.0]), False)
+    assert loose_record.residuals[-1][-1] <= 1e-8 * np.linalg.norm(load[~problem.fixed])  # the last step to rtol
+    assert max(h[-1] for h in loose_record.residuals[:-1]) > max(h[-1] for h in full_record.residuals[:-1])
+    assert sum(loose_record.iterations) < sum(full_record.iterations)
+    assert np.abs(loose - full).max() < 1e-6 * np.abs(full).max()

@@ -46,7 +46,9 @@ if TYPE_CHECKING:  # only annotations: the report loads stage results without th
 #: 6: the torsion reported where the curvature is at least a fifth of its largest (TORSION_REL_FLOOR), not noise.
 #: 7: ``blend: pcc`` keeps its sections' joints: each section splined on its own, every break a sample.
 #: 8: ``blend: auto`` judges the fitted body over the morph, not only the inscribed radius (``body_morph``).
-VERSION = 8
+#: 9: ``blend: pcc`` keeps the samples its target curve was built from (it kept that curve's own points, which
+#:    differ by round-off, so a loaded blend was not the one built and later stages wrote other bytes).
+VERSION = 9
 
 
 @dataclass(frozen=True)
@@ -67,10 +69,13 @@ def run_blend(case: Case, ingest: IngestResult, design: DesignResult | None = No
     if case.blend == "pcc":
         if design is None:  # the case file's check refuses blend: pcc without a design: block
             raise RuntimeError("blend: pcc without a design")
-        final = smooth_curve_from_samples(final.points(final.l_grid))  # as the design stage and load_blend build it
+        # as the design stage and load_blend build it: from the samples kept (the rebuilt curve's own points differ
+        # from them by round-off, and a blend loaded from the folder must be this one, bit for bit)
+        kept = final.points(final.l_grid)
+        final = smooth_curve_from_samples(kept)
         shape = pcc_shape(final, design, case.frames)
         figures = pcc_choice(shape, ingest.path, design.document)
-        return BlendResult(shape, {**_summary(case, shape), **figures}, (final.points(final.l_grid),))
+        return BlendResult(shape, {**_summary(case, shape), **figures}, (kept,))
     same_grid = curve_options(case, count=len(final.l_grid))
     spec = InitialSpec(
         kind=case.initial.kind,
