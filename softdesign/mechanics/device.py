@@ -27,6 +27,7 @@ Assumptions
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 
@@ -50,6 +51,12 @@ FIBRE_ROUNDOFF = 10.0
 #: The tolerance of the device's load steps before the last, relative to their pressure load (the last converges to
 #: the settings' ``rtol``): the path's equilibria only start the next step (NewtonSettings.path_rtol).
 DEVICE_PATH_RTOL = 1e-4
+#: The first load step's largest pressure, in shear moduli of the silicone.  From rest Newton's first iterate is the
+#: linear answer, good for strains of about a tenth; past that the first step fails and is halved, each failure
+#: costing up to ``max_iterations`` factorizations.  Measured on the sample single-supply device from rest: steps
+#: of 0.07 and 0.09 mu converged (9 and 10 iterations), 0.14 and 0.18 mu failed after 12 (at P*, four halvings
+#: from the default first step, 1/8 of 11.3 mu: 23 factorizations, 7 % of the solve).
+FIRST_STEP_MU = 0.1
 #: Centerline points located per batch (each batch holds an (n, E, 4) array of barycentric coordinates).
 LOCATE_BATCH = 16
 
@@ -276,6 +283,13 @@ class DeviceSolve:
     stopped_because: str = ""  #: why it stopped short ("" when it reached the pressures)
 
 
+def first_steps(load_steps: int, largest_kpa: float, mu_kpa: float) -> int:
+    """``load_steps``, or more (a power of two) so that the first step's largest pressure is at most FIRST_STEP_MU
+    shear moduli; a converged easy step doubles the next (:func:`~softdesign.mechanics.newton.solve_pressures`)."""
+    needed = largest_kpa / (FIRST_STEP_MU * mu_kpa)
+    return max(load_steps, 2 ** math.ceil(math.log2(needed)) if needed > 1.0 else 1)
+
+
 def solve_device(device: DeviceMesh, law: HyperelasticLaw, pressures: FloatArray, settings: NewtonSettings,
                  thread: HoopThread | None = None, feed_pressures: FloatArray | None = None,
                  on_step: Callable[[float, list[float]], None] | None = None,
@@ -283,10 +297,12 @@ def solve_device(device: DeviceMesh, law: HyperelasticLaw, pressures: FloatArray
     """The device at chamber ``pressures`` (k,) kPa (feeds at ``feed_pressures`` (m,); None: their chambers').
 
     The pressures grow in load steps (:func:`~softdesign.mechanics.newton.solve_pressures`, ``settings``'
-    steps and halvings), not in the cavities' volume (:mod:`~softdesign.mechanics.continuation`): a reinforced
-    chamber's volume barely grows with its pressure, and a volume step asked for 8.5 kPa on the demo's device
-    landed at 67-176 kPa.  ``on_step`` is told of every converged step (load factor, residuals); ``backbone``:
-    the thread along the axis (``backbone: inextensible``), None: none.  ``keep_stop``: a solve that stops short
+    steps and halvings, the first at most FIRST_STEP_MU shear moduli: :func:`first_steps`; the steps before the
+    last converged to DEVICE_PATH_RTOL), not in the cavities' volume
+    (:mod:`~softdesign.mechanics.continuation`): a reinforced chamber's volume barely grows with its pressure,
+    and a volume step asked for 8.5 kPa on the demo's device landed at 67-176 kPa.  ``on_step`` is told of
+    every converged step (load factor, residuals); ``backbone``: the thread along the axis (``backbone:
+    inextensible``), None: none.  ``keep_stop``: a solve that stops short
     returns its last equilibrium (``load_factor`` below 1, its pressures, ``stopped_because``) instead of
     raising, so that its figures at the largest load it held can be reported.
 
@@ -307,7 +323,8 @@ def solve_device(device: DeviceMesh, law: HyperelasticLaw, pressures: FloatArray
     located = locate_samples(device)
     every = np.concatenate([pressures, feeds])
     path_rtol = DEVICE_PATH_RTOL if settings.path_rtol is None else settings.path_rtol
-    settings = replace(settings, atol=max(settings.atol, roundoff_floor_mn(problem)), path_rtol=path_rtol)
+    settings = replace(settings, atol=max(settings.atol, roundoff_floor_mn(problem)), path_rtol=path_rtol,
+                       load_steps=first_steps(settings.load_steps, float(np.abs(every).max()), law.mu_kpa))
     try:
         u, record = solve_pressures(problem, every, settings, solver=TangentSolver(), on_step=on_step)
     except SolveStopped as err:
