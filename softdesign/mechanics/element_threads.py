@@ -30,7 +30,9 @@ def _cores() -> int:
 
 
 @cache
-def _pool(threads: int) -> ThreadPoolExecutor:
+def _pool(threads: int, pid: int) -> ThreadPoolExecutor:
+    """The threads of process ``pid``: a forked child has none of its parent's threads, and a pool copied with a
+    lock held at the fork would never run its work; the child makes its own."""
     return ThreadPoolExecutor(max_workers=threads, thread_name_prefix="softdesign-elements")
 
 
@@ -43,6 +45,7 @@ def in_parts(count: int, work: Callable[[slice], None]) -> None:
         work(slice(0, count))
         return
     bounds = [count * k // threads for k in range(threads + 1)]
-    futures = [_pool(threads).submit(work, slice(lo, hi)) for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)]
+    pool = _pool(threads, os.getpid())
+    futures = [pool.submit(work, slice(lo, hi)) for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)]
     for future in futures:
         future.result()
