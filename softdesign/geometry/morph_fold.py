@@ -39,6 +39,13 @@ from softdesign.types import FloatArray
 
 #: q samples of the sweep (then a bounded refinement around the worst).
 MORPH_Q_SAMPLES = 41
+
+
+def morph_q_grid() -> FloatArray:
+    """The sweep's q values (MORPH_Q_SAMPLES,): ``i / (n - 1)``, each a correctly rounded quotient, so an export q
+    ``j / (m - 1)`` (``export.frames``) on the same rational is the same double and its curves, built once by the
+    kinematics, are found again (``np.linspace``'s ``i * step`` differs in the last bit for 15 of 41 values)."""
+    return np.arange(MORPH_Q_SAMPLES) / (MORPH_Q_SAMPLES - 1)
 #: The reach r * kappa, with r the inscribed radius, at which a shape is taken to fold.  The wall's
 #: rho exceeds r on an elliptical section (on the VMTK aorta, up to 1.8 r at the inlet), so a
 #: reach of 0.8 of the inscribed radius already leaves rho * kappa little room below 1.
@@ -103,7 +110,7 @@ def morph_reach(shape: BlendedShape, radius_l: npt.ArrayLike, radius_mm: npt.Arr
     def reach_at(q: float) -> float:
         return float(np.max(radius * shape.smooth_curve_at(q).curvature(l)))
 
-    grid = np.linspace(0.0, 1.0, MORPH_Q_SAMPLES)
+    grid = morph_q_grid()
     values = np.array([reach_at(q) for q in grid])
     best = int(np.argmax(values))
     q_max = float(grid[best])

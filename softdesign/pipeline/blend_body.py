@@ -26,7 +26,7 @@ from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.selection import NetworkContext, inscribed_profile
 from softdesign.fitting.wall_fit import fit_body
 from softdesign.geometry.blend import BlendedShape
-from softdesign.geometry.morph_fold import MORPH_Q_SAMPLES
+from softdesign.geometry.morph_fold import morph_q_grid
 from softdesign.kinematics.links import link_breaks
 from softdesign.pipeline.fit_options import AUTO_START_SPACING_MM, wall_fit_options
 from softdesign.pipeline.item_progress import step_counter
@@ -74,7 +74,7 @@ def body_morph(shape: BlendedShape, field: RadiusField) -> MorphFold:
     # worker as here: the blend's shape is rebuilt after, so no later stage finds the curves built here either);
     # on a busy machine (load 5) the workers waited on the other jobs and took longer, on free cores they halve
     # the stage's largest step
-    return fold_over_morph(shape.curve_at, field, np.linspace(0.0, 1.0, MORPH_Q_SAMPLES), map_items)
+    return fold_over_morph(shape.curve_at, field, morph_q_grid(), map_items)
 
 
 def body_folds(fold: MorphFold) -> bool:

@@ -47,7 +47,8 @@ if TYPE_CHECKING:  # only annotations: the report loads stage results without th
 #: 7: ``blend: pcc`` keeps its sections' joints: each section splined on its own, every break a sample.
 #: 8: ``blend: auto`` judges the fitted body over the morph, not only the inscribed radius (``body_morph``).
 #: 9: ``blend: pcc`` keeps the samples its target curve was built from (it kept that curve's own points, which
-#:    differ by round-off, so a loaded blend was not the one built and later stages wrote other bytes).
+#:    differ by round-off, so a loaded blend was not the one built and later stages wrote other bytes); the
+#:    body's morph check on the q grid i / 40 (morph_q_grid: the last bit of 15 of its 41 q).
 VERSION = 9
 
 

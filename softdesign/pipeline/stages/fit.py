@@ -29,7 +29,7 @@ from softdesign.fitting.selection import NetworkContext, inscribed_profile
 from softdesign.fitting.wall_fit import FIT_STEPS, fit_wall
 from softdesign.geometry.curves import SmoothCurve, measure_deviation
 from softdesign.geometry.end_cut import choose_end_cuts
-from softdesign.geometry.morph_fold import MORPH_Q_SAMPLES
+from softdesign.geometry.morph_fold import morph_q_grid
 from softdesign.geometry.network import SelectedPath
 from softdesign.kinematics.links import LinkChain
 from softdesign.meshing.mould.frame import parting_frame
@@ -49,7 +49,7 @@ from softdesign.types import FloatArray
 if TYPE_CHECKING:  # only annotations: the report loads stage results without the case file's models
     from softdesign.config import Case
 
-VERSION = 10  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
+VERSION = 11  # 2: flat-cap points and too-small rho excluded; hold-out sampled above 200k points
 # 3: points fitted in path order; distances sampled above 200k points (max still over all)
 # 4: end prior and end radii (issue 20); true distances on the regularized backbone's stretches (``backbone``)
 # 5: each end's cut plane in the end frame (``end_cut``, issue 20)
@@ -59,6 +59,7 @@ VERSION = 10  # 2: flat-cap points and too-small rho excluded; hold-out sampled 
 # 9: fit.local_max_radius, and the all-wall figures outside its stretches (issue 43)
 # 10: above 200k kept points the spline is fitted to an even subset, and the all-wall figures are sampled by
 #     stratum from the kept points' distances (issue 46); fewer points fit and measure as before
+# 11: the morph's q grid i / 40 (morph_q_grid), so the export q's curves and fold reports are reused, not rebuilt
 #: Seed of the hold-out folds: the same case always gets the same folds.
 HOLDOUT_SEED = 4
 #: A failed fit is blamed on the centerline when the smoothed one strays from the input by this fraction of the
@@ -101,7 +102,7 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     fit = case.fit
     options = wall_fit_options(case, tuple(chain.breaks), map_items)  # the hold-out's folds on the build's workers
     options = replace(options, progress=step_counter("fit", FIT_STEPS))  # a bar on a terminal
-    q_grid = np.linspace(0.0, 1.0, MORPH_Q_SAMPLES)
+    q_grid = morph_q_grid()
     if ingest.initial_surface is None:  # the body is the wall's field: its morph's grid joins the hold-out's pool
         options = replace(options, with_field=lambda field: _morph_job(chain, field, q_grid))
     problems = check_caps_on_path(options.local_caps, curve.length)
