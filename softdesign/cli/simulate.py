@@ -169,6 +169,11 @@ def simulate(
             write_bytes_atomically(figure, simulate_figure_png(result))
         emit_json(result) if as_json else _print(result)
         if "target" in result and not result["target"]["converged"]:
+            found = result["target"]
+            reach = ("out of the section's reach: its best within the bounds" if found.get("best_within_bounds")
+                     else "the search stopped short")
+            note(f"simulate --target {target:g}: not within tolerance ({reach}, error "
+                 f"{math.hypot(*found['error_mm']):.4g} mm)")
             raise typer.Exit(code=1)
 
     run_guarded(action)

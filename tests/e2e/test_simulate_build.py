@@ -58,3 +58,17 @@ def test_a_case_without_chambers_is_refused(tmp_path: Path) -> None:
     result = runner.invoke(app, ["simulate", str(case), "--out", str(tmp_path / "build"), "--pressures", "10,0,0"])
     assert result.exit_code == 2
     assert "no actuation chambers" in result.output
+
+
+def test_a_target_out_of_reach_within_the_bound_is_said_so_and_exits_1(tmp_path: Path) -> None:
+    # q = 1 asks a bend the rod model gives at hundreds of kPa; within a bound of 1 kPa the search stops at its best,
+    # with the chamber the bound holds, and the command exits 1 (not within tolerance) with its figures
+    case = demo_case(tmp_path, actuation=True)
+    result = runner.invoke(app, ["simulate", str(case), "--out", str(tmp_path / "build"), "--section", "1",
+                                 "--target", "1", "--max-pressure", "1", "--size-mm", "4", "--layer-mm", "10",
+                                 "--timeout", "1800", "--json"])
+    assert result.exit_code == 1, result.output
+    found = json.loads(result.stdout)["target"]
+    assert not found["converged"] and found["best_within_bounds"]
+    assert "at the pressure bound 1 kPa" in found["how"]
+    assert "not within tolerance (out of the section's reach: its best within the bounds" in result.stderr
