@@ -61,9 +61,11 @@ def test_a_search_that_stopped_short_is_missed_however_fast(bench) -> None:
     assert not ok and "(not converged)" in text and text.endswith("MISSED")
 
 
-def test_the_reachable_q_puts_the_rod_models_largest_pressure_at_a_quarter_of_the_bound(bench, tmp_path) -> None:
-    rows = ["q,section,chamber,pressure_kpa", "1.0,1,1,0.0", "1.0,1,2,1089.75", "1.0,1,3,263.5",
-            "1.0,2,1,5000.0", "0.5,1,2,556.0"]  # another section's and another q's rows are not read
-    (tmp_path / "actuation.csv").write_text("\n".join(rows) + "\n", encoding="utf-8")
-    assert bench.REACH_SHARE == 0.25 and bench.MAX_PRESSURE_KPA == 100.0
-    assert bench.reachable_q(tmp_path) == 0.0229  # 25 / 1089.75 = 0.02294, three digits
+def test_a_round_trip_says_how_close_the_pressures_come_back_and_hands_on_every_digit_of_the_arc(bench) -> None:
+    found = payload() | {"pressures_kpa": [19.98, 0.004, 0.0]}
+    text, ok = bench.line("demo", "--target-arc", 60.0, 40.0, found, "", reachable=True, expected_kpa="20,0,0")
+    assert ok and "pressures back within 0.02 kPa of 20,0,0" in text
+    arc = {"arc": {"kappa_per_mm": 0.0012345678901234, "phi_rad": 0.5, "length_mm": 26.123456789012345}}
+    kappa, phi, length = (float(v) for v in bench.arc_text(arc).split(","))
+    assert kappa == 0.0012345678901234 and length == 26.123456789012345
+    assert abs(phi - 28.64788975654116) < 1e-12  # 0.5 rad in degrees
