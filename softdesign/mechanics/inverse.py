@@ -57,15 +57,17 @@ Cost
     (a start at a tenth of the bound, two load steps of 5-7 iterations a trial,
     six halvings for a trial without equilibrium): on the VMTK aorta's section 1
     at q = 1, three trials in 378 s wall (182 s CPU, load 8), one of them 266 s.
-    Round 4 (the command's ``--target 1``, section 1, in-process, load 2-4):
-    the demo's search started at 10 kPa in every chamber took 4 trials and 84
-    factorizations, 126 s of CPU (the first trial, from rest, 38 of them);
-    from the linear answer, stopped at its best within 100 kPa (chamber 2 on
-    the bound), 4 trials and 48, 57 s, the same error to 1e-3 mm (12.90 mm).
-    The aorta's: 4 trials, 66 factorizations, 184 s, against 1 trial and 51,
-    126 s (1.260 mm).  Either way most of it is the path from rest to the
-    bound: a first load step from rest takes 10-12 Newton iterations, every
-    later one 5-6, whatever its length.
+    Round 4, section 1, ``--target 1`` (out of reach at 100 kPa): the demo's
+    search started at 10 kPa in every chamber took 4 trials and 84
+    factorizations, 126 s of CPU in-process (the first trial, from rest, 38 of
+    them), the command 132 s wall; from the linear answer within its first
+    step, stopped at its best within the bounds (chamber 2 on the 100 kPa
+    bound), 4 trials and 45 factorizations, the command 55.8 s wall (55.3 s
+    CPU, load 2.5), the same error (12.90 mm).  The aorta's: 184 s of CPU
+    in-process before, the command 109 s wall after (1.260 mm, chamber 1 on
+    the bound).  Most of it is the path from rest to the bound: a first load
+    step from rest takes 10-12 Newton iterations, every later one 5-6,
+    whatever its length (rest to 25 kPa: 23 factorizations of the 45).
 """
 
 from __future__ import annotations
@@ -377,6 +379,7 @@ def find_pressures(section: SectionMesh, law: HyperelasticLaw, target: tuple[flo
     except _Reached as reached:
         p, message = reached.args[0], "the error is below the tolerance"
     except _Stationary as stop:
+        runs.polish(stop.pressures)  # the message's figures are the answer's
         p, best, message = stop.pressures, True, _best_within_bounds(runs, stop, target)
     except _TimeUp:
         p = runs.best()
