@@ -63,9 +63,10 @@ Cost
     them), the command 132 s wall; from the linear answer within its first
     step, stopped at its best within the bounds (chamber 2 on the 100 kPa
     bound), 4 trials and 45 factorizations, the command 55.8 s wall (55.3 s
-    CPU, load 2.5), the same error (12.90 mm).  The aorta's: 184 s of CPU
-    in-process before, the command 109 s wall after (1.260 mm, chamber 1 on
-    the bound).  Most of it is the path from rest to the bound: a first load
+    CPU, load 2.5) and 65.9 s in a later run (load 1: the machine's own speed
+    swings, its forward line 45.7 and 50.1 s alike), the same error (12.90
+    mm).  The aorta's: 184 s of CPU in-process before, the command 109-123 s
+    wall after (1.260 mm, chamber 1 on the bound).  Most of it is the path from rest to the bound: a first load
     step from rest takes 10-12 Newton iterations, every later one 5-6,
     whatever its length (rest to 25 kPa: 23 factorizations of the 45).
 """
