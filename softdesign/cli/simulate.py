@@ -33,6 +33,10 @@ FeedPressuresOpt = Annotated[str | None, typer.Option(
     "cavities with these pressures in kPa (one per feed, comma-separated); without it they are meshed solid.")]
 TargetOpt = Annotated[float | None, typer.Option(
     "--target", help="Find the pressures whose section best matches the designed arc at this q.")]
+TargetArcOpt = Annotated[str | None, typer.Option(
+    "--target-arc", help="Find the pressures whose section best matches this arc rather than a designed one: "
+    "KAPPA,PHI,L (1/mm, degrees, mm), as --json's arc gives them (phi in degrees), e.g. a forward solve's to "
+    "search back. Otherwise as --target.")]
 SizeOpt = Annotated[float, typer.Option("--size-mm", help="Element size in the cross-section, mm.")]
 LayerOpt = Annotated[float, typer.Option("--layer-mm", help="Layer spacing along the section, mm.")]
 TimeoutOpt = Annotated[float, typer.Option("--timeout", help="Longest time the solve may take, s.")]
@@ -56,6 +60,16 @@ def pressures_from_text(text: str) -> tuple[float, ...]:
     if len(parts) != 3:
         raise ConfigError(f"--pressures: got {len(parts)} values in {text!r}, expected 3; {PRESSURES_FIX}")
     return tuple(finite_number(p, f"--pressures value {k + 1}", PRESSURES_FIX) for k, p in enumerate(parts))
+
+
+def arc_from_text(text: str) -> tuple[float, float, float]:
+    """``--target-arc`` as (kappa 1/mm, phi rad, L mm) from three finite numbers (ConfigError naming the bad one)."""
+    fix = "give the curvature (1/mm), the bend's direction (degrees) and the length (mm), e.g. --target-arc 0.004,30,26"
+    parts = text.split(",")
+    if len(parts) != 3:
+        raise ConfigError(f"--target-arc: got {len(parts)} values in {text!r}, expected 3; {fix}")
+    kappa, phi, length = (finite_number(p, f"--target-arc value {k + 1}", fix) for k, p in enumerate(parts))
+    return kappa, math.radians(phi), length
 
 
 def feed_pressures_from_text(text: str) -> tuple[float, ...]:
@@ -101,7 +115,8 @@ def _print(payload: dict[str, Any]) -> None:
                    f"{step['residuals_mN'][-1]:.2e} mN")
     if "target" in payload:
         t = payload["target"]
-        typer.echo(f"target q={t['q']:g}: error mm {', '.join(f'{e:.4f}' for e in t['error_mm'])} "
+        asked = "the arc given" if t["q"] is None else f"q={t['q']:g}"
+        typer.echo(f"target {asked}: error mm {', '.join(f'{e:.4f}' for e in t['error_mm'])} "
                    f"({'converged' if t['converged'] else 'NOT converged'}: {t['how']})")
     typer.echo("leaves out: " + "; ".join(payload["leaves_out"]))
     if "written" in payload:
@@ -114,6 +129,7 @@ def simulate(
     pressures: PressuresOpt = None,
     feed_pressures: FeedPressuresOpt = None,
     target: TargetOpt = None,
+    target_arc: TargetArcOpt = None,
     out: OutOpt = None,
     size_mm: SizeOpt = 3.0,
     layer_mm: LayerOpt = 8.0,
@@ -140,9 +156,10 @@ def simulate(
 
     def action() -> None:
         if whole or q is not None or pressure is not None:
-            if not whole or pressures is not None or target is not None or write or figure is not None:
+            if (not whole or pressures is not None or target is not None or target_arc is not None or write
+                    or figure is not None):
                 raise ConfigError("simulate: --q and --pressure go with --all (the whole device), and --all takes "
-                                  "neither --pressures, --target, --write nor --figure")
+                                  "neither --pressures, --target, --target-arc, --write nor --figure")
             payload = run_all(case_file, out, q, pressure, size_mm, layer_mm, timeout, as_json, note)
             if payload["reached"] is not None:  # the figures are printed; the solve did not reach its load
                 note(f"simulate --all: {payload['reached']['stopped_because']}")
@@ -157,8 +174,10 @@ def simulate(
                               "actuation.csv numbers them")
         values = None if pressures is None else pressures_from_text(pressures)
         feeds = None if feed_pressures is None else feed_pressures_from_text(feed_pressures)
-        shown = target is not None and not as_json and sys.stderr.isatty()
+        arc = None if target_arc is None else arc_from_text(target_arc)
+        shown = (target is not None or arc is not None) and not as_json and sys.stderr.isatty()
         options = SimulateOptions(section - 1, values, target, size_mm, layer_mm, max_pressure_kpa=max_pressure,
+                                  target_arc=arc,
                                   timeout_s=timeout, time_limit_s=time_limit,
                                   trial_progress=TrialProgress() if shown else None, feed_pressures_kpa=feeds)
         result = (write_to_table if write else run_simulate)(case_file, out, options, note)
@@ -169,6 +188,12 @@ def simulate(
             write_bytes_atomically(figure, simulate_figure_png(result))
         emit_json(result) if as_json else _print(result)
         if "target" in result and not result["target"]["converged"]:
+            found = result["target"]
+            reach = ("out of the section's reach: its best within the bounds" if found.get("best_within_bounds")
+                     else "the search stopped short")
+            asked = "--target-arc" if target is None else f"--target {target:g}"
+            note(f"simulate {asked}: not within tolerance ({reach}, error "
+                 f"{math.hypot(*found['error_mm']):.4g} mm)")
             raise typer.Exit(code=1)
 
     run_guarded(action)

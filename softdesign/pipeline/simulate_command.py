@@ -51,6 +51,8 @@ def run_simulate(case_file: Path, out: Path | None, o: SimulateOptions, progress
     if o.target_q is not None:
         arc = fit_links(outcome.results["kinematics"].chain, o.target_q, ARC_SAMPLES)[o.section]
         target = (arc.kappa, arc.phi, arc.length)
+    elif o.target_arc is not None:
+        target = o.target_arc
     what = f"the finite-element solve of section {o.section + 1} ({len(section.points)} nodes)"
     fix = "raise --size-mm or --layer-mm, lower the pressures, or raise --timeout"
     try:

@@ -15,7 +15,8 @@ runner = CliRunner()
 def test_help_names_the_options() -> None:
     result = runner.invoke(app, ["simulate", "--help"])
     assert result.exit_code == 0
-    for option in ("--section", "--pressures", "--feed-pressures", "--target", "--json", "--timeout", "--time-limit"):
+    for option in ("--section", "--pressures", "--feed-pressures", "--target", "--target-arc", "--json", "--timeout",
+                   "--time-limit"):
         assert option in result.output
 
 
@@ -24,8 +25,13 @@ def test_help_names_the_options() -> None:
     (["--pressures", "10,x,0"], "is not a number"),
     (["--pressures", "10,2000,0"], "expected a number in [0, 1000]"),
     (["--pressures", "-1,0,0"], "expected a number in [0, 1000]"),
-    (["--pressures", "10,0,0", "--target", "1"], "not both or neither"),
-    ([], "not both or neither"),
+    (["--pressures", "10,0,0", "--target", "1"], "not several, not none"),
+    ([], "not several, not none"),
+    (["--target", "1", "--target-arc", "0.01,0,20"], "not several, not none"),
+    (["--target-arc", "0.01,0"], "--target-arc: got 2 values"),
+    (["--target-arc", "0.01,x,20"], "--target-arc value 2: 'x' is not a number"),
+    (["--target-arc", "-0.01,0,20"], "--target-arc curvature (1/mm): got -0.01"),
+    (["--target-arc", "0.01,0,0"], "--target-arc length (mm): got 0"),
     (["--target", "1.5"], "--target: got 1.5"),
     (["--pressures", "10,0,0", "--size-mm", "0"], "--size-mm: got 0"),
     (["--pressures", "10,0,0", "--timeout", "1e9"], "--timeout"),

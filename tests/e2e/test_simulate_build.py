@@ -58,3 +58,48 @@ def test_a_case_without_chambers_is_refused(tmp_path: Path) -> None:
     result = runner.invoke(app, ["simulate", str(case), "--out", str(tmp_path / "build"), "--pressures", "10,0,0"])
     assert result.exit_code == 2
     assert "no actuation chambers" in result.output
+
+
+def test_a_target_out_of_reach_within_the_bound_is_said_so_and_exits_1(tmp_path: Path) -> None:
+    # q = 1 asks a bend the rod model gives at hundreds of kPa; within a bound of 1 kPa the search stops at its best,
+    # with the chamber the bound holds, and the command exits 1 (not within tolerance) with its figures
+    case = demo_case(tmp_path, actuation=True)
+    result = runner.invoke(app, ["simulate", str(case), "--out", str(tmp_path / "build"), "--section", "1",
+                                 "--target", "1", "--max-pressure", "1", "--size-mm", "4", "--layer-mm", "10",
+                                 "--timeout", "1800", "--json"])
+    assert result.exit_code == 1, result.output
+    found = json.loads(result.stdout)["target"]
+    assert not found["converged"] and found["best_within_bounds"]
+    assert "at the pressure bound 1 kPa" in found["how"]
+    assert "not within tolerance (out of the section's reach: its best within the bounds" in result.stderr
+
+
+#: The command's tolerance on the weighted arc error, mm (simulate_run.solve_in_child).
+SEARCH_TOLERANCE_MM = 1e-3
+#: A converged search is within SEARCH_TOLERANCE_MM of the target's error (0), so to first order its pressures are
+#: within SEARCH_TOLERANCE_MM / sigma_min of the forward solve's, sigma_min the weighted Jacobian's smallest singular
+#: value (the payload's "how" gives them: the common pressure lengthens the section little and is least determined);
+#: this share on top allows for the second order (measured: (5.165, 0.155, 0.162) kPa, 0.165 kPa off along the common
+#: pressure, against 1e-3 / 0.00349 = 0.29 kPa).
+ROUND_TRIP_MARGIN = 0.5
+
+
+def test_a_forward_solves_arc_searched_back_with_target_arc_gives_its_pressures_again(tmp_path: Path) -> None:
+    import re
+
+    case = demo_case(tmp_path, actuation=True)
+    common = [str(case), "--out", str(tmp_path / "build"), "--section", "1", "--size-mm", "4", "--layer-mm", "10",
+              "--timeout", "1800", "--json"]
+    forward = runner.invoke(app, ["simulate", *common, "--pressures", "5,0,0"])
+    assert forward.exit_code == 0, forward.output
+    arc = json.loads(forward.stdout)["arc"]
+    text = f"{arc['kappa_per_mm']!r},{math.degrees(arc['phi_rad'])!r},{arc['length_mm']!r}"
+    back = runner.invoke(app, ["simulate", *common, "--target-arc", text])
+    assert back.exit_code == 0, back.output
+    found = json.loads(back.stdout)
+    assert found["target"]["converged"] and found["target"]["q"] is None
+    values = re.search(r"singular values ([0-9.e, -]+) mm/kPa", found["target"]["how"])
+    assert values is not None, found["target"]["how"]
+    sigma_min = min(float(v) for v in values.group(1).split(","))
+    off = max(abs(p - e) for p, e in zip(found["pressures_kpa"], (5.0, 0.0, 0.0), strict=True))
+    assert off <= (1 + ROUND_TRIP_MARGIN) * SEARCH_TOLERANCE_MM / sigma_min, (off, sigma_min)

@@ -4,8 +4,9 @@ report draws it, and without it actuation.csv keeps its columns and rows.
 
 Kept small so that it runs in seconds: the demo's first section only, q = 1 only, a coarse mesh (4 mm, layers
 10 mm, 8 nodes around: 450 corner nodes) and one search evaluation (``max_solves: 1``: the pressures are the
-search's start, 10 % of ``max_pressure_kpa`` each).  It checks the plumbing and the honesty of the reported error,
-not how close the inverse gets (tests/mechanics and issue 33's note do that).
+search's start, the linear answer scaled into its first step of 25 % of ``max_pressure_kpa``).  It checks the
+plumbing and the honesty of the reported error, not how close the inverse gets (tests/mechanics and issue 33's
+note do that).
 """
 
 from __future__ import annotations
@@ -70,8 +71,11 @@ def test_the_pressures_are_in_actuation_csv_labelled_as_model_estimates(built: t
     assert [r["chamber"] for r in solved] == ["1", "2", "3"]
     mesh = json.loads((build_dir / "simulate" / "summary.json").read_text())["solves"][0]["mesh"]
     assert mesh["size_mm"] == 4 and mesh["nodes"] > 0
+    # one evaluation: the search's start, the linear answer scaled into its first step (25 % of the 100 kPa bound):
+    # q = 1 is far beyond the linear answer's reach, so the largest pressure is that step's
+    assert max(float(r["fe_pressure_kpa"]) for r in solved) == pytest.approx(25.0)
     for r in solved:
-        assert float(r["fe_pressure_kpa"]) == pytest.approx(10.0)  # one evaluation: the start, 10 % of 100 kPa
+        assert float(r["fe_pressure_kpa"]) >= 0.0
         assert "model estimate" in r["fe_pressure_source"] and "ecoflex-00-30" in r["fe_pressure_source"]
         assert f"section mesh {mesh['nodes']} nodes {mesh['tets']} tets, size 4 mm" in r["fe_pressure_source"]
     others = [r for r in table if r not in solved]
