@@ -290,6 +290,15 @@ def first_steps(load_steps: int, largest_kpa: float, mu_kpa: float) -> int:
     return max(load_steps, 2 ** math.ceil(math.log2(needed)) if needed > 1.0 else 1)
 
 
+def first_step_settings(settings: NewtonSettings, largest_kpa: float, mu_kpa: float) -> NewtonSettings:
+    """``settings`` with :func:`first_steps`'s load steps and as many fewer halvings, so that the smallest step,
+    ``1 / (load_steps 2^max_cutbacks)`` of the load, is the one asked or at most half of it (more steps to start
+    with and the same halvings would let a solve that cannot go on creep further before it stops)."""
+    steps = first_steps(settings.load_steps, largest_kpa, mu_kpa)
+    fewer = int(math.floor(math.log2(steps / settings.load_steps)))
+    return replace(settings, load_steps=steps, max_cutbacks=max(0, settings.max_cutbacks - fewer))
+
+
 def solve_device(device: DeviceMesh, law: HyperelasticLaw, pressures: FloatArray, settings: NewtonSettings,
                  thread: HoopThread | None = None, feed_pressures: FloatArray | None = None,
                  on_step: Callable[[float, list[float]], None] | None = None,
@@ -297,7 +306,7 @@ def solve_device(device: DeviceMesh, law: HyperelasticLaw, pressures: FloatArray
     """The device at chamber ``pressures`` (k,) kPa (feeds at ``feed_pressures`` (m,); None: their chambers').
 
     The pressures grow in load steps (:func:`~softdesign.mechanics.newton.solve_pressures`, ``settings``'
-    steps and halvings, the first at most FIRST_STEP_MU shear moduli: :func:`first_steps`; the steps before the
+    steps and halvings, the first at most FIRST_STEP_MU shear moduli: :func:`first_step_settings`; the steps before the
     last converged to DEVICE_PATH_RTOL), not in the cavities' volume
     (:mod:`~softdesign.mechanics.continuation`): a reinforced chamber's volume barely grows with its pressure,
     and a volume step asked for 8.5 kPa on the demo's device landed at 67-176 kPa.  ``on_step`` is told of
@@ -323,8 +332,8 @@ def solve_device(device: DeviceMesh, law: HyperelasticLaw, pressures: FloatArray
     located = locate_samples(device)
     every = np.concatenate([pressures, feeds])
     path_rtol = DEVICE_PATH_RTOL if settings.path_rtol is None else settings.path_rtol
-    settings = replace(settings, atol=max(settings.atol, roundoff_floor_mn(problem)), path_rtol=path_rtol,
-                       load_steps=first_steps(settings.load_steps, float(np.abs(every).max()), law.mu_kpa))
+    settings = first_step_settings(replace(settings, atol=max(settings.atol, roundoff_floor_mn(problem)),
+                                           path_rtol=path_rtol), float(np.abs(every).max()), law.mu_kpa)
     try:
         u, record = solve_pressures(problem, every, settings, solver=TangentSolver(), on_step=on_step)
     except SolveStopped as err:

@@ -133,7 +133,7 @@ def test_a_device_that_stops_keeps_its_last_equilibrium_and_says_where() -> None
 
 
 def test_the_first_load_step_is_at_most_a_tenth_of_the_shear_modulus() -> None:
-    from softdesign.mechanics.device import FIRST_STEP_MU, first_steps
+    from softdesign.mechanics.device import FIRST_STEP_MU, first_step_settings, first_steps
 
     mu = 39.4
     for asked, largest in ((8, 446.6), (8, 223.3), (8, 44.7), (8, 2.0), (256, 446.6), (1, 0.0)):
@@ -144,3 +144,9 @@ def test_the_first_load_step_is_at_most_a_tenth_of_the_shear_modulus() -> None:
             assert steps > asked and steps & (steps - 1) == 0
             assert largest / steps <= FIRST_STEP_MU * mu < largest / (steps // 2)
     assert first_steps(8, 446.6, mu) == 128  # the sample device at P*: 3.5 kPa, 0.09 mu
+    for asked, cutbacks, largest in ((8, 10, 446.6), (4, 6, 197.0), (5, 6, 197.0), (8, 2, 446.6), (8, 10, 2.0)):
+        chosen = first_step_settings(NewtonSettings(load_steps=asked, max_cutbacks=cutbacks), largest, mu)
+        smallest, asked_smallest = 1 / (chosen.load_steps * 2**chosen.max_cutbacks), 1 / (asked * 2**cutbacks)
+        assert chosen.load_steps == first_steps(asked, largest, mu)
+        # the smallest step the one asked or at most half of it (none finer is possible when no halving is left)
+        assert asked_smallest / 2 <= smallest <= asked_smallest or chosen.max_cutbacks == 0
