@@ -39,7 +39,12 @@ TargetArcOpt = Annotated[str | None, typer.Option(
     "search back. Otherwise as --target.")]
 SizeOpt = Annotated[float, typer.Option("--size-mm", help="Element size in the cross-section, mm.")]
 LayerOpt = Annotated[float, typer.Option("--layer-mm", help="Layer spacing along the section, mm.")]
-TimeoutOpt = Annotated[float, typer.Option("--timeout", help="Longest time the solve may take, s.")]
+#: --timeout's defaults, s: a section's solve or search, and the whole device's (--all: 8-9 minutes of CPU for the
+#: sample device at P*; at 600 s it stopped short of P* on a machine running 1.7x slower than usual).
+SECTION_TIMEOUT_S, DEVICE_TIMEOUT_S = 600.0, 1800.0
+TimeoutOpt = Annotated[float | None, typer.Option(
+    "--timeout", help=f"Longest time the solve may take, s (default {SECTION_TIMEOUT_S:g}; with --all "
+    f"{DEVICE_TIMEOUT_S:g}).")]
 FigureOpt = Annotated[Path | None, typer.Option(
     "--figure", help="Also draw the deformed centerline, its arcs and the convergence to this .png file.")]
 WriteOpt = Annotated[bool, typer.Option(
@@ -134,7 +139,7 @@ def simulate(
     size_mm: SizeOpt = 3.0,
     layer_mm: LayerOpt = 8.0,
     max_pressure: MaxPressureOpt = 100.0,
-    timeout: TimeoutOpt = 600.0,
+    timeout: TimeoutOpt = None,
     time_limit: TimeLimitOpt = None,
     figure: FigureOpt = None,
     force: ReplaceFigureOpt = False,
@@ -160,7 +165,8 @@ def simulate(
                     or figure is not None):
                 raise ConfigError("simulate: --q and --pressure go with --all (the whole device), and --all takes "
                                   "neither --pressures, --target, --target-arc, --write nor --figure")
-            payload = run_all(case_file, out, q, pressure, size_mm, layer_mm, timeout, as_json, note)
+            payload = run_all(case_file, out, q, pressure, size_mm, layer_mm,
+                              DEVICE_TIMEOUT_S if timeout is None else timeout, as_json, note)
             if payload["reached"] is not None:  # the figures are printed; the solve did not reach its load
                 note(f"simulate --all: {payload['reached']['stopped_because']}")
                 raise typer.Exit(code=1)
@@ -178,7 +184,8 @@ def simulate(
         shown = (target is not None or arc is not None) and not as_json and sys.stderr.isatty()
         options = SimulateOptions(section - 1, values, target, size_mm, layer_mm, max_pressure_kpa=max_pressure,
                                   target_arc=arc,
-                                  timeout_s=timeout, time_limit_s=time_limit,
+                                  timeout_s=SECTION_TIMEOUT_S if timeout is None else timeout,
+                                  time_limit_s=time_limit,
                                   trial_progress=TrialProgress() if shown else None, feed_pressures_kpa=feeds)
         result = (write_to_table if write else run_simulate)(case_file, out, options, note)
         if figure is not None:

@@ -63,3 +63,19 @@ def test_a_solve_that_stops_short_prints_its_figures_and_exits_1(monkeypatch: py
     assert result.exit_code == 1, result.output
     assert "NOT REACHED: figures" in result.output
     assert "simulate --all: the whole device: the solve stopped at 86.9 kPa (load factor 0.1947)" in result.output
+
+
+def test_the_whole_device_waits_longer_by_default_than_a_section(monkeypatch: pytest.MonkeyPatch) -> None:
+    # --all's default --timeout is the whole device's (8-9 minutes of CPU for the sample at P*), a user's is kept
+    seen: list[float] = []
+
+    def device(case_file, out, o, progress):  # noqa: ANN001, ANN202 - run_device's signature
+        seen.append(o.timeout_s)
+        return {"reached": None, "leaves_out": []}
+
+    monkeypatch.setattr("softdesign.pipeline.device_command.run_device", device)
+    monkeypatch.setattr("softdesign.pipeline.device_figures.device_lines", lambda p: ["figures"])
+    for args in ([], ["--timeout", "900"]):
+        result = runner.invoke(app, ["simulate", str(ACTUATOR), "--all", "--q", "1", *args])
+        assert result.exit_code == 0, result.output
+    assert seen == [1800.0, 900.0]
