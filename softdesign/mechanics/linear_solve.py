@@ -85,17 +85,7 @@ class TangentSolver:
         matrix = sp.csc_matrix(matrix)
         matrix.sort_indices()
         order = self._order_of(matrix)
-        lu = spla.splu(matrix[order][:, order], permc_spec="NATURAL", diag_pivot_thresh=0.0,
-                       options={"SymmetricMode": True})
-        self.factorizations += 1
-
-        def solve(rhs: FloatArray) -> FloatArray:
-            x = np.empty_like(rhs)
-            x[order] = lu.solve(rhs[order])
-            return x
-
-        n = matrix.shape[0]
-        return spla.LinearOperator((n, n), matvec=solve, dtype=float)
+        return self._factored(matrix[order][:, order], order)
 
     def factor_free(self, whole: sp.csr_matrix, free: np.ndarray) -> spla.LinearOperator:
         """The solver of ``whole[free][:, free]`` (``whole`` (n, n) csr in canonical form, ``free`` (n,) bool) as
@@ -104,16 +94,21 @@ class TangentSolver:
         m = len(plan.indptr) - 1
         # copies: splu puts its matrix in canonical order in place, which must not reorder the plan's arrays
         gathered = sp.csc_matrix((whole.data[plan.take], plan.indices.copy(), plan.indptr.copy()), shape=(m, m))
-        lu = spla.splu(gathered, permc_spec="NATURAL", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+        return self._factored(gathered, plan.order)
+
+    def _factored(self, ordered: sp.csc_matrix, order: IntArray) -> spla.LinearOperator:
+        """The solver ``b -> x`` of the matrix whose rows and columns ``order`` gives as ``ordered`` (factored as
+        it stands: the order is already the fill-reducing one)."""
+        lu = spla.splu(ordered, permc_spec="NATURAL", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
         self.factorizations += 1
-        order = plan.order
 
         def solve(rhs: FloatArray) -> FloatArray:
             x = np.empty_like(rhs)
             x[order] = lu.solve(rhs[order])
             return x
 
-        return spla.LinearOperator((m, m), matvec=solve, dtype=float)
+        n = ordered.shape[0]
+        return spla.LinearOperator((n, n), matvec=solve, dtype=float)
 
     def _plan_of(self, whole: sp.csr_matrix, free: np.ndarray) -> _Plan:
         """Where each entry of the factored matrix comes from in ``whole.data``, found by taking :meth:`factor`'s

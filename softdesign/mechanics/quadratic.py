@@ -193,16 +193,28 @@ def cell_dofs(cells: IntArray) -> IntArray:
 
 def _volume_gradient(mesh: QuadraticMesh, state: QuadraticState) -> FloatArray:
     """``dv_e/dx`` (E, 10, 3), mm^2."""
-    return np.einsum("eq,eqai->eai", mesh.weights * state.J, state.spatial_grads)
+    return _volume_gradient_of(mesh.weights, state.J, state.spatial_grads)
+
+
+def _volume_gradient_of(weights: FloatArray, J: FloatArray, spatial_grads: FloatArray) -> FloatArray:
+    """``dv_e/dx`` (e, 10, 3) mm^2 of elements' weights (e, Q), det F (e, Q) and spatial gradients (e, Q, 10, 3)."""
+    return np.einsum("eq,eqai->eai", weights * J, spatial_grads)
+
+
+def _element_forces(weights: FloatArray, P_iso: FloatArray, grads: FloatArray, pressure: FloatArray,
+                    dv: FloatArray) -> FloatArray:
+    """Elements' nodal forces (e, 30) mN: ``sum_q w P_iso : dN/dX + p_e dv_e/dx`` (P_iso (e Q, 3, 3) kPa)."""
+    E, Q = weights.shape
+    forces = np.einsum("eq,eqiJ,eqaJ->eai", weights, P_iso.reshape(E, Q, 3, 3), grads) + pressure[:, None, None] * dv
+    return np.asarray(forces.reshape(E, 30), np.float64)
 
 
 def quadratic_force(mesh: QuadraticMesh, law: HyperelasticLaw, state: QuadraticState) -> FloatArray:
     """Internal nodal forces (3N,) mN."""
     E, Q = mesh.weights.shape
     P_iso, _ = isochoric_stress(law, state.F.reshape(E * Q, 3, 3))
-    forces = (np.einsum("eq,eqiJ,eqaJ->eai", mesh.weights, P_iso.reshape(E, Q, 3, 3), mesh.grads)
-              + state.pressure[:, None, None] * _volume_gradient(mesh, state))
-    return summed(cell_dofs(mesh.cells), forces.reshape(E, 30), mesh.dof_count)
+    forces = _element_forces(mesh.weights, P_iso, mesh.grads, state.pressure, _volume_gradient(mesh, state))
+    return summed(cell_dofs(mesh.cells), forces, mesh.dof_count)
 
 
 def quadratic_force_and_tangent(mesh: QuadraticMesh, law: HyperelasticLaw, state: QuadraticState,
@@ -231,9 +243,8 @@ def _element_forces_and_tangents(mesh: QuadraticMesh, law: HyperelasticLaw, stat
     F, J, g4 = state.F[part], state.J[part], state.spatial_grads[part]
     E, Q = weights.shape
     P_iso, A_iso = isochoric_tangent(law, F.reshape(E * Q, 3, 3))
-    dv = np.einsum("eq,eqai->eai", weights * J, g4)
-    forces[part] = (np.einsum("eq,eqiJ,eqaJ->eai", weights, P_iso.reshape(E, Q, 3, 3), grads)
-                    + state.pressure[part, None, None] * dv).reshape(E, 30)
+    dv = _volume_gradient_of(weights, J, g4)
+    forces[part] = _element_forces(weights, P_iso, grads, state.pressure[part], dv)
     # K_(ai)(bk) = sum_q w G_aJ A_iJkL G_bL as batched products: B (EQ, 30, 9) with B_(ai)(i'J) = d_ii' G_aJ
     B = np.einsum("eqaJ,ij->eqaijJ", grads, np.eye(3)).reshape(E * Q, 30, 9)
     A = A_iso.reshape(E * Q, 9, 9) * weights.reshape(E * Q, 1, 1)
