@@ -27,7 +27,6 @@ Assumptions
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 
@@ -39,6 +38,7 @@ from softdesign.mechanics.backbone import backbone_fibres
 from softdesign.mechanics.device_ties import Ties, joint_faces, tie_joints
 from softdesign.mechanics.embedded_thread import thread_fibres
 from softdesign.mechanics.linear_solve import TangentSolver
+from softdesign.mechanics.load_steps import stepped_from_rest
 from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord, SolveStopped, solve_pressures
 from softdesign.mechanics.quadratic import QuadraticMesh, shape_values
 from softdesign.mechanics.reinforcement import HoopThread
@@ -48,15 +48,6 @@ from softdesign.types import FloatArray, IntArray
 
 #: The threads' rounding floor on the residual over its estimate (:func:`roundoff_floor_mn`): a safety factor.
 FIBRE_ROUNDOFF = 10.0
-#: The tolerance of the device's load steps before the last, relative to their pressure load (the last converges to
-#: the settings' ``rtol``): the path's equilibria only start the next step (NewtonSettings.path_rtol).
-DEVICE_PATH_RTOL = 1e-4
-#: The first load step's largest pressure, in shear moduli of the silicone.  From rest Newton's first iterate is the
-#: linear answer, good for strains of about a tenth; past that the first step fails and is halved, each failure
-#: costing up to ``max_iterations`` factorizations.  Measured on the sample single-supply device from rest: steps
-#: of 0.07 and 0.09 mu converged (9 and 10 iterations), 0.14 and 0.18 mu failed after 12 (at P*, four halvings
-#: from the default first step, 1/8 of 11.3 mu: 23 factorizations, 7 % of the solve).
-FIRST_STEP_MU = 0.1
 #: Centerline points located per batch (each batch holds an (n, E, 4) array of barycentric coordinates).
 LOCATE_BATCH = 16
 
@@ -283,22 +274,6 @@ class DeviceSolve:
     stopped_because: str = ""  #: why it stopped short ("" when it reached the pressures)
 
 
-def first_steps(load_steps: int, largest_kpa: float, mu_kpa: float) -> int:
-    """``load_steps``, or more (a power of two) so that the first step's largest pressure is at most FIRST_STEP_MU
-    shear moduli; a converged easy step doubles the next (:func:`~softdesign.mechanics.newton.solve_pressures`)."""
-    needed = largest_kpa / (FIRST_STEP_MU * mu_kpa)
-    return max(load_steps, 2 ** math.ceil(math.log2(needed)) if needed > 1.0 else 1)
-
-
-def first_step_settings(settings: NewtonSettings, largest_kpa: float, mu_kpa: float) -> NewtonSettings:
-    """``settings`` with :func:`first_steps`'s load steps and as many fewer halvings, so that the smallest step,
-    ``1 / (load_steps 2^max_cutbacks)`` of the load, is the one asked or at most half of it (more steps to start
-    with and the same halvings would let a solve that cannot go on creep further before it stops)."""
-    steps = first_steps(settings.load_steps, largest_kpa, mu_kpa)
-    fewer = int(math.floor(math.log2(steps / settings.load_steps)))
-    return replace(settings, load_steps=steps, max_cutbacks=max(0, settings.max_cutbacks - fewer))
-
-
 def solve_device(device: DeviceMesh, law: HyperelasticLaw, pressures: FloatArray, settings: NewtonSettings,
                  thread: HoopThread | None = None, feed_pressures: FloatArray | None = None,
                  on_step: Callable[[float, list[float]], None] | None = None,
@@ -306,8 +281,8 @@ def solve_device(device: DeviceMesh, law: HyperelasticLaw, pressures: FloatArray
     """The device at chamber ``pressures`` (k,) kPa (feeds at ``feed_pressures`` (m,); None: their chambers').
 
     The pressures grow in load steps (:func:`~softdesign.mechanics.newton.solve_pressures`, ``settings``'
-    steps and halvings, the first at most FIRST_STEP_MU shear moduli: :func:`first_step_settings`; the steps before the
-    last converged to DEVICE_PATH_RTOL), not in the cavities' volume
+    steps and halvings, the first at most a tenth of the shear modulus and the steps before the last converged to
+    1e-4: :func:`~softdesign.mechanics.load_steps.stepped_from_rest`), not in the cavities' volume
     (:mod:`~softdesign.mechanics.continuation`): a reinforced chamber's volume barely grows with its pressure,
     and a volume step asked for 8.5 kPa on the demo's device landed at 67-176 kPa.  ``on_step`` is told of
     every converged step (load factor, residuals); ``backbone``: the thread along the axis (``backbone:
@@ -331,9 +306,8 @@ def solve_device(device: DeviceMesh, law: HyperelasticLaw, pressures: FloatArray
     problem, ties, hoops = device_problem(device, law, thread, backbone)
     located = locate_samples(device)
     every = np.concatenate([pressures, feeds])
-    path_rtol = DEVICE_PATH_RTOL if settings.path_rtol is None else settings.path_rtol
-    settings = first_step_settings(replace(settings, atol=max(settings.atol, roundoff_floor_mn(problem)),
-                                           path_rtol=path_rtol), float(np.abs(every).max()), law.mu_kpa)
+    settings = stepped_from_rest(replace(settings, atol=max(settings.atol, roundoff_floor_mn(problem))),
+                                 float(np.abs(every).max()), law.mu_kpa)
     try:
         u, record = solve_pressures(problem, every, settings, solver=TangentSolver(), on_step=on_step)
     except SolveStopped as err:

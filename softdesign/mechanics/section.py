@@ -28,6 +28,7 @@ from softdesign.errors import MeshError, SolveError
 from softdesign.kinematics.pcc_fit import arc_points, fit_arc, trapezoid_weights
 from softdesign.mechanics.continuation import ContinuationSettings, follow_pressures
 from softdesign.mechanics.linear_solve import TangentSolver
+from softdesign.mechanics.load_steps import stepped_from_rest
 from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord, solve_pressures
 from softdesign.mechanics.quadratic import (
     QuadraticMesh,
@@ -299,8 +300,9 @@ def simulate_section(section: SectionMesh, law: HyperelasticLaw, pressures: Floa
         # Reinforced: the thread holds the chambers' radius, so there is no limit point to find, and their volume
         # barely grows with pressure, which makes volume control ill-conditioned (with kevlar it stopped at 0.3 kPa
         # of 10 on the demo's section, and stepped past the asked pressure on the whole device); load steps from
-        # zero reach it, as the simulate stage's search does.
-        u, record = solve_pressures(prepared.problem, every, settings, solver=prepared.solver)
+        # zero reach it, as the simulate stage's search does, the first step and the path as the whole device's.
+        stepped = stepped_from_rest(settings, float(np.max(np.abs(every), initial=0.0)), law.mu_kpa)
+        u, record = solve_pressures(prepared.problem, every, stepped, solver=prepared.solver)
         return measure_section(prepared, u, pressures, record)
     path = follow_pressures(prepared.problem, every, ContinuationSettings(
         first_step=1.0 / settings.load_steps, max_cutbacks=settings.max_cutbacks, newton=settings),

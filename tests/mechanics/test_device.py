@@ -130,23 +130,3 @@ def test_a_device_that_stops_keeps_its_last_equilibrium_and_says_where() -> None
     assert f"load factor {held.load_factor:.4g}" in held.stopped_because
     figures = measure_device(held)  # measured where it stopped: bent away from its chamber, the tip moved
     assert figures.arcs[0].kappa > 0.0 and np.linalg.norm(figures.tip_frame[:3, 3] - [0, 0, SECTION_MM]) > 0.0
-
-
-def test_the_first_load_step_is_at_most_a_tenth_of_the_shear_modulus() -> None:
-    from softdesign.mechanics.device import FIRST_STEP_MU, first_step_settings, first_steps
-
-    mu = 39.4
-    for asked, largest in ((8, 446.6), (8, 223.3), (8, 44.7), (8, 2.0), (256, 446.6), (1, 0.0)):
-        steps = first_steps(asked, largest, mu)
-        if steps == asked:  # the asked steps already start low enough
-            assert largest / asked <= FIRST_STEP_MU * mu
-        else:  # the fewest steps, a power of two, that start low enough
-            assert steps > asked and steps & (steps - 1) == 0
-            assert largest / steps <= FIRST_STEP_MU * mu < largest / (steps // 2)
-    assert first_steps(8, 446.6, mu) == 128  # the sample device at P*: 3.5 kPa, 0.09 mu
-    for asked, cutbacks, largest in ((8, 10, 446.6), (4, 6, 197.0), (5, 6, 197.0), (8, 2, 446.6), (8, 10, 2.0)):
-        chosen = first_step_settings(NewtonSettings(load_steps=asked, max_cutbacks=cutbacks), largest, mu)
-        smallest, asked_smallest = 1 / (chosen.load_steps * 2**chosen.max_cutbacks), 1 / (asked * 2**cutbacks)
-        assert chosen.load_steps == first_steps(asked, largest, mu)
-        # the smallest step the one asked or at most half of it (none finer is possible when no halving is left)
-        assert asked_smallest / 2 <= smallest <= asked_smallest or chosen.max_cutbacks == 0
