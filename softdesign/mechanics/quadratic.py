@@ -235,6 +235,14 @@ def curved_barycentric(mesh: QuadraticMesh, elements: IntArray, bary: FloatArray
     return np.concatenate([1.0 - xi.sum(axis=1, keepdims=True), xi], axis=1)
 
 
+def curved_gradients_at(mesh: QuadraticMesh, elements: IntArray, bary: FloatArray) -> FloatArray:
+    """``dN/dX`` (n, 10, 3) 1/mm at barycentric points ``bary`` (n, 4) of ``elements`` (n,) under their quadratic
+    maps (curved or not: "Curved elements" in the module's docstring)."""
+    dxi = _reference_derivatives(bary)  # (n, 10, 3)
+    jacobian = np.einsum("nai,nak->nik", mesh.points[mesh.cells[elements]], dxi)
+    return np.asarray(np.einsum("nak,nki->nai", dxi, np.linalg.inv(jacobian)), np.float64)
+
+
 def quadratic_faces(mesh: QuadraticMesh, faces: IntArray) -> IntArray:
     """6-node faces (F, 6) of corner triangles (F, 3): the corners, then the midpoints of c0c1, c1c2, c2c0."""
     mids = [midpoint_nodes(mesh, faces[:, pair]) for pair in ([0, 1], [1, 2], [2, 0])]
