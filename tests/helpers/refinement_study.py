@@ -2,10 +2,10 @@
 
 A straight three-chamber section (octagonal chambers, 4 mm elements across, 8.5 mm along: 648 tets, about the
 ``simulate`` command's default mesh of 3 mm across, 8 mm layers and octagonal chambers) is solved at its coarse mesh
-and at one and two red refinements (:mod:`softdesign.mechanics.refine`) with 5 kPa in chamber 0. Each study
+and at one and two red refinements (:mod:`softdesign.mechanics.refine`) with 5 kPa in chamber 0.  Each study
 (:data:`STUDIES`) is that section bare, or with the sample case's hoop thread under one of the thread's quadrature
 rules, or with round chambers (more wall nodes round each), or with the octagons' walls curved onto their circles
-(:mod:`softdesign.mechanics.curved_walls`, refined through the curved elements' maps). Level 0 takes 1-8 s of CPU,
+(:mod:`softdesign.mechanics.curved_walls`, refined through the curved elements' maps).  Level 0 takes 1-8 s of CPU,
 level 1 13-75 s, level 2 (61,188 quadratic nodes) 10-25 minutes, so a test reads the levels above 0 from the study's
 recorded file, which ``make study`` re-derives (every level) and rewrites.  The tests solve level 0 afresh and check
 it against the recorded one, and refine the coarse mesh to every recorded level to check its size: a change to the
