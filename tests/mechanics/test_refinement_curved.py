@@ -18,18 +18,23 @@ from softdesign.mechanics.quadratic import (
     QUAD_POINTS,
     QuadraticMesh,
     curved_gradients_at,
+    quadratic_force,
+    quadratic_force_and_tangent,
     quadratic_mesh,
     quadratic_state,
     shape_values,
 )
 from softdesign.mechanics.refine import refine_section
 from softdesign.mechanics.reinforcement import HoopThread
-from softdesign.mechanics.section import SectionMesh, check_section, prepare_section, simulate_section
+from softdesign.mechanics.section import SectionMesh, check_section, prepare_section, section_problem, simulate_section
 from tests.helpers import refinement_study as study
 from tests.helpers.fe_meshes import symmetric_disc_with_holes, three_chamber_section
 
 #: Round-off of sums of a few terms of the coordinates' size (mm), or of order-one quantities.
 ROUND_OFF = 1e-12
+#: Central differences at 1e-6 mm against the tangent along a direction, relative: truncation ~1e-12 relative,
+#: round-off of forces of the thread's stiffness (1e7 mN/mm) over 2e-6 mm.
+TANGENT_RTOL = 1e-6
 
 
 @functools.cache
@@ -274,3 +279,27 @@ def test_three_equal_chambers_barely_bend_the_pipelines_curved_section() -> None
     three = simulate_section(_pipeline_section(True), symmetry.LAW, np.array([10.0, 10.0, 10.0]), settings,
                              symmetry.THREAD)
     assert three.kappa < symmetry.SYMMETRY_FRACTION * one.kappa
+
+
+def test_the_curved_sections_tangent_is_the_derivative_of_its_forces() -> None:
+    # the elements' and the thread's forces on the curved section (its curved elements' gradients and weights, the
+    # fibres on curved faces) against central differences along random directions: relative, because the thread's
+    # stiffness (1e7 mN/mm) makes the forces' round-off large in absolute terms.  Measured: 4e-11
+    problem = section_problem(_coarse(), study.LAW, study.sample_thread())
+    mesh, fibres = problem.mesh, problem.fibres
+    assert isinstance(mesh, QuadraticMesh) and fibres is not None
+    rng = np.random.default_rng(3)
+    u = 1e-3 * rng.standard_normal(mesh.points.shape)
+
+    def forces(v: np.ndarray) -> np.ndarray:
+        return quadratic_force(mesh, study.LAW, quadratic_state(mesh, study.LAW, v)) + fibres.force_and_tangent_at(
+            v, False)[0]
+
+    K = quadratic_force_and_tangent(mesh, study.LAW, quadratic_state(mesh, study.LAW, u))[1]
+    K = K + fibres.force_and_tangent_at(u, True)[1]
+    for _ in range(3):
+        direction = rng.standard_normal(mesh.points.shape)
+        h = 1e-6
+        difference = (forces(u + h * direction) - forces(u - h * direction)) / (2 * h)
+        exact = K @ direction.ravel()
+        assert np.linalg.norm(exact - difference) < TANGENT_RTOL * np.linalg.norm(exact)
