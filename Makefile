@@ -106,7 +106,8 @@ test-seconds:
 
 # `make study`: re-derive the nested-refinement studies' recorded levels
 # (tests/mechanics/refinement_reference*.json: bare and with the sample case's hoop thread, 12-25 minutes of
-# CPU each, and threaded with round chambers, two levels, about 2 minutes); `make study STUDY=thread` re-derives
+# CPU each, threaded with round chambers, two levels, about 2 minutes, and threaded with curved chamber walls,
+# three levels, about 12 minutes); `make study STUDY=thread` re-derives
 # one (STUDY=thread-six: the thread's six-point rule, not read by the tests, much longer).  `make test` solves
 # the coarse level and says to run this when it no longer matches the record.
 study: $(STAMP)

@@ -42,7 +42,7 @@ from tests.helpers.refinement_study import (  # noqa: E402
 
 def run_study(study: Study, out: Path) -> None:
     """Solve ``study`` at every level, print each, and write its record to ``out`` (whole, or not at all)."""
-    coarse = coarse_section(study.ring_count)
+    coarse = coarse_section(study.ring_count, study.curved)
     levels: list[dict[str, Any]] = []
     for level in range(study.levels):
         row = solve_level(coarse, level, study)
@@ -64,6 +64,7 @@ def run_study(study: Study, out: Path) -> None:
         "study": study.name,
         "pressure_kpa": STUDY_KPA,
         "ring_count": study.ring_count,
+        "curved_walls": study.curved,
         "thread": None if thread is None else {"pitch_mm": thread.pitch_mm, "diameter_mm": thread.diameter_mm,
                                                "modulus_kpa": thread.modulus_kpa, "rule": study.rule,
                                                "six_point_share": six_point_share(study.rule)},

@@ -45,7 +45,7 @@ import scipy.sparse as sp
 
 from softdesign.errors import MeshError
 from softdesign.mechanics import reinforcement
-from softdesign.mechanics.quadratic import QuadraticMesh
+from softdesign.mechanics.quadratic import QuadraticMesh, curved_barycentric, curved_gradients_at
 from softdesign.mechanics.reinforcement import FibreMembrane, HoopThread
 from softdesign.mechanics.section import locate
 from softdesign.mechanics.tets import TetMesh, make_tet_mesh
@@ -103,7 +103,11 @@ def embedded_fibres(mesh: QuadraticMesh, polyline: FloatArray, thread: HoopThrea
     found = [locate(sub, middles[k:k + LOCATE_BATCH]) for k in range(0, len(middles), LOCATE_BATCH)]
     host = pool[np.concatenate([e for e, _ in found])]
     bary = np.concatenate([b for _, b in found])
-    grads = quadratic_gradients_at(mesh.linear.grads[host], bary)  # (k, 10, 3)
+    if mesh.curved_volumes is None:
+        grads = quadratic_gradients_at(mesh.linear.grads[host], bary)  # (k, 10, 3)
+    else:  # curved hosts (softdesign.mechanics.curved_walls): the points and gradients of their quadratic maps
+        bary = curved_barycentric(mesh, host, bary, middles)
+        grads = curved_gradients_at(mesh, host, bary)
     d = np.einsum("kbi,ki->kb", grads, tangents)
     q = len(reinforcement.FIBRE_WEIGHTS)  # the hoop thread's rule's count and kind, so that both sets join
     count = len(middles)

@@ -40,6 +40,7 @@ from dataclasses import replace
 import numpy as np
 
 from softdesign.geometry.frames import FramedSpline
+from softdesign.mechanics.curved_walls import round_chamber_walls
 from softdesign.mechanics.section import SectionMesh
 from softdesign.mechanics.section_taper import check_taper, tapered_offsets
 from softdesign.meshing.chambers.carve import area_radius
@@ -66,8 +67,10 @@ def section_layers(curve0: FramedSpline, l0: float, l1: float, size_mm: float) -
     return np.linspace(l0, l1, count + 1)
 
 
-def _holes(layout: ChamberLayout, section: int, scale_mm: float, size_mm: float) -> list[Hole]:
-    """The section's chambers as holes, their l-ranges in the section's own l (0 at its start, 1 at its end)."""
+def _holes(layout: ChamberLayout, section: int, scale_mm: float, size_mm: float, equal_area: bool = True
+           ) -> list[Hole]:
+    """The section's chambers as holes, their l-ranges in the section's own l (0 at its start, 1 at its end);
+    ``equal_area``: their polygons have their circles' area (else their nodes are on the circles)."""
     l0, l1 = layout.breaks[section], layout.breaks[section + 1]
     holes = []
     for c in layout.section_chambers(section):
@@ -75,7 +78,7 @@ def _holes(layout: ChamberLayout, section: int, scale_mm: float, size_mm: float)
         nodes = max(MIN_CHAMBER_NODES, int(np.ceil(np.pi * c.diameter_mm / size_mm)))
         centre = (c.distance_mm * np.cos(c.angle) / scale_mm, c.distance_mm * np.sin(c.angle) / scale_mm)
         own = ((c.l_start - l0) / (l1 - l0), (c.l_end - l0) / (l1 - l0))
-        holes.append(Hole(f"s{section}_c{c.index}", Circle(centre, radius, nodes, equal_area=True), own))
+        holes.append(Hole(f"s{section}_c{c.index}", Circle(centre, radius, nodes, equal_area=equal_area), own))
     return holes
 
 
@@ -95,7 +98,7 @@ def _feed_holes(layout: ChamberLayout, section: int, scale_mm: float, size_mm: f
 
 def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, layout: ChamberLayout, section: int,
                         size_mm: float, angular_count: int, layer_mm: float, feeds: bool = False,
-                        taper: bool = True) -> SectionMesh:
+                        taper: bool = True, curved_walls: bool = False) -> SectionMesh:
     """Section ``section``'s mesh at q = 0 in its base frame, with its base fixed and chamber walls named.
 
     Parameters
@@ -113,6 +116,8 @@ def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, lay
         distal part), not solid
     taper : mesh a tapered chamber as designed (:mod:`softdesign.mechanics.section_taper`); False: as a cylinder
         of its middle distance and diameter
+    curved_walls : the chambers' nodes on their circles and their side walls' midside nodes too
+        (:mod:`softdesign.mechanics.curved_walls`); False: polygons of their circles' area, straight
 
     Raises
     ------
@@ -124,7 +129,7 @@ def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, lay
     rho = field.evaluate_grid(0.0, layers, angle_grid(angular_count))  # type: ignore[attr-defined]
     scale = float(np.median(rho))
     chambers = layout.section_chambers(section)
-    holes = _holes(layout, section, scale, size_mm)
+    holes = _holes(layout, section, scale, size_mm, equal_area=not curved_walls)
     feed_holes = _feed_holes(layout, section, scale, size_mm) if feeds else []
     # the area-matched polygons' corners reach past the circles: the rigid core holds them (round and in place)
     reach = scale * max(math.hypot(*h.circle.center) + h.circle.node_radius(h.circle.nodes) for h in holes + feed_holes)
@@ -160,7 +165,8 @@ def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, lay
                   np.concatenate([np.full(len(w), k, np.int64) for k, w in enumerate(feed_walls)]),
                   np.array([0.5 * f.diameter_mm for f in layout.feeds_through(section)])) if feed_walls else (
                       None, None, None)
-    return SectionMesh(local, mesh.tets, mesh.node_layer == 0, np.concatenate(walls),
+    made = SectionMesh(local, mesh.tets, mesh.node_layer == 0, np.concatenate(walls),
                        np.concatenate([np.full(len(w), k, np.int64) for k, w in enumerate(walls)]),
                        centerline, (s - s[0])[mesh.node_layer], np.array([c.angle for c in chambers]),
                        np.array([0.5 * c.diameter_mm for c in chambers]), *feed_parts)
+    return round_chamber_walls(made) if curved_walls else made

@@ -27,17 +27,28 @@ Formulation (near-incompressible, no locking)
         d2v_e/dx_a,i dx_b,k = sum_q w J_q (g_qa,i g_qb,k - g_qa,k g_qb,i),
 
     with ``p_e = U'(theta_e)``, ``g = F^-T dN/dX`` the spatial gradients.
+Curved (isoparametric) elements
+    An element may have midside nodes off its straight edges' middles (a
+    chamber's wall on its true circle: :mod:`softdesign.mechanics.curved_walls`).
+    Its reference map ``X(xi) = sum_a N_a(xi) X_a`` is then quadratic, and at
+    each point ``dN/dX = dN/dxi (dX/dxi)^-1`` and the weight is
+    ``det(dX/dxi) / 24`` (the unit tetrahedron's volume 1/6, a quarter each);
+    its volume ``V_e`` is the sum of its weights, so that ``theta_e = 1`` at
+    rest.  The four-point rule is then not exact for the volume (``det`` is
+    cubic), an error of the order of the edges' bow squared.  Straight
+    elements keep the affine form above, bit for bit.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
 
 from softdesign.continuum.laws import HyperelasticLaw, isochoric_stress, isochoric_tangent
+from softdesign.errors import MeshError
 from softdesign.mechanics.assembly import InvertedElementError
 from softdesign.mechanics.element_threads import in_parts
 from softdesign.mechanics.tets import TetMesh, node_dofs, summed
@@ -63,6 +74,8 @@ class QuadraticMesh:
     grads : (E, Q, 10, 3) float, 1/mm: ``dN/dX`` at the quadrature points
     weights : (E, Q) float, mm^3: quadrature weights (sum: the element's volume)
     edges : (M, 2) int, sorted corner pairs: node ``V + k`` is the midpoint of ``edges[k]``
+    curved_volumes : (E,) float, mm^3, every element's volume (the sum of its weights) when some are curved
+        (module docstring), else None (the corners' volumes)
     """
 
     linear: TetMesh
@@ -71,6 +84,7 @@ class QuadraticMesh:
     grads: FloatArray
     weights: FloatArray
     edges: IntArray
+    curved_volumes: FloatArray | None = None
 
     @property
     def dof_count(self) -> int:
@@ -80,7 +94,7 @@ class QuadraticMesh:
     @property
     def volumes(self) -> FloatArray:
         """Reference volumes (E,), mm^3."""
-        return self.linear.volumes
+        return self.linear.volumes if self.curved_volumes is None else self.curved_volumes
 
     @cached_property
     def stiffness_pattern(self) -> tuple[IntArray, IntArray, IntArray]:
@@ -123,14 +137,74 @@ def edge_midpoints(tets: IntArray, vertex_count: int) -> tuple[IntArray, IntArra
     return edges, vertex_count + inverse.reshape(len(tets), 6)
 
 
-def quadratic_mesh(linear: TetMesh) -> QuadraticMesh:
-    """The 10-node mesh of ``linear``: straight edges, midpoints at their middles."""
+def quadratic_mesh(linear: TetMesh, curved_edges: IntArray | None = None, curved_midpoints: FloatArray | None = None
+                   ) -> QuadraticMesh:
+    """The 10-node mesh of ``linear``: straight edges, midpoints at their middles, but the edges ``curved_edges``
+    (K, 2) (corner pairs, edges of the mesh) whose midside nodes are at ``curved_midpoints`` (K, 3) mm: their
+    elements are curved (module docstring).
+
+    Raises
+    ------
+    MeshError
+        A curved pair is not an edge, or a curved element's map folds (``det(dX/dxi) <= 0`` at a point).
+    """
     V = len(linear.points)
     edges, mids = edge_midpoints(linear.tets, V)
     points = np.concatenate([linear.points, 0.5 * (linear.points[edges[:, 0]] + linear.points[edges[:, 1]])])
     cells = np.concatenate([linear.tets, mids], axis=1)
     weights = linear.volumes[:, None] * QUAD_WEIGHTS[None, :]
-    return QuadraticMesh(linear, points, cells, _shape_gradients(linear.grads), weights, edges)
+    mesh = QuadraticMesh(linear, points, cells, _shape_gradients(linear.grads), weights, edges)
+    if curved_edges is None or len(curved_edges) == 0:
+        return mesh
+    return _curved(mesh, np.asarray(curved_edges, np.int64), np.asarray(curved_midpoints, float))
+
+
+def _reference_derivatives(bary: FloatArray) -> FloatArray:
+    """The ten shape functions' derivatives (n, 10, 3) by the last three barycentric coordinates at ``bary``."""
+    by_l = np.zeros((len(bary), 10, 4))
+    corners = np.arange(4)
+    by_l[:, corners, corners] = 4.0 * bary - 1.0
+    edge = 4 + np.arange(6)
+    by_l[:, edge, TET_EDGES[:, 0]] = 4.0 * bary[:, TET_EDGES[:, 1]]
+    by_l[:, edge, TET_EDGES[:, 1]] = 4.0 * bary[:, TET_EDGES[:, 0]]
+    return by_l[:, :, 1:] - by_l[:, :, :1]
+
+
+#: ``dN/dxi`` (Q, 10, 3) at the quadrature points, xi the barycentrics 1..3 (the first is 1 - their sum).
+QUAD_DXI = _reference_derivatives(QUAD_POINTS)
+
+
+def isoparametric_geometry(nodes: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """``dN/dX`` (E, Q, 10, 3) 1/mm and the weights (E, Q) mm^3 of elements with reference nodes ``nodes``
+    (E, 10, 3) mm, at the four-point rule (module docstring, "Curved elements")."""
+    jacobian = np.einsum("eai,qak->eqik", nodes, QUAD_DXI)  # dX_i / dxi_k
+    grads = np.einsum("qak,eqki->eqai", QUAD_DXI, np.linalg.inv(jacobian))
+    return grads, np.linalg.det(jacobian) * (QUAD_WEIGHTS / 6.0)[None, :]
+
+
+def _curved(mesh: QuadraticMesh, curved_edges: IntArray, curved_midpoints: FloatArray) -> QuadraticMesh:
+    """``mesh`` with the midside nodes of ``curved_edges`` (K, 2) at ``curved_midpoints`` (K, 3) mm."""
+    if curved_midpoints.shape != (len(curved_edges), 3):
+        raise MeshError(f"curved edges: one midside position (3,) per edge; got {curved_midpoints.shape} for "
+                        f"{len(curved_edges)} edges")
+    try:
+        nodes = midpoint_nodes(mesh, curved_edges)
+    except ValueError as error:
+        raise MeshError(f"curved edges: {error}") from error
+    points = mesh.points.copy()
+    points[nodes] = curved_midpoints
+    moved = np.zeros(len(points), bool)
+    moved[nodes] = True
+    curved = np.flatnonzero(moved[mesh.cells].any(axis=1))
+    grads, weights = mesh.grads.copy(), mesh.weights.copy()
+    grads[curved], weights[curved] = isoparametric_geometry(points[mesh.cells[curved]])
+    if not np.all(weights[curved] > 0):
+        bad = int(curved[np.argmin(weights[curved].min(axis=1))])
+        raise MeshError(f"curved edges: element {bad}'s curved map folds (a midside node too far off its edge's "
+                        "middle for the element's size); curve only edges on a smooth wall, or refine the mesh")
+    volumes = mesh.linear.volumes.copy()
+    volumes[curved] = weights[curved].sum(axis=1)
+    return replace(mesh, points=points, grads=grads, weights=weights, curved_volumes=volumes)
 
 
 def midpoint_nodes(mesh: QuadraticMesh, pairs: IntArray) -> IntArray:
@@ -143,6 +217,30 @@ def midpoint_nodes(mesh: QuadraticMesh, pairs: IntArray) -> IntArray:
     if not np.array_equal(keys[at], wanted):
         raise ValueError("midpoint_nodes: a corner pair is not an edge of the mesh")
     return V + at
+
+
+def curved_barycentric(mesh: QuadraticMesh, elements: IntArray, bary: FloatArray, query: FloatArray,
+                       iterations: int = 8) -> FloatArray:
+    """Barycentric coordinates (n, 4) of reference points ``query`` (n, 3) mm under their ``elements``' (n,)
+    quadratic maps, from their straight-element ones ``bary`` (n, 4): Newton's method on ``X(xi) = query``
+    (converged to round-off in a few steps where the edges bow little against the element; a straight element's
+    are its own)."""
+    nodes = mesh.points[mesh.cells[elements]]  # (n, 10, 3)
+    xi = np.array(bary[:, 1:], float)
+    for _ in range(iterations):
+        full = np.concatenate([1.0 - xi.sum(axis=1, keepdims=True), xi], axis=1)
+        miss = query - np.einsum("na,nai->ni", shape_values(full), nodes)
+        jacobian = np.einsum("nai,nak->nik", nodes, _reference_derivatives(full))
+        xi += np.linalg.solve(jacobian, miss[..., None])[..., 0]
+    return np.concatenate([1.0 - xi.sum(axis=1, keepdims=True), xi], axis=1)
+
+
+def curved_gradients_at(mesh: QuadraticMesh, elements: IntArray, bary: FloatArray) -> FloatArray:
+    """``dN/dX`` (n, 10, 3) 1/mm at barycentric points ``bary`` (n, 4) of ``elements`` (n,) under their quadratic
+    maps (curved or not: "Curved elements" in the module's docstring)."""
+    dxi = _reference_derivatives(bary)  # (n, 10, 3)
+    jacobian = np.einsum("nai,nak->nik", mesh.points[mesh.cells[elements]], dxi)
+    return np.asarray(np.einsum("nak,nki->nai", dxi, np.linalg.inv(jacobian)), np.float64)
 
 
 def quadratic_faces(mesh: QuadraticMesh, faces: IntArray) -> IntArray:

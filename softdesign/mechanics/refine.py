@@ -20,7 +20,13 @@ What a :class:`~softdesign.mechanics.section.SectionMesh` carries:
 - node levels: a midpoint's is the mean of its edge's ends' (exact where the
   level is linear along the edge, as on a straight section);
 - the centerline and the chamber angles: kept as they are, so every level
-  measures its arc on the same reference points.
+  measures its arc on the same reference points;
+- curved edges (:mod:`softdesign.mechanics.curved_walls`): a curved parent is
+  split through its quadratic map: the children's corners at its midside
+  nodes, and every child's midside nodes where the parent's map puts its
+  edges' middles.  A quadratic map on a sub-tetrahedron is quadratic, so the
+  children's maps are the parent's: the refined geometry is the parent's
+  (curved walls stay the same curve), and the refinement is nested.
 """
 
 from __future__ import annotations
@@ -30,8 +36,10 @@ from dataclasses import replace
 import numpy as np
 
 from softdesign.errors import MeshError
-from softdesign.mechanics.quadratic import edge_midpoints
+from softdesign.mechanics.curved_walls import curved_children
+from softdesign.mechanics.quadratic import TET_EDGES, edge_midpoints, quadratic_mesh
 from softdesign.mechanics.section import SectionMesh
+from softdesign.mechanics.tets import make_tet_mesh
 from softdesign.types import FloatArray, IntArray
 
 #: The most refinements one call makes: each multiplies the elements by 8.
@@ -55,6 +63,13 @@ def refine_tets(points: FloatArray, tets: IntArray) -> tuple[FloatArray, IntArra
     tets : (8 E, 4) int, positively oriented; element ``8 e + c`` is child ``c`` of parent ``e``
     edges : (M, 2) int, sorted corner pairs: node ``V + k`` is the midpoint of ``edges[k]``
     """
+    fine, out, edges, _ = _split(points, tets)
+    return fine, out, edges
+
+
+def _split(points: FloatArray, tets: IntArray) -> tuple[FloatArray, IntArray, IntArray, IntArray]:
+    """:func:`refine_tets`'s points, children and edges, and the children's corners (E, 8, 4) as their parents'
+    local nodes 0..9 (corners, then the midpoints of edges 01, 02, 03, 12, 13, 23)."""
     V = len(points)
     edges, mids = edge_midpoints(tets, V)
     fine = np.concatenate([points, 0.5 * (points[edges[:, 0]] + points[edges[:, 1]])])
@@ -65,7 +80,7 @@ def refine_tets(points: FloatArray, tets: IntArray) -> tuple[FloatArray, IntArra
     inner = np.stack([np.concatenate([diagonal, ring[:, [k, (k + 1) % 4]]], axis=1) for k in range(4)], axis=1)
     children = np.concatenate([np.broadcast_to(_CORNER_CHILDREN, (len(tets), 4, 4)), inner], axis=1)  # (E, 8, 4)
     out = np.take_along_axis(local, children.reshape(len(tets), -1), axis=1).reshape(-1, 4)
-    return fine, _positive(fine, out), edges
+    return fine, _positive(fine, out), edges, children
 
 
 def _positive(points: FloatArray, tets: IntArray) -> IntArray:
@@ -120,9 +135,31 @@ def refine_section(section: SectionMesh, levels: int = 1) -> SectionMesh:
 def _refine_once(section: SectionMesh) -> SectionMesh:
     """One red refinement of ``section`` and its named sets."""
     V = len(section.points)
-    points, tets, edges = refine_tets(np.asarray(section.points, float), np.asarray(section.tets, np.int64))
+    points, tets, edges, children = _split(np.asarray(section.points, float), np.asarray(section.tets, np.int64))
+    curved_edges, curved_midpoints = None, None
+    if section.curved_edges is not None:
+        points, tets, curved_edges, curved_midpoints = _curved_split(section, points, tets, children)
     base = np.concatenate([section.base, section.base[edges[:, 0]] & section.base[edges[:, 1]]])
     node_l = np.concatenate([section.node_l, 0.5 * (section.node_l[edges[:, 0]] + section.node_l[edges[:, 1]])])
     faces = refine_faces(np.asarray(section.wall_faces, np.int64), edges, V)
     return replace(section, points=points, tets=tets, base=base, wall_faces=faces,
-                   face_chamber=np.repeat(np.asarray(section.face_chamber, np.int64), 4), node_l=node_l)
+                   face_chamber=np.repeat(np.asarray(section.face_chamber, np.int64), 4), node_l=node_l,
+                   curved_edges=curved_edges, curved_midpoints=curved_midpoints)
+
+
+def _curved_split(section: SectionMesh, points: FloatArray, tets: IntArray, children: IntArray
+                  ) -> tuple[FloatArray, IntArray, IntArray, FloatArray]:
+    """A curved ``section``'s red split (straight ``points`` and children ``tets`` from :func:`_split`) put on its
+    parents' maps: the points, the children (oriented on them), and the children's curved edges (K, 2) and their
+    midside nodes (K, 3) mm (the module's docstring)."""
+    parent = quadratic_mesh(make_tet_mesh(np.asarray(section.points, float), np.asarray(section.tets, np.int64)),
+                            section.curved_edges, section.curved_midpoints)
+    V = len(section.points)
+    moved = np.any(parent.points[V:] != points[V:], axis=1)  # the parent's midside nodes off their middles
+    curved = np.flatnonzero(np.concatenate([np.zeros(V, bool), moved])[parent.cells].any(axis=1))
+    points = parent.points  # numbered as the split's: a corner, then the midside node of each parent edge
+    middles = curved_children(parent.points[parent.cells[curved]], children[curved])  # (C, 8, 6, 3)
+    corners = tets.reshape(-1, 8, 4)[curved]  # (C, 8, 4)
+    pairs = np.sort(corners[:, :, TET_EDGES].reshape(-1, 2), axis=1)
+    kept, first = np.unique(pairs, axis=0, return_index=True)
+    return points, _positive(points, tets), kept, middles.reshape(-1, 3)[first]

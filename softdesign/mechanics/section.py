@@ -32,6 +32,7 @@ from softdesign.mechanics.load_steps import stepped_from_rest
 from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord, solve_pressures
 from softdesign.mechanics.quadratic import (
     QuadraticMesh,
+    curved_barycentric,
     quadratic_faces,
     quadratic_fixed,
     quadratic_mesh,
@@ -67,6 +68,9 @@ class SectionMesh:
         their distal chambers' pressures), normals out of the feed
     face_feed : (G,) int or None, the feed (0 .. m-1) of each feed face
     feed_radii_mm : (m,) float or None, each feed's radius, mm
+    curved_edges : (K, 2) int or None, edges (corner pairs) whose quadratic midside nodes are off their middles
+        (:mod:`softdesign.mechanics.curved_walls`); None: every edge straight
+    curved_midpoints : (K, 3) float or None, mm, those midside nodes' positions
     """
 
     points: FloatArray
@@ -81,6 +85,8 @@ class SectionMesh:
     feed_faces: IntArray | None = None
     face_feed: IntArray | None = None
     feed_radii_mm: FloatArray | None = None
+    curved_edges: IntArray | None = None
+    curved_midpoints: FloatArray | None = None
 
     @property
     def chamber_count(self) -> int:
@@ -142,7 +148,7 @@ def section_problem(section: SectionMesh, law: HyperelasticLaw, thread: HoopThre
     every feed's (the feed's core wound as the chambers', a feed that does not swell).  The feeds crossing the
     section (``feed_faces``) are cavities after the chambers: the problem takes k + m pressures.
     """
-    mesh = quadratic_mesh(check_section(section))
+    mesh = quadratic_mesh(check_section(section), section.curved_edges, section.curved_midpoints)
     fixed = quadratic_fixed(mesh, np.repeat(section.base[:, None], 3, axis=1)).ravel()
     walls, chambers = np.asarray(section.wall_faces, np.int64), np.asarray(section.face_chamber, np.int64)
     if section.feed_count:  # the feeds are cavities k .. k + m - 1
@@ -254,6 +260,8 @@ def prepare_section(section: SectionMesh, law: HyperelasticLaw, thread: HoopThre
     problem = section_problem(section, law, thread)
     assert isinstance(problem.mesh, QuadraticMesh)
     elements, weights = locate(problem.mesh.linear, section.centerline)
+    if problem.mesh.curved_volumes is not None:  # the centerline's points where the curved elements' maps put them
+        weights = curved_barycentric(problem.mesh, elements, weights, section.centerline)
     steps = np.linalg.norm(np.diff(section.centerline, axis=0), axis=1)
     fractions = np.concatenate([[0.0], np.cumsum(steps)]) / steps.sum()
     return PreparedSection(section, problem, elements, weights, fractions)

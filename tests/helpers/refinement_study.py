@@ -1,16 +1,17 @@
 """The section curvature's nested-refinement studies, shared by their tests and by ``make study`` (pipelines/study.py).
 
 A straight three-chamber section (octagonal chambers, 4 mm elements across, 8.5 mm along: 648 tets, about the
-``simulate`` command's default mesh of 3 mm across, 8 mm layers and octagonal chambers) is solved at its coarse
-mesh and at one and two red refinements (:mod:`softdesign.mechanics.refine`) with 5 kPa in chamber 0.  Each
-study (:data:`STUDIES`) is that section bare, or with the sample case's hoop thread under one of the thread's
-quadrature rules, or with round chambers (more wall nodes round each).  Level 0 takes 2-8 s of CPU, level 1
-25-75 s, level 2 (61,188 quadratic nodes) 10-25 minutes, so a test reads the levels above 0 from the study's
-recorded file, which ``make study`` re-derives (every level) and rewrites.  The tests solve level 0 afresh and
-check it against the recorded one, and refine the coarse mesh to every recorded level to check its size: a change
-to the mesher, the law, the thread or the solver moves level 0 (the same code solves every level), a change to
-the refinement moves the sizes, and the test says to run ``make study`` (the refinement's own geometry is
-checked by tests/mechanics/test_refine.py).
+``simulate`` command's default mesh of 3 mm across, 8 mm layers and octagonal chambers) is solved at its coarse mesh
+and at one and two red refinements (:mod:`softdesign.mechanics.refine`) with 5 kPa in chamber 0.  Each study
+(:data:`STUDIES`) is that section bare, or with the sample case's hoop thread under one of the thread's quadrature
+rules, or with round chambers (more wall nodes round each), or with the octagons' walls curved onto their circles
+(:mod:`softdesign.mechanics.curved_walls`, refined through the curved elements' maps).  Level 0 takes 1-8 s of CPU,
+level 1 13-75 s, level 2 (61,188 quadratic nodes) 10-25 minutes, so a test reads the levels above 0 from the study's
+recorded file, which ``make study`` re-derives (every level) and rewrites.  The tests solve level 0 afresh and check
+it against the recorded one, and refine the coarse mesh to every recorded level to check its size: a change to the
+mesher, the law, the thread or the solver moves level 0 (the same code solves every level), a change to the
+refinement moves the sizes, and the test says to run ``make study`` (the refinement's own geometry is checked by
+tests/mechanics/test_refine.py, the curved one's by tests/mechanics/test_refinement_curved.py).
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ import numpy as np
 
 from softdesign.continuum.laws import HyperelasticLaw
 from softdesign.materials.threads import thread_presets
+from softdesign.mechanics.curved_walls import round_chamber_walls
 from softdesign.mechanics.newton import NewtonSettings
 from softdesign.mechanics.refine import refine_section
 from softdesign.mechanics.reinforcement import HoopThread
@@ -67,6 +69,7 @@ class Study:
     rule: str = "solver"  #: the thread's quadrature on a wall face (:data:`tests.helpers.fibre_rules.RULES`)
     ring_count: int = 0  #: wall nodes round each chamber of the coarse mesh (0: the lattice's eight)
     levels: int = LEVELS  #: the coarse mesh and its refinements solved
+    curved: bool = False  #: the chambers' side walls on their circles (:mod:`softdesign.mechanics.curved_walls`)
 
     def thread(self) -> HoopThread | None:
         """The study's thread, or None (bare)."""
@@ -79,21 +82,27 @@ THREADED_SIX = Study("thread-six", HERE / "refinement_reference_thread_six.json"
 #: The threaded study with round chambers, levels 0 and 1 (its level 2, about 600k unknowns, is out of reach).
 THREADED_ROUND = Study("thread-round", HERE / "refinement_reference_thread_round.json", threaded=True,
                        ring_count=ROUND_CHAMBER_NODES, levels=2)
-STUDIES = {s.name: s for s in (BARE, THREADED, THREADED_SIX, THREADED_ROUND)}
+#: The threaded study with its octagonal chambers' walls on their circles (isoparametric), refined through the
+#: curved elements' maps (nested).
+THREADED_CURVED = Study("thread-curved", HERE / "refinement_reference_thread_curved.json", threaded=True,
+                        curved=True)
+STUDIES = {s.name: s for s in (BARE, THREADED, THREADED_SIX, THREADED_ROUND, THREADED_CURVED)}
 #: The studies ``make study`` re-derives unless told which: those the tests read.  The six-point one is for the
 #: comparison of the rules (its level 1 took 43 Newton iterations and 282 s of CPU, its level 2 far longer).
-RECORDED = ("bare", "thread", "thread-round")
+RECORDED = ("bare", "thread", "thread-round", "thread-curved")
 #: Level 0 solved afresh against the recorded one: Newton stops at a relative residual of 1e-8, so a re-solve on
 #: other BLAS or METIS builds moves the curvature by far less than this, while any change to the mesh, the law,
 #: the thread or the solver moves it by more.
 REPRODUCE_RTOL = 1e-6
 
 
-def coarse_section(ring_count: int = 0) -> SectionMesh:
-    """The study's level-0 section; ``ring_count`` wall nodes round each chamber (0: the lattice's, eight)."""
-    return three_chamber_section(SHAPE["radius"], SHAPE["distance"], SHAPE["chamber_diameter"], SHAPE["length"],
-                                 SHAPE["end_wall"], FULL_STUDY["size"], axial_size=FULL_STUDY["axial_size"],
-                                 ring_turn=FULL_STUDY["ring_turn"], ring_count=ring_count)
+def coarse_section(ring_count: int = 0, curved: bool = False) -> SectionMesh:
+    """The study's level-0 section; ``ring_count`` wall nodes round each chamber (0: the lattice's, eight);
+    ``curved``: their side walls on their circles."""
+    section = three_chamber_section(SHAPE["radius"], SHAPE["distance"], SHAPE["chamber_diameter"], SHAPE["length"],
+                                    SHAPE["end_wall"], FULL_STUDY["size"], axial_size=FULL_STUDY["axial_size"],
+                                    ring_turn=FULL_STUDY["ring_turn"], ring_count=ring_count)
+    return round_chamber_walls(section) if curved else section
 
 
 def _angle_between(a: float, b: float) -> float:
@@ -134,7 +143,7 @@ def checked_levels(study: Study) -> tuple[np.ndarray, np.ndarray]:
     ones recorded.  Fails, saying to run ``make study``, when level 0 or the refined meshes' sizes moved."""
     recorded = load_reference(study.reference)["levels"]
     assert len(recorded) == study.levels, f"run `make study STUDY={study.name}`"
-    coarse = coarse_section(study.ring_count)
+    coarse = coarse_section(study.ring_count, study.curved)
     fresh = solve_level(coarse, 0, study)
     stale = f"{study.name}: level 0 moved, so the recorded levels are stale: run `make study STUDY={study.name}`"
     np.testing.assert_allclose([fresh["kappa_per_mm"], fresh["phi_error_rad"]],

@@ -52,17 +52,40 @@ def test_with_round_chambers_one_refinement_moves_the_threaded_curvature_little(
     # stiffness against the hourglass mode costs 0.4 %).  With the centroid alone the change under one refinement fell
     # with the chamber's polygon (8 nodes -3.19 %, 16 -2.36 %, 32 -1.78 %), grew when the lattice or the layers alone
     # were finer (2 mm across -4.74 %, 4.25 mm layers -4.06 %, both with octagons), and a near-hoop winding of the
-    # same stiffness (pitch 0.05 mm) gave -3.04 % on octagons: what converges slowly is, most likely, the stiff thread
-    # on a polygon, whose corners it pulls in as a cable (a line load that finer elements resolve ever more sharply),
-    # not the helix, the rule or the element size.  Red refinement keeps the coarse polygon, so only the coarse mesh's
-    # chamber nodes help.
+    # same stiffness (pitch 0.05 mm) gave -3.04 % on octagons.
+    # What the polygon costs is its straight facets (the next test: curved walls), not its area: an octagon of the
+    # circle's area (nodes on r sqrt(h / sin h), the pipeline's sections') gave 6.86512e-4 -> 6.64899e-4, -3.15 %,
+    # as the inscribed one.  With curved walls the refined level is the same whatever the ring (8, 16, 32 nodes:
+    # 7.03747e-4, 7.04127e-4, 7.03763e-4, within 0.06 %) but level 0 is not (7.14264e-4, 7.19066e-4, 7.19495e-4):
+    # -1.47 %, -2.08 %, -2.19 %.  What is left with 32 nodes is level 0's elements: the 32-node ring's fan of
+    # triangles into the 4 mm lattice (smallest quality 4 sqrt(3) A / sum l^2 0.09, median 0.15; the octagon's
+    # 0.35 and 0.67), which red refinement keeps in shape; with a 2 mm lattice (smallest 0.13, median 0.17) the
+    # curved 32-node section moved -1.65 % (octagons -0.93 %).
     assert -ROUND_CHAMBER_GUARD < _round_chamber_change() < 0.0
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="issue 42's 2 % under one refinement is not met with the stabilised thread "
-                                       "rule: -2.19 % with 32 nodes round each chamber (48 nodes took over 11 "
-                                       "minutes of CPU and was stopped)")
+@pytest.mark.xfail(strict=True, reason="issue 42's 2 % under one refinement is not met with 32 straight wall nodes "
+                                       "round each chamber: -2.19 % (curved walls give -2.19 % on this mesh too: "
+                                       "its level 0's elements, see the test above; the octagons' curved walls "
+                                       "meet it, the next test)")
 def test_with_round_chambers_one_refinement_moves_the_threaded_curvature_by_less_than_two_percent() -> None:
     # the same level 0 solve as the test above, and the same record
     assert abs(_round_chamber_change()) < REFINEMENT_RTOL
+
+
+@pytest.mark.slow
+def test_with_curved_chamber_walls_one_refinement_moves_the_threaded_curvature_by_less_than_two_percent() -> None:
+    # about 1 s of CPU (level 0; levels 1 and 2, 13 s and 11 minutes of CPU, recorded by `make study`).  Issue 42's
+    # known answer "with reinforcement, curvature changes less than 2 % under one nested refinement" on the
+    # recorded study's default-like mesh (octagons, 4 mm across, 8.5 mm layers, the sample case's thread), its
+    # chambers' walls on their circles (softdesign.mechanics.curved_walls) and refined through the curved elements'
+    # maps, so that every level has the same round chambers.  Measured: 7.14264e-4, 7.03747e-4, 7.02614e-4 1/mm:
+    # -1.47 % and -0.16 %, observed order 3.2 (Richardson 7.0248e-4).  With straight octagons the same mesh gave
+    # -3.10 % and -3.78 % with no asymptotic range (the first test).  On the pipeline's own section at the simulate
+    # command's mesh (tests/mechanics/test_section_symmetry.py's, 5 kPa, its thread), one refinement moved the
+    # curvature by -3.83 % with its straight octagons of the circles' area and -0.45 % with curved walls.
+    kappas, phi_errors = study.checked_levels(study.THREADED_CURVED)
+    changes = kappas[1:] / kappas[:-1] - 1
+    assert np.all(np.abs(changes) < REFINEMENT_RTOL)
+    assert phi_errors.max() < np.deg2rad(0.5)
