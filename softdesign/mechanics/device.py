@@ -40,7 +40,7 @@ from softdesign.mechanics.embedded_thread import thread_fibres
 from softdesign.mechanics.linear_solve import TangentSolver
 from softdesign.mechanics.load_steps import stepped_from_rest
 from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord, SolveStopped, solve_pressures
-from softdesign.mechanics.quadratic import QuadraticMesh, shape_values
+from softdesign.mechanics.quadratic import QuadraticMesh, curved_barycentric, shape_values
 from softdesign.mechanics.reinforcement import HoopThread
 from softdesign.mechanics.section import SectionMesh, locate, section_problem
 from softdesign.mechanics.tets import make_tet_mesh
@@ -81,8 +81,9 @@ def placed_section(section: SectionMesh, origin: FloatArray, frame: FloatArray) 
     ``origin`` (3,) mm, ``frame`` (3, 3) columns (N, B, T) of the section's base frame in the device's frame.
     """
     origin, frame = np.asarray(origin, float), np.asarray(frame, float)
+    curved = None if section.curved_midpoints is None else origin + section.curved_midpoints @ frame.T
     return replace(section, points=origin + section.points @ frame.T,
-                   centerline=origin + section.centerline @ frame.T)
+                   centerline=origin + section.centerline @ frame.T, curved_midpoints=curved)
 
 
 @dataclass(frozen=True)
@@ -161,8 +162,19 @@ def assemble_device(parts: Sequence[DevicePart]) -> DeviceMesh:
         face_feed=np.concatenate([m.face_feed + feeds[i] for i, m in enumerate(meshes) if m.feed_count])
         if feed_faces else None,
         feed_radii_mm=np.concatenate([m.feed_radii_mm for m in meshes if m.feed_count]) if feed_faces else None,
+        **_curved_parts(meshes, nodes),
     )
     return DeviceMesh(whole, tuple(parts), nodes, tets, chambers, feeds)
+
+
+def _curved_parts(meshes: Sequence[SectionMesh], nodes: IntArray) -> dict[str, np.ndarray | None]:
+    """The sections' curved chamber-wall edges (their corners numbered in the whole mesh) and their midside nodes'
+    positions (:mod:`softdesign.mechanics.curved_walls`), or None for both when every edge is straight."""
+    edges = [m.curved_edges + nodes[i] for i, m in enumerate(meshes) if m.curved_edges is not None]
+    if not edges:
+        return {"curved_edges": None, "curved_midpoints": None}
+    midpoints = [np.asarray(m.curved_midpoints, float) for m in meshes if m.curved_edges is not None]
+    return {"curved_edges": np.concatenate(edges), "curved_midpoints": np.concatenate(midpoints)}
 
 
 def _length(line: FloatArray) -> float:
@@ -238,14 +250,17 @@ class Located:
     weights: tuple[FloatArray, ...]
 
 
-def locate_samples(device: DeviceMesh) -> Located:
-    """Each section's centerline samples located in its own elements (MeshError: a sample outside the material)."""
+def locate_samples(device: DeviceMesh, mesh: QuadraticMesh | None = None) -> Located:
+    """Each section's centerline samples located in its own elements (MeshError: a sample outside the material);
+    in curved elements where ``mesh`` (the whole device's quadratic mesh) maps them, when it has any."""
     elements, weights = [], []
     for i, part in enumerate(device.parts):
         tets = make_tet_mesh(part.mesh.points, part.mesh.tets)
         found = [locate(tets, part.samples[k:k + LOCATE_BATCH]) for k in range(0, len(part.samples), LOCATE_BATCH)]
         elements.append(np.concatenate([e for e, _ in found]) + device.tet_start[i])
         weights.append(np.concatenate([w for _, w in found]))
+        if mesh is not None and mesh.curved_volumes is not None:
+            weights[-1] = curved_barycentric(mesh, elements[-1], weights[-1], part.samples)
     return Located(tuple(elements), tuple(weights))
 
 
@@ -304,7 +319,8 @@ def solve_device(device: DeviceMesh, law: HyperelasticLaw, pressures: FloatArray
     if feeds.shape != (device.feed_count,):
         raise ValueError(f"expected {device.feed_count} feed pressures, got shape {feeds.shape}")
     problem, ties, hoops = device_problem(device, law, thread, backbone)
-    located = locate_samples(device)
+    assert isinstance(problem.mesh, QuadraticMesh)
+    located = locate_samples(device, problem.mesh)
     every = np.concatenate([pressures, feeds])
     settings = stepped_from_rest(replace(settings, atol=max(settings.atol, roundoff_floor_mn(problem))),
                                  float(np.abs(every).max()), law.mu_kpa)
