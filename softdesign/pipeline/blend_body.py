@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from softdesign.errors import FitError
-from softdesign.fitting.morph_folds import MorphFold, fold_over_morph
+from softdesign.fitting.morph_folds import MorphFold, fold_over_morph_from, morph_grid
 from softdesign.fitting.radius_field import RadiusField
 from softdesign.fitting.selection import NetworkContext, inscribed_profile
 from softdesign.fitting.wall_fit import fit_body
@@ -69,12 +69,21 @@ def body_field(case: Case, ingest: IngestResult, shape: BlendedShape) -> RadiusF
 
 
 def body_morph(shape: BlendedShape, field: RadiusField) -> MorphFold:
-    """The largest rho(q) * kappa_n(q) of the body over ``shape``'s morph (the fit stage's q grid)."""
-    # on the build's workers, as the fit stage's: each q's curve and fold margin are their own (the same CPU in a
-    # worker as here: the blend's shape is rebuilt after, so no later stage finds the curves built here either);
-    # on a busy machine (load 5) the workers waited on the other jobs and took longer, on free cores they halve
-    # the stage's largest step
-    return fold_over_morph(shape.curve_at, field, morph_q_grid(), map_items)
+    """The largest rho(q) * kappa_n(q) of the body over ``shape``'s morph (the fit stage's q grid).
+
+    Each q's curve and fold margin are their own, on the build's workers (on free cores they halve the stage's
+    largest step); the curves come back with the reports and are kept on ``shape``
+    (:meth:`~softdesign.geometry.blend.BlendedShape.keep_curve`), so that a stage that builds on this very shape
+    (the blend stage keeps the one it judged, :func:`softdesign.pipeline.blend_choice.choose_blend`) finds them
+    built: the kinematics' export q are this grid's.  The same reports as
+    :func:`~softdesign.fitting.morph_folds.fold_over_morph`.
+    """
+    q_grid = morph_q_grid()
+    task, items = morph_grid(shape.curve_at, field, q_grid)
+    done = map_items(lambda q: (task(q), shape.curve_at(float(q))), items)
+    for q, (_, curve) in zip(items, done, strict=True):
+        shape.keep_curve(q, curve)
+    return fold_over_morph_from(shape.curve_at, field, q_grid, [report for report, _ in done])
 
 
 def body_folds(fold: MorphFold) -> bool:
