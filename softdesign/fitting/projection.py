@@ -73,7 +73,8 @@ class PolarPoints:
         return PolarPoints(self.points[mask], self.l[mask], self.angle[mask], self.rho[mask], self.end_side[mask])
 
 
-def project_points(curve: FramedCurve, points: npt.ArrayLike, mapper: Mapper = serial_map) -> PolarPoints:
+def project_points(curve: FramedCurve, points: npt.ArrayLike, mapper: Mapper = serial_map,
+                   known: tuple[slice, PolarPoints] | None = None) -> PolarPoints:
     """Foot point, angle and distance of every point on a framed centerline.
 
     Parameters
@@ -82,6 +83,9 @@ def project_points(curve: FramedCurve, points: npt.ArrayLike, mapper: Mapper = s
     points : (n, 3) float, mm
     mapper : runs the blocks of at most ``PROJECT_BLOCK`` points above ``SPLIT_POINTS`` (each point's projection
         is its own), perhaps on other processes; the same numbers for any, and for any block size
+    known : the rows of ``points`` (a slice) already projected on this very curve, and their projection (e.g. the
+        blend's look at the body, every fifth vertex): only the others are projected here, and each point's
+        projection being its own, the result is the same
 
     Returns
     -------
@@ -98,12 +102,38 @@ def project_points(curve: FramedCurve, points: npt.ArrayLike, mapper: Mapper = s
             f"surface points: expected an (n, 3) array of finite mm coordinates, got shape {points.shape}; "
             "check the surface file"
         )
+    if known is not None:
+        return _with_known(curve, points, mapper, *known)
     if len(points) <= SPLIT_POINTS:
         return PolarPoints(points.copy(), *_polar(curve, points))
-    blocks = bb.chunks(len(points), min(PROJECT_BLOCK, -(-len(points) // 2)))
-    parts = mapper(lambda rows: _polar(curve, points[rows]), blocks)
+    parts = mapper(lambda rows: _polar(curve, points[rows]), even_blocks(len(points)))
     l, angle, rho, side = (np.concatenate([part[k] for part in parts]) for k in range(4))
     return PolarPoints(points.copy(), l, angle, rho, side)
+
+
+def even_blocks(count: int) -> list[slice]:
+    """``count`` rows in an even number of blocks of at most ``PROJECT_BLOCK`` rows, of equal size but the last:
+    two processes share them evenly (500k rows: 4 of 125k, where blocks of ``PROJECT_BLOCK`` left one worker 262k
+    and the other 238k)."""
+    pairs = -(-count // (2 * PROJECT_BLOCK))
+    return bb.chunks(count, -(-count // (2 * pairs)))
+
+
+def _with_known(curve: FramedCurve, points: Points, mapper: Mapper, rows: slice, polar: PolarPoints) -> PolarPoints:
+    """:func:`project_points` of ``points`` (n, 3) mm whose ``rows`` are projected already (``polar``)."""
+    todo = np.ones(len(points), bool)
+    todo[rows] = False
+    rest = np.flatnonzero(todo)
+    found = project_points(curve, points[rest], mapper) if len(rest) else None
+    out = []
+    for name in ("l", "angle", "rho", "end_side"):
+        kept = getattr(polar, name)
+        merged = np.empty(len(points), kept.dtype)
+        merged[rows] = kept
+        if found is not None:
+            merged[rest] = getattr(found, name)
+        out.append(merged)
+    return PolarPoints(points.copy(), *out)
 
 
 def _polar(curve: FramedCurve, points: Points) -> tuple[FloatArray, FloatArray, FloatArray, npt.NDArray[np.int8]]:

@@ -83,6 +83,8 @@ class WallFitOptions:
     with_field : more work on the fitted radius field, ``field -> (task, items)`` (each item its own), run in the
         hold-out's call of the mapper, where its items keep a worker busy while the folds' last fits run; its
         results, in the order of its items, are ``WallFit.field_results`` (None: no such work)
+    known_projection : rows of the vertices (a slice) already projected on the curve fitted around, and their
+        projection (:func:`~softdesign.fitting.projection.project_points`' ``known``): not projected again
     """
 
     fit: FitSettings = field(default_factory=FitSettings)
@@ -98,6 +100,7 @@ class WallFitOptions:
     progress: Callable[[str], None] | None = None
     fit_points: int = MAX_FIT_POINTS
     with_field: Callable[[RadiusField], Job] | None = None
+    known_projection: tuple[slice, PolarPoints] | None = None
 
 
 @dataclass(frozen=True)
@@ -170,15 +173,17 @@ def _fit_kept(curve: FramedCurve, kept: PolarPoints, options: WallFitOptions,
     return settings, scores, prior, surface
 
 
-def fit_body(curve: FramedCurve, vertices: npt.ArrayLike, network: NetworkContext, options: WallFitOptions
-             ) -> RadiusField:
+def fit_body(curve: FramedCurve, vertices: npt.ArrayLike, network: NetworkContext, options: WallFitOptions,
+             polar: PolarPoints | None = None) -> RadiusField:
     """The radius field alone, as :func:`fit_wall` fits it, for a quick look at the body before the fit stage.
 
     The same projection, selection, end margin, end prior, caps and end hold; no hold-out (``auto_spacing``
     keeps the settings' spacing), no metrics, no fold check (the caller judges the body).  ``blend: auto``
-    judges its morph on it (:mod:`softdesign.pipeline.blend_body`).
+    judges its morph on it (:mod:`softdesign.pipeline.blend_body`).  ``polar``: the vertices' projection on
+    ``curve`` when the caller has it (:func:`~softdesign.fitting.projection.project_points`).
     """
-    polar = project_points(curve, vertices, options.mapper)
+    if polar is None:
+        polar = project_points(curve, vertices, options.mapper)
     selection = select_wall_points(polar, curve.length, network, options.selection)
     kept_index = np.flatnonzero(selection.keep)
     kept = polar.subset(kept_index[np.argsort(polar.l[kept_index], kind="stable")])
@@ -218,7 +223,7 @@ def fit_wall(
         The wall does not surround the path, the solve fails, or the tube folds at q = 1.
     """
     tell = options.progress or (lambda name: None)
-    polar = project_points(curve, vertices, options.mapper)
+    polar = project_points(curve, vertices, options.mapper, options.known_projection)
     tell("projection")
     selection = select_wall_points(polar, curve.length, network, options.selection)
     tell("selection")

@@ -120,6 +120,8 @@ class BlendedShape:
     _smooth: dict[float, SmoothCurve] = field(default_factory=dict, repr=False, compare=False)
     _framed: dict[float, FramedSpline] = field(default_factory=dict, repr=False, compare=False)
     _targets: dict[str, FramedSpline] = field(default_factory=dict, repr=False, compare=False)
+    #: work a stage did on this shape that a later stage may take instead of doing it again (:meth:`keep`)
+    _kept: dict[str, object] = field(default_factory=dict, repr=False, compare=False)
 
     def smooth_curve_at(self, q: float) -> SmoothCurve:
         """The centerline c(q, .) as a :class:`SmoothCurve` (no frames)."""
@@ -174,6 +176,15 @@ class BlendedShape:
         q = float(q)
         self._framed.setdefault(q, framed)
         self._smooth.setdefault(q, self._framed[q].curve)
+
+    def keep(self, name: str, value: object) -> None:
+        """Keep ``value``, work done on this shape (e.g. the blend's projection of the wall on its q = 1 curve), for a
+        later stage of this build to take (:meth:`take`); the shape's own figures do not depend on it."""
+        self._kept[name] = value
+
+    def take(self, name: str) -> object | None:
+        """The value kept as ``name`` (:meth:`keep`), once: it is dropped here; None when none was kept."""
+        return self._kept.pop(name, None)
 
     def stats_at(self, q: float, l_range: tuple[float, float] = (0.0, 1.0)) -> BlendStats:
         """Length, stretch range and curvature range at q over ``l_range`` (dense grid)."""

@@ -44,6 +44,9 @@ class BlendChoice:
     warning: str | None = None
     #: ``auto``'s look at the fitted body over each blend's morph, when it switched on it
     body_morph: dict[str, Any] | None = None
+    #: the shape ``auto`` judged on the body (``shape`` rebuilt by :func:`choose_blend`'s ``rebuild``), with the
+    #: curves of the morph's q grid built; None when no body was judged
+    judged: BlendedShape | None = None
 
     def summary(self) -> dict[str, Any]:
         """The blend summary's extra keys: ``requested``, ``morph`` (reach figures), ``choice`` (text)."""
@@ -63,13 +66,16 @@ def choose_blend(
     frames: FrameMode,
     path: SelectedPath,
     body: Callable[[BlendedShape], RadiusField | None] | None = None,
+    rebuild: Callable[[BlendedShape], BlendedShape] | None = None,
 ) -> BlendChoice:
     """Build the blend ``requested`` ("auto", "linear" or "intrinsic") and check its morph for folds.
 
     A q = 1 centerline that turns tighter than the inscribed radius gives a warning, not a refusal: the
     fitted wall, not the inscribed sphere, decides whether the body folds.  ``body`` gives the wall fitted
     around a shape's q = 1 centerline (:func:`softdesign.pipeline.blend_body.body_field`): ``auto`` judges
-    the linear blend's body over the morph on it, and switches to intrinsic when it folds.
+    the linear blend's body over the morph on it, and switches to intrinsic when it folds.  ``rebuild`` gives the
+    shape the build keeps for a blended shape (the blend stage's, from its key curves' samples): the body is
+    judged on that one, returned as ``judged`` with its morph's curves built (None: on the shape as blended).
     """
     mode: BlendMode = "intrinsic" if requested == "intrinsic" else "linear"
     shape = blend_shapes(initial, final, keyframes, mode, frames)
@@ -90,28 +96,33 @@ def choose_blend(
         fold = morph_reach(intrinsic, *profile)
         why = f"intrinsic (auto: the linear blend {_fold_text(reach)}; intrinsic: {_figure(fold)})"
         return BlendChoice(intrinsic, requested, fold, reach, why, tight)
+    judged = None
     if requested == "auto" and body is not None:
-        switched = _judged_on_body(shape, body, (initial, final, keyframes, frames), profile, reach, tight)
+        rebuilt = rebuild or (lambda blended: blended)
+        judged = rebuilt(shape)
+        switched = _judged_on_body(judged, body, (initial, final, keyframes, frames, rebuilt), profile, reach, tight)
         if switched is not None:
             return switched
     why = "asked for" if requested == mode else "the linear blend does not fold"
-    return BlendChoice(shape, requested, reach, None, f"linear ({why}: {figure})", tight)
+    return BlendChoice(shape, requested, reach, None, f"linear ({why}: {figure})", tight, judged=judged)
 
 
-def _judged_on_body(shape: BlendedShape, body: Callable[[BlendedShape], RadiusField | None], ends: tuple[Any, ...],
-                    profile: tuple[Any, Any] | None, reach: MorphReach | None, tight: str | None
-                    ) -> BlendChoice | None:
+def _judged_on_body(judged: BlendedShape, body: Callable[[BlendedShape], RadiusField | None],
+                    ends: tuple[Any, ...], profile: tuple[Any, Any] | None, reach: MorphReach | None,
+                    tight: str | None) -> BlendChoice | None:
     """``auto``: the intrinsic blend when the linear blend's fitted body folds mid-morph and the intrinsic one's
-    folds less; else None (linear stays, with the body's figures in its summary)."""
-    field = body(shape)
+    folds less; else None (linear stays).  ``judged`` is the linear blend as the build keeps it, ``ends`` the key
+    curves, the frames and the rebuild that gave it."""
+    field = body(judged)
     if field is None:
         return None
-    linear = body_morph(shape, field)
+    linear = body_morph(judged, field)
     if not body_folds(linear):
         return None
-    initial, final, keyframes, frames = ends
+    initial, final, keyframes, frames, rebuilt = ends
     intrinsic = blend_shapes(initial, final, keyframes, "intrinsic", frames)
-    fold = body_morph(intrinsic, field)
+    kept = rebuilt(intrinsic)
+    fold = body_morph(kept, field)
     if fold.report.max_rho_kappa >= linear.report.max_rho_kappa:
         return None
     r = linear.report
@@ -120,7 +131,7 @@ def _judged_on_body(shape: BlendedShape, body: Callable[[BlendedShape], RadiusFi
            f"largest rho * kappa {fold.report.max_rho_kappa:.3f} at q = {fold.q:.3f})")
     intrinsic_reach = None if profile is None else morph_reach(intrinsic, *profile)
     return BlendChoice(intrinsic, "auto", intrinsic_reach, reach, why, tight,
-                       {"linear": linear.as_dict(), "intrinsic": fold.as_dict()})
+                       {"linear": linear.as_dict(), "intrinsic": fold.as_dict()}, kept)
 
 
 def pcc_choice(shape: BlendedShape, path: SelectedPath, design: dict[str, Any]) -> dict[str, Any]:

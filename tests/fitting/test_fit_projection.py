@@ -75,7 +75,8 @@ def test_blocks_on_worker_processes_give_the_same_bits(monkeypatch):
     whole = project_points(curve, points)
     monkeypatch.setattr(projection, "SPLIT_POINTS", 200)
     mapper, blocks = two_worker_mapper()
-    for block, count in ((300, 7), (1500, 2)):  # blocks of PROJECT_BLOCK, or halves below twice that
+    # an even number of equal blocks of at most PROJECT_BLOCK (2000 points: 8 of 250), or halves below twice that
+    for block, count in ((300, 8), (1500, 2)):
         monkeypatch.setattr(projection, "PROJECT_BLOCK", block)
         split = project_points(curve, points, mapper)
         assert blocks[-1] == count

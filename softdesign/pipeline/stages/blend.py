@@ -49,7 +49,9 @@ if TYPE_CHECKING:  # only annotations: the report loads stage results without th
 #: 9: ``blend: pcc`` keeps the samples its target curve was built from (it kept that curve's own points, which
 #:    differ by round-off, so a loaded blend was not the one built and later stages wrote other bytes); the
 #:    body's morph check on the q grid i / 40 (morph_q_grid: the last bit of 15 of its 41 q).
-VERSION = 9
+#: 10: ``blend: auto`` judges the body on the shape the stage keeps (rebuilt from the samples, as load_blend
+#:     rebuilds it; its figures move by round-off, 1e-13), and keeps that shape with the morph's curves built.
+VERSION = 10
 
 
 @dataclass(frozen=True)
@@ -92,15 +94,26 @@ def run_blend(case: Case, ingest: IngestResult, design: DesignResult | None = No
         (q, initial_shape_from_polyline(final, p.points, same_grid, case.initial.align_base))
         for q, p in ingest.keyframes
     )
-    choice = choose_blend(initial, final, keyframes, case.blend, case.frames, ingest.path,
-                          body=lambda shape: body_field(case, ingest, shape))
     # the shape rebuilt from the samples the folder keeps, as load_blend rebuilds it: the splines through them equal
     # the smoothed ones to round-off (1e-13 mm), not to the bit, and the stages after this one must get the same
-    # shape whether the blend ran now or was loaded, or a stage re-run on cached results writes other bytes
-    samples = tuple(curve.points(curve.l_grid) for curve in choice.shape.keys)
+    # shape whether the blend ran now or was loaded, or a stage re-run on cached results writes other bytes.
+    # ``auto`` judges the body on that rebuilt shape, and the stage keeps the one it judged: the morph's curves
+    # built for the judgement are the export q's (the kinematics finds them built)
     joints = final.joints
-    shape = _shape_from_samples(choice.shape.key_q, samples, choice.shape.mode, choice.shape.frames, joints)
+
+    def rebuilt(shape: BlendedShape) -> BlendedShape:
+        return _shape_from_samples(shape.key_q, _samples(shape), shape.mode, shape.frames, joints)
+
+    choice = choose_blend(initial, final, keyframes, case.blend, case.frames, ingest.path,
+                          body=lambda shape: body_field(case, ingest, shape), rebuild=rebuilt)
+    samples = _samples(choice.shape)
+    shape = choice.judged if choice.judged is not None else rebuilt(choice.shape)
     return BlendResult(shape, {**_summary(case, shape), **choice.summary()}, samples, joints)
+
+
+def _samples(shape: BlendedShape) -> tuple[np.ndarray, ...]:
+    """The key curves' samples (the points each curve was built through, on its own l grid): what the folder keeps."""
+    return tuple(curve.points(curve.l_grid) for curve in shape.keys)
 
 
 def pcc_shape(final: SmoothCurve, design: DesignResult, frames: FrameMode) -> BlendedShape:

@@ -35,6 +35,7 @@ from softdesign.kinematics.links import LinkChain
 from softdesign.meshing.mould.frame import parting_frame
 from softdesign.pipeline import layout
 from softdesign.pipeline.backbone_step import describe_backbone_fit, stretch_fit_errors
+from softdesign.pipeline.blend_body import known_projection
 from softdesign.pipeline.fit_options import wall_fit_options
 from softdesign.pipeline.fold_paths import with_avoiding_paths
 from softdesign.pipeline.item_progress import step_counter
@@ -105,6 +106,8 @@ def run_fit(case: Case, ingest: IngestResult, links: LinksResult) -> FitResult:
     q_grid = morph_q_grid()
     if ingest.initial_surface is None:  # the body is the wall's field: its morph's grid joins the hold-out's pool
         options = replace(options, with_field=lambda field: _morph_job(chain, field, q_grid))
+    # the rows blend: auto's look at the body projected on this curve are not projected again
+    options = replace(options, known_projection=known_projection(chain.shape, ingest.vertices, curve))
     problems = check_caps_on_path(options.local_caps, curve.length)
     if problems:
         raise ConfigError(f"{problems[0]}; move or remove that entry")

@@ -116,9 +116,11 @@ def shape_figures(chain: LinkChain, q: float) -> dict[str, Any]:
     }
 
 
-def _at_q(chain: LinkChain, q: float) -> tuple[dict[str, Any], dict[str, Any], FramedSpline]:
-    """The shape's figures and the pose at q, and the framed curve built for them (to keep in the build process)."""
-    return shape_figures(chain, q), pose_document(chain, q), chain.shape.curve_at(q)
+def _at_q(chain: LinkChain, q: float, built: bool = False
+          ) -> tuple[dict[str, Any], dict[str, Any], FramedSpline | None]:
+    """The shape's figures and the pose at q, and the framed curve built for them (to keep in the build process;
+    None when ``built``: the build process has it already)."""
+    return shape_figures(chain, q), pose_document(chain, q), None if built else chain.shape.curve_at(q)
 
 
 def run_kinematics(case: Case, links: LinksResult, design: DesignResult | None = None) -> KinematicsResult:
@@ -128,9 +130,11 @@ def run_kinematics(case: Case, links: LinksResult, design: DesignResult | None =
     """
     chain = links.chain
     q_values = case.export.q_values()
-    per_q = map_per_q(lambda q: _at_q(chain, q), q_values)
+    built = {q for q in q_values if chain.shape.built_curve(q) is not None}  # the blend's judgement of the body
+    per_q = map_per_q(lambda q: _at_q(chain, q, q in built), q_values)
     for q, (_, _, curve) in zip(q_values, per_q, strict=True):
-        chain.shape.keep_curve(q, curve)  # export and feasibility then use them, as when built here
+        if curve is not None:
+            chain.shape.keep_curve(q, curve)  # export and feasibility then use them, as when built here
     poses = [pose for _, pose, _ in per_q]
     pcc_design = design if chain.shape.mode == "pcc" else None  # the chain's links are its sections
     if pcc_design is not None:
