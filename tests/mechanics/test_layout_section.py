@@ -60,7 +60,7 @@ def test_section_volume_frame_and_chambers() -> None:
         np.testing.assert_allclose(centre, expected_centre, atol=0.05)
 
 
-#: Curved chamber walls (the default): each side wall is a quadratic through its circle's points, short of the
+#: Curved chamber walls (``curved_walls=True``): each side wall is a quadratic through its circle's points, short of the
 #: circle's area by 0.08 % with 8 nodes round it (a parabola's segment against the arc's), so the cavities hold
 #: the designed cylinders to this share of their volume.
 CURVED_CAVITY_RTOL = 1e-3

@@ -47,7 +47,7 @@ def _layout(distances: tuple[float, float], diameters: tuple[float, float]) -> t
     return replace(layout, chambers=(replace(c, profile=profile),)), curve0
 
 
-def _mesh(distances: tuple[float, float], diameters: tuple[float, float], curved_walls: bool = True
+def _mesh(distances: tuple[float, float], diameters: tuple[float, float], curved_walls: bool = False
           ) -> tuple[SectionMesh, ChamberLayout]:
     layout, curve0 = _layout(distances, diameters)
     section = layout_section_mesh(curve0, _constant_field(RADIUS_MM, RADIUS_MM), BodySpec(), layout, 0,
@@ -56,7 +56,7 @@ def _mesh(distances: tuple[float, float], diameters: tuple[float, float], curved
 
 
 def test_a_tapered_chamber_is_meshed_as_designed() -> None:
-    # straight polygons of the circles' area: the cavity is the designed frustum to rounding
+    # straight polygons of the circles' area (the default): the cavity is the designed frustum to rounding
     section, layout = _mesh(DISTANCE_ENDS, DIAMETER_ENDS, curved_walls=False)
     check_section(section)  # every element positive
     chamber = layout.chambers[0]
@@ -76,8 +76,8 @@ def test_a_tapered_chamber_is_meshed_as_designed() -> None:
 
 
 def test_a_tapered_chambers_curved_wall_is_on_its_designed_circles() -> None:
-    # the default: every layer's wall nodes, corners and side walls' midside nodes, on the circle of d(l), r(l)
-    section, layout = _mesh(DISTANCE_ENDS, DIAMETER_ENDS)
+    # curved walls: every layer's wall nodes, corners and side walls' midside nodes, on the circle of d(l), r(l)
+    section, layout = _mesh(DISTANCE_ENDS, DIAMETER_ENDS, curved_walls=True)
     assert section.curved_edges is not None and section.curved_midpoints is not None
     chamber = layout.chambers[0]
     z0, z1 = chamber.l_start * LENGTH_MM, chamber.l_end * LENGTH_MM
