@@ -35,8 +35,9 @@ MIN_SAMPLES = 9
 
 
 def device_parts(curve0: FramedSpline, field: object, spec: BodySpec, layout: ChamberLayout, size_mm: float,
-                 angular_count: int, layer_mm: float) -> list[DevicePart]:
-    """Every section of ``layout`` meshed (feeds that cross it as cavities) and placed on ``curve0``.
+                 angular_count: int, layer_mm: float, curved_walls: bool = False) -> list[DevicePart]:
+    """Every section of ``layout`` meshed (feeds that cross it as cavities) and placed on ``curve0``;
+    ``curved_walls``: the chambers' side walls curved onto their circles (:mod:`softdesign.mechanics.curved_walls`).
 
     Raises
     ------
@@ -49,10 +50,10 @@ def device_parts(curve0: FramedSpline, field: object, spec: BodySpec, layout: Ch
         notes: tuple[str, ...] = ()
         try:
             local = layout_section_mesh(curve0, field, spec, layout, i, size_mm, angular_count, layer_mm,
-                                        feeds=bool(layout.feeds_through(i)))
+                                        feeds=bool(layout.feeds_through(i)), curved_walls=curved_walls)
         except TaperError as err:  # meshed as a cylinder of its middle values, and the answer says so
             local = layout_section_mesh(curve0, field, spec, layout, i, size_mm, angular_count, layer_mm,
-                                        feeds=bool(layout.feeds_through(i)), taper=False)
+                                        feeds=bool(layout.feeds_through(i)), taper=False, curved_walls=curved_walls)
             notes = (f"a taper the mesh cannot follow ({err}): that chamber is meshed as a cylinder of its middle "
                      "distance and diameter",)
         origin, frames = curve0.points([l0])[0], curve0.frames([l0, l1])

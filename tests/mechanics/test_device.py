@@ -51,7 +51,7 @@ GAP_TOL_MM = 1e-4
 
 
 @functools.cache
-def straight_device(sections: int) -> DeviceMesh:
+def straight_device(sections: int, curved_walls: bool = False) -> DeviceMesh:
     """``sections`` sections of a straight body, the supply's feed left out (as ``supply: single``'s series)."""
     length = sections * SECTION_MM
     s = np.linspace(0.0, length, 801)
@@ -62,7 +62,7 @@ def straight_device(sections: int) -> DeviceMesh:
     layout = plan_layout(SPEC, tuple(np.linspace(0.0, 1.0, sections + 1)), l, curve0.curve.arc_length(l))
     layout = replace(layout, feeds=())
     return assemble_device(device_parts(curve0, _constant_field(RADIUS_MM, RADIUS_MM), BodySpec(), layout,
-                                        SIZE_MM, ANGULAR, LAYER_MM))
+                                        SIZE_MM, ANGULAR, LAYER_MM, curved_walls))
 
 
 @functools.cache
@@ -130,3 +130,46 @@ def test_a_device_that_stops_keeps_its_last_equilibrium_and_says_where() -> None
     assert f"load factor {held.load_factor:.4g}" in held.stopped_because
     figures = measure_device(held)  # measured where it stopped: bent away from its chamber, the tip moved
     assert figures.arcs[0].kappa > 0.0 and np.linalg.norm(figures.tip_frame[:3, 3] - [0, 0, SECTION_MM]) > 0.0
+
+
+#: Curved walls' midside nodes on their chambers' circles and the centerline samples' places under the curved
+#: maps: both exact but for rounding, mm.
+CURVED_TOL_MM = 1e-9
+
+
+def test_a_device_of_curved_sections_keeps_their_walls_curved_in_its_frame() -> None:
+    from softdesign.mechanics.device import carried_samples, device_problem, locate_samples
+    from softdesign.mechanics.quadratic import QuadraticMesh
+
+    device = straight_device(2, curved_walls=True)
+    whole = device.whole
+    assert whole.curved_edges is not None and whole.curved_midpoints is not None
+    counts = [len(np.asarray(p.mesh.curved_edges)) for p in device.parts]
+    assert len(whole.curved_edges) == sum(counts) and min(counts) > 0  # none dropped
+    # each section's chamber: 2.5 mm from the axis at 90 + 180 i degrees, 1 mm round; its side walls' midside
+    # nodes on that circle in the device's frame, and their edges' corners within the same section's nodes
+    starts = np.cumsum([0, *counts])
+    probes = []
+    for i in range(len(device.parts)):
+        edges = whole.curved_edges[starts[i]:starts[i + 1]]
+        midpoints = whole.curved_midpoints[starts[i]:starts[i + 1]]
+        assert np.all((edges >= device.node_start[i]) & (edges < device.node_start[i + 1]))
+        angle = np.deg2rad(90.0 + 180.0 * i)
+        centre = SPEC.distance_mm * np.array([np.cos(angle), np.sin(angle)])
+        np.testing.assert_allclose(np.linalg.norm(midpoints[:, :2] - centre, axis=1), 0.5 * SPEC.diameter_mm,
+                                   rtol=0, atol=CURVED_TOL_MM)
+        assert np.all((midpoints[:, 2] > i * SECTION_MM) & (midpoints[:, 2] < (i + 1) * SECTION_MM))
+        # points in the rubber just outside the chamber's circle, where the curved elements are
+        around = np.linspace(0.0, 2 * np.pi, 16, endpoint=False)
+        ring = centre + 1.15 * 0.5 * SPEC.diameter_mm * np.column_stack([np.cos(around), np.sin(around)])
+        probes.append(np.column_stack([ring, np.full(len(ring), (i + 0.4) * SECTION_MM)]))  # between layers
+    problem, _, _ = device_problem(device, LAW, THREAD)
+    assert isinstance(problem.mesh, QuadraticMesh) and problem.mesh.curved_volumes is not None
+    probed = replace(device, parts=tuple(replace(p, samples=q) for p, q in zip(device.parts, probes, strict=True)))
+    located = locate_samples(probed, problem.mesh)
+    curved = ~np.isclose(problem.mesh.weights.sum(axis=1), problem.mesh.linear.volumes, rtol=1e-12, atol=0)
+    assert all(curved[e].any() for e in located.elements)  # the maps that matter are curved ones
+    # the elements' maps at the located coordinates (the nodes' positions carried from zero) give the points back
+    mapped = carried_samples(problem, located, [np.zeros_like(q) for q in probes], problem.mesh.points)
+    for placed, probe in zip(mapped, probes, strict=True):
+        np.testing.assert_allclose(placed, probe, rtol=0, atol=CURVED_TOL_MM)
