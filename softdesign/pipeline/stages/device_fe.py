@@ -41,7 +41,7 @@ if TYPE_CHECKING:
 VERSION = 7  # 2: area-matched polygons, the backbone thread embedded in the elements; 3: a stop is kept, judged;
 #             4: the thread's stabilised rule, patched ends, the thread's ends in the figures; 5: the thread's
 #             hourglass control a penalty (its tension the centroid's), load steps bounded by length; 6: the
-#             steps before the last converged to DEVICE_PATH_RTOL (the figures move by 1e-7 relative); 7: the
+#             steps before the last converged to 1e-4, load_steps.PATH_RTOL (the figures move by 1e-7 relative); 7: the
 #             first step at most FIRST_STEP_MU shear moduli
 SUMMARY = "simulate/device.json"
 
