@@ -259,7 +259,7 @@ def locate_samples(device: DeviceMesh, mesh: QuadraticMesh | None = None) -> Loc
         found = [locate(tets, part.samples[k:k + LOCATE_BATCH]) for k in range(0, len(part.samples), LOCATE_BATCH)]
         elements.append(np.concatenate([e for e, _ in found]) + device.tet_start[i])
         weights.append(np.concatenate([w for _, w in found]))
-        if mesh is not None and mesh.curved_volumes is not None:
+        if mesh is not None:
             weights[-1] = curved_barycentric(mesh, elements[-1], weights[-1], part.samples)
     return Located(tuple(elements), tuple(weights))
 

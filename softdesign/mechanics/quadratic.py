@@ -224,7 +224,9 @@ def curved_barycentric(mesh: QuadraticMesh, elements: IntArray, bary: FloatArray
     """Barycentric coordinates (n, 4) of reference points ``query`` (n, 3) mm under their ``elements``' (n,)
     quadratic maps, from their straight-element ones ``bary`` (n, 4): Newton's method on ``X(xi) = query``
     (converged to round-off in a few steps where the edges bow little against the element; a straight element's
-    are its own)."""
+    are its own).  A mesh without curved elements gets ``bary`` back as it is."""
+    if mesh.curved_volumes is None:
+        return bary
     nodes = mesh.points[mesh.cells[elements]]  # (n, 10, 3)
     xi = np.array(bary[:, 1:], float)
     for _ in range(iterations):

@@ -260,8 +260,8 @@ def prepare_section(section: SectionMesh, law: HyperelasticLaw, thread: HoopThre
     problem = section_problem(section, law, thread)
     assert isinstance(problem.mesh, QuadraticMesh)
     elements, weights = locate(problem.mesh.linear, section.centerline)
-    if problem.mesh.curved_volumes is not None:  # the centerline's points where the curved elements' maps put them
-        weights = curved_barycentric(problem.mesh, elements, weights, section.centerline)
+    # the centerline's points where curved elements' maps put them (a straight mesh's as located)
+    weights = curved_barycentric(problem.mesh, elements, weights, section.centerline)
     steps = np.linalg.norm(np.diff(section.centerline, axis=0), axis=1)
     fractions = np.concatenate([[0.0], np.cumsum(steps)]) / steps.sum()
     return PreparedSection(section, problem, elements, weights, fractions)
