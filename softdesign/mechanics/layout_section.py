@@ -118,9 +118,10 @@ def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, lay
         of its middle distance and diameter
     curved_walls : the chambers' nodes on their circles and their side walls' midside nodes too
         (:mod:`softdesign.mechanics.curved_walls`: under one refinement the reinforced section's curvature moves
-        -0.45 % at the simulate command's mesh, -3.83 % straight); False (the default): polygons of their circles'
-        area, straight.  Not the default: the sample aorta's whole device, curved, found no equilibrium past 0.30 of
-        its P* (80.8 kPa; straight, it reaches P*), the demo's reaches P* 6.4 mm from the shape (9.3 mm straight)
+        -0.44 % at the simulate command's mesh, -3.83 % straight); False (the default): polygons of their circles'
+        area, straight.  Not the default: the sample aorta's whole device, curved, finds no equilibrium past 0.30 of
+        its P* (79.9 kPa, Newton cycling at its second section's chamber ends; straight, it reaches P*), the
+        demo's reaches P* 6.5 mm from the shape (9.3 mm straight)
 
     Raises
     ------

@@ -172,6 +172,10 @@ def _reference_derivatives(bary: FloatArray) -> FloatArray:
 
 #: ``dN/dxi`` (Q, 10, 3) at the quadrature points, xi the barycentrics 1..3 (the first is 1 - their sum).
 QUAD_DXI = _reference_derivatives(QUAD_POINTS)
+#: The same at the element's ten nodes: a curved map that folds shows ``det(dX/dxi) <= 0`` at a node or a
+#: quadrature point (a fold between them is not ruled out, but a wall's bow folds an element first at its nodes).
+NODE_DXI = _reference_derivatives(np.concatenate([np.eye(4), 0.5 * (np.eye(4)[TET_EDGES[:, 0]]
+                                                                      + np.eye(4)[TET_EDGES[:, 1]])]))
 
 
 def isoparametric_geometry(nodes: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -198,8 +202,9 @@ def _curved(mesh: QuadraticMesh, curved_edges: IntArray, curved_midpoints: Float
     curved = np.flatnonzero(moved[mesh.cells].any(axis=1))
     grads, weights = mesh.grads.copy(), mesh.weights.copy()
     grads[curved], weights[curved] = isoparametric_geometry(points[mesh.cells[curved]])
-    if not np.all(weights[curved] > 0):
-        bad = int(curved[np.argmin(weights[curved].min(axis=1))])
+    at_nodes = np.linalg.det(np.einsum("eai,nak->enik", points[mesh.cells[curved]], NODE_DXI))
+    if not (np.all(weights[curved] > 0) and np.all(at_nodes > 0)):
+        bad = int(curved[np.argmin(np.minimum(weights[curved].min(axis=1), at_nodes.min(axis=1)))])
         raise MeshError(f"curved edges: element {bad}'s curved map folds (a midside node too far off its edge's "
                         "middle for the element's size); curve only edges on a smooth wall, or refine the mesh")
     volumes = mesh.linear.volumes.copy()

@@ -11,13 +11,15 @@ import pytest
 from scipy.spatial import cKDTree
 
 from softdesign.errors import MeshError
-from softdesign.mechanics.curved_walls import round_chamber_walls
+from softdesign.mechanics.curved_walls import on_walls, round_chamber_walls
 from softdesign.mechanics.embedded_thread import embedded_fibres
 from softdesign.mechanics.newton import NewtonSettings
 from softdesign.mechanics.quadratic import (
+    NODE_DXI,
     QUAD_POINTS,
     QuadraticMesh,
     curved_gradients_at,
+    isoparametric_geometry,
     quadratic_force,
     quadratic_force_and_tangent,
     quadratic_mesh,
@@ -27,6 +29,7 @@ from softdesign.mechanics.quadratic import (
 from softdesign.mechanics.refine import refine_section
 from softdesign.mechanics.reinforcement import HoopThread
 from softdesign.mechanics.section import SectionMesh, check_section, prepare_section, section_problem, simulate_section
+from softdesign.mechanics.tets import boundary_faces, make_tet_mesh
 from tests.helpers import refinement_study as study
 from tests.helpers.fe_meshes import symmetric_disc_with_holes, three_chamber_section
 
@@ -117,7 +120,8 @@ def test_curved_elements_reproduce_a_linear_displacement_exactly() -> None:
     state = quadratic_state(mesh, study.LAW, mesh.points @ gradient.T)
     np.testing.assert_allclose(state.F, np.broadcast_to(np.eye(3) + gradient, state.F.shape), rtol=0, atol=ROUND_OFF)
     np.testing.assert_allclose(state.theta, np.linalg.det(np.eye(3) + gradient), rtol=0, atol=ROUND_OFF)
-    assert mesh.curved_volumes is not None and 0 < np.sum(mesh.curved_volumes != mesh.linear.volumes) < len(mesh.cells)
+    # the walls' elements and, through the spread of their bow, the rubber's near them (here every element)
+    assert mesh.curved_volumes is not None and np.sum(mesh.curved_volumes != mesh.linear.volumes) > 0
 
 
 def test_without_curved_edges_the_quadratic_mesh_is_the_straight_one_bit_for_bit() -> None:
@@ -303,3 +307,56 @@ def test_the_curved_sections_tangent_is_the_derivative_of_its_forces() -> None:
         difference = (forces(u + h * direction) - forces(u - h * direction)) / (2 * h)
         exact = K @ direction.ravel()
         assert np.linalg.norm(exact - difference) < TANGENT_RTOL * np.linalg.norm(exact)
+
+
+def test_a_midside_node_past_its_edges_quarter_point_is_refused_as_a_fold() -> None:
+    # the quarter-point element's known answer: a midside node moved along its edge to a quarter of it from a corner
+    # makes det(dX/dxi) = 4 f - 1 vanish at that corner; past it the map folds there, while the four quadrature
+    # points' weights stay positive (so the check at the nodes is what refuses it)
+    linear = make_tet_mesh(np.eye(4, 3, k=-1), np.array([[0, 1, 2, 3]]))
+    assert np.allclose(linear.points, [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    edge = np.array([[0, 1]])
+    kept = quadratic_mesh(linear, edge, np.array([[0.26, 0.0, 0.0]]))
+    assert np.all(kept.weights > 0)
+    nodes = kept.points[kept.cells[0]].copy()
+    nodes[4] = [0.24, 0.0, 0.0]
+    _, weights = isoparametric_geometry(nodes[None])
+    assert np.all(weights > 0)  # at the quadrature points the folded map looks sound
+    with pytest.raises(MeshError, match="folds"):
+        quadratic_mesh(linear, edge, np.array([[0.24, 0.0, 0.0]]))
+
+
+def _smallest_jacobian_share(section: SectionMesh) -> float:
+    """The smallest ``det(dX/dxi)`` at any element's ten nodes over its straight value (6 V)."""
+    linear = check_section(section)
+    mesh = quadratic_mesh(linear, section.curved_edges, section.curved_midpoints)
+    dets = np.linalg.det(np.einsum("eai,nak->enik", mesh.points[mesh.cells], NODE_DXI))
+    return float((dets / (6.0 * linear.volumes[:, None])).min())
+
+
+def test_the_walls_bow_is_spread_into_the_rubber_and_no_element_takes_it_whole() -> None:
+    # the simulate command's own section (tests/mechanics/test_section_symmetry.py's: 2 mm chambers in a 5 mm body,
+    # octagons, 3 mm across, 8 mm layers)
+    from tests.mechanics.test_section_symmetry import SPEC, pipeline_section
+
+    straight = pipeline_section()
+    walls_only, spread = round_chamber_walls(straight, spread=False), round_chamber_walls(straight)
+    assert walls_only.curved_edges is not None and spread.curved_edges is not None
+    assert spread.curved_midpoints is not None and walls_only.curved_midpoints is not None
+    # the walls' own midside nodes are where the walls alone put them; the others are the rubber's, none of them on
+    # a boundary (the skin, the ends, the base and the caps keep their straight edges) and none a corner
+    walls = on_walls(spread)
+    np.testing.assert_array_equal(spread.curved_edges[walls], walls_only.curved_edges)
+    np.testing.assert_array_equal(spread.curved_midpoints[walls], walls_only.curved_midpoints)
+    V = len(straight.points)
+    outside = boundary_faces(np.asarray(straight.tets))
+    keys = np.sort(outside[:, [[0, 1], [1, 2], [2, 0]]].reshape(-1, 2), axis=1) @ np.array([V, 1])
+    inner = np.sort(spread.curved_edges[~walls], axis=1) @ np.array([V, 1])
+    assert len(inner) > 0 and not np.isin(inner, keys).any()
+    # each moved interior midside node stays within the wall's largest bow of its straight place
+    bow = np.linalg.norm(walls_only.curved_midpoints - straight.points[walls_only.curved_edges].mean(axis=1), axis=1)
+    moved = np.linalg.norm(spread.curved_midpoints[~walls] - straight.points[spread.curved_edges[~walls]].mean(axis=1),
+                           axis=1)
+    assert 0 < moved.max() <= bow.max() < 0.25 * SPEC.diameter_mm
+    # and the thinnest curved elements are less bowed: measured 0.465 -> 0.603 of their straight Jacobian
+    assert _smallest_jacobian_share(spread) > _smallest_jacobian_share(walls_only) > 0
