@@ -14,12 +14,16 @@ from __future__ import annotations
 
 import random
 
+import pytest
 from typer.testing import CliRunner
 
 from softdesign.cli import app
 from tests.helpers.paths import DEMO
 
 runner = CliRunner()
+#: Each fuzz runs a few hundred validations: 5-9 s of CPU alone (11-19 s in a loaded make test-fast), so slow
+#: (tests/conftest.py: about a second or more); make test runs them.
+pytestmark = pytest.mark.slow
 
 #: How many case files, and the generator's seed (fixed: the same files every run).
 CASES = 300

@@ -35,13 +35,27 @@ def demo_case(folder: Path, actuation: bool) -> Path:
     return path
 
 
-def test_one_chamber_bends_the_demo_section_away_from_it(tmp_path: Path) -> None:
-    case = demo_case(tmp_path, actuation=True)
-    result = runner.invoke(app, ["simulate", str(case), "--out", str(tmp_path / "build"), "--section", "1",
-                                 "--pressures", "5,0,0", "--size-mm", "4", "--layer-mm", "10", "--timeout", "1800",
-                                 "--json"])
+def coarse_args(case: Path, out: Path) -> list[str]:
+    """The simulate command's arguments for section 1 of ``case`` on the coarse mesh, built into ``out``."""
+    return [str(case), "--out", str(out), "--section", "1", "--size-mm", "4", "--layer-mm", "10", "--timeout", "1800",
+            "--json"]
+
+
+@pytest.fixture(scope="module")
+def forward(tmp_path_factory: pytest.TempPathFactory) -> tuple[list[str], dict]:
+    """The coarse forward solve at 5, 0, 0 kPa, run once for the file: the command's arguments but the pressures
+    (its build folder, which the other runs on the same case reuse: simulate builds through actuation, cached, and
+    writes nothing else there) and its JSON payload.  The bend test checks the payload; the round trip searches its
+    arc back, as it would from a forward run of its own (the same command, the same output)."""
+    folder = tmp_path_factory.mktemp("simulate-demo")
+    common = coarse_args(demo_case(folder, actuation=True), folder / "build")
+    result = runner.invoke(app, ["simulate", *common, "--pressures", "5,0,0"])
     assert result.exit_code == 0, result.output
-    payload = json.loads(result.stdout)
+    return common, json.loads(result.stdout)
+
+
+def test_one_chamber_bends_the_demo_section_away_from_it(forward: tuple[list[str], dict]) -> None:
+    _, payload = forward
     phi = math.degrees(payload["arc"]["phi_rad"])
     assert abs((phi - (90.0 + 180.0) + 180.0) % 360.0 - 180.0) < PHI_TOL_DEG  # chamber 0 lies at 90 deg
     lengths = payload["chamber_lengths_mm"]
@@ -60,13 +74,11 @@ def test_a_case_without_chambers_is_refused(tmp_path: Path) -> None:
     assert "no actuation chambers" in result.output
 
 
-def test_a_target_out_of_reach_within_the_bound_is_said_so_and_exits_1(tmp_path: Path) -> None:
+def test_a_target_out_of_reach_within_the_bound_is_said_so_and_exits_1(forward: tuple[list[str], dict]) -> None:
     # q = 1 asks a bend the rod model gives at hundreds of kPa; within a bound of 1 kPa the search stops at its best,
     # with the chamber the bound holds, and the command exits 1 (not within tolerance) with its figures
-    case = demo_case(tmp_path, actuation=True)
-    result = runner.invoke(app, ["simulate", str(case), "--out", str(tmp_path / "build"), "--section", "1",
-                                 "--target", "1", "--max-pressure", "1", "--size-mm", "4", "--layer-mm", "10",
-                                 "--timeout", "1800", "--json"])
+    common, _ = forward  # the forward run's case and build (its stages cached)
+    result = runner.invoke(app, ["simulate", *common, "--target", "1", "--max-pressure", "1"])
     assert result.exit_code == 1, result.output
     found = json.loads(result.stdout)["target"]
     assert not found["converged"] and found["best_within_bounds"]
@@ -84,15 +96,12 @@ SEARCH_TOLERANCE_MM = 1e-3
 ROUND_TRIP_MARGIN = 0.5
 
 
-def test_a_forward_solves_arc_searched_back_with_target_arc_gives_its_pressures_again(tmp_path: Path) -> None:
+def test_a_forward_solves_arc_searched_back_with_target_arc_gives_its_pressures_again(
+        forward: tuple[list[str], dict]) -> None:
     import re
 
-    case = demo_case(tmp_path, actuation=True)
-    common = [str(case), "--out", str(tmp_path / "build"), "--section", "1", "--size-mm", "4", "--layer-mm", "10",
-              "--timeout", "1800", "--json"]
-    forward = runner.invoke(app, ["simulate", *common, "--pressures", "5,0,0"])
-    assert forward.exit_code == 0, forward.output
-    arc = json.loads(forward.stdout)["arc"]
+    common, payload = forward  # the forward solve at 5, 0, 0 kPa (the bend test's), its case and build
+    arc = payload["arc"]
     text = f"{arc['kappa_per_mm']!r},{math.degrees(arc['phi_rad'])!r},{arc['length_mm']!r}"
     back = runner.invoke(app, ["simulate", *common, "--target-arc", text])
     assert back.exit_code == 0, back.output

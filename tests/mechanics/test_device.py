@@ -21,14 +21,16 @@ from softdesign.errors import SolveError
 from softdesign.geometry.blend import blend_shapes
 from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
 from softdesign.geometry.initial import straight_initial_shape
+from softdesign.mechanics import device as device_module
 from softdesign.mechanics.curved_walls import on_walls
 from softdesign.mechanics.device import DeviceMesh, assemble_device, solve_device
 from softdesign.mechanics.device_layout import device_parts
 from softdesign.mechanics.device_measure import DeviceFigures, measure_device
-from softdesign.mechanics.newton import NewtonSettings
+from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord, SolveStopped, solve_pressures
 from softdesign.mechanics.reinforcement import HoopThread
 from softdesign.meshing.chambers.layout import ActuationSpec, plan_layout
 from softdesign.meshing.volume import BodySpec
+from softdesign.types import FloatArray
 from tests.fitting.test_fit_strain import _constant_field
 
 MU = 40.0
@@ -117,14 +119,35 @@ def test_one_section_with_a_backbone_agrees_with_the_rod_model() -> None:
 
 
 @pytest.mark.slow
-def test_a_device_that_stops_keeps_its_last_equilibrium_and_says_where() -> None:
-    # about 20-40 s of CPU.  A bare chamber (no thread) in a 1.5 mm skin balloons near mu (Rivlin's thick tube:
+def test_a_device_that_stops_keeps_its_last_equilibrium_and_says_where(monkeypatch: pytest.MonkeyPatch) -> None:
+    # about 10-20 s of CPU.  A bare chamber (no thread) in a 1.5 mm skin balloons near mu (Rivlin's thick tube:
     # about 0.9-1.3 mu for these radii), far below 5 mu: the solve must stop short and say where.
     device = straight_device(1)
     asked = np.array([5.0 * MU])
     settings = NewtonSettings(load_steps=4, max_cutbacks=6)
+    # The load-stepped solve runs once: keep_stop only decides what solve_device does with its stop (raise or
+    # return the last equilibrium), so the second call's solve, asked the same problem, pressures and settings
+    # (checked), gets the first one's stop again rather than repeating the same 12 s of CPU (solve_pressures is
+    # deterministic: the same inputs, the same bytes)
+    first: list[tuple[FloatArray, FloatArray, NewtonSettings, SolveStopped]] = []
+
+    def solved_once(problem: PressureProblem, pressures: FloatArray, steps: NewtonSettings, **kwargs: object
+                    ) -> tuple[FloatArray, SolveRecord]:
+        if first:
+            points, asked_before, steps_before, stop = first[0]
+            assert np.array_equal(problem.mesh.points, points) and np.array_equal(pressures, asked_before)
+            assert steps == steps_before
+            raise stop
+        try:
+            return solve_pressures(problem, pressures, steps, **kwargs)  # type: ignore[arg-type]
+        except SolveStopped as stop:
+            first.append((problem.mesh.points.copy(), pressures.copy(), steps, stop))
+            raise
+
+    monkeypatch.setattr(device_module, "solve_pressures", solved_once)
     with pytest.raises(SolveError, match=r"the whole device: the solve stopped at [0-9.]+ kPa \(load factor"):
         solve_device(device, LAW, asked, settings)
+    assert len(first) == 1  # it stopped (SolveStopped), and only the second call below may replay it
     held = solve_device(device, LAW, asked, settings, keep_stop=True)
     assert 0.0 < held.load_factor < 1.0 and held.record.load_factors[-1] == held.load_factor
     assert held.pressures_kpa[0] == pytest.approx(held.load_factor * asked[0], rel=1e-12)

@@ -66,7 +66,8 @@ def _side_wall_nodes(section: SectionMesh, mesh: QuadraticMesh, chamber: int) ->
     faces = section.wall_faces[section.face_chamber == chamber]
     z = section.points[faces, 2]
     side = faces[z.min(axis=1) < z.max(axis=1)]
-    mids = [mesh.edges.tolist().index(sorted(pair)) for pair in side[:, [[0, 1], [1, 2], [2, 0]]].reshape(-1, 2)]
+    edge = {tuple(pair): k for k, pair in enumerate(mesh.edges.tolist())}  # the mesh's edges are sorted pairs
+    mids = [edge[tuple(sorted(pair))] for pair in side[:, [[0, 1], [1, 2], [2, 0]]].reshape(-1, 2).tolist()]
     return np.unique(np.concatenate([side.ravel(), len(section.points) + np.array(mids)]))
 
 

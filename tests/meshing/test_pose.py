@@ -235,7 +235,7 @@ def demo(tmp_path_factory):
     # its own build, not a copy of the README's demo build: make test-fast runs the quick tests below without the
     # README's commands, and that build (with its report, in a child) cost it 51 s at load 7 against about 4 s here
     out = tmp_path_factory.mktemp("pose") / "build"
-    result = runner.invoke(app, ["build", str(DEMO), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(DEMO), "--out", str(out), "--jobs", "1"])  # no pool: tests/conftest.py
     assert result.exit_code == 0, result.output
     from softdesign.pipeline.api import build_through
 
@@ -320,7 +320,7 @@ def test_a_coil_posed_with_nearly_equal_rings_reads_back_closed(tmp_path):
     # the sample cohort's coil at these q has rings 3e-7 mm apart at joint 1|2: written before the joints shared
     # them, the STL read back with two edges in four faces (Euler 3)
     case, out = REPO / "configs" / "cohort" / "coil.yaml", tmp_path / "build"
-    assert runner.invoke(app, ["build", str(case), "--out", str(out)]).exit_code == 0
+    assert runner.invoke(app, ["build", str(case), "--out", str(out), "--jobs", "1"]).exit_code == 0
     result = runner.invoke(app, ["pose", str(case), "--q", "0.12,0.67,0.65,0.62,0.38", "--output",
                                  str(tmp_path / "pose.stl"), "--out", str(out), "--json"])
     assert result.exit_code == 0, result.output
@@ -374,7 +374,7 @@ def hollow_build(hollow_case, tmp_path_factory) -> Path:
     """``hollow_case`` built once for the two tests that pose it: each poses a copy (pose builds, cached, into the
     folder it is given, so the copy's stages are all reused and only the pose is made)."""
     out = tmp_path_factory.mktemp("hollow-build") / "build"
-    result = runner.invoke(app, ["build", str(hollow_case), "--out", str(out)])
+    result = runner.invoke(app, ["build", str(hollow_case), "--out", str(out), "--jobs", "1"])
     assert result.exit_code == 0, result.output
     return out
 

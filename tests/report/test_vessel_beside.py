@@ -4,11 +4,16 @@ workers inherit it (the 3D view and the surface figure each decimated it again b
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import softdesign.report.display_mesh as display_mesh
 from softdesign.report.build_folder import load_build
 from softdesign.report.drawing_run import vessel_beside_imports
 from tests.helpers.shared_builds import demo_build
+
+#: Both read the README's demo build with its report (a whole build in a child, made once per run): slow, as the
+#: other tests of that build are (make test-fast had made it for these two alone).
+pytestmark = pytest.mark.slow
 
 
 def _counted(monkeypatch) -> list[int]:
