@@ -54,7 +54,10 @@ def _lines(stream, into: queue.Queue) -> None:
 
 def _kill_when_workers_run(stage: str, tmp_path: Path) -> tuple[set[int], Path, Path]:
     """Start a --jobs 2 build, SIGKILL it once ``stage`` has started workers; their pids, the case, the folder."""
-    case = demo_case(tmp_path, export={"q": [0, 0.25, 0.5, 0.75, 1]})  # five q: the pool lives long enough to see
+    # 33 q: the coarse export's meshes are worth two workers (softdesign.pipeline.bounds.VERTICES_PER_WORKER: with
+    # five q export had one, and the export case killed the build during feasibility's pool instead), and they live
+    # long enough to see
+    case = demo_case(tmp_path, export={"q": [k / 32 for k in range(33)]})
     out = tmp_path / "build"
     code = "import sys; from softdesign.cli import main; sys.argv[0] = 'softdesign'; main()"
     build = subprocess.Popen([sys.executable, "-c", code, "build", str(case), "--out", str(out), "--jobs", "2"],
