@@ -250,17 +250,15 @@ class Located:
     weights: tuple[FloatArray, ...]
 
 
-def locate_samples(device: DeviceMesh, mesh: QuadraticMesh | None = None) -> Located:
+def locate_samples(device: DeviceMesh, mesh: QuadraticMesh) -> Located:
     """Each section's centerline samples located in its own elements (MeshError: a sample outside the material);
-    in curved elements where ``mesh`` (the whole device's quadratic mesh) maps them, when it has any."""
+    in curved elements where ``mesh`` (the whole device's quadratic mesh) maps them."""
     elements, weights = [], []
     for i, part in enumerate(device.parts):
         tets = make_tet_mesh(part.mesh.points, part.mesh.tets)
         found = [locate(tets, part.samples[k:k + LOCATE_BATCH]) for k in range(0, len(part.samples), LOCATE_BATCH)]
         elements.append(np.concatenate([e for e, _ in found]) + device.tet_start[i])
-        weights.append(np.concatenate([w for _, w in found]))
-        if mesh is not None:
-            weights[-1] = curved_barycentric(mesh, elements[-1], weights[-1], part.samples)
+        weights.append(curved_barycentric(mesh, elements[-1], np.concatenate([w for _, w in found]), part.samples))
     return Located(tuple(elements), tuple(weights))
 
 

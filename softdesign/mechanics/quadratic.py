@@ -178,6 +178,12 @@ NODE_DXI = _reference_derivatives(np.concatenate([np.eye(4), 0.5 * (np.eye(4)[TE
                                                                       + np.eye(4)[TET_EDGES[:, 1]])]))
 
 
+def node_jacobians(nodes: FloatArray) -> FloatArray:
+    """``det(dX/dxi)`` (E, 10) of elements with reference nodes ``nodes`` (E, 10, 3) mm at their ten nodes (6 V each
+    for a straight element)."""
+    return np.asarray(np.linalg.det(np.einsum("eai,nak->enik", nodes, NODE_DXI)), np.float64)
+
+
 def isoparametric_geometry(nodes: FloatArray) -> tuple[FloatArray, FloatArray]:
     """``dN/dX`` (E, Q, 10, 3) 1/mm and the weights (E, Q) mm^3 of elements with reference nodes ``nodes``
     (E, 10, 3) mm, at the four-point rule (module docstring, "Curved elements")."""
@@ -202,9 +208,10 @@ def _curved(mesh: QuadraticMesh, curved_edges: IntArray, curved_midpoints: Float
     curved = np.flatnonzero(moved[mesh.cells].any(axis=1))
     grads, weights = mesh.grads.copy(), mesh.weights.copy()
     grads[curved], weights[curved] = isoparametric_geometry(points[mesh.cells[curved]])
-    at_nodes = np.linalg.det(np.einsum("eai,nak->enik", points[mesh.cells[curved]], NODE_DXI))
-    if not (np.all(weights[curved] > 0) and np.all(at_nodes > 0)):
-        bad = int(curved[np.argmin(np.minimum(weights[curved].min(axis=1), at_nodes.min(axis=1)))])
+    at_points = weights[curved] / (QUAD_WEIGHTS / 6.0)[None, :]  # det(dX/dxi) at the quadrature points
+    smallest = np.minimum(at_points.min(axis=1), node_jacobians(points[mesh.cells[curved]]).min(axis=1))
+    if not np.all(smallest > 0):
+        bad = int(curved[np.argmin(smallest)])
         raise MeshError(f"curved edges: element {bad}'s curved map folds (a midside node too far off its edge's "
                         "middle for the element's size); curve only edges on a smooth wall, or refine the mesh")
     volumes = mesh.linear.volumes.copy()

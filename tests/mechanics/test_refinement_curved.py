@@ -15,11 +15,11 @@ from softdesign.mechanics.curved_walls import on_walls, round_chamber_walls
 from softdesign.mechanics.embedded_thread import embedded_fibres
 from softdesign.mechanics.newton import NewtonSettings
 from softdesign.mechanics.quadratic import (
-    NODE_DXI,
     QUAD_POINTS,
     QuadraticMesh,
     curved_gradients_at,
     isoparametric_geometry,
+    node_jacobians,
     quadratic_force,
     quadratic_force_and_tangent,
     quadratic_mesh,
@@ -331,8 +331,7 @@ def _smallest_jacobian_share(section: SectionMesh) -> float:
     """The smallest ``det(dX/dxi)`` at any element's ten nodes over its straight value (6 V)."""
     linear = check_section(section)
     mesh = quadratic_mesh(linear, section.curved_edges, section.curved_midpoints)
-    dets = np.linalg.det(np.einsum("eai,nak->enik", mesh.points[mesh.cells], NODE_DXI))
-    return float((dets / (6.0 * linear.volumes[:, None])).min())
+    return float((node_jacobians(mesh.points[mesh.cells]) / (6.0 * linear.volumes[:, None])).min())
 
 
 def test_the_walls_bow_is_spread_into_the_rubber_and_no_element_takes_it_whole() -> None:
