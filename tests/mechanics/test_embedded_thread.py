@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from softdesign.continuum.laws import HyperelasticLaw
+from softdesign.mechanics import newton
 from softdesign.mechanics.device import roundoff_floor_mn
 from softdesign.mechanics.embedded_thread import (
     ThreadFibres,
@@ -17,7 +18,7 @@ from softdesign.mechanics.embedded_thread import (
     quadratic_gradients_at,
     thread_fibres,
 )
-from softdesign.mechanics.newton import NewtonSettings, PressureProblem, solve_pressures
+from softdesign.mechanics.newton import NewtonSettings, PressureProblem, SolveRecord, solve_pressures
 from softdesign.mechanics.quadratic import QUAD_POINTS, QuadraticMesh, quadratic_faces, quadratic_fixed, quadratic_mesh
 from softdesign.mechanics.reinforcement import HoopThread, hoop_membrane
 from softdesign.mechanics.tets import boundary_faces, make_tet_mesh
@@ -34,6 +35,8 @@ SIDE_MM, LENGTH_MM, FIBRE_XY = 4.0, 60.0, (2.0, 2.0)
 MIDDLE_MM = (20.0, 40.0)
 #: Gradients at the rule's points: the same formula, rounding only.
 GRAD_TOL = 1e-12
+#: The plain method's equilibrium against the mixed one's: each converged to 1e-8 of the load (measured: 7e-15).
+PLAIN_RTOL = 1e-8
 #: Finite differences (central, step 1e-6 mm) against the analytic force and tangent, relative to their size.
 FD_RTOL = 1e-5
 
@@ -97,6 +100,11 @@ def test_force_and_tangent_are_the_energys_derivatives() -> None:
 
 
 def _middle_strain(fibre: HoopThread | None, pull_kpa: float) -> float:
+    """:func:`_middle_solve`'s strain."""
+    return _middle_solve(fibre, pull_kpa)[0]
+
+
+def _middle_solve(fibre: HoopThread | None, pull_kpa: float) -> tuple[float, SolveRecord]:
     """The bar's axial strain over its middle third (mean z displacement of its cross-sections there) under a pull
     ``pull_kpa`` on its tip face, its base held in z only (and the least in x, y to hold it: free to narrow), with
     the embedded ``fibre`` or none."""
@@ -114,10 +122,10 @@ def _middle_strain(fibre: HoopThread | None, pull_kpa: float) -> float:
                               np.zeros(len(tip), np.int64), fibres)
     # the stiff fibre's rounding floor, as the device's solve takes it
     settings = NewtonSettings(load_steps=1, atol=max(NewtonSettings().atol, roundoff_floor_mn(problem)))
-    u, _ = solve_pressures(problem, np.array([pull_kpa]), settings)
+    u, record = solve_pressures(problem, np.array([pull_kpa]), settings)
     z = mesh.points[:, 2]
     low, high = (float(u[np.isclose(z, level), 2].mean()) for level in MIDDLE_MM)
-    return (high - low) / (MIDDLE_MM[1] - MIDDLE_MM[0])
+    return (high - low) / (MIDDLE_MM[1] - MIDDLE_MM[0]), record
 
 
 #: The bar's strain against F / (E A) and F / (E A + E_t A_t): the law's E is 3 mu to 1e-3 (kappa = 1000 mu), the
@@ -137,3 +145,26 @@ def test_a_bar_with_an_embedded_fibre_stretches_as_the_composite(share: float) -
     pull = 1e-4 * (bar + fibre.axial_stiffness_mn) / area  # kPa
     np.testing.assert_allclose(_middle_strain(None, pull), pull * area / bar, rtol=COMPOSITE_RTOL)
     np.testing.assert_allclose(_middle_strain(fibre, pull), 1e-4, rtol=COMPOSITE_RTOL)
+
+
+def test_a_step_the_mixed_fibre_strain_fails_is_solved_again_by_the_plain_method(monkeypatch) -> None:
+    # The mixed method's fibre strain can cycle where the threads turn rather than stretch (newton's docstring,
+    # "When the mixed fibres cycle"); the step is then tried again from the same start by the plain method before
+    # it is halved.  Made to fail here (the mixed attempt refused outright): the solve takes no halving, counts one
+    # plain step, and reaches the mixed solve's equilibrium (the bar's strain) to the Newton tolerance.
+    area = SIDE_MM**2
+    bar = 3 * MU * area
+    fibre = HoopThread(pitch_mm=1.0, diameter_mm=0.5, modulus_kpa=4.0 * bar / (np.pi * 0.25**2))
+    pull = 1e-4 * (bar + fibre.axial_stiffness_mn) / area
+    mixed, mixed_record = _middle_solve(fibre, pull)
+    original, tries = newton._newton_step, []
+
+    def mixed_fails(*args, **kwargs):
+        tries.append(kwargs.get("mixed_fibres", args[7] if len(args) > 7 else True))
+        return (None, [1.0]) if tries[-1] else original(*args, **kwargs)
+
+    monkeypatch.setattr(newton, "_newton_step", mixed_fails)
+    plain, record = _middle_solve(fibre, pull)
+    assert tries == [True, False]
+    assert (mixed_record.plain_steps, record.plain_steps, record.cutbacks) == (0, 1, 0)
+    np.testing.assert_allclose(plain, mixed, rtol=PLAIN_RTOL)
