@@ -40,8 +40,21 @@ Spread
     sections 0.040, 0.29, 0.18 before, 0.046, 0.44, 0.40 after (its smallest
     is an element with three corners on one chamber's ring, whose two curved
     edges meet nearly tangent at the middle corner: no interior offset
-    changes that).  :func:`~softdesign.mechanics.quadratic.quadratic_mesh`
-    refuses a map that folds at a node or a quadrature point.
+    changes that).
+Folds
+    Where an element's map would still fold (``det(dX/dxi) <= 0`` at a node
+    or a quadrature point), the walls' edges at its corners stay straight
+    (chords, as the straight model has them), the spread holds its midside
+    nodes where they are, and the spread is found again, for up to
+    :data:`UNFOLD_ROUNDS` rounds: a section the curved walls cannot follow
+    everywhere is meshed with them where they can, not refused.  At the
+    default mesh none of the sample single-supply device's or the VMTK
+    aorta's elements fold; the per-chamber sample's section 2 at a coarse
+    mesh (4 mm across, 10 mm layers, 8 nodes round) had slivers 7.7 mm long
+    and 0.3 mm across that the spread folded (-0.27 of the straight ``det``
+    at a corner), one per layer as the last was held: five rounds.
+    :func:`~softdesign.mechanics.quadratic.quadratic_mesh` still refuses a
+    map that folds, the last guard.
 Assumptions
     Each level's side-wall nodes of a chamber lie on a circle (checked:
     MeshError otherwise), a level being the nodes of one ``node_l``; a
@@ -58,7 +71,15 @@ from scipy import sparse
 from scipy.sparse.linalg import spsolve
 
 from softdesign.errors import MeshError
-from softdesign.mechanics.quadratic import TET_EDGES, midpoint_nodes, quadratic_mesh, shape_values
+from softdesign.mechanics.quadratic import (
+    TET_EDGES,
+    QuadraticMesh,
+    isoparametric_geometry,
+    midpoint_nodes,
+    node_jacobians,
+    quadratic_mesh,
+    shape_values,
+)
 from softdesign.mechanics.section import LEVEL_TOL_MM, SectionMesh
 from softdesign.mechanics.tets import boundary_faces, make_tet_mesh
 from softdesign.types import FloatArray, IntArray
@@ -68,6 +89,8 @@ from softdesign.types import FloatArray, IntArray
 CIRCLE_RTOL = 1e-6
 #: The walls' bow is spread over the elements within this many node rings of a curved wall edge.
 SPREAD_RINGS = 2
+#: Rounds of keeping straight the walls' edges at the corners of elements whose curved map folds ("Folds").
+UNFOLD_ROUNDS = 32
 
 
 def round_chamber_walls(section: SectionMesh, spread: bool = True) -> SectionMesh:
@@ -89,22 +112,52 @@ def round_chamber_walls(section: SectionMesh, spread: bool = True) -> SectionMes
         circles = _level_circles(section.points, np.unique(walls), levels, chamber)
         edges.append(pairs)
         positions.append(_on_surface(section.points, pairs, levels, circles))
-    wall_edges, wall_midpoints = np.concatenate(edges), np.concatenate(positions)
-    if not spread:
-        return replace(section, curved_edges=wall_edges, curved_midpoints=wall_midpoints)
-    inner, moved = _spread_inwards(section, wall_edges, wall_midpoints)
-    return replace(section, curved_edges=np.concatenate([wall_edges, inner]),
-                   curved_midpoints=np.concatenate([wall_midpoints, moved]))
+    return _unfolded(section, np.concatenate(edges), np.concatenate(positions), spread)
 
 
-def _spread_inwards(section: SectionMesh, walls: IntArray, midpoints: FloatArray) -> tuple[IntArray, FloatArray]:
+def _unfolded(section: SectionMesh, walls: IntArray, midpoints: FloatArray, spread: bool) -> SectionMesh:
+    """``section`` with the wall edges ``walls`` (K, 2) curved to ``midpoints`` (K, 3) mm (and, if ``spread``, their
+    bow spread), except where an element's map would fold: the walls' edges at its corners stay straight, and the
+    spread leaves its midside nodes where they are, in up to :data:`UNFOLD_ROUNDS` rounds (module docstring,
+    "Folds")."""
+    straight = quadratic_mesh(make_tet_mesh(section.points, section.tets))
+    keep = np.ones(len(walls), bool)
+    pinned = np.zeros(len(straight.points), bool)  # midside nodes the spread must leave where they are
+    for _ in range(UNFOLD_ROUNDS):
+        edges, positions = walls[keep], midpoints[keep]
+        if spread:
+            inner, moved = _spread_inwards(section, straight, edges, positions, pinned)
+            edges, positions = np.concatenate([edges, inner]), np.concatenate([positions, moved])
+        folded = _folded(straight, edges, positions)
+        touching = keep & np.isin(walls, section.tets[folded]).any(axis=1)
+        by_spread = straight.cells[folded][:, 4:].ravel()
+        if not touching.any() and pinned[by_spread].all():
+            break
+        keep &= ~touching  # a wall's bow folds them: their walls' edges straight
+        pinned[by_spread] = True  # the spread folds them: their midside nodes held
+    return replace(section, curved_edges=edges, curved_midpoints=positions)
+
+
+def _folded(straight: QuadraticMesh, edges: IntArray, midpoints: FloatArray) -> IntArray:
+    """The elements (n,) of the ``straight`` quadratic mesh whose map folds (``det(dX/dxi) <= 0`` at a node or a
+    quadrature point, :func:`~softdesign.mechanics.quadratic.quadratic_mesh`'s test) with the midside nodes of
+    ``edges`` (K, 2) at ``midpoints`` (K, 3) mm."""
+    points = straight.points.copy()
+    points[midpoint_nodes(straight, edges)] = midpoints
+    nodes = points[straight.cells]
+    _, weights = isoparametric_geometry(nodes)
+    return np.flatnonzero(np.minimum(weights.min(axis=1), node_jacobians(nodes).min(axis=1)) <= 0.0)
+
+
+def _spread_inwards(section: SectionMesh, straight: QuadraticMesh, walls: IntArray, midpoints: FloatArray,
+                    pinned: np.ndarray | None = None) -> tuple[IntArray, FloatArray]:
     """The interior edges (K, 2) near the curved walls and their midside positions (K, 3) mm: the walls' midside
     offsets carried into the rubber by a discrete harmonic extension (the quadratic elements' Laplacian on the
     straight mesh, each element's weighted by the patch's largest volume over its own, every corner and every
     other boundary midside node held), over the elements within :data:`SPREAD_RINGS` node rings of a curved wall
-    edge, so that no element next to a wall takes the wall's whole bow (module docstring, "Spread")."""
-    linear = make_tet_mesh(section.points, section.tets)
-    straight = quadratic_mesh(linear)
+    edge, so that no element next to a wall takes the wall's whole bow (module docstring, "Spread"); ``straight``:
+    the section's quadratic mesh with every edge straight; ``pinned`` (its nodes,) bool: midside nodes held too."""
+    linear = straight.linear
     V = len(linear.points)
     wall_nodes = midpoint_nodes(straight, walls)
     offsets = np.zeros((len(straight.points), 3))
@@ -114,6 +167,8 @@ def _spread_inwards(section: SectionMesh, walls: IntArray, midpoints: FloatArray
     held[np.unique(straight.cells[patch][:, 4:])] = False
     held[np.unique(straight.cells[~patch][:, 4:])] = True  # the patch's rim: shared with elements outside it
     held[midpoint_nodes(straight, _boundary_edges(linear.tets))] = True
+    if pinned is not None:
+        held |= pinned
     free = np.flatnonzero(~held)
     if len(free) == 0:
         return np.zeros((0, 2), np.int64), np.zeros((0, 3))

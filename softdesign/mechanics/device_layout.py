@@ -35,9 +35,10 @@ MIN_SAMPLES = 9
 
 
 def device_parts(curve0: FramedSpline, field: object, spec: BodySpec, layout: ChamberLayout, size_mm: float,
-                 angular_count: int, layer_mm: float, curved_walls: bool = False) -> list[DevicePart]:
+                 angular_count: int, layer_mm: float, curved_walls: bool = True) -> list[DevicePart]:
     """Every section of ``layout`` meshed (feeds that cross it as cavities) and placed on ``curve0``;
-    ``curved_walls``: the chambers' side walls curved onto their circles (:mod:`softdesign.mechanics.curved_walls`).
+    ``curved_walls``: the chambers' side walls curved onto their circles (:mod:`softdesign.mechanics.curved_walls`;
+    False: straight polygons of their circles' area).
 
     Raises
     ------

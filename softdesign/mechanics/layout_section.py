@@ -98,7 +98,7 @@ def _feed_holes(layout: ChamberLayout, section: int, scale_mm: float, size_mm: f
 
 def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, layout: ChamberLayout, section: int,
                         size_mm: float, angular_count: int, layer_mm: float, feeds: bool = False,
-                        taper: bool = True, curved_walls: bool = False) -> SectionMesh:
+                        taper: bool = True, curved_walls: bool = True) -> SectionMesh:
     """Section ``section``'s mesh at q = 0 in its base frame, with its base fixed and chamber walls named.
 
     Parameters
@@ -116,12 +116,11 @@ def layout_section_mesh(curve0: FramedSpline, field: object, spec: BodySpec, lay
         distal part), not solid
     taper : mesh a tapered chamber as designed (:mod:`softdesign.mechanics.section_taper`); False: as a cylinder
         of its middle distance and diameter
-    curved_walls : the chambers' nodes on their circles and their side walls' midside nodes too
-        (:mod:`softdesign.mechanics.curved_walls`: under one refinement the reinforced section's curvature moves
-        -0.44 % at the simulate command's mesh, -3.83 % straight); False (the default): polygons of their circles'
-        area, straight.  Not the default: the sample aorta's whole device, curved, finds no equilibrium past 0.30 of
-        its P* (79.9 kPa, Newton cycling at its second section's chamber ends; straight, it reaches P*), the
-        demo's reaches P* 6.5 mm from the shape (9.3 mm straight)
+    curved_walls : the chambers' nodes on their circles and their side walls' midside nodes too, the bow spread
+        into the rubber (:mod:`softdesign.mechanics.curved_walls`; the default: under one refinement the
+        reinforced section's curvature moves -0.44 % at the simulate command's mesh, -3.83 % straight); False:
+        polygons of their circles' area, straight (the model of rounds 1-4 until the mixed fibres' retry,
+        :mod:`softdesign.mechanics.newton`, let the aorta's curved device reach its P*)
 
     Raises
     ------

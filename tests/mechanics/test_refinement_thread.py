@@ -87,8 +87,8 @@ def test_with_curved_chamber_walls_one_refinement_moves_the_threaded_curvature_b
     # on this mesh no element beside a wall is thin enough for its bow to matter).  With straight octagons it gave
     # -3.10 % and -3.78 % with no asymptotic range (the first test).  On the pipeline's own section at the simulate
     # command's mesh (tests/mechanics/test_section_symmetry.py's, 5 kPa, its thread), one refinement moved the
-    # curvature by -3.83 % with its straight octagons of the circles' area and -0.44 % with curved walls
-    # (6.40708e-4 -> 6.37901e-4 1/mm; -0.45 % before the spread).
+    # curvature by -3.83 % with its straight octagons of the circles' area and -0.44 % with curved walls (the model's
+    # default: 6.40708e-4 -> 6.37901e-4 1/mm; -0.45 % before the spread).
     kappas, phi_errors = study.checked_levels(study.THREADED_CURVED)
     changes = kappas[1:] / kappas[:-1] - 1
     assert np.all(np.abs(changes) < REFINEMENT_RTOL)

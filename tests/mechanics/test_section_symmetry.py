@@ -33,8 +33,9 @@ SYMMETRY_FRACTION = 0.01
 
 
 @functools.cache
-def pipeline_section() -> SectionMesh:
-    """Section 0 of the straight body, meshed as ``softdesign simulate`` does at its default mesh options."""
+def pipeline_section(curved_walls: bool = True) -> SectionMesh:
+    """Section 0 of the straight body, meshed as ``softdesign simulate`` does at its default mesh options (its
+    chambers' walls curved; False: the straight octagons of the circles' area)."""
     s = np.linspace(0.0, LENGTH_MM, 801)
     line = np.column_stack([np.zeros_like(s), np.zeros_like(s), s])
     final = smooth_curve_from_polyline(line, CurveOptions(spacing_mm=0.25, smoothing_mm=0.0))
@@ -43,7 +44,8 @@ def pipeline_section() -> SectionMesh:
     layout = plan_layout(SPEC, (0.0, 0.5, 1.0), l, curve0.curve.arc_length(l))
     o = SimulateOptions(section=0, pressures_kpa=None, target_q=None)
     return layout_section_mesh(curve0, _constant_field(RADIUS_MM, RADIUS_MM), BodySpec(), layout, 0,
-                               size_mm=o.size_mm, angular_count=o.angular_count, layer_mm=o.layer_mm)
+                               size_mm=o.size_mm, angular_count=o.angular_count, layer_mm=o.layer_mm,
+                               curved_walls=curved_walls)
 
 
 @pytest.mark.slow

@@ -48,7 +48,7 @@ def _layout(distances: tuple[float, float], diameters: tuple[float, float]) -> t
     return replace(layout, chambers=(replace(c, profile=profile),)), curve0
 
 
-def _mesh(distances: tuple[float, float], diameters: tuple[float, float], curved_walls: bool = False
+def _mesh(distances: tuple[float, float], diameters: tuple[float, float], curved_walls: bool = True
           ) -> tuple[SectionMesh, ChamberLayout]:
     layout, curve0 = _layout(distances, diameters)
     section = layout_section_mesh(curve0, _constant_field(RADIUS_MM, RADIUS_MM), BodySpec(), layout, 0,
@@ -57,7 +57,7 @@ def _mesh(distances: tuple[float, float], diameters: tuple[float, float], curved
 
 
 def test_a_tapered_chamber_is_meshed_as_designed() -> None:
-    # straight polygons of the circles' area (the default): the cavity is the designed frustum to rounding
+    # straight polygons of the circles' area (curved_walls=False): the cavity is the designed frustum to rounding
     section, layout = _mesh(DISTANCE_ENDS, DIAMETER_ENDS, curved_walls=False)
     check_section(section)  # every element positive
     chamber = layout.chambers[0]
@@ -101,6 +101,7 @@ def test_an_untapered_chamber_does_not_move() -> None:
                                 replace(layout, chambers=(replace(layout.chambers[0], profile=()),)), 0,
                                 size_mm=3.0, angular_count=12, layer_mm=4.0)
     np.testing.assert_array_equal(tapered_flat.points, plain.points)
+    np.testing.assert_array_equal(tapered_flat.curved_midpoints, plain.curved_midpoints)
 
 
 def test_a_taper_the_blend_cannot_take_is_refused() -> None:

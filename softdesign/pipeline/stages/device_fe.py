@@ -38,11 +38,12 @@ from softdesign.pipeline.store import Staging
 if TYPE_CHECKING:
     from softdesign.config import Case
 
-VERSION = 7  # 2: area-matched polygons, the backbone thread embedded in the elements; 3: a stop is kept, judged;
+VERSION = 8  # 2: area-matched polygons, the backbone thread embedded in the elements; 3: a stop is kept, judged;
 #             4: the thread's stabilised rule, patched ends, the thread's ends in the figures; 5: the thread's
 #             hourglass control a penalty (its tension the centroid's), load steps bounded by length; 6: the
 #             steps before the last converged to 1e-4, load_steps.PATH_RTOL (the figures move by 1e-7 relative); 7: the
-#             first step at most FIRST_STEP_MU shear moduli
+#             first step at most FIRST_STEP_MU shear moduli; 8: curved chamber walls (mechanics.curved_walls), a
+#             step the mixed fibre strain fails retried by the plain method
 SUMMARY = "simulate/device.json"
 
 

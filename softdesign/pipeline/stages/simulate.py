@@ -42,10 +42,11 @@ if TYPE_CHECKING:
     from softdesign.pipeline.stages.fit import FitResult
     from softdesign.pipeline.stages.kinematics import KinematicsResult
 
-VERSION = 7  # 2: the section meshes three-fold symmetric; 3: the case's hoop thread (reinforcement) in the model;
+VERSION = 8  # 2: the section meshes three-fold symmetric; 3: the case's hoop thread (reinforcement) in the model;
 # 4: the section mesh's polygons (chambers, feeds, skin) have their circles' areas; 5: the thread's stabilised rule
 # and patched ends (actuation.reinforcement.ends); 6: the thread's hourglass control a penalty, load steps
-# bounded by length; 7: the search starts from the linear answer and stops at its best within the bounds
+# bounded by length; 7: the search starts from the linear answer and stops at its best within the bounds; 8: curved
+# chamber walls (mechanics.curved_walls), a step the mixed fibre strain fails retried by the plain method
 SUMMARY = "simulate/summary.json"
 
 
