@@ -91,13 +91,18 @@ demo: bytecode
 # tests to the end), and the slowest 15 tests printed at the end.  How to keep a test safe in parallel: tests/conftest.py.
 # `bytecode` first: the suite starts softdesign in child processes (43 call sites, some in loops), and with
 # PYTHONDONTWRITEBYTECODE set (CI) each child compiled the modules it imports again (validate's: ~0.17 s of CPU).
+# PYTEST runs with PYTHONDONTWRITEBYTECODE unset: pytest keeps the test modules it rewrites for its assertions
+# (tests/**/__pycache__/*-pytest-*.pyc, ignored by git) only where Python may write bytecode; with it set, every
+# xdist worker rewrote all ~245 test files at every run (collection 7.0 s of CPU a worker, 2.6 s from the kept
+# files).  A fresh clone (CI) rewrites them once, as before.
+PYTEST := env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest
 PYTEST_PARALLEL := -n auto --dist loadfile --no-loadscope-reorder --durations=15
 test: bytecode $(CLUSTER_STAMP)
-	$(BIN)/python -m pytest $(PYTEST_PARALLEL)
+	$(PYTEST) $(PYTEST_PARALLEL)
 
 # Everything but the tests marked slow (whole builds, cohorts, reports).
 test-fast: bytecode $(CLUSTER_STAMP)
-	$(BIN)/python -m pytest $(PYTEST_PARALLEL) -m "not slow"
+	$(PYTEST) $(PYTEST_PARALLEL) -m "not slow"
 
 # `make test-seconds`: after a full `make test`, write each file's seconds from pytest's cache to
 # tests/file_seconds.json, the order a fresh clone (CI) starts the files in.  Commit it when the order moved.
@@ -116,7 +121,7 @@ study: $(STAMP)
 # `make study-property`: the incremental-build property (tests/pipeline/test_incremental_property.py) with 20 drawn
 # examples beside its written ones (about 2 minutes); `make test` draws 5.
 study-property: bytecode
-	SOFTDESIGN_PROPERTY_EXAMPLES=20 $(BIN)/python -m pytest -n 0 tests/pipeline/test_incremental_property.py
+	SOFTDESIGN_PROPERTY_EXAMPLES=20 $(PYTEST) -n 0 tests/pipeline/test_incremental_property.py
 
 # ruff (style, imports, bugbear, pyupgrade, numpy rules) and mypy, both
 # configured in pyproject.toml; both run, and either failing fails the target.

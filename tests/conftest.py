@@ -33,10 +33,19 @@ from pathlib import Path
 
 import pytest
 
-from tests.helpers.attacks import BUILD_TIMEOUT_S, demo_case, run_limited
-from tests.helpers.paths import AORTA_DIR
-from tests.helpers.schedule import SecondsRecorder, known_seconds, longest_first
-from tests.helpers.shared_builds import made_once, shared_root
+from softdesign.pipeline.parallel import one_blas_thread
+
+# One OpenBLAS thread per test process, as the command line asks for itself before numpy loads (softdesign.cli.main;
+# an xdist worker inherits it from the controller, which loads this file first): the commands a test runs in its own
+# process (CliRunner, build_through) ran with OpenBLAS's thread per core, which wait on the cores the two workers
+# already fill.  The design stage's small dense solves paid most: tests/pipeline/test_design_stage.py took 14.7 s of
+# CPU, 8.7 s with one thread.  Before the helpers below import numpy (OpenBLAS reads the variable when it loads).
+one_blas_thread()
+
+from tests.helpers.attacks import BUILD_TIMEOUT_S, demo_case, run_limited  # noqa: E402
+from tests.helpers.paths import AORTA_DIR  # noqa: E402
+from tests.helpers.schedule import SecondsRecorder, known_seconds, longest_first  # noqa: E402
+from tests.helpers.shared_builds import made_once, shared_root  # noqa: E402
 
 _RECORDER = SecondsRecorder()
 

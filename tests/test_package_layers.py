@@ -8,6 +8,7 @@ Every ``import`` statement counts, wherever it stands (module level, inside a fu
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 import pytest
@@ -64,7 +65,11 @@ def _imports(path: Path) -> set[str]:
     return {name for name in names if name in MODULES}
 
 
-GRAPH = {name: _imports(path) - {name} for name, path in MODULES.items()}
+@functools.cache
+def import_graph() -> dict[str, set[str]]:
+    """Each module -> the softdesign modules it imports: every source parsed (about 0.8 s of CPU), once, when a test
+    first asks, not at collection (where every xdist worker paid it, whichever worker ran this file)."""
+    return {name: _imports(path) - {name} for name, path in MODULES.items()}
 
 
 def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
@@ -115,7 +120,7 @@ def test_the_cycle_finder_finds_a_cycle_and_passes_a_chain():
 
 
 def test_no_two_modules_import_each_other_even_late():
-    assert _cycles(GRAPH) == []
+    assert _cycles(import_graph()) == []
 
 
 def test_the_root_holds_only_its_named_modules():
@@ -132,7 +137,7 @@ def test_a_layer_imports_nothing_above_it(layer):
 
     above = tuple(f"softdesign.{name}" for name in FORBIDDEN[layer])
     home = (f"softdesign.{layer}",)
-    wrong = sorted(f"{module} -> {target}" for module, targets in GRAPH.items() if within(module, home)
+    wrong = sorted(f"{module} -> {target}" for module, targets in import_graph().items() if within(module, home)
                    for target in targets if within(target, above))
     assert wrong == []
 
@@ -144,10 +149,11 @@ MESHING_ROOMS = ("body", "chambers", "mould", "volume_mesh")
 def test_meshings_shared_modules_import_none_of_its_rooms():
     for room in MESHING_ROOMS:
         assert (PACKAGE / "meshing" / room / "__init__.py").is_file()
-    shared = [name for name in GRAPH if name.count(".") == 2 and name.startswith("softdesign.meshing.")
+    graph = import_graph()
+    shared = [name for name in graph if name.count(".") == 2 and name.startswith("softdesign.meshing.")
               and name.rsplit(".", 1)[1] not in MESHING_ROOMS]
     assert "softdesign.meshing.topology" in shared  # the selection is not empty
     rooms = tuple(f"softdesign.meshing.{room}" for room in MESHING_ROOMS)
-    wrong = sorted(f"{module} -> {target}" for module in shared for target in GRAPH[module]
+    wrong = sorted(f"{module} -> {target}" for module in shared for target in graph[module]
                    if any(target == r or target.startswith(f"{r}.") for r in rooms))
     assert wrong == []
