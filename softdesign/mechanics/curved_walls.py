@@ -89,7 +89,7 @@ from softdesign.types import FloatArray, IntArray
 CIRCLE_RTOL = 1e-6
 #: The walls' bow is spread over the elements within this many node rings of a curved wall edge.
 SPREAD_RINGS = 2
-#: Rounds of keeping straight the walls' edges at the corners of elements whose curved map folds ("Folds").
+#: Rounds of unfolding ("Folds"): the walls' edges at a folded element kept straight, its spread midside nodes held.
 UNFOLD_ROUNDS = 32
 
 
