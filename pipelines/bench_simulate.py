@@ -158,7 +158,11 @@ def shown(row: tuple[str, bool]) -> bool:
     return not row[1]
 
 
-def main() -> int:
+def main(argv: list[str] | None = None) -> int:
+    import argparse
+
+    # no options: --help says what it runs (about ten minutes) instead of running it
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args(argv)
     from softdesign.pipeline.api import build_through
 
     missed = False
