@@ -150,8 +150,8 @@ def test_a_bar_with_an_embedded_fibre_stretches_as_the_composite(share: float) -
 def test_a_step_the_mixed_fibre_strain_fails_is_solved_again_by_the_plain_method(monkeypatch) -> None:
     # The mixed method's fibre strain can cycle where the threads turn rather than stretch (newton's docstring,
     # "When the mixed fibres cycle"); the step is then tried again from the same start by the plain method before
-    # it is halved.  Made to fail here (the mixed attempt refused outright): the solve takes no halving, counts one
-    # plain step, and reaches the mixed solve's equilibrium (the bar's strain) to the Newton tolerance.
+    # it is halved, when it went through every iteration.  Made to fail so here: the solve takes no halving, counts
+    # one plain step, and reaches the mixed solve's equilibrium (the bar's strain) to the Newton tolerance.
     area = SIDE_MM**2
     bar = 3 * MU * area
     fibre = HoopThread(pitch_mm=1.0, diameter_mm=0.5, modulus_kpa=4.0 * bar / (np.pi * 0.25**2))
@@ -159,12 +159,26 @@ def test_a_step_the_mixed_fibre_strain_fails_is_solved_again_by_the_plain_method
     mixed, mixed_record = _middle_solve(fibre, pull)
     original, tries = newton._newton_step, []
 
-    def mixed_fails(*args, **kwargs):
+    def mixed_fails(*args, **kwargs):  # cycling through every iteration (a history of max_iterations residuals)
         tries.append(kwargs.get("mixed_fibres", args[7] if len(args) > 7 else True))
-        return (None, [1.0]) if tries[-1] else original(*args, **kwargs)
+        return (None, [1.0] * args[3].max_iterations) if tries[-1] else original(*args, **kwargs)
 
     monkeypatch.setattr(newton, "_newton_step", mixed_fails)
     plain, record = _middle_solve(fibre, pull)
     assert tries == [True, False]
     assert (mixed_record.plain_steps, record.plain_steps, record.cutbacks) == (0, 1, 0)
     np.testing.assert_allclose(plain, mixed, rtol=PLAIN_RTOL)
+
+    # a mixed step stopped early (an element turned inside out: a short history) is halved, not tried again
+    tries.clear()
+
+    def mixed_stops_early(*args, **kwargs):
+        tries.append(kwargs.get("mixed_fibres", args[7] if len(args) > 7 else True))
+        if len(tries) == 1:
+            return None, [1.0]
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(newton, "_newton_step", mixed_stops_early)
+    halved, record = _middle_solve(fibre, pull)
+    assert tries[:2] == [True, True] and record.plain_steps == 0 and record.cutbacks == 1
+    np.testing.assert_allclose(halved, mixed, rtol=PLAIN_RTOL)
