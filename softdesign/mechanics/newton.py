@@ -64,14 +64,15 @@ When the mixed fibres cycle
     method from the same start converged there in about ten iterations.  So a step
     the mixed method fails is tried once more, from the same start, by the
     plain method (the fibres' tension in the matrix their own), before it is
-    halved: that device then reached its P* (28 steps, 183 iterations, 4 of
-    the steps plain, 9 halvings, 281 s of CPU).  A step the mixed method
-    converges is unchanged; the sample device at its P* moved by 3e-6 mm
-    (tip 9.311664 against 9.311667 mm from the designed chain).  Only a step
-    that used every iteration is tried again: one stopped early by an element
-    turned inside out is halved at once, as before (on the sample device with
-    curved walls 23 mixed steps failed, most within 4-5 iterations; retrying
-    each, 15 plain attempts failed too, about a tenth of the solve's CPU).
+    halved: that device then reached its P* (32 steps, 175 iterations, one
+    step plain, 12 halvings, 233 s of CPU).  A step the mixed method
+    converges is unchanged; the straight sample device at its P* moved by
+    3e-6 mm (tip 9.311664 against 9.311667 mm from the designed chain).  Only
+    a step that went through every iteration is tried again: one stopped
+    early by an element turned inside out is halved at once, as before (on
+    the curved sample device 23 mixed steps failed, most within 4-5
+    iterations, and when each was retried 15 plain attempts failed too: 428 s
+    of CPU to P*, 378 s retrying only the full-length failures).
 """
 
 from __future__ import annotations
