@@ -48,6 +48,7 @@ build benchmark (pipelines/bench.py).
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import subprocess
@@ -159,8 +160,6 @@ def shown(row: tuple[str, bool]) -> bool:
 
 
 def main(argv: list[str] | None = None) -> int:
-    import argparse
-
     # no options: --help says what it runs (about ten minutes) instead of running it
     argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args(argv)
     from softdesign.pipeline.api import build_through

@@ -74,11 +74,10 @@ from softdesign.errors import MeshError
 from softdesign.mechanics.quadratic import (
     TET_EDGES,
     QuadraticMesh,
-    isoparametric_geometry,
     midpoint_nodes,
-    node_jacobians,
     quadratic_mesh,
     shape_values,
+    smallest_jacobians,
 )
 from softdesign.mechanics.section import LEVEL_TOL_MM, SectionMesh
 from softdesign.mechanics.tets import boundary_faces, make_tet_mesh
@@ -140,13 +139,11 @@ def _unfolded(section: SectionMesh, walls: IntArray, midpoints: FloatArray, spre
 
 def _folded(straight: QuadraticMesh, edges: IntArray, midpoints: FloatArray) -> IntArray:
     """The elements (n,) of the ``straight`` quadratic mesh whose map folds (``det(dX/dxi) <= 0`` at a node or a
-    quadrature point, :func:`~softdesign.mechanics.quadratic.quadratic_mesh`'s test) with the midside nodes of
+    quadrature point: :func:`~softdesign.mechanics.quadratic.smallest_jacobians`) with the midside nodes of
     ``edges`` (K, 2) at ``midpoints`` (K, 3) mm."""
     points = straight.points.copy()
     points[midpoint_nodes(straight, edges)] = midpoints
-    nodes = points[straight.cells]
-    _, weights = isoparametric_geometry(nodes)
-    return np.flatnonzero(np.minimum(weights.min(axis=1), node_jacobians(nodes).min(axis=1)) <= 0.0)
+    return np.flatnonzero(smallest_jacobians(points[straight.cells]) <= 0.0)
 
 
 def _spread_inwards(section: SectionMesh, straight: QuadraticMesh, walls: IntArray, midpoints: FloatArray,

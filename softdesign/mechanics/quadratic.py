@@ -184,6 +184,13 @@ def node_jacobians(nodes: FloatArray) -> FloatArray:
     return np.asarray(np.linalg.det(np.einsum("eai,nak->enik", nodes, NODE_DXI)), np.float64)
 
 
+def smallest_jacobians(nodes: FloatArray) -> FloatArray:
+    """The smallest ``det(dX/dxi)`` (E,) of elements with reference nodes ``nodes`` (E, 10, 3) mm over their ten
+    nodes and the four quadrature points: ``<= 0`` where the map folds (the test of :func:`quadratic_mesh`)."""
+    at_points = np.linalg.det(np.einsum("eai,qak->eqik", nodes, QUAD_DXI))
+    return np.asarray(np.minimum(at_points.min(axis=1), node_jacobians(nodes).min(axis=1)), np.float64)
+
+
 def isoparametric_geometry(nodes: FloatArray) -> tuple[FloatArray, FloatArray]:
     """``dN/dX`` (E, Q, 10, 3) 1/mm and the weights (E, Q) mm^3 of elements with reference nodes ``nodes``
     (E, 10, 3) mm, at the four-point rule (module docstring, "Curved elements")."""
@@ -208,8 +215,7 @@ def _curved(mesh: QuadraticMesh, curved_edges: IntArray, curved_midpoints: Float
     curved = np.flatnonzero(moved[mesh.cells].any(axis=1))
     grads, weights = mesh.grads.copy(), mesh.weights.copy()
     grads[curved], weights[curved] = isoparametric_geometry(points[mesh.cells[curved]])
-    at_points = weights[curved] / (QUAD_WEIGHTS / 6.0)[None, :]  # det(dX/dxi) at the quadrature points
-    smallest = np.minimum(at_points.min(axis=1), node_jacobians(points[mesh.cells[curved]]).min(axis=1))
+    smallest = smallest_jacobians(points[mesh.cells[curved]])
     if not np.all(smallest > 0):
         bad = int(curved[np.argmin(smallest)])
         raise MeshError(f"curved edges: element {bad}'s curved map folds (a midside node too far off its edge's "
