@@ -17,10 +17,24 @@ ended; one left by a parent that was itself killed is removed by the next
 call, once that parent's process is gone (:func:`remove_stale_scratch`).  The function and its
 arguments and result travel by pickle, so the function must be importable
 by name (a module-level function).
+
+A child may be given variables of its own environment (``environment``): the
+finite-element solves ask glibc's malloc for transparent huge pages
+(:data:`HUGE_PAGES`).  Their Newton loops factor a matrix every iteration, and
+SuperLU allocates the factors afresh each time (about 180 MB on the sample
+device), which the kernel maps and zeroes again page by page: the sample
+single-supply device at P* (curved walls, 252 factorizations) took 11.6 M page
+faults and 53 s of system time, 306 s of CPU in all; with huge pages 2.4 M,
+27 s and 269 s, the same steps and the same answer (the run's two processes side by side, load 4).
+glibc reads the variable when a process starts (``glibc.malloc.hugetlb``,
+glibc 2.35 and later; older ones and other C libraries ignore it, and with
+the kernel's transparent huge pages off it changes nothing), so it is set
+for the child only, which is a fresh interpreter.
 """
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import os
 import re
@@ -28,7 +42,7 @@ import resource
 import shutil
 import signal
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import Any
@@ -43,6 +57,9 @@ _REAP_S = 10.0
 SCRATCH_PREFIX = "softdesign-child-"
 SCRATCH_MARKER = ".softdesign-child"
 _SCRATCH = re.compile(re.escape(SCRATCH_PREFIX) + r"(\d+)-[A-Za-z0-9_]+")
+#: The environment of a finite-element solve's child: glibc's malloc backs its large blocks with transparent huge
+#: pages (the module's docstring).  Added to a ``GLIBC_TUNABLES`` the user set, after it.
+HUGE_PAGES = {"GLIBC_TUNABLES": "glibc.malloc.hugetlb=1"}
 
 
 def remove_stale_scratch(folder: str | None = None) -> None:
@@ -100,7 +117,7 @@ def _how_it_ended(exitcode: int | None) -> str:
 
 def run_in_child(
     target: Callable[..., Any], args: tuple[Any, ...], timeout_s: float, what: str, fix: str,
-    memory_bytes: int | None = None,
+    memory_bytes: int | None = None, environment: dict[str, str] | None = None,
 ) -> Any:
     """``target(*args)`` computed in a child process, waiting at most ``timeout_s`` seconds.
 
@@ -113,6 +130,8 @@ def run_in_child(
     fix : what the user can change, ending the messages of a timeout, a crash or a failure
     memory_bytes : the child's address space limit (``RLIMIT_AS``), bytes; None for none.  An
         allocation beyond it fails (MemoryError, or a native ``bad_alloc`` that may abort the child)
+    environment : variables the child starts with besides the parent's (a ``GLIBC_TUNABLES`` the parent has is
+        kept, this one's settings after it); the parent's own environment is as it was once the child has started
 
     Raises
     ------
@@ -127,21 +146,39 @@ def run_in_child(
     scratch = tempfile.mkdtemp(prefix=f"{SCRATCH_PREFIX}{os.getpid()}-")
     try:
         (Path(scratch) / SCRATCH_MARKER).write_bytes(b"")
-        return _run_and_wait(target, args, timeout_s, what, fix, memory_bytes, scratch)
+        return _run_and_wait(target, args, timeout_s, what, fix, memory_bytes, scratch, environment or {})
     finally:
         shutil.rmtree(scratch, ignore_errors=True)  # the child has ended (reaped or killed): nothing writes there
 
 
+@contextlib.contextmanager
+def _started_with(environment: dict[str, str]) -> Iterator[None]:
+    """The process's environment with ``environment`` added (``GLIBC_TUNABLES`` appended to), as it was after."""
+    saved = {name: os.environ.get(name) for name in environment}
+    try:
+        for name, value in environment.items():
+            before = saved[name]
+            os.environ[name] = value if not before or name != "GLIBC_TUNABLES" else f"{before}:{value}"
+        yield
+    finally:
+        for name, before in saved.items():
+            if before is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = before
+
+
 def _run_and_wait(
     target: Callable[..., Any], args: tuple[Any, ...], timeout_s: float, what: str, fix: str,
-    memory_bytes: int | None, scratch: str,
+    memory_bytes: int | None, scratch: str, environment: dict[str, str],
 ) -> Any:
     """:func:`run_in_child`'s work, the child working in ``scratch``."""
     context = multiprocessing.get_context("spawn")
     receive, send = context.Pipe(duplex=False)
     process = context.Process(target=_child_main, args=(send, target, args, memory_bytes, os.getpid(), scratch),
                               daemon=True)
-    process.start()
+    with _started_with(environment):  # a spawned child starts with the process's environment as it is now
+        process.start()
     send.close()  # the child holds the only writer: its death ends the pipe, and poll() sees it at once
     try:
         if not receive.poll(timeout_s):

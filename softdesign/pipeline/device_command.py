@@ -28,7 +28,7 @@ def run_device(case_file: Path, out: Path | None, o: DeviceOptions, progress: An
     """Build through actuation, mesh the device, solve it in a child process; the figures as a dict."""
     from softdesign.config import load_case
     from softdesign.pipeline.api import build_through
-    from softdesign.pipeline.child import run_in_child
+    from softdesign.pipeline.child import HUGE_PAGES, run_in_child
     from softdesign.pipeline.device_figures import device_payload
     from softdesign.pipeline.simulate_run import no_law_error
     from softdesign.pipeline.stages.volume_sweep import material_of
@@ -49,7 +49,7 @@ def run_device(case_file: Path, out: Path | None, o: DeviceOptions, progress: An
     try:
         answer = run_in_child(solve_device_in_child, (device, material.law, pressures, o,
                                                       device_threads(outcome.case)), o.timeout_s, what, fix,
-                              DEVICE_MEMORY_BYTES)
+                              DEVICE_MEMORY_BYTES, HUGE_PAGES)
     except MeshError as err:  # the child's failures, a stopped solve among them
         raise SolveError(str(err)) from err
     times = {"mesh_s": meshed - start, "solve_s": time.perf_counter() - meshed, "solve_cpu_s": answer["cpu_s"]}

@@ -32,7 +32,7 @@ def run_simulate(case_file: Path, out: Path | None, o: SimulateOptions, progress
     """Build through actuation, mesh the section, solve it in a child process; the figures as a dict."""
     from softdesign.kinematics.pcc_fit import fit_links
     from softdesign.pipeline.api import build_through
-    from softdesign.pipeline.child import run_in_child
+    from softdesign.pipeline.child import HUGE_PAGES, run_in_child
     from softdesign.pipeline.stages.volume_sweep import material_of
 
     check_options(o)
@@ -57,7 +57,7 @@ def run_simulate(case_file: Path, out: Path | None, o: SimulateOptions, progress
     fix = "raise --size-mm or --layer-mm, lower the pressures, or raise --timeout"
     try:
         answer = run_in_child(solve_in_child, (section, material.law, o, target), o.timeout_s, what, fix,
-                              SIMULATE_MEMORY_BYTES)
+                              SIMULATE_MEMORY_BYTES, HUGE_PAGES)
     except MeshError as err:  # the child's failures, a non-converging solve among them
         raise SolveError(str(err)) from err
     return payload(o, section, material, answer, target, time.perf_counter() - start)

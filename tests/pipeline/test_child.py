@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from softdesign.errors import MeshError
-from softdesign.pipeline.child import run_in_child
+from softdesign.pipeline.child import HUGE_PAGES, run_in_child
 
 FIX = "try a coarser size"
 
@@ -34,6 +34,10 @@ def allocate(gib: float) -> int:
 def write_stray_file() -> str:
     Path("stray.txt").write_text("native libraries write such files")
     return os.getcwd()
+
+
+def environment_variable(name: str) -> str | None:
+    return os.environ.get(name)
 
 
 def raise_value_error() -> None:
@@ -77,3 +81,15 @@ def test_files_the_child_writes_in_its_working_folder_go_with_it(tmp_path, monke
     monkeypatch.chdir(tmp_path)
     scratch = Path(run_in_child(write_stray_file, (), 60.0, "writing", FIX))
     assert scratch != tmp_path and not scratch.exists() and not (tmp_path / "stray.txt").exists()
+
+
+def test_a_child_starts_with_the_environment_asked_and_the_parent_keeps_its_own(monkeypatch):
+    monkeypatch.delenv("GLIBC_TUNABLES", raising=False)
+    seen = run_in_child(environment_variable, ("GLIBC_TUNABLES",), 60, "a child", "nothing", environment=HUGE_PAGES)
+    assert seen == "glibc.malloc.hugetlb=1" and "GLIBC_TUNABLES" not in os.environ
+    assert run_in_child(environment_variable, ("GLIBC_TUNABLES",), 60, "a child", "nothing") is None
+    # a setting the user made is kept, the huge pages after it; the parent's is as it was
+    monkeypatch.setenv("GLIBC_TUNABLES", "glibc.malloc.arena_max=2")
+    seen = run_in_child(environment_variable, ("GLIBC_TUNABLES",), 60, "a child", "nothing", environment=HUGE_PAGES)
+    assert seen == "glibc.malloc.arena_max=2:glibc.malloc.hugetlb=1"
+    assert os.environ["GLIBC_TUNABLES"] == "glibc.malloc.arena_max=2"

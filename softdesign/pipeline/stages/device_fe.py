@@ -58,7 +58,7 @@ def run_device_stage(case: Case, results: dict[str, Any]) -> dict[str, Any] | No
     import time
 
     from softdesign.limits.simulate import DEVICE_MEMORY_BYTES, MAX_PRESSURE_KPA
-    from softdesign.pipeline.child import run_in_child
+    from softdesign.pipeline.child import HUGE_PAGES, run_in_child
     from softdesign.pipeline.device_figures import LEAVES_OUT, device_payload
     from softdesign.pipeline.simulate_device import (
         DeviceOptions,
@@ -95,7 +95,7 @@ def run_device_stage(case: Case, results: dict[str, Any]) -> dict[str, Any] | No
                                                           device_threads(case)), s.timeout_s,
                                   f"simulate: the whole device at q = {q:g} ({len(device.whole.points)} nodes)",
                                   "raise simulate.size_mm or simulate.layer_mm, or raise simulate.timeout_s",
-                                  DEVICE_MEMORY_BYTES)
+                                  DEVICE_MEMORY_BYTES, HUGE_PAGES)
         except MeshError as err:  # the child's failures, a stopped solve among them
             raise SolveError(str(err)) from err
         seconds = {"mesh_s": 0.0, "solve_s": time.perf_counter() - start, "solve_cpu_s": answer["cpu_s"]}

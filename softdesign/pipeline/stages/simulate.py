@@ -95,7 +95,7 @@ def _solve_section(case: Case, kinematics: KinematicsResult, mesh: Any, index: i
     """(q, target arc, answer) at every requested q of one section, solved in a child process (SolveError)."""
     from softdesign.kinematics.pcc_fit import fit_links
     from softdesign.limits.simulate import SIMULATE_MEMORY_BYTES
-    from softdesign.pipeline.child import run_in_child
+    from softdesign.pipeline.child import HUGE_PAGES, run_in_child
     from softdesign.pipeline.simulate_run import inverses_in_child
     from softdesign.pipeline.stages.actuation import ARC_SAMPLES
 
@@ -110,7 +110,7 @@ def _solve_section(case: Case, kinematics: KinematicsResult, mesh: Any, index: i
     fix = "raise simulate.size_mm or simulate.layer_mm, lower simulate.max_pressure_kpa, or raise simulate.timeout_s"
     try:
         answers = run_in_child(inverses_in_child, (mesh, law, _options(case, index), targets), s.timeout_s, what,
-                               fix, SIMULATE_MEMORY_BYTES)
+                               fix, SIMULATE_MEMORY_BYTES, HUGE_PAGES)
     except MeshError as err:  # the child's failures, a non-converging Newton solve among them
         raise SolveError(str(err)) from err
     return [(q, target, answer) for (q, target), answer in zip(targets, answers, strict=True)]
