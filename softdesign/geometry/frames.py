@@ -19,10 +19,10 @@ flips) and report the largest one.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Literal
+from typing import Literal, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -30,6 +30,8 @@ import numpy.typing as npt
 from softdesign.errors import ConfigError, GeometryError
 from softdesign.geometry.curves import SmoothCurve, checked_l
 from softdesign.types import FRENET_KAPPA_TOL, FloatArray, Frames, Points, Pose
+
+T = TypeVar("T")
 
 FrameMode = Literal["rmf", "frenet"]
 FRAME_MODES = ("rmf", "frenet")
@@ -239,6 +241,17 @@ class FramedSpline:
     def poses(self, l: npt.ArrayLike) -> Pose:
         """F(l) = [[N B T c], [0 0 0 1]], (n, 4, 4)."""
         return poses_from_frames(self.frames(l), self.points(l))
+
+    def kept(self, key: Hashable, make: Callable[[], T]) -> T:
+        """``make()``, made once per ``key`` for this curve and kept with it: figures of the curve alone that
+        several stages ask for (the fold check's curvature on its grid, in the blend's look at the body and
+        again in the fit).  Kept as :attr:`dense_jets` is (the curve's ``__dict__``), so a curve built on a
+        worker process comes back with them; the caller keeps what it gets read-only.
+        """
+        memo = self.__dict__.setdefault("_kept", {})
+        if key not in memo:
+            memo[key] = make()
+        return memo[key]
 
 
 def framed_curve(
