@@ -95,8 +95,9 @@ def reflection_rotations_between(chords: Points, tangents_a: Points, tangents_b:
     return _reflections(tangents_b - t_left) @ h1
 
 
-def taylor_sum(derivatives: Sequence[Points], dl: FloatArray) -> Points:
-    """``sum_k dl^k / k! d^k c / dl^k``, (n, 3) mm, from the derivatives (n, 3) of orders 1, 2, ... at the start.
+def taylor_sum(derivatives: Sequence[Points] | FloatArray, dl: FloatArray) -> Points:
+    """``sum_k dl^k / k! d^k c / dl^k``, (n, 3) mm, from the derivatives (n, 3) of orders 1, 2, ... at the start
+    (a sequence of them, or one (orders, n, 3) array).
 
     With every order of the spline's pieces this is c(l + dl) - c(l) without cancellation for tiny dl, exact
     while l + dl does not pass a knot (true from a dense sample to anywhere before the next one).
@@ -225,20 +226,21 @@ class FramedSpline:
         start = np.clip(np.searchsorted(self.dense_l, l, side="right") - 1, 0, len(self.dense_l) - 2)
         dense_tangents, dense_derivatives = self.dense_jets
         tangents = self.curve.tangents(l) if tangents is None else tangents
-        chords = taylor_sum([d[start] for d in dense_derivatives], l - self.dense_l[start])
+        # every order's rows in one gather (a third of the time of one per order), each order (n, 3) contiguous
+        chords = taylor_sum(np.take(dense_derivatives, start, axis=1), l - self.dense_l[start])
         rotations = reflection_rotations_between(chords, dense_tangents[start], tangents)
         return _orthonormal_with_tangent(rotations @ self.dense_frames[start], tangents)
 
     @cached_property
-    def dense_jets(self) -> tuple[Points, list[Points]]:
-        """Unit tangents (k, 3) and the derivatives of orders 1 .. degree, each (k, 3), at the dense samples.
+    def dense_jets(self) -> tuple[Points, FloatArray]:
+        """Unit tangents (k, 3) and the derivatives of orders 1 .. degree (degree, k, 3) at the dense samples.
 
         Every :meth:`frames` call steps from dense samples: their values are
         found once per curve (the same numbers as at each call, only not again);
         :func:`framed_curve` fills them in from the evaluations its rmf frames are made of.
         """
         orders = range(1, self.curve.spline.k + 1)
-        return self.curve.tangents(self.dense_l), [self.curve.derivative(self.dense_l, k) for k in orders]
+        return self.curve.tangents(self.dense_l), np.stack([self.curve.derivative(self.dense_l, k) for k in orders])
 
     def poses(self, l: npt.ArrayLike) -> Pose:
         """F(l) = [[N B T c], [0 0 0 1]], (n, 4, 4)."""
@@ -293,7 +295,7 @@ def framed_curve(
 
 
 def _rmf_along(curve: SmoothCurve, l: FloatArray, base_normal: npt.ArrayLike | None
-               ) -> tuple[Frames, tuple[Points, list[Points]]]:
+               ) -> tuple[Frames, tuple[Points, FloatArray]]:
     """Double-reflection frames on the grid l, chords from Taylor sums (exact on dense steps), and the unit
     tangents and derivatives of orders 1 .. degree at l they are made from (:attr:`FramedSpline.dense_jets`).
 
@@ -306,7 +308,8 @@ def _rmf_along(curve: SmoothCurve, l: FloatArray, base_normal: npt.ArrayLike | N
     base = frame_from_tangent(tangents[0], reference)
     chords = taylor_sum([d[:-1] for d in derivatives], np.diff(l))
     steps = accumulate_rotations(reflection_rotations(chords, tangents), "left")
-    return _orthonormal_with_tangent(np.concatenate([base[None], steps @ base]), tangents), (tangents, derivatives)
+    jets = tangents, np.stack(derivatives)
+    return _orthonormal_with_tangent(np.concatenate([base[None], steps @ base]), tangents), jets
 
 
 def frenet_frames(curve: SmoothCurve, l: npt.ArrayLike, label: str = "curve") -> Frames:
