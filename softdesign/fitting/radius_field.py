@@ -27,6 +27,7 @@ from softdesign.errors import FitError, FoldError
 from softdesign.fitting import bspline_basis as bb
 from softdesign.fitting.bspline_surface import RadiusSpline, grid_from_local
 from softdesign.fitting.radius_rows import SlopeRows, row_blocks
+from softdesign.geometry.frames import FramedSpline
 from softdesign.types import FloatArray, FramedCurve, IntArray
 
 #: Grid spacing along the centerline for the folding check, mm.
@@ -351,15 +352,26 @@ def fold_fix_radius(curve: FramedCurve, field: RadiusField, q: float = 1.0, reac
 
 def fold_grid(curve: FramedCurve, field: RadiusField) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """The fold checks' grid (l every FOLD_SPACING_MM, FOLD_ANGLES_PER_INTERVAL angles per interval) and the
-    curvature vector's components along each l's N and B, 1/mm."""
+    curvature vector's components along each l's N and B, 1/mm (l and the components read-only: a
+    :class:`~softdesign.geometry.frames.FramedSpline` keeps them for the next check of the same curve)."""
     count = max(int(np.ceil(curve.length / FOLD_SPACING_MM)), 16) + 1
-    l = np.linspace(0.0, 1.0, count)
     a = np.linspace(0.0, 2.0 * np.pi, FOLD_ANGLES_PER_INTERVAL * field.final[0].angular_intervals, endpoint=False)
-    d1, d2, frames = curve.derivative(l, 1), curve.derivative(l, 2), curve.frames(l)
-    speed2 = np.einsum("ni,ni->n", d1, d1)
-    tangent = d1 / np.sqrt(speed2)[:, None]
-    kvec = (d2 - np.einsum("ni,ni->n", d2, tangent)[:, None] * tangent) / speed2[:, None]
-    return l, a, np.einsum("ni,ni->n", kvec, frames[:, :, 0]), np.einsum("ni,ni->n", kvec, frames[:, :, 1])
+
+    def along() -> tuple[FloatArray, FloatArray, FloatArray]:
+        l = np.linspace(0.0, 1.0, count)
+        d1, d2, frames = curve.derivative(l, 1), curve.derivative(l, 2), curve.frames(l)
+        speed2 = np.einsum("ni,ni->n", d1, d1)
+        tangent = d1 / np.sqrt(speed2)[:, None]
+        kvec = (d2 - np.einsum("ni,ni->n", d2, tangent)[:, None] * tangent) / speed2[:, None]
+        out = l, np.einsum("ni,ni->n", kvec, frames[:, :, 0]), np.einsum("ni,ni->n", kvec, frames[:, :, 1])
+        for array in out:
+            array.setflags(write=False)
+        return out
+
+    # the curve's part is the same for every field: kept on a FramedSpline (the blend's look at the body and
+    # the fit each check the same curves of the morph), the same numbers
+    l, k_n, k_b = curve.kept(("fold_grid", count), along) if isinstance(curve, FramedSpline) else along()
+    return l, a, k_n, k_b
 
 
 def _trim(cache: dict[Any, Any], limit: int, size: Callable[[Any], int], keep: int) -> None:

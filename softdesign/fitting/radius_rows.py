@@ -66,6 +66,7 @@ class SlopeRows:
         l = np.asarray(l, float).reshape(-1)
         self.shape = (len(l), int(np.size(a)))
         self.slopes, self.angular = slopes, slopes and angular
+        angles = np.ascontiguousarray(a, float).reshape(-1)
         around: dict[tuple[int, int], tuple[IntArray, FloatArray]] = {}
         #: per link present: its rows (ascending), local basis indices along l, values, slopes (or values),
         #: and the coefficients summed over the periodic basis (n, m) and over its derivative (or the same)
@@ -75,7 +76,7 @@ class SlopeRows:
             m = f.angular_intervals
             for da in (0, 1) if self.angular else (0,):
                 if (m, da) not in around:
-                    around[m, da] = bb.periodic_local(m, a, da)
+                    around[m, da] = _sorted_around(m, angles, da)
             coefficients = (1.0 - q) * i.coefficients + q * f.coefficients  # as link_spline blends them
             inner = _around_sum(coefficients, around[m, 0])
             inner_a = _around_sum(coefficients, around[m, 1]) if self.angular else inner
@@ -133,10 +134,35 @@ class SlopeRows:
         return rho, rho_l, rho_a
 
 
+#: The angular bases :func:`_sorted_around` made last, by (intervals, angles' bytes, derivative), least recently
+#: used first: every q of a grid asks for the same ones, each link for the same (a few kB each).
+_AROUND: dict[tuple[int, bytes, int], tuple[IntArray, FloatArray]] = {}
+#: How many :data:`_AROUND` keeps.
+AROUND_CACHE = 8
+
+
+def _sorted_around(intervals: int, angles: FloatArray, deriv: int) -> tuple[IntArray, FloatArray]:
+    """The periodic basis at ``angles`` (m,) (:func:`~softdesign.fitting.bspline_basis.periodic_local`), each row
+    in ascending basis index (the order :func:`_around_sum` adds in), read-only; made once for the last few asked.
+    """
+    key = (int(intervals), angles.tobytes(), int(deriv))
+    found = _AROUND.pop(key, None)  # put back last: the dict runs from least to most recently used
+    if found is None:
+        rows, values = bb.periodic_local(intervals, angles, deriv)
+        order = np.argsort(rows, axis=1, kind="stable")
+        found = np.take_along_axis(rows, order, axis=1), np.take_along_axis(values, order, axis=1)
+        for array in found:
+            array.setflags(write=False)
+    _AROUND[key] = found
+    while len(_AROUND) > AROUND_CACHE:
+        _AROUND.pop(next(iter(_AROUND)))
+    return found
+
+
 def _around_sum(coefficients: FloatArray, around: tuple[IntArray, FloatArray]) -> FloatArray:
-    """``sum_s P_s(a_m) C[:, j_ms]`` (n, m), in ascending basis index from zero (as grid_from_local)."""
-    order = np.argsort(around[0], axis=1, kind="stable")
-    rows_a, values_a = np.take_along_axis(around[0], order, axis=1), np.take_along_axis(around[1], order, axis=1)
+    """``sum_s P_s(a_m) C[:, j_ms]`` (n, m), in ascending basis index from zero (as grid_from_local); ``around`` is
+    :func:`_sorted_around`'s, each row's indices ascending."""
+    rows_a, values_a = around
     inner = np.zeros((coefficients.shape[0], rows_a.shape[0]))
     for s in range(rows_a.shape[1]):
         inner += coefficients[:, rows_a[:, s]] * values_a[:, s]

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
+import numpy.typing as npt
 from scipy.interpolate import make_interp_spline
 from scipy.optimize import minimize_scalar
 
@@ -196,6 +197,30 @@ class BlendedShape:
         s = curve.arc_length(np.array(l_range, float))
         return BlendStats(float(q), float(s[1] - s[0]), float(stretch.min()), float(stretch.max()),
                           float(kappa.min()), float(kappa.max()))
+
+    def stats_of_links(self, q: float, breaks: npt.ArrayLike) -> list[BlendStats]:
+        """:meth:`stats_at` of each link ``(breaks[j], breaks[j + 1])`` at q (``breaks`` increasing): the same
+        figures, bit for bit, the curve's speed and curvature evaluated once over every link.
+
+        Each value is a point's own (a spline evaluated point by point), and link j's points are the dense
+        grid strictly inside it plus its two ends, as :meth:`stats_at` takes them: the links share their
+        ends, so the evaluations of one call replace the links' own (one small call per link and q was a
+        fifth of the 1M-triangle benchmark's kinematics stage, mostly per-call overhead).
+        """
+        curve = self.smooth_curve_at(q)
+        ends = np.asarray(breaks, float)
+        dense = self.keys[-1].dense_l()
+        l = np.unique(np.concatenate([dense[(dense > ends[0]) & (dense < ends[-1])], ends]))
+        stretch = curve.speed(l) / self.keys[0].speed(l) if q > 0.0 else np.ones(len(l))
+        kappa = curve.curvature(l)
+        at = np.searchsorted(l, ends)  # each end is in l: its index
+        out = []
+        for lo, hi, first, last in zip(ends[:-1], ends[1:], at[:-1], at[1:], strict=True):
+            s = curve.arc_length(np.array([lo, hi]))  # as stats_at: one call per link
+            part = slice(int(first), int(last) + 1)
+            out.append(BlendStats(float(q), float(s[1] - s[0]), float(stretch[part].min()),
+                                  float(stretch[part].max()), float(kappa[part].min()), float(kappa[part].max())))
+        return out
 
     def shortening(self) -> Shortening:
         """Shortest c(q, .) over q in [0, 1] against min(L(0), L(1)) (grid, then bounded refinement)."""

@@ -19,10 +19,10 @@ flips) and report the largest one.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Literal
+from typing import Literal, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -30,6 +30,8 @@ import numpy.typing as npt
 from softdesign.errors import ConfigError, GeometryError
 from softdesign.geometry.curves import SmoothCurve, checked_l
 from softdesign.types import FRENET_KAPPA_TOL, FloatArray, Frames, Points, Pose
+
+T = TypeVar("T")
 
 FrameMode = Literal["rmf", "frenet"]
 FRAME_MODES = ("rmf", "frenet")
@@ -93,17 +95,13 @@ def reflection_rotations_between(chords: Points, tangents_a: Points, tangents_b:
     return _reflections(tangents_b - t_left) @ h1
 
 
-def taylor_chords(curve: SmoothCurve, l: FloatArray, dl: FloatArray) -> Points:
-    """c(l + dl) - c(l), (n, 3) mm, summed from the derivatives at l (no cancellation for tiny dl).
+def taylor_sum(derivatives: Sequence[Points] | FloatArray, dl: FloatArray) -> Points:
+    """``sum_k dl^k / k! d^k c / dl^k``, (n, 3) mm, from the derivatives (n, 3) of orders 1, 2, ... at the start
+    (a sequence of them, or one (orders, n, 3) array).
 
-    Exact for a polynomial piece: l + dl must not pass a knot of the spline
-    (true from a dense sample to anywhere before the next one).
+    With every order of the spline's pieces this is c(l + dl) - c(l) without cancellation for tiny dl, exact
+    while l + dl does not pass a knot (true from a dense sample to anywhere before the next one).
     """
-    return taylor_sum([curve.derivative(l, order) for order in range(1, curve.spline.k + 1)], dl)
-
-
-def taylor_sum(derivatives: Sequence[Points], dl: FloatArray) -> Points:
-    """``sum_k dl^k / k! d^k c / dl^k``, (n, 3) mm, from the derivatives (n, 3) of orders 1, 2, ... at the start."""
     chord = np.zeros((len(dl), 3))
     power = np.ones(len(dl))
     for order, derivative in enumerate(derivatives, start=1):
@@ -155,6 +153,12 @@ def check_no_flips(
 
     ``why`` is appended to the message (the likely cause for the frame mode), then ``fix``.
     """
+    return _largest_step(frames, l, label, limit_rad, why, fix)[0]
+
+
+def _largest_step(frames: Frames, l: FloatArray, label: str, limit_rad: float, why: str, fix: str
+                  ) -> tuple[float, int]:
+    """:func:`check_no_flips`' largest adjacent rotation (rad) and the index of the step's first frame."""
     angles = adjacent_rotation_angles(frames)
     worst = int(np.argmax(angles))
     if angles[worst] > limit_rad:
@@ -162,7 +166,7 @@ def check_no_flips(
             f"frames: {label}: adjacent frames at l = {l[worst]:.6f} and {l[worst + 1]:.6f} differ by "
             f"{angles[worst]:.3g} rad (limit {limit_rad:g}): the frame flips there{why}; {fix}"
         )
-    return float(angles[worst])
+    return float(angles[worst]), worst
 
 
 @dataclass(frozen=True)
@@ -222,23 +226,36 @@ class FramedSpline:
         start = np.clip(np.searchsorted(self.dense_l, l, side="right") - 1, 0, len(self.dense_l) - 2)
         dense_tangents, dense_derivatives = self.dense_jets
         tangents = self.curve.tangents(l) if tangents is None else tangents
-        chords = taylor_sum([d[start] for d in dense_derivatives], l - self.dense_l[start])
+        # every order's rows in one gather (a third of the time of one per order), each order (n, 3) contiguous
+        chords = taylor_sum(np.take(dense_derivatives, start, axis=1), l - self.dense_l[start])
         rotations = reflection_rotations_between(chords, dense_tangents[start], tangents)
         return _orthonormal_with_tangent(rotations @ self.dense_frames[start], tangents)
 
     @cached_property
-    def dense_jets(self) -> tuple[Points, list[Points]]:
-        """Unit tangents (k, 3) and the derivatives of orders 1 .. degree, each (k, 3), at the dense samples.
+    def dense_jets(self) -> tuple[Points, FloatArray]:
+        """Unit tangents (k, 3) and the derivatives of orders 1 .. degree (degree, k, 3) at the dense samples.
 
         Every :meth:`frames` call steps from dense samples: their values are
-        found once per curve (the same numbers as at each call, only not again).
+        found once per curve (the same numbers as at each call, only not again);
+        :func:`framed_curve` fills them in from the evaluations its rmf frames are made of.
         """
         orders = range(1, self.curve.spline.k + 1)
-        return self.curve.tangents(self.dense_l), [self.curve.derivative(self.dense_l, k) for k in orders]
+        return self.curve.tangents(self.dense_l), np.stack([self.curve.derivative(self.dense_l, k) for k in orders])
 
     def poses(self, l: npt.ArrayLike) -> Pose:
         """F(l) = [[N B T c], [0 0 0 1]], (n, 4, 4)."""
         return poses_from_frames(self.frames(l), self.points(l))
+
+    def kept(self, key: Hashable, make: Callable[[], T]) -> T:
+        """``make()``, made once per ``key`` for this curve and kept with it: figures of the curve alone that
+        several stages ask for (the fold check's curvature on its grid, in the blend's look at the body and
+        again in the fit).  Kept as :attr:`dense_jets` is (the curve's ``__dict__``), so a curve built on a
+        worker process comes back with them; the caller keeps what it gets read-only.
+        """
+        memo = self.__dict__.setdefault("_kept", {})
+        if key not in memo:
+            memo[key] = make()
+        return memo[key]
 
 
 def framed_curve(
@@ -264,23 +281,35 @@ def framed_curve(
     if mode not in FRAME_MODES:
         raise ConfigError(f"frames must be one of {', '.join(FRAME_MODES)}, got {mode!r}")
     l = curve.dense_l()
+    jets = None
     if mode == "frenet":
         frames = frenet_frames(curve, l, label)
     else:
-        frames = _rmf_along(curve, l, base_normal)
+        frames, jets = _rmf_along(curve, l, base_normal)
     why = " (the Frenet normal reverses where the curvature passes through zero)" if mode == "frenet" else ""
-    worst = check_no_flips(frames, l, f"{mode}, {label}", why=why, fix=FLIP_FIXES[mode])
-    at = float(l[int(np.argmax(adjacent_rotation_angles(frames)))])
-    return FramedSpline(curve, mode, label, l, frames, worst, at)
+    worst, step = _largest_step(frames, l, f"{mode}, {label}", FLIP_LIMIT_RAD, why, FLIP_FIXES[mode])
+    framed = FramedSpline(curve, mode, label, l, frames, worst, float(l[step]))
+    if jets is not None:  # the dense samples' jets, as dense_jets would evaluate them again
+        framed.__dict__["dense_jets"] = jets
+    return framed
 
 
-def _rmf_along(curve: SmoothCurve, l: FloatArray, base_normal: npt.ArrayLike | None) -> Frames:
-    """Double-reflection frames on the grid l, chords from Taylor sums (exact on dense steps)."""
-    tangents = curve.tangents(l)
+def _rmf_along(curve: SmoothCurve, l: FloatArray, base_normal: npt.ArrayLike | None
+               ) -> tuple[Frames, tuple[Points, FloatArray]]:
+    """Double-reflection frames on the grid l, chords from Taylor sums (exact on dense steps), and the unit
+    tangents and derivatives of orders 1 .. degree at l they are made from (:attr:`FramedSpline.dense_jets`).
+
+    Each value is a point's own: the chords' derivatives are those at l without the last, the tangents
+    ``SmoothCurve.tangents``' operations on the first derivative, the same numbers as evaluated apart.
+    """
+    derivatives = [curve.derivative(l, order) for order in range(1, curve.spline.k + 1)]
+    tangents = derivatives[0] / np.linalg.norm(derivatives[0], axis=1, keepdims=True)
     reference = base_normal_from_tangent(tangents[0]) if base_normal is None else base_normal
     base = frame_from_tangent(tangents[0], reference)
-    steps = accumulate_rotations(reflection_rotations(taylor_chords(curve, l[:-1], np.diff(l)), tangents), "left")
-    return _orthonormal_with_tangent(np.concatenate([base[None], steps @ base]), tangents)
+    chords = taylor_sum([d[:-1] for d in derivatives], np.diff(l))
+    steps = accumulate_rotations(reflection_rotations(chords, tangents), "left")
+    jets = tangents, np.stack(derivatives)
+    return _orthonormal_with_tangent(np.concatenate([base[None], steps @ base]), tangents), jets
 
 
 def frenet_frames(curve: SmoothCurve, l: npt.ArrayLike, label: str = "curve") -> Frames:

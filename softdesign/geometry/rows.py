@@ -142,11 +142,15 @@ def rows_all_distinct(values: npt.ArrayLike) -> bool:
 
 def _row_keys(array: np.ndarray) -> np.ndarray:
     """(n,) uint64 hash of each row of ``array`` (n, k), k <= 4 columns of at most 8 bytes: equal bits, equal key."""
-    bits = np.ascontiguousarray(array).view(f"u{array.dtype.itemsize}").astype(np.uint64)
+    # 8-byte columns are read as they are (no copy); each step's product or shift into one buffer: the same bits
+    bits = np.ascontiguousarray(array).view(f"u{array.dtype.itemsize}").astype(np.uint64, copy=False)
     key = np.zeros(len(array), np.uint64)
+    term = np.empty_like(key)
     for column, mixer in zip(bits.T, _MIXERS, strict=False):
-        key ^= column * np.uint64(mixer)
-        key = (key << np.uint64(29)) | (key >> np.uint64(35))  # rotate, so that columns do not cancel by position
+        key ^= np.multiply(column, np.uint64(mixer), out=term)
+        np.left_shift(key, np.uint64(29), out=term)  # rotate, so that columns do not cancel by position
+        key >>= np.uint64(35)
+        key |= term
     return key
 
 

@@ -108,9 +108,10 @@ def _read_trimesh(path: Path, scale_to_mm: float = 1.0, mapper: Mapper | None = 
     return np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces, np.int64)
 
 
-def _binary_stl(path: Path) -> Mesh | None:
-    """A binary STL's corners (3F, 3) float64 and faces (F, 3) as trimesh's binary loader reads them; None for an
-    ASCII or empty one (then :func:`_load_stl`)."""
+def _binary_stl(path: Path) -> tuple[np.ndarray, np.ndarray] | None:
+    """A binary STL's corners (3F, 3) as stored (float32) and faces (F, 3) int64 as trimesh's binary loader reads
+    them; None for an ASCII or empty one (then :func:`_load_stl`).  The corners stay float32: the merge widens
+    them a block at a time (:func:`_merge_keys`) and only its vertices whole, each to the same float64."""
     from trimesh.exchange.stl import HeaderError, load_stl_binary
 
     with path.open("rb") as handle:
@@ -120,7 +121,7 @@ def _binary_stl(path: Path) -> Mesh | None:
             return None
     if "vertices" not in loaded or "faces" not in loaded or not len(loaded["faces"]):
         return None
-    return np.asarray(loaded["vertices"], np.float64), np.asarray(loaded["faces"], np.int64)
+    return np.asarray(loaded["vertices"]), np.asarray(loaded["faces"], np.int64)
 
 
 def _merged_as_trimesh_merges(vertices: np.ndarray, faces: np.ndarray, digits: int, mapper: Mapper | None = None,
@@ -134,30 +135,47 @@ def _merged_as_trimesh_merges(vertices: np.ndarray, faces: np.ndarray, digits: i
     (:func:`~softdesign.geometry.rows.rows_in_first_order`).
     ``in_order``: ``faces`` is ``arange(len(vertices)).reshape(-1, 3)`` (a binary STL's corners, each face's own),
     so that every vertex is used and the faces are the merged numbering reshaped: no scatter or gather of 3 F ids.
+    ``vertices`` may be float32 (a binary STL's, as stored): the merged ones come back float64, each the same number.
     """
     from softdesign.geometry.rows import rows_in_first_order
 
     if in_order:
         first, inverse_used = rows_in_first_order(_merge_keys(vertices, digits), mapper)
-        return vertices[first], inverse_used.reshape(faces.shape)
+        return np.asarray(vertices[first], np.float64), inverse_used.reshape(faces.shape)
     referenced = np.zeros(len(vertices), bool)
     referenced[faces] = True
     if referenced.all():  # every corner is a face's: the vertices as they are, no gather
         first, inverse_used = rows_in_first_order(_merge_keys(vertices, digits), mapper)
-        return vertices[first], inverse_used[faces]
+        return np.asarray(vertices[first], np.float64), inverse_used[faces]
     used = np.flatnonzero(referenced)
     first, inverse_used = rows_in_first_order(_merge_keys(vertices[used], digits), mapper)
     inverse = np.zeros(len(vertices), np.int64)
     inverse[used] = inverse_used
-    return vertices[used[first]], inverse[faces]
+    return np.asarray(vertices[used[first]], np.float64), inverse[faces]
+
+
+#: Rows of the vertices :func:`_merge_keys` scales at a time: its float64 block (768 kB) stays in a core's cache.
+MERGE_BLOCK_ROWS = 1 << 15
 
 
 def _merge_keys(vertices: np.ndarray, digits: int) -> np.ndarray:
-    """(V, 3) int64, trimesh's merge keys: the coordinates times 10^digits, rounded (one scaled copy, rounded in
-    place: ``(vertices * 10.0**digits).round()``'s numbers without its second (V, 3) float array)."""
-    scaled = vertices * 10.0**digits
-    scaled.round(out=scaled)
-    return scaled.astype(np.int64)
+    """(V, 3) int64, trimesh's merge keys: the coordinates (float32 or float64) as float64 times 10^digits,
+    rounded: ``(vertices.astype(float) * 10.0**digits).round().astype(int)``'s numbers, a block of rows at a time.
+
+    Each number is its own, so the blocks change none; the whole (V, 3) float64 arrays of the plain expression
+    (three on a binary STL's 3M corners, 216 MB of fresh memory) cost ten times the arithmetic.
+    """
+    keys = np.empty(vertices.shape, np.int64)
+    block = np.empty((min(MERGE_BLOCK_ROWS, len(vertices)),) + vertices.shape[1:])
+    scale = 10.0**digits
+    for start in range(0, len(vertices), MERGE_BLOCK_ROWS):
+        rows = slice(start, min(start + MERGE_BLOCK_ROWS, len(vertices)))
+        scaled = block[: rows.stop - start]
+        scaled[...] = vertices[rows]  # float32 widens exactly
+        scaled *= scale
+        scaled.round(out=scaled)
+        np.copyto(keys[rows], scaled, casting="unsafe")  # whole numbers: astype(int64)'s
+    return keys
 
 
 def _load_stl(path: Path) -> object:

@@ -132,6 +132,8 @@ class LinkChain:
         """S_T_E^(j)(q_j) of every link, (n_links, 4, 4)."""
         q = self.q_per_link(q)
         curves = self._curves(q)
+        if len(curves) == 1:  # one q: every link's in one call, each pose and product its own (the same numbers)
+            return link_transforms(curves[float(q[0])], self.breaks)
         out = np.empty((self.count, 4, 4))
         for j in range(self.count):
             out[j] = link_transforms(curves[float(q[j])], self.breaks[j : j + 2])[0]
@@ -157,10 +159,11 @@ class LinkChain:
         """Per link: l range, length, transform, POE, stretch and curvature at its own q."""
         q = self.q_per_link(q)
         transforms = self.transforms(q)
+        common = self.shape.stats_of_links(float(q[0]), self.breaks) if np.all(q == q[0]) else None
         out = []
         for j in range(self.count):
             l_range = (float(self.breaks[j]), float(self.breaks[j + 1]))
-            stats = self.shape.stats_at(float(q[j]), l_range)
+            stats = self.shape.stats_at(float(q[j]), l_range) if common is None else common[j]
             out.append(LinkReport(j, float(q[j]), *l_range, stats.length_mm, transforms[j],
                                   poe_from_pose(transforms[j]), stats))
         return out

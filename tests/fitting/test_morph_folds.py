@@ -67,3 +67,32 @@ def test_the_reports_around_curves_built_here_are_kept_for_a_later_stage_and_onl
     other = Arc(10.0, 0.5)  # another curve at a kept q is computed, not answered from the kept report
     answer = known_fold_margin(other, field, 0.0)
     assert answer == fold_margin(other, field, 0.0) != fold_margin(curves[0.0], field, 0.0)
+
+
+
+def test_a_framed_curves_fold_grid_is_made_once_and_the_same_for_every_field():
+    # the blend's look at the body and the fit check the same curves with different fields: the curve's part of
+    # the grid is kept on it (and travels with it from a worker), the reports the same as a fresh curve's
+    import pickle
+
+    from softdesign.fitting.radius_field import fold_grid, fold_margin
+    from softdesign.geometry.blend import blend_shapes
+    from softdesign.geometry.curves import CurveOptions, smooth_curve_from_polyline
+    from softdesign.geometry.initial import arc_initial_shape, straight_initial_shape
+
+    def shape():
+        line = np.column_stack([np.zeros(50), np.zeros(50), np.linspace(0, 60, 50)])
+        final = arc_initial_shape(smooth_curve_from_polyline(line, CurveOptions(count=121, smoothing_mm=0.0)),
+                                  bend_radius_mm=25.0, bend_plane_rad=0.7)
+        return blend_shapes(straight_initial_shape(final), final)
+
+    thin, thick = _round_field(lambda l: np.full_like(l, 1.0)), _round_field(lambda l: np.full_like(l, RHO))
+    curve = pickle.loads(pickle.dumps(shape().curve_at(0.6)))  # as a worker hands it back
+    first = fold_grid(curve, thin)
+    again = fold_grid(pickle.loads(pickle.dumps(curve)), thick)  # made once: kept, and carried by the pickle
+    assert np.shares_memory(first[0], curve.kept(("fold_grid", len(first[0])), lambda: None)[0])
+    for mine, other in zip(first[::2], again[::2], strict=True):
+        np.testing.assert_array_equal(mine, other)
+    fresh = shape().curve_at(0.6)
+    for field in (thin, thick):
+        assert fold_margin(curve, field, 0.6) == fold_margin(fresh, field, 0.6)

@@ -205,6 +205,17 @@ def test_stats_over_a_range_shorter_than_a_dense_step(final):
     np.testing.assert_allclose(stats.curvature_max_per_mm, 1 / RADIUS, rtol=1e-6, atol=0)
 
 
+@pytest.mark.parametrize("mode", ["linear", "intrinsic"])
+def test_the_links_stats_at_once_are_each_links_own_bit_for_bit(final, mode):
+    # kinematics asks for every link's figures at one q in one call: the same numbers as one call per link
+    shape = blend_shapes(straight_initial_shape(final), final, mode=mode)
+    breaks = np.array([0.0, 0.1234, 0.3, 0.5001, 0.5002, 1.0])  # a link shorter than a dense step too
+    for q in (0.0, 0.37, 1.0):
+        together = shape.stats_of_links(q, breaks)
+        own = [shape.stats_at(q, (float(lo), float(hi))) for lo, hi in zip(breaks[:-1], breaks[1:], strict=True)]
+        assert together == own
+
+
 def test_a_kept_curve_is_the_one_curve_at_returns(final):
     # a stage's worker processes build the curves; the build process keeps them instead of building them again
     straight = straight_initial_shape(final)

@@ -176,3 +176,18 @@ def test_frames_and_derivative_are_frames_and_derivative_bit_for_bit(helix_curve
     l = np.random.default_rng(9).uniform(0.0, 1.0, FRAME_CHUNK + 1000)  # more than one chunk of frames
     frames, d1 = framed.frames_and_derivative(l)
     assert np.array_equal(frames, framed.frames(l)) and np.array_equal(d1, framed.derivative(l, 1))
+
+
+@pytest.mark.parametrize("mode", ["rmf", "frenet"])
+def test_the_dense_jets_framed_curve_keeps_are_the_curves_own_bit_for_bit(helix_curve, mode):
+    # rmf: framed_curve keeps the derivatives its frames were made from as dense_jets, not evaluated again
+    framed = framed_curve(helix_curve, mode)
+    l = framed.dense_l
+    tangents, derivatives = framed.dense_jets
+    assert np.array_equal(tangents, helix_curve.tangents(l))
+    assert len(derivatives) == helix_curve.spline.k
+    for order, derivative in enumerate(derivatives, start=1):
+        assert np.array_equal(derivative, helix_curve.derivative(l, order))
+    # the largest step and where it is, as check_no_flips and adjacent_rotation_angles give them
+    assert framed.max_frame_step == check_no_flips(framed.dense_frames, l, "again", fix="")
+    assert framed.max_frame_step_l == l[int(np.argmax(adjacent_rotation_angles(framed.dense_frames)))]

@@ -135,3 +135,19 @@ def test_the_demo_surface_read_with_its_merge_split_is_trimesh_s_merge(monkeypat
     expected = _trimesh_merged(np.asarray(loaded["vertices"], np.float64), loaded["faces"], _merge_digits(1.0))
     monkeypatch.setattr(module, "SPLIT_ROWS", 1000)  # the demo's 50k corners split too
     _assert_same(read_surface(path, 1.0, serial_map), expected)
+
+
+@pytest.mark.parametrize("scale_to_mm", [1.0, 1000.0])
+def test_float32_corners_merged_a_block_at_a_time_are_trimesh_s_merge_of_them_widened(monkeypatch, scale_to_mm):
+    # a binary STL's corners stay float32 until merged; the keys are made a few rows at a time
+    from softdesign.io import formats
+
+    monkeypatch.setattr(formats, "MERGE_BLOCK_ROWS", 7)  # blocks that split faces and the last one short
+    rng = np.random.default_rng(11)
+    base = (rng.normal(size=(200, 3)) * 20.0 / scale_to_mm).astype(np.float32)
+    corners = base[rng.integers(0, 200, size=600)]  # 200 faces, their corners in order
+    faces = np.arange(600, dtype=np.int64).reshape(-1, 3)
+    digits = _merge_digits(scale_to_mm)
+    expected = _trimesh_merged(corners.astype(np.float64), faces, digits)
+    _assert_same(_merged_as_trimesh_merges(corners, faces, digits, in_order=True), expected)
+    _assert_same(_merged_as_trimesh_merges(corners.astype(np.float64), faces, digits), expected)

@@ -217,6 +217,16 @@ def test_forward_kinematics_with_one_q_per_link(chain):
         chain.transforms([0.2, 0.8])
 
 
+def test_one_q_for_every_link_gives_each_links_own_numbers_bit_for_bit(chain):
+    # one q: the links' transforms and stats in one call each, the same numbers as link by link
+    for q in (0.0, 0.4, 1.0):
+        curve = chain.shape.curve_at(q)
+        own = [link_transforms(curve, chain.breaks[j : j + 2])[0] for j in range(3)]
+        np.testing.assert_array_equal(chain.transforms(q), np.array(own))
+        stats = [chain.shape.stats_at(q, (float(chain.breaks[j]), float(chain.breaks[j + 1]))) for j in range(3)]
+        assert [r.stats for r in chain.reports(q)] == stats
+
+
 def test_link_reports_carry_poe_and_lengths(chain):
     reports = chain.reports(1.0)
     assert [r.index for r in reports] == [0, 1, 2]
