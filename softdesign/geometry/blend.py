@@ -188,24 +188,18 @@ class BlendedShape:
         return self._kept.pop(name, None)
 
     def stats_at(self, q: float, l_range: tuple[float, float] = (0.0, 1.0)) -> BlendStats:
-        """Length, stretch range and curvature range at q over ``l_range`` (dense grid)."""
-        curve = self.smooth_curve_at(q)
-        l = self.keys[-1].dense_l()
-        l = np.unique(np.concatenate([l[(l > l_range[0]) & (l < l_range[1])], l_range]))
-        stretch = curve.speed(l) / self.keys[0].speed(l) if q > 0.0 else np.ones(len(l))
-        kappa = curve.curvature(l)
-        s = curve.arc_length(np.array(l_range, float))
-        return BlendStats(float(q), float(s[1] - s[0]), float(stretch.min()), float(stretch.max()),
-                          float(kappa.min()), float(kappa.max()))
+        """Length, stretch range and curvature range at q over ``l_range`` (dense grid): :meth:`stats_of_links` of
+        the one link ``l_range``."""
+        return self.stats_of_links(q, l_range)[0]
 
     def stats_of_links(self, q: float, breaks: npt.ArrayLike) -> list[BlendStats]:
-        """:meth:`stats_at` of each link ``(breaks[j], breaks[j + 1])`` at q (``breaks`` increasing): the same
-        figures, bit for bit, the curve's speed and curvature evaluated once over every link.
+        """Length, stretch range and curvature range at q of each link ``(breaks[j], breaks[j + 1])`` (``breaks``
+        increasing), over the dense grid strictly inside it plus its two ends.
 
-        Each value is a point's own (a spline evaluated point by point), and link j's points are the dense
-        grid strictly inside it plus its two ends, as :meth:`stats_at` takes them: the links share their
-        ends, so the evaluations of one call replace the links' own (one small call per link and q was a
-        fifth of the 1M-triangle benchmark's kinematics stage, mostly per-call overhead).
+        Each value is a point's own (a spline evaluated point by point), so a link's figures are the same, bit for
+        bit, whether it is asked alone or with its neighbours: the links share their ends, and one call evaluates
+        every link's points at once (one small call per link and q was a fifth of the 1M-triangle benchmark's
+        kinematics stage, mostly per-call overhead).
         """
         curve = self.smooth_curve_at(q)
         ends = np.asarray(breaks, float)
@@ -216,7 +210,7 @@ class BlendedShape:
         at = np.searchsorted(l, ends)  # each end is in l: its index
         out = []
         for lo, hi, first, last in zip(ends[:-1], ends[1:], at[:-1], at[1:], strict=True):
-            s = curve.arc_length(np.array([lo, hi]))  # as stats_at: one call per link
+            s = curve.arc_length(np.array([lo, hi]))  # one call per link: its own ends' numbers
             part = slice(int(first), int(last) + 1)
             out.append(BlendStats(float(q), float(s[1] - s[0]), float(stretch[part].min()),
                                   float(stretch[part].max()), float(kappa[part].min()), float(kappa[part].max())))
